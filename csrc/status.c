@@ -1,0 +1,15 @@
+/* status.c -- messages for the status codes of mcgeom.h. */
+#include "mcgeom.h"
+
+const char *mcg_status_message(int status)
+{
+    switch (status) {
+    case MCG_OK: return "ok";
+    case MCG_EINVAL: return "invalid argument (size, NULL pointer, NaN or inf)";
+    case MCG_ENUMERIC: return "numerical failure (no convergence or singular system)";
+    case MCG_ENOMEM: return "workspace too small";
+    case MCG_EINFEASIBLE: return "problem is infeasible";
+    case MCG_EDEGENERATE: return "degenerate data or motion for this method";
+    default: return "unknown status code";
+    }
+}

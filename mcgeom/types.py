@@ -1,0 +1,160 @@
+"""Data types shared by every layer: ray correspondences and rig motions.
+
+Frames and units follow DESIGN.md section 3: rays are expressed in the rig frame
+(metres), a motion is rig2_from_rig1, ``X_rig2 = R @ X_rig1 + t``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+
+__all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "as_vectors"]
+
+
+def as_vectors(name: str, a: Any, n: Optional[int] = None) -> np.ndarray:
+    """Return ``a`` as a C-contiguous float64 (N, 3) array or raise ValueError.
+
+    Finiteness is not checked here (the C kernels check it without an extra
+    pass over the data); shape and dtype are.
+    """
+    arr = np.asarray(a)
+    if arr.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must be a numeric array, got dtype {arr.dtype}")
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (N, 3), got {arr.shape}")
+    if n is not None and arr.shape[0] != n:
+        raise ValueError(f"{name} has {arr.shape[0]} rows, expected {n}")
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
+def _as_ids(name: str, a: Any, n: int) -> Optional[np.ndarray]:
+    if a is None:
+        return None
+    arr = np.asarray(a)
+    if arr.ndim != 1 or arr.shape[0] != n:
+        raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
+    if arr.dtype.kind not in "iu":
+        if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
+            arr = arr.astype(np.int64)
+        else:
+            raise ValueError(f"{name} must hold integer camera ids, got dtype {arr.dtype}")
+    if arr.size and arr.min() < 0:
+        raise ValueError(f"{name} holds a negative camera id ({int(arr.min())})")
+    return np.ascontiguousarray(arr, dtype=np.int64)
+
+
+@dataclass(frozen=True)
+class RayPairs:
+    """N ray correspondences between two instants of a rig, in the rig frame.
+
+    Ray k at time 1 starts at ``origins1[k]`` (metres, rig frame at time 1) and
+    points along ``dirs1[k]``; ray k at time 2 likewise in the rig frame at
+    time 2. Both rays see the same scene point. Origins should be the camera
+    centres (required for the axial generalized-camera cases). Directions need
+    not be unit length. ``cam1``/``cam2`` optionally give the camera ids, used
+    for diagnostics and for sampling across cameras.
+    """
+
+    origins1: np.ndarray
+    dirs1: np.ndarray
+    origins2: np.ndarray
+    dirs2: np.ndarray
+    cam1: Optional[np.ndarray] = None
+    cam2: Optional[np.ndarray] = None
+
+    def __post_init__(self) -> None:
+        o1 = as_vectors("origins1", self.origins1)
+        n = o1.shape[0]
+        object.__setattr__(self, "origins1", o1)
+        object.__setattr__(self, "dirs1", as_vectors("dirs1", self.dirs1, n))
+        object.__setattr__(self, "origins2", as_vectors("origins2", self.origins2, n))
+        object.__setattr__(self, "dirs2", as_vectors("dirs2", self.dirs2, n))
+        object.__setattr__(self, "cam1", _as_ids("cam1", self.cam1, n))
+        object.__setattr__(self, "cam2", _as_ids("cam2", self.cam2, n))
+
+    def __len__(self) -> int:
+        return self.origins1.shape[0]
+
+    def take(self, index: Any) -> "RayPairs":
+        """Subset (or permutation) of the correspondences by an index array or mask."""
+        idx = np.asarray(index)
+        return RayPairs(
+            self.origins1[idx], self.dirs1[idx], self.origins2[idx], self.dirs2[idx],
+            None if self.cam1 is None else self.cam1[idx],
+            None if self.cam2 is None else self.cam2[idx],
+        )
+
+    def swapped(self) -> "RayPairs":
+        """The same correspondences with time 1 and time 2 exchanged."""
+        return RayPairs(self.origins2, self.dirs2, self.origins1, self.dirs1, self.cam2, self.cam1)
+
+    def in_frame(self, R: np.ndarray, t: np.ndarray) -> "RayPairs":
+        """Re-express the rays in a new rig frame ``X_new = R @ X_old + t``."""
+        R = np.asarray(R, dtype=np.float64)
+        t = np.asarray(t, dtype=np.float64)
+        return RayPairs(
+            self.origins1 @ R.T + t, self.dirs1 @ R.T,
+            self.origins2 @ R.T + t, self.dirs2 @ R.T,
+            self.cam1, self.cam2,
+        )
+
+    def is_locally_central(self) -> Optional[bool]:
+        """True if every correspondence is seen by the same camera at both times."""
+        if self.cam1 is None or self.cam2 is None:
+            return None
+        return bool(np.all(self.cam1 == self.cam2))
+
+
+@dataclass(frozen=True)
+class ScaleVerdict:
+    """Whether the metric scale of ``t`` is determined by the data, and why.
+
+    ``conditioning`` is in [0, 1]: how strongly the data constrain the length of
+    ``t`` relative to its best-constrained direction (0 = not at all, the
+    critical configuration of thesis ch. 7.3.2). ``rel_std`` is the first-order
+    relative standard deviation of ``|t|`` estimated from the residuals.
+    ``critical_angle`` (radians) is filled by the methods of ch. 7.
+    """
+
+    observable: bool
+    reason: str
+    conditioning: float = float("nan")
+    rel_std: float = float("nan")
+    critical_angle: float = float("nan")
+
+
+@dataclass(frozen=True)
+class RigMotion:
+    """A relative rig motion rig2_from_rig1: ``X_rig2 = R @ X_rig1 + t``.
+
+    ``R`` is a 3x3 rotation, ``t`` the translation in metres (the unit of the
+    rig extrinsics); when ``scale.observable`` is False, ``t`` has unit norm and
+    only its direction is meaningful. ``residual_rms`` is the RMS residual of
+    the method's own cost (documented by each estimator in ``info``),
+    ``inliers`` a boolean mask where the method is robust, ``info`` holds
+    method-specific diagnostics (detected camera case, ranks, iterations...).
+    """
+
+    R: np.ndarray
+    t: np.ndarray
+    scale: ScaleVerdict
+    method: str
+    residual_rms: float = float("nan")
+    inliers: Optional[np.ndarray] = None
+    info: dict = field(default_factory=dict)
+
+    @property
+    def T(self) -> np.ndarray:
+        """4x4 homogeneous matrix of rig2_from_rig1."""
+        T = np.eye(4)
+        T[:3, :3] = self.R
+        T[:3, 3] = self.t
+        return T
+
+    def inverse(self) -> "RigMotion":
+        """rig1_from_rig2 with the same verdict and diagnostics."""
+        return RigMotion(self.R.T.copy(), -self.R.T @ self.t, self.scale, self.method,
+                         self.residual_rms, self.inliers, dict(self.info))
