@@ -173,6 +173,8 @@ typedef struct {
     double R[9];            /* rotation rig2_from_rig1 */
     double t[3];            /* translation (metres), unit norm if the scale
                                is unobservable */
+    double t_metric[3];     /* least-squares metric translation even when its
+                               scale is not trusted (0 if not determined) */
     double E[9];            /* E = [t]x R of the linear step (unit norm,
                                normalised frame) */
     int gc_case;            /* MCG_GC_* detected from the data */

@@ -1,0 +1,5 @@
+"""Built-in estimator plugins; importing this package registers them all."""
+
+from . import linear17  # noqa: F401  (registers "linear17")
+
+__all__ = ["linear17"]

@@ -1,0 +1,767 @@
+/*
+ * linear17.c -- linear 17-point relative motion of a generalized camera
+ * (thesis ch. 8): generalized epipolar rows (eqs. 8.15-8.18), detection of the
+ * four kinds of generalized camera (ch. 8.3), the constrained least squares of
+ * Algorithm 4 / eq. 8.36 for the locally-central and axial kinds and the plain
+ * SVD for the most-general kind (Algorithm 2), decomposition of E into its
+ * rotation candidates, the translation WITH scale from eq. 8.15, and the
+ * alternation of ch. 8.4.3 (R given t, then t given R).
+ *
+ * Why everything works on the 18 x 18 Gram matrix M = A^T A:
+ * |A x|^2 = x^T M x for every x = (vec E, vec R), so after one O(N) pass over
+ * the rays the linear step, the candidate choice and every alternation step
+ * cost O(18^2) regardless of N. Squaring the condition number is harmless
+ * here: rows are normalised (Algorithm 2 step 1) and the alternation polishes
+ * the final R, t on a 3-parameter well-conditioned problem.
+ *
+ * Frames: inputs and outputs in the rig frame; internally the normalised frame
+ * X' = s (X - o) (o = centroid of the ray origins, s = 1 / RMS distance), which
+ * keeps the rig axis through the origin for axial rigs, as eqs. 8.24-8.33
+ * assume. A motion (R, t') there is (R, t'/s + o - R o) in the rig frame.
+ */
+#include "mcgeom.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#define NX 18
+#define MAX_RAYS (1 << 26)
+
+/* ---------------------------------------------------------- small helpers */
+
+static void cross3(const double a[3], const double b[3], double c[3])
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void mul33(const double *a, const double *b, double *c)
+{
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] +
+                           a[3 * i + 2] * b[6 + j];
+}
+
+static void mul33_abt(const double *a, const double *b, double *c)
+{   /* c = a b^T */
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            c[3 * i + j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] +
+                           a[3 * i + 2] * b[3 * j + 2];
+}
+
+static double det33(const double *a)
+{
+    return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+           a[2] * (a[3] * a[7] - a[4] * a[6]);
+}
+
+static void skew_times(const double w[3], const double *r, double *out)
+{   /* out = [w]x r */
+    double s[9];
+    s[0] = 0.0;   s[1] = -w[2]; s[2] = w[1];
+    s[3] = w[2];  s[4] = 0.0;   s[5] = -w[0];
+    s[6] = -w[1]; s[7] = w[0];  s[8] = 0.0;
+    mul33(s, r, out);
+}
+
+static void matvec(int n, const double *m, const double *x, double *y)
+{
+    int i, j;
+    for (i = 0; i < n; i++) {
+        double acc = 0.0;
+        for (j = 0; j < n; j++)
+            acc += m[i * n + j] * x[j];
+        y[i] = acc;
+    }
+}
+
+static double quad18(const double *m, const double *x)
+{
+    double y[NX], acc = 0.0;
+    int i;
+    matvec(NX, m, x, y);
+    for (i = 0; i < NX; i++)
+        acc += x[i] * y[i];
+    return acc;
+}
+
+/* x = (vec([t]x R), vec(R)): the unknown vector of eq. 8.18 for a motion. */
+static void motion_vector(const double r[9], const double t[3], double x[NX])
+{
+    skew_times(t, r, x);
+    memcpy(x + 9, r, 9 * sizeof(double));
+}
+
+/* -------------------------------------------------- accumulation of M */
+
+/* One pass over the rays: validate, normalise (Algorithm 2 step 1) and add
+ * each generalized epipolar row (eq. 8.16) to the Gram matrix. */
+static int accumulate(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2,
+                      double *m, double origin[3], double *scale)
+{
+    double o[3] = {0.0, 0.0, 0.0}, ss = 0.0, s;
+    int k, i, j;
+
+    for (k = 0; k < 3 * n; k++) {
+        if (!isfinite(o1[k]) || !isfinite(o2[k]) || !isfinite(d1[k]) ||
+            !isfinite(d2[k]))
+            return MCG_EINVAL;
+    }
+    for (k = 0; k < n; k++)
+        for (i = 0; i < 3; i++)
+            o[i] += o1[3 * k + i] + o2[3 * k + i];
+    for (i = 0; i < 3; i++)
+        o[i] /= 2.0 * n;
+    for (k = 0; k < n; k++)
+        for (i = 0; i < 3; i++) {
+            double a = o1[3 * k + i] - o[i], b = o2[3 * k + i] - o[i];
+            ss += a * a + b * b;
+        }
+    ss = sqrt(ss / (2.0 * n));
+    /* A central camera (all origins equal) has nothing to scale. */
+    s = (ss > 1e-12 * (1.0 + sqrt(dot3(o, o)))) ? 1.0 / ss : 1.0;
+    memcpy(origin, o, sizeof o);
+    *scale = s;
+
+    memset(m, 0, NX * NX * sizeof(double));
+    for (k = 0; k < n; k++) {
+        double a[3], b[3], p[3], q[3], m1[3], m2[3], row[NX], na, nb;
+        for (i = 0; i < 3; i++) {
+            a[i] = d1[3 * k + i];
+            b[i] = d2[3 * k + i];
+            p[i] = s * (o1[3 * k + i] - o[i]);
+            q[i] = s * (o2[3 * k + i] - o[i]);
+        }
+        na = sqrt(dot3(a, a));
+        nb = sqrt(dot3(b, b));
+        if (!(na > 0.0) || !(nb > 0.0) || !isfinite(na) || !isfinite(nb))
+            return MCG_EINVAL;
+        for (i = 0; i < 3; i++) {
+            a[i] /= na;
+            b[i] /= nb;
+        }
+        cross3(p, a, m1);
+        cross3(q, b, m2);
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++) {
+                row[3 * i + j] = b[i] * a[j];
+                row[9 + 3 * i + j] = b[i] * m1[j] + m2[i] * a[j];
+            }
+        for (i = 0; i < NX; i++) {
+            double ri = row[i];
+            double *mi = m + i * NX;
+            for (j = i; j < NX; j++)
+                mi[j] += ri * row[j];
+        }
+    }
+    for (i = 0; i < NX; i++)
+        for (j = 0; j < i; j++)
+            m[i * NX + j] = m[j * NX + i];
+    return MCG_OK;
+}
+
+/* ------------------------------------------- case detection (ch. 8.3) */
+
+static void block(const double *m, int r0, int c0, double *out)
+{
+    int i, j;
+    for (i = 0; i < 9; i++)
+        for (j = 0; j < 9; j++)
+            out[9 * i + j] = m[(r0 + i) * NX + c0 + j];
+}
+
+/* Classify from the null space of A_R^T A_R (= M_RR): the structural
+ * solutions (0, I), (0, w w^T), (0, [w]x) of eqs. 8.20-8.33 all have E = 0,
+ * so they live in null(A_R); the true solution does not (E != 0). */
+static int classify(const double *wr, const double *vr, double rtol,
+                    double tr_m, int *nullity)
+{
+    int k, i, nul = 0;
+    double wmax = wr[8];
+    if (!(wmax > 1e-14 * tr_m)) {
+        *nullity = 9;
+        return MCG_GC_CENTRAL;
+    }
+    for (k = 0; k < 9; k++)
+        if (wr[k] <= rtol * wmax)
+            nul++;
+    *nullity = nul;
+    if (nul == 0)
+        return MCG_GC_MOST_GENERAL;
+    if (nul == 1) {
+        double nv[9], tr, off = 0.0, asym = 0.0, w3[3], v3[9], sym[9];
+        for (i = 0; i < 9; i++)
+            nv[i] = vr[9 * i];
+        tr = (nv[0] + nv[4] + nv[8]) / 3.0;
+        for (i = 0; i < 9; i++) {
+            double d = nv[i] - ((i % 4 == 0) ? tr : 0.0);
+            off += d * d;
+        }
+        if (sqrt(off) < 1e-4)
+            return MCG_GC_LOCALLY_CENTRAL;
+        for (i = 0; i < 3; i++) {
+            int j;
+            for (j = 0; j < 3; j++) {
+                double d = nv[3 * i + j] - nv[3 * j + i];
+                asym += d * d;
+                sym[3 * i + j] = 0.5 * (nv[3 * i + j] + nv[3 * j + i]);
+            }
+        }
+        if (sqrt(asym) < 1e-4 && mcg_sym_eig(3, sym, w3, v3) == MCG_OK) {
+            double big = fabs(w3[0]) > fabs(w3[2]) ? fabs(w3[0]) : fabs(w3[2]);
+            int small = 0;
+            for (i = 0; i < 3; i++)
+                if (fabs(w3[i]) < 1e-4 * big)
+                    small++;
+            if (small == 2)
+                return MCG_GC_AXIAL;
+        }
+        return MCG_GC_DEGENERATE;
+    }
+    if (nul == 3) {
+        /* vec(I)/sqrt(3) must lie in the null space: project and compare */
+        double res = 0.0;
+        for (i = 0; i < 9; i++) {
+            double acc = (i % 4 == 0) ? 1.0 / sqrt(3.0) : 0.0;
+            for (k = 0; k < 3; k++) {
+                double c = (vr[0 * 9 + k] + vr[4 * 9 + k] + vr[8 * 9 + k]) / sqrt(3.0);
+                acc -= c * vr[9 * i + k];
+            }
+            res += acc * acc;
+        }
+        return sqrt(res) < 1e-4 ? MCG_GC_LOCALLY_CENTRAL_AXIAL : MCG_GC_DEGENERATE;
+    }
+    return MCG_GC_DEGENERATE;
+}
+
+/* ------------------------------------------- translation given R (eq 8.15) */
+
+typedef struct {
+    double t[3];        /* minimiser (metric mode) or unit direction */
+    double cost;        /* x^T M x at (R, t) */
+    double cond;        /* lambda_min(H) / lambda_max(H) */
+    double h[3], hv[9]; /* eigen-decomposition of H */
+} tsolve;
+
+/* Cost in t for fixed R is t^T H t + 2 g^T t + c0 with
+ * H_kl = b_k^T M_EE b_l, b_k = vec([e_k]x R), g_k = b_k^T M_ER vec R. */
+static int solve_t(const double *m, const double r[9], int unit_mode,
+                   const double tprev[3], tsolve *out)
+{
+    double b[3][9], mb[3][9], mee[81], mer[81], mervr[9], h[9], g[3];
+    double c0 = 0.0, hmax;
+    int k, l, i;
+    block(m, 0, 0, mee);
+    block(m, 0, 9, mer);
+    for (k = 0; k < 3; k++) {
+        double e[3] = {0.0, 0.0, 0.0};
+        e[k] = 1.0;
+        skew_times(e, r, b[k]);
+        matvec(9, mee, b[k], mb[k]);
+    }
+    matvec(9, mer, r, mervr);
+    {
+        double mrr[81], tmp[9];
+        block(m, 9, 9, mrr);
+        matvec(9, mrr, r, tmp);
+        for (i = 0; i < 9; i++)
+            c0 += r[i] * tmp[i];
+    }
+    for (k = 0; k < 3; k++) {
+        g[k] = 0.0;
+        for (i = 0; i < 9; i++)
+            g[k] += b[k][i] * mervr[i];
+        for (l = 0; l < 3; l++) {
+            double acc = 0.0;
+            for (i = 0; i < 9; i++)
+                acc += b[k][i] * mb[l][i];
+            h[3 * k + l] = acc;
+        }
+    }
+    {
+        double hc[9];
+        memcpy(hc, h, sizeof hc);
+        if (mcg_sym_eig(3, hc, out->h, out->hv) != MCG_OK)
+            return MCG_ENUMERIC;
+    }
+    hmax = out->h[2];
+    out->cond = hmax > 0.0 ? (out->h[0] > 0.0 ? out->h[0] / hmax : 0.0) : 0.0;
+    if (unit_mode || !(hmax > 0.0)) {
+        /* scale unobservable: keep |t| = 1 along the least-constrained
+         * direction, with the sign of the previous estimate */
+        double sgn = 1.0;
+        for (i = 0; i < 3; i++)
+            out->t[i] = out->hv[3 * i];
+        if (tprev && dot3(out->t, tprev) < 0.0)
+            sgn = -1.0;
+        for (i = 0; i < 3; i++)
+            out->t[i] *= sgn;
+    } else {
+        for (i = 0; i < 3; i++)
+            out->t[i] = 0.0;
+        for (k = 0; k < 3; k++) {
+            double vk[3] = {out->hv[k], out->hv[3 + k], out->hv[6 + k]};
+            double c;
+            if (!(out->h[k] > 1e-15 * hmax))
+                continue;
+            c = -dot3(vk, g) / out->h[k];
+            for (i = 0; i < 3; i++)
+                out->t[i] += c * vk[i];
+        }
+    }
+    {
+        double ht[3];
+        matvec(3, h, out->t, ht);
+        out->cost = dot3(out->t, ht) + 2.0 * dot3(g, out->t) + c0;
+        if (out->cost < 0.0)
+            out->cost = 0.0;
+    }
+    return MCG_OK;
+}
+
+/* ------------------------------------------- rotation given t (ch. 8.4.3) */
+
+/* One Gauss-Newton step on SO(3) for min_R x(R,t)^T M x(R,t) with t fixed,
+ * R = exp([w]x) R0; accepted only if it lowers the cost (step halving). */
+static int step_r(const double *m, double r[9], const double t[3], double *cost)
+{
+    double x0[NX], c[3][NX], mc[3][NX], mx0[NX], a[9], rhs[3], w[3];
+    int k, l, i, tries;
+    motion_vector(r, t, x0);
+    matvec(NX, m, x0, mx0);
+    for (k = 0; k < 3; k++) {
+        double e[3] = {0.0, 0.0, 0.0}, dr[9];
+        e[k] = 1.0;
+        skew_times(e, r, dr);          /* d R / d w_k = [e_k]x R */
+        skew_times(t, dr, c[k]);       /* d ([t]x R) / d w_k */
+        memcpy(c[k] + 9, dr, sizeof dr);
+        matvec(NX, m, c[k], mc[k]);
+    }
+    for (k = 0; k < 3; k++) {
+        rhs[k] = 0.0;
+        for (i = 0; i < NX; i++)
+            rhs[k] -= c[k][i] * mx0[i];
+        for (l = 0; l < 3; l++) {
+            double acc = 0.0;
+            for (i = 0; i < NX; i++)
+                acc += c[k][i] * mc[l][i];
+            a[3 * k + l] = acc;
+        }
+    }
+    {   /* tiny Levenberg damping keeps the 3x3 system positive definite */
+        double tr = a[0] + a[4] + a[8];
+        if (!(tr > 0.0))
+            return MCG_OK;
+        for (k = 0; k < 3; k++)
+            a[4 * k] += 1e-12 * tr;
+        if (mcg_spd_solve(3, a, rhs, w) != MCG_OK)
+            return MCG_OK;
+    }
+    for (tries = 0; tries < 8; tries++) {
+        double dr[9], rn[9], xn[NX], cn;
+        if (mcg_rot_from_angle_axis(w, dr) != MCG_OK)
+            return MCG_ENUMERIC;
+        mul33(dr, r, rn);
+        motion_vector(rn, t, xn);
+        cn = quad18(m, xn);
+        if (cn <= *cost) {
+            memcpy(r, rn, sizeof rn);
+            *cost = cn;
+            return MCG_OK;
+        }
+        for (k = 0; k < 3; k++)
+            w[k] *= 0.5;
+    }
+    return MCG_OK;
+}
+
+/* ------------------------------------------------- cheirality */
+
+/* Number of correspondences whose rays, moved by (R, t) into the time-2 rig
+ * frame, meet in front of both origins (mid-point triangulation). */
+static int count_in_front(int n, const double *o1, const double *d1,
+                          const double *o2, const double *d2,
+                          const double r[9], const double t[3])
+{
+    int k, i, cnt = 0;
+    for (k = 0; k < n; k++) {
+        double p[3], a[3], w[3], aa, ab, bb, aw, bw, den, s1, s2;
+        const double *b = d2 + 3 * k;
+        for (i = 0; i < 3; i++) {
+            p[i] = r[3 * i] * o1[3 * k] + r[3 * i + 1] * o1[3 * k + 1] +
+                   r[3 * i + 2] * o1[3 * k + 2] + t[i];
+            a[i] = r[3 * i] * d1[3 * k] + r[3 * i + 1] * d1[3 * k + 1] +
+                   r[3 * i + 2] * d1[3 * k + 2];
+            w[i] = o2[3 * k + i] - p[i];
+        }
+        aa = dot3(a, a); ab = dot3(a, b); bb = dot3(b, b);
+        aw = dot3(a, w); bw = dot3(b, w);
+        den = aa * bb - ab * ab;
+        if (!(den > 1e-14 * aa * bb))
+            continue; /* parallel rays: no depth information */
+        s1 = (aw * bb - bw * ab) / den;
+        s2 = (aw * ab - bw * aa) / den;
+        if (s1 > 0.0 && s2 > 0.0)
+            cnt++;
+    }
+    return cnt;
+}
+
+/* -------------------------------------------------------------- driver */
+
+void mcg_linear17_default_options(mcg_linear17_options *opt)
+{
+    if (!opt)
+        return;
+    opt->refine = 1;
+    opt->max_iterations = 100;
+    opt->tolerance = 1e-10;
+    opt->rank_rtol = 1e-10;
+    opt->min_scale_conditioning = 1e-10;
+    opt->max_scale_rel_std = 0.1;
+}
+
+static int check_options(const mcg_linear17_options *o)
+{
+    if (o->refine != 0 && o->refine != 1)
+        return 0;
+    if (o->max_iterations < 0 || o->max_iterations > 10000)
+        return 0;
+    if (!isfinite(o->tolerance) || o->tolerance < 0.0)
+        return 0;
+    if (!isfinite(o->rank_rtol) || o->rank_rtol <= 0.0 || o->rank_rtol >= 1.0)
+        return 0;
+    if (!isfinite(o->min_scale_conditioning) || o->min_scale_conditioning < 0.0)
+        return 0;
+    if (isnan(o->max_scale_rel_std) || o->max_scale_rel_std <= 0.0)
+        return 0;
+    return 1;
+}
+
+/* Linear step: the 9-vector e of E (and the R part r) minimising |A x|. */
+static int linear_step(const double *m, int gc_case, int nullity,
+                       const double *wr, const double *vr, double rtol,
+                       double e[9], double r[9], mcg_linear17_result *res)
+{
+    int i, j, k;
+    if (gc_case == MCG_GC_MOST_GENERAL) {
+        /* plain SVD of A == smallest eigenvector of M, |x| = 1 */
+        double mc[NX * NX], w[NX], v[NX * NX];
+        memcpy(mc, m, sizeof mc);
+        if (mcg_sym_eig(NX, mc, w, v) != MCG_OK)
+            return MCG_ENUMERIC;
+        for (k = 0; k < 9; k++)
+            res->schur_eig[k] = w[8 + k] > 0.0 ? w[k] / w[NX - 1] : 0.0;
+        if (!(w[1] > rtol * w[NX - 1]))
+            return MCG_EDEGENERATE;
+        for (i = 0; i < 9; i++) {
+            e[i] = v[i * NX];
+            r[i] = v[(9 + i) * NX];
+        }
+        (void)nullity;
+        return MCG_OK;
+    }
+    {
+        /* Algorithm 4 / eq. 8.36: r = -M_RR^+ M_RE e, and e minimises
+         * e^T (M_EE - M_ER M_RR^+ M_RE) e with |e| = 1 (the Schur complement
+         * equals A''^T A'' with A'' = (A_R A_R^+ - I) A_E). */
+        double pinv[81], mer[81], q[81], s[81], ws[9], vs[81];
+        double wmax = wr[8];
+        memset(pinv, 0, sizeof pinv);
+        if (gc_case != MCG_GC_CENTRAL) {
+            for (k = 0; k < 9; k++) {
+                if (wr[k] <= rtol * wmax)
+                    continue;
+                for (i = 0; i < 9; i++)
+                    for (j = 0; j < 9; j++)
+                        pinv[9 * i + j] += vr[9 * i + k] * vr[9 * j + k] / wr[k];
+            }
+        }
+        block(m, 0, 9, mer);
+        for (i = 0; i < 9; i++)          /* q = M_RR^+ M_RE = pinv mer^T */
+            for (j = 0; j < 9; j++) {
+                double acc = 0.0;
+                for (k = 0; k < 9; k++)
+                    acc += pinv[9 * i + k] * mer[9 * j + k];
+                q[9 * i + j] = acc;
+            }
+        block(m, 0, 0, s);
+        for (i = 0; i < 9; i++)
+            for (j = 0; j < 9; j++) {
+                double acc = 0.0;
+                for (k = 0; k < 9; k++)
+                    acc += mer[9 * i + k] * q[9 * k + j];
+                s[9 * i + j] -= acc;
+            }
+        if (mcg_sym_eig(9, s, ws, vs) != MCG_OK)
+            return MCG_ENUMERIC;
+        for (k = 0; k < 9; k++)
+            res->schur_eig[k] = ws[8] > 0.0 ? ws[k] / ws[8] : 0.0;
+        if (!(ws[1] > rtol * ws[8]))
+            return MCG_EDEGENERATE; /* E not unique: e.g. no translation */
+        for (i = 0; i < 9; i++)
+            e[i] = vs[9 * i];
+        for (i = 0; i < 9; i++) {
+            double acc = 0.0;
+            for (k = 0; k < 9; k++)
+                acc += q[9 * i + k] * e[k];
+            r[i] = -acc;
+        }
+    }
+    return MCG_OK;
+}
+
+/* Rotation candidates: the two rotations of E = [t]x R (twisted pair) and,
+ * where the R part is not ambiguous (most-general case), the projection of
+ * the R part itself. */
+static int rotation_candidates(const double e[9], const double r[9], int use_r,
+                               double cand[4][9], int *ncand)
+{
+    double u[9], s[3], v[9], work[64], w[9] = {0, -1, 0, 1, 0, 0, 0, 0, 1};
+    double uw[9];
+    int nc = 0, i;
+    size_t lw = mcg_svd_work_size(3, 3);
+    if (lw > 64)
+        return MCG_ENOMEM;
+    if (mcg_svd(3, 3, e, u, s, v, work, lw) != MCG_OK)
+        return MCG_ENUMERIC;
+    mul33(u, w, uw);
+    mul33_abt(uw, v, cand[nc]);
+    if (det33(cand[nc]) < 0.0)
+        for (i = 0; i < 9; i++)
+            cand[nc][i] = -cand[nc][i];
+    nc++;
+    {
+        double wt[9] = {0, 1, 0, -1, 0, 0, 0, 0, 1};
+        mul33(u, wt, uw);
+        mul33_abt(uw, v, cand[nc]);
+        if (det33(cand[nc]) < 0.0)
+            for (i = 0; i < 9; i++)
+                cand[nc][i] = -cand[nc][i];
+        nc++;
+    }
+    if (use_r) {
+        double rr[9], sg = det33(r) < 0.0 ? -1.0 : 1.0;
+        for (i = 0; i < 9; i++)
+            rr[i] = sg * r[i];
+        if (mcg_project_so3(rr, cand[nc]) == MCG_OK)
+            nc++;
+    }
+    *ncand = nc;
+    return MCG_OK;
+}
+
+int mcg_linear17(int n, const double *origins1, const double *dirs1,
+                 const double *origins2, const double *dirs2,
+                 const mcg_linear17_options *opt, mcg_linear17_result *res)
+{
+    mcg_linear17_options o;
+    double m[NX * NX], mrr[81], wr[9], vr[81], tr_m = 0.0;
+    double e[9], rpart[9], cand[4][9], rbest[9], tbest[3];
+    double cost, tiny;
+    int st, i, k, nullity = 0, gc, ncand = 0, best = -1, unit_mode = 0;
+    tsolve ts;
+
+    if (!res)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    res->gc_case = MCG_GC_DEGENERATE;
+    if (!origins1 || !dirs1 || !origins2 || !dirs2)
+        return MCG_EINVAL;
+    if (n < 14 || n > MAX_RAYS)
+        return MCG_EINVAL;
+    if (opt) {
+        if (!check_options(opt))
+            return MCG_EINVAL;
+        o = *opt;
+    } else {
+        mcg_linear17_default_options(&o);
+    }
+
+    st = accumulate(n, origins1, dirs1, origins2, dirs2, m, res->norm_origin,
+                    &res->norm_scale);
+    if (st != MCG_OK)
+        return st;
+    for (i = 0; i < NX; i++)
+        tr_m += m[i * NX + i];
+    if (!(tr_m > 0.0) || !isfinite(tr_m))
+        return MCG_EINVAL;
+    tiny = 1e-26 * tr_m;
+
+    /* generalized camera kind from the structural null space of A_R */
+    block(m, 9, 9, mrr);
+    if (mcg_sym_eig(9, mrr, wr, vr) != MCG_OK)
+        return MCG_ENUMERIC;
+    for (k = 0; k < 9; k++)
+        res->ar_eig[k] = wr[8] > 0.0 ? (wr[k] > 0.0 ? wr[k] / wr[8] : 0.0) : 0.0;
+    gc = classify(wr, vr, o.rank_rtol, tr_m, &nullity);
+    res->gc_case = gc;
+    res->rank_ar = 9 - nullity;
+    res->rank_a = 17 - (gc == MCG_GC_CENTRAL ? 9 : nullity);
+    if (gc == MCG_GC_DEGENERATE)
+        return MCG_EDEGENERATE;
+    if (n < res->rank_a)
+        return MCG_EDEGENERATE; /* too few rays for the detected kind */
+
+    st = linear_step(m, gc, nullity, wr, vr, o.rank_rtol, e, rpart, res);
+    if (st != MCG_OK)
+        return st;
+    {
+        double ne = 0.0;
+        for (i = 0; i < 9; i++)
+            ne += e[i] * e[i];
+        ne = sqrt(ne);
+        for (i = 0; i < 9; i++)
+            res->E[i] = e[i] / ne;
+    }
+    st = rotation_candidates(res->E, rpart, gc == MCG_GC_MOST_GENERAL, cand, &ncand);
+    if (st != MCG_OK)
+        return st;
+
+    /* translation with scale for each candidate (eq. 8.15), pick by cost */
+    res->n_candidates = ncand;
+    {
+        double bestcost = HUGE_VAL;
+        for (k = 0; k < ncand; k++) {
+            if (solve_t(m, cand[k], 0, NULL, &ts) != MCG_OK)
+                return MCG_ENUMERIC;
+            res->candidate_cost[k] = ts.cost;
+            if (ts.cost < bestcost) {
+                bestcost = ts.cost;
+                best = k;
+            }
+        }
+        memcpy(rbest, cand[best], sizeof rbest);
+        if (solve_t(m, rbest, 0, NULL, &ts) != MCG_OK)
+            return MCG_ENUMERIC;
+        memcpy(tbest, ts.t, sizeof tbest);
+        cost = ts.cost;
+        if (ts.cond < o.min_scale_conditioning) {
+            /* critical motion (ch. 7.3.2): |t| is not determined. Choose the
+             * rotation among equally good candidates and the sign of the
+             * direction by cheirality, in the normalised frame. */
+            int bestcnt = -1;
+            unit_mode = 1;
+            for (k = 0; k < ncand; k++) {
+                int sg;
+                if (res->candidate_cost[k] > 10.0 * bestcost + tiny)
+                    continue;
+                if (solve_t(m, cand[k], 1, NULL, &ts) != MCG_OK)
+                    return MCG_ENUMERIC;
+                for (sg = -1; sg <= 1; sg += 2) {
+                    double tt[3], tr[3], rc[3];
+                    int cnt;
+                    for (i = 0; i < 3; i++)
+                        tt[i] = sg * ts.t[i] / res->norm_scale;
+                    /* undo normalisation of the translation direction */
+                    matvec(3, cand[k], res->norm_origin, rc);
+                    for (i = 0; i < 3; i++)
+                        tr[i] = tt[i] + res->norm_origin[i] - rc[i];
+                    cnt = count_in_front(n, origins1, dirs1, origins2, dirs2,
+                                         cand[k], tr);
+                    if (cnt > bestcnt) {
+                        bestcnt = cnt;
+                        memcpy(rbest, cand[k], sizeof rbest);
+                        for (i = 0; i < 3; i++)
+                            tbest[i] = sg * ts.t[i];
+                        cost = ts.cost;
+                    }
+                }
+            }
+        }
+    }
+    res->cost_linear = sqrt(cost / n);
+
+    /* alternation (ch. 8.4.3): R given t, then t given R */
+    res->converged = 0;
+    if (o.refine) {
+        for (k = 0; k < o.max_iterations; k++) {
+            double prev = cost;
+            if (cost <= tiny) {
+                res->converged = 1;
+                break;
+            }
+            if (step_r(m, rbest, tbest, &cost) != MCG_OK)
+                return MCG_ENUMERIC;
+            if (solve_t(m, rbest, unit_mode, tbest, &ts) != MCG_OK)
+                return MCG_ENUMERIC;
+            if (ts.cost <= cost || !unit_mode) {
+                memcpy(tbest, ts.t, sizeof tbest);
+                cost = ts.cost;
+            }
+            res->iterations = k + 1;
+            if (prev - cost <= o.tolerance * prev) {
+                res->converged = 1;
+                break;
+            }
+        }
+    }
+
+    /* scale observability: conditioning of the scale equation and the
+     * first-order std of |t| from the residual (normalised frame) */
+    if (solve_t(m, rbest, unit_mode, tbest, &ts) != MCG_OK)
+        return MCG_ENUMERIC;
+    if (!unit_mode) {
+        memcpy(tbest, ts.t, sizeof tbest);
+        cost = ts.cost;
+    }
+    res->scale_conditioning = ts.cond;
+    {
+        double nt = sqrt(dot3(tbest, tbest)), var = 0.0, sigma2;
+        int dof = n > 6 ? n - 6 : 1;
+        sigma2 = cost / dof;
+        if (unit_mode || !(nt > 0.0)) {
+            res->scale_rel_std = HUGE_VAL;
+        } else {
+            for (k = 0; k < 3; k++) {
+                double vk[3] = {ts.hv[k], ts.hv[3 + k], ts.hv[6 + k]};
+                double c = dot3(vk, tbest) / nt;
+                if (ts.h[k] > 0.0)
+                    var += c * c / ts.h[k];
+                else if (c != 0.0)
+                    var = HUGE_VAL;
+            }
+            res->scale_rel_std = sqrt(sigma2 * var) / nt;
+        }
+    }
+    res->scale_observable = !unit_mode &&
+                            res->scale_conditioning >= o.min_scale_conditioning &&
+                            res->scale_rel_std <= o.max_scale_rel_std;
+    res->cost_final = sqrt(cost / n);
+
+    /* back to the rig frame: t = t'/s + o - R o */
+    memcpy(res->R, rbest, sizeof rbest);
+    {
+        double ro[3];
+        matvec(3, rbest, res->norm_origin, ro);
+        for (i = 0; i < 3; i++)
+            res->t[i] = tbest[i] / res->norm_scale + res->norm_origin[i] - ro[i];
+        if (!unit_mode)
+            memcpy(res->t_metric, res->t, sizeof res->t_metric);
+        if (!res->scale_observable) {
+            /* only the direction is meaningful: report it with unit norm */
+            double nt;
+            if (unit_mode)
+                memcpy(res->t, tbest, sizeof tbest);
+            nt = sqrt(dot3(res->t, res->t));
+            if (nt > 0.0)
+                for (i = 0; i < 3; i++)
+                    res->t[i] /= nt;
+        }
+    }
+    res->n_in_front = count_in_front(n, origins1, dirs1, origins2, dirs2,
+                                     res->R, res->t);
+    return MCG_OK;
+}

@@ -1,0 +1,30 @@
+"""mcgeom: relative motion, with metric scale, of calibrated multi-camera rigs.
+
+Conventions (DESIGN.md section 3): rays and camera centres in the rig frame
+(metres); a motion is rig2_from_rig1, ``X_rig2 = R @ X_rig1 + t`` as in
+``cv2.recoverPose``; angles in radians.
+"""
+
+from __future__ import annotations
+
+from . import registry
+from .errors import DegenerateError, InfeasibleError, McgeomError, NumericalError
+from .types import RayPairs, RigMotion, ScaleVerdict
+from . import estimators as _estimators  # noqa: F401  (registers the built-ins)
+
+__version__ = "0.1.0"
+
+
+def estimate(rays: RayPairs, method: str = "linear17", **options) -> RigMotion:
+    """Estimate the rig motion from ray correspondences with a registered method.
+
+    ``method`` is any name of :func:`mcgeom.registry.names`; ``options`` are the
+    method's keyword options (see ``mcgeom methods``).
+    """
+    return registry.get(method)(rays, **options)
+
+
+__all__ = [
+    "RayPairs", "RigMotion", "ScaleVerdict", "estimate", "registry",
+    "McgeomError", "NumericalError", "InfeasibleError", "DegenerateError", "__version__",
+]

@@ -1,0 +1,353 @@
+"""Thin wrappers over the C kernels of libmcgeom: the only module that uses cffi.
+
+Each wrapper converts its arguments to C-contiguous float64 arrays, checks
+shapes and finiteness with a message that names the argument, calls the
+kernel with a workspace of the size the kernel asks for, and turns a non-OK
+status into an exception (``ValueError`` for bad input, ``NumericalError``,
+``InfeasibleError`` or ``DegenerateError`` otherwise). Nothing above this module
+sees a pointer.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from ._mcgeom_cffi import ffi, lib
+from .errors import DegenerateError, InfeasibleError, NumericalError
+
+__all__ = [
+    "qr", "svd", "pinv", "sym_eig", "spd_solve",
+    "rot_from_angle_axis", "angle_axis_from_rot", "rot_from_quat", "quat_from_rot",
+    "project_so3", "plucker_from_points", "gec_rows",
+    "cls_general", "cls_partial", "cls_range",
+    "Linear17Options", "linear17", "GC_CASE_NAMES",
+]
+
+GC_CASE_NAMES = {
+    lib.MCG_GC_MOST_GENERAL: "most-general",
+    lib.MCG_GC_LOCALLY_CENTRAL: "locally-central",
+    lib.MCG_GC_AXIAL: "axial",
+    lib.MCG_GC_LOCALLY_CENTRAL_AXIAL: "locally-central-and-axial",
+    lib.MCG_GC_CENTRAL: "central",
+    lib.MCG_GC_DEGENERATE: "degenerate",
+}
+
+
+def _message(status: int) -> str:
+    return ffi.string(lib.mcg_status_message(status)).decode()
+
+
+def _check(status: int, what: str) -> None:
+    """Map a C status code to the matching Python exception."""
+    if status == lib.MCG_OK:
+        return
+    msg = f"{what}: {_message(status)}"
+    if status == lib.MCG_EINVAL:
+        raise ValueError(msg)
+    if status == lib.MCG_EDEGENERATE:
+        raise DegenerateError(msg)
+    if status == lib.MCG_EINFEASIBLE:
+        raise InfeasibleError(msg)
+    if status == lib.MCG_ENOMEM:
+        raise MemoryError(msg)
+    raise NumericalError(msg)
+
+
+def _arr(name: str, a: Any, shape: tuple, check_finite: bool = True) -> np.ndarray:
+    """float64 C-contiguous copy/view of ``a`` with the given shape (-1 = any)."""
+    arr = np.asarray(a)
+    if arr.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must be a real numeric array, got dtype {arr.dtype}")
+    if arr.ndim != len(shape) or any(s != -1 and s != d for s, d in zip(shape, arr.shape)):
+        want = "(" + ", ".join("N" if s == -1 else str(s) for s in shape) + ")"
+        raise ValueError(f"{name} must have shape {want}, got {arr.shape}")
+    arr = np.ascontiguousarray(arr, dtype=np.float64)
+    if check_finite and not np.isfinite(arr).all():
+        raise ValueError(f"{name} contains NaN or inf")
+    return arr
+
+
+def _p(a: np.ndarray):
+    return ffi.from_buffer("double[]", a)
+
+
+def _work(size: int) -> np.ndarray:
+    return np.empty(max(int(size), 1), dtype=np.float64)
+
+
+def _nonempty(name: str, a: np.ndarray) -> None:
+    if a.size == 0:
+        raise ValueError(f"{name} is empty (shape {a.shape})")
+
+
+# ------------------------------------------------------------------ linalg.c
+
+def qr(a: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Thin Householder QR ``a = q @ r`` of an m x n matrix with m >= n."""
+    a = _arr("a", a, (-1, -1))
+    _nonempty("a", a)
+    m, n = a.shape
+    if m < n:
+        raise ValueError(f"qr needs m >= n, got a of shape {a.shape}")
+    q = np.empty((m, n))
+    r = np.empty((n, n))
+    w = _work(lib.mcg_qr_work_size(m, n))
+    _check(lib.mcg_qr(m, n, _p(a), _p(q), _p(r), _p(w), w.size), "qr")
+    return q, r
+
+
+def svd(a: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """SVD ``a = u @ diag(s[:p]) @ v[:, :p].T``; ``v`` is the full n x n basis.
+
+    ``s`` has n entries (descending, zero-padded when m < n), ``u`` is m x p
+    with p = min(m, n).
+    """
+    a = _arr("a", a, (-1, -1))
+    _nonempty("a", a)
+    m, n = a.shape
+    u = np.empty((m, min(m, n)))
+    s = np.empty(n)
+    v = np.empty((n, n))
+    w = _work(lib.mcg_svd_work_size(m, n))
+    _check(lib.mcg_svd(m, n, _p(a), _p(u), _p(s), _p(v), _p(w), w.size), "svd")
+    return u, s, v
+
+
+def pinv(a: Any, rcond: float = 0.0) -> tuple[np.ndarray, int]:
+    """Moore-Penrose pseudo-inverse and numerical rank of an m x n matrix."""
+    a = _arr("a", a, (-1, -1))
+    _nonempty("a", a)
+    m, n = a.shape
+    out = np.empty((n, m))
+    rank = ffi.new("int *")
+    w = _work(lib.mcg_pinv_work_size(m, n))
+    _check(lib.mcg_pinv(m, n, _p(a), float(rcond), _p(out), rank, _p(w), w.size), "pinv")
+    return out, int(rank[0])
+
+
+def sym_eig(a: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (ascending) and eigenvectors (columns) of a symmetric matrix."""
+    a = _arr("a", a, (-1, -1)).copy()
+    _nonempty("a", a)
+    n = a.shape[0]
+    if a.shape[1] != n:
+        raise ValueError(f"a must be square, got shape {a.shape}")
+    w = np.empty(n)
+    v = np.empty((n, n))
+    _check(lib.mcg_sym_eig(n, _p(a), _p(w), _p(v)), "sym_eig")
+    return w, v
+
+
+def spd_solve(a: Any, b: Any) -> np.ndarray:
+    """Solve a symmetric positive definite system ``a x = b`` (n <= 64)."""
+    a = _arr("a", a, (-1, -1))
+    _nonempty("a", a)
+    n = a.shape[0]
+    if a.shape[1] != n:
+        raise ValueError(f"a must be square, got shape {a.shape}")
+    b = _arr("b", b, (n,))
+    x = np.empty(n)
+    _check(lib.mcg_spd_solve(n, _p(a), _p(b), _p(x)), "spd_solve")
+    return x
+
+
+def rot_from_angle_axis(w: Any) -> np.ndarray:
+    """Rotation matrix of an angle-axis vector (radians)."""
+    w = _arr("w", w, (3,))
+    r = np.empty((3, 3))
+    _check(lib.mcg_rot_from_angle_axis(_p(w), _p(r)), "rot_from_angle_axis")
+    return r
+
+
+def angle_axis_from_rot(R: Any) -> np.ndarray:
+    """Angle-axis vector (radians, angle in [0, pi]) of a rotation matrix."""
+    R = _arr("R", R, (3, 3))
+    w = np.empty(3)
+    _check(lib.mcg_angle_axis_from_rot(_p(R), _p(w)), "angle_axis_from_rot")
+    return w
+
+
+def rot_from_quat(q: Any) -> np.ndarray:
+    """Rotation matrix of a quaternion (w, x, y, z), normalised first."""
+    q = _arr("q", q, (4,))
+    r = np.empty((3, 3))
+    _check(lib.mcg_rot_from_quat(_p(q), _p(r)), "rot_from_quat")
+    return r
+
+
+def quat_from_rot(R: Any) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) with w >= 0 of a rotation matrix."""
+    R = _arr("R", R, (3, 3))
+    q = np.empty(4)
+    _check(lib.mcg_quat_from_rot(_p(R), _p(q)), "quat_from_rot")
+    return q
+
+
+def project_so3(M: Any) -> np.ndarray:
+    """Nearest rotation (Frobenius norm) to a 3x3 matrix."""
+    M = _arr("M", M, (3, 3))
+    r = np.empty((3, 3))
+    _check(lib.mcg_project_so3(_p(M), _p(r)), "project_so3")
+    return r
+
+
+# ----------------------------------------------------------------- plucker.c
+
+def plucker_from_points(origins: Any, dirs: Any) -> np.ndarray:
+    """Pluecker rays (d, m), |d| = 1, m = o x d, as an (N, 6) array."""
+    origins = _arr("origins", origins, (-1, 3))
+    _nonempty("origins", origins)
+    dirs = _arr("dirs", dirs, (origins.shape[0], 3))
+    rays = np.empty((origins.shape[0], 6))
+    _check(lib.mcg_plucker_from_points(origins.shape[0], _p(origins), _p(dirs), _p(rays)),
+           "plucker_from_points")
+    return rays
+
+
+def gec_rows(rays1: Any, rays2: Any) -> np.ndarray:
+    """(N, 18) generalized epipolar rows (eq. 8.16, row-major vec(E), vec(R))."""
+    rays1 = _arr("rays1", rays1, (-1, 6))
+    _nonempty("rays1", rays1)
+    rays2 = _arr("rays2", rays2, (rays1.shape[0], 6))
+    rows = np.empty((rays1.shape[0], 18))
+    _check(lib.mcg_gec_rows(rays1.shape[0], _p(rays1), _p(rays2), _p(rows)), "gec_rows")
+    return rows
+
+
+# --------------------------------------------------------------------- cls.c
+
+def cls_general(A: Any, C: Any) -> tuple[np.ndarray, float]:
+    """min |A x| subject to |C x| = 1 (thesis Algorithm 3); returns (x, |A x|)."""
+    A = _arr("A", A, (-1, -1))
+    _nonempty("A", A)
+    m, n = A.shape
+    C = _arr("C", C, (-1, n))
+    _nonempty("C", C)
+    k = C.shape[0]
+    x = np.empty(n)
+    resid = ffi.new("double *")
+    w = _work(lib.mcg_cls_general_work_size(m, n, k))
+    _check(lib.mcg_cls_general(m, n, k, _p(A), _p(C), _p(x), resid, _p(w), w.size),
+           "cls_general")
+    return x, float(resid[0])
+
+
+def cls_partial(A: Any, p: int, rcond: float = 0.0) -> tuple[np.ndarray, float, int]:
+    """min |A x| subject to |x[:p]| = 1 (Algorithm 4, eq. 8.36).
+
+    Returns (x, |A x|, rank of A[:, p:]).
+    """
+    A = _arr("A", A, (-1, -1))
+    _nonempty("A", A)
+    m, n = A.shape
+    if not 1 <= int(p) <= n:
+        raise ValueError(f"p must be in 1..{n}, got {p}")
+    x = np.empty(n)
+    resid = ffi.new("double *")
+    rank2 = ffi.new("int *")
+    w = _work(lib.mcg_cls_partial_work_size(m, n, int(p)))
+    _check(lib.mcg_cls_partial(m, n, int(p), _p(A), float(rcond), _p(x), resid, rank2,
+                               _p(w), w.size), "cls_partial")
+    return x, float(resid[0]), int(rank2[0])
+
+
+def cls_range(A: Any, G: Any, rcond: float = 0.0) -> tuple[np.ndarray, float]:
+    """min |A x| subject to |x| = 1, x in range(G) (thesis ch. 6.3)."""
+    A = _arr("A", A, (-1, -1))
+    _nonempty("A", A)
+    m, n = A.shape
+    G = _arr("G", G, (n, -1))
+    _nonempty("G", G)
+    r = G.shape[1]
+    x = np.empty(n)
+    resid = ffi.new("double *")
+    w = _work(lib.mcg_cls_range_work_size(m, n, r))
+    _check(lib.mcg_cls_range(m, n, r, _p(A), _p(G), float(rcond), _p(x), resid, _p(w), w.size),
+           "cls_range")
+    return x, float(resid[0])
+
+
+# --------------------------------------------------------------- linear17.c
+
+class Linear17Options:
+    """Options of :func:`linear17` (see ``mcg_linear17_options`` in mcgeom.h)."""
+
+    __slots__ = ("_c",)
+
+    def __init__(self, refine: bool = True, max_iterations: Optional[int] = None,
+                 tolerance: Optional[float] = None, rank_rtol: Optional[float] = None,
+                 min_scale_conditioning: Optional[float] = None,
+                 max_scale_rel_std: Optional[float] = None) -> None:
+        c = ffi.new("mcg_linear17_options *")
+        lib.mcg_linear17_default_options(c)
+        c.refine = 1 if refine else 0
+        if max_iterations is not None:
+            if not 0 <= int(max_iterations) <= 10000:
+                raise ValueError(f"max_iterations must be in 0..10000, got {max_iterations}")
+            c.max_iterations = int(max_iterations)
+        for name, val in (("tolerance", tolerance), ("rank_rtol", rank_rtol),
+                          ("min_scale_conditioning", min_scale_conditioning),
+                          ("max_scale_rel_std", max_scale_rel_std)):
+            if val is not None:
+                v = float(val)
+                if not np.isfinite(v) and name != "max_scale_rel_std" or v < 0:
+                    raise ValueError(f"{name} must be a finite non-negative number, got {val}")
+                setattr(c, name, v)
+        if not 0.0 < c.rank_rtol < 1.0:
+            raise ValueError(f"rank_rtol must be in (0, 1), got {c.rank_rtol}")
+        if not c.max_scale_rel_std > 0.0:
+            raise ValueError(f"max_scale_rel_std must be positive, got {c.max_scale_rel_std}")
+        self._c = c
+
+
+_DEFAULT_L17 = Linear17Options()
+_L17_DOUBLES = {name: ffi.offsetof("mcg_linear17_result", name) // 8
+                for name in ("R", "t", "t_metric", "E", "ar_eig", "schur_eig", "candidate_cost",
+                             "norm_origin")}
+
+
+def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
+             dirs2: np.ndarray, options: Optional[Linear17Options] = None) -> tuple[int, dict]:
+    """Run ``mcg_linear17``; returns (status, result dict) without raising.
+
+    The arrays must already be float64 C-contiguous (N, 3) (see
+    :func:`mcgeom.types.as_vectors`); finiteness is checked by the kernel.
+    The caller decides how to report a non-OK status (``raise_for``).
+    """
+    n = origins1.shape[0]
+    res = ffi.new("mcg_linear17_result *")
+    opt = (options or _DEFAULT_L17)._c
+    st = lib.mcg_linear17(n, _p(origins1), _p(dirs1), _p(origins2), _p(dirs2), opt, res)
+    raw = np.frombuffer(ffi.buffer(res), dtype=np.uint8)
+    d = _L17_DOUBLES
+    f64 = raw[: (ffi.sizeof("mcg_linear17_result") // 8) * 8].view(np.float64)
+    out = {
+        "R": f64[d["R"]:d["R"] + 9].reshape(3, 3).copy(),
+        "t": f64[d["t"]:d["t"] + 3].copy(),
+        "t_metric": f64[d["t_metric"]:d["t_metric"] + 3].copy(),
+        "E": f64[d["E"]:d["E"] + 9].reshape(3, 3).copy(),
+        "gc_case": GC_CASE_NAMES.get(res.gc_case, "degenerate"),
+        "rank_ar": res.rank_ar,
+        "rank_a": res.rank_a,
+        "ar_eig": f64[d["ar_eig"]:d["ar_eig"] + 9].copy(),
+        "schur_eig": f64[d["schur_eig"]:d["schur_eig"] + 9].copy(),
+        "candidate_cost": f64[d["candidate_cost"]:d["candidate_cost"] + res.n_candidates].copy(),
+        "cost_linear": res.cost_linear,
+        "cost_final": res.cost_final,
+        "iterations": res.iterations,
+        "converged": bool(res.converged),
+        "scale_observable": bool(res.scale_observable),
+        "scale_conditioning": res.scale_conditioning,
+        "scale_rel_std": res.scale_rel_std,
+        "n_in_front": res.n_in_front,
+        "norm_origin": f64[d["norm_origin"]:d["norm_origin"] + 3].copy(),
+        "norm_scale": res.norm_scale,
+    }
+    return st, out
+
+
+def raise_for(status: int, what: str) -> None:
+    """Raise the exception matching a C status code (no-op for MCG_OK)."""
+    _check(status, what)

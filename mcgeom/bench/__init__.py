@@ -1,0 +1,1 @@
+"""Benchmarks run by ``mcgeom bench``: timings against references, printed as ratios."""

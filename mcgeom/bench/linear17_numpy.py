@@ -1,0 +1,97 @@
+"""A straightforward numpy implementation of the linear 17-point method.
+
+The same algorithm as ``csrc/linear17.c`` (thesis Algorithm 2 with Algorithm 4,
+eq. 8.15 for t, the alternation of ch. 8.4.3), written the obvious way with the
+explicit N x 18 matrix A and numpy.linalg. It is the baseline of
+``mcgeom bench linear17`` and an independent cross-check in the tests; it is
+not used by the library itself.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["linear17_numpy"]
+
+_W = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def _exp(w: np.ndarray) -> np.ndarray:
+    th = np.linalg.norm(w)
+    if th < 1e-300:
+        return np.eye(3)
+    k = _skew(w / th)
+    return np.eye(3) + np.sin(th) * k + (1.0 - np.cos(th)) * k @ k
+
+
+def _rows(d1, m1, d2, m2):
+    n = d1.shape[0]
+    ae = (d2[:, :, None] * d1[:, None, :]).reshape(n, 9)
+    ar = (d2[:, :, None] * m1[:, None, :] + m2[:, :, None] * d1[:, None, :]).reshape(n, 9)
+    return np.hstack([ae, ar])
+
+
+def _x(R, t):
+    return np.concatenate([(_skew(t) @ R).ravel(), R.ravel()])
+
+
+def _solve_t(A, R):
+    # A x(R, t) = J t - b with J_k = A_E vec([e_k]x R), b = -A_R vec(R)  (eq. 8.15)
+    J = np.stack([A[:, :9] @ (_skew(e) @ R).ravel() for e in np.eye(3)], axis=1)
+    b = -A[:, 9:] @ R.ravel()
+    t = np.linalg.lstsq(J, b, rcond=None)[0]
+    return t, float(np.sum((J @ t - b) ** 2))
+
+
+def linear17_numpy(o1, d1, o2, d2, refine=True, max_iterations=100, tolerance=1e-10,
+                   rank_rtol=1e-10):
+    """Return (R, t, iterations) for ray correspondences in the rig frame."""
+    n = o1.shape[0]
+    o = (o1.sum(0) + o2.sum(0)) / (2 * n)
+    rms = np.sqrt(np.mean(np.concatenate([((o1 - o) ** 2).sum(1), ((o2 - o) ** 2).sum(1)])))
+    s = 1.0 / rms if rms > 1e-12 * (1 + np.linalg.norm(o)) else 1.0
+    d1 = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
+    d2 = d2 / np.linalg.norm(d2, axis=1, keepdims=True)
+    m1 = np.cross(s * (o1 - o), d1)
+    m2 = np.cross(s * (o2 - o), d2)
+    A = _rows(d1, m1, d2, m2)
+    AE, AR = A[:, :9], A[:, 9:]
+    sv = np.linalg.svd(AR, compute_uv=False)
+    nullity = int(np.sum(sv ** 2 <= rank_rtol * sv[0] ** 2))
+    if nullity == 0:
+        x = np.linalg.svd(A)[2][-1]          # plain SVD, most-general case
+        e = x[:9]
+    else:                                    # Algorithm 4 / eq. 8.36
+        App = (AR @ np.linalg.pinv(AR, rcond=np.sqrt(rank_rtol)) - np.eye(n)) @ AE
+        e = np.linalg.svd(App)[2][-1]
+    U, _, Vt = np.linalg.svd(e.reshape(3, 3))
+    cands = []
+    for W in (_W, _W.T):
+        R = U @ W @ Vt
+        cands.append(R if np.linalg.det(R) > 0 else -R)
+    best = min(((R,) + _solve_t(A, R) for R in cands), key=lambda c: c[2])
+    R, t, cost = best
+    it = 0
+    if refine:
+        for it in range(1, max_iterations + 1):
+            prev = cost
+            # R given t: Gauss-Newton step on SO(3)
+            x0 = _x(R, t)
+            # d x / d w_k for R = exp([w]x) R: ([t]x [e_k]x R, [e_k]x R)
+            C = np.stack([np.concatenate([(_skew(t) @ _skew(e) @ R).ravel(),
+                                          (_skew(e) @ R).ravel()])
+                          for e in np.eye(3)], axis=1)
+            AC = A @ C
+            w = np.linalg.lstsq(AC, -A @ x0, rcond=None)[0]
+            Rn = _exp(w) @ R
+            if np.sum((A @ _x(Rn, t)) ** 2) <= cost:
+                R = Rn
+            t, cost = _solve_t(A, R)
+            if prev - cost <= tolerance * prev:
+                break
+    t_rig = t / s + o - R @ o
+    return R, t_rig, it

@@ -1,0 +1,131 @@
+"""``linear17``: the linear 17-point generalized essential matrix (thesis ch. 8).
+
+Thesis Algorithm 2 with the constrained least squares of Algorithm 4
+(eq. 8.36) for the locally-central, axial and locally-central-and-axial
+generalized cameras, the plain SVD for the most-general one (cross-camera
+correspondences), the translation with metric scale from eq. 8.15 and the
+alternation refinement of ch. 8.4.3. The whole computation runs in one C call
+(``csrc/linear17.c``); this module only validates, converts and reports.
+
+The cost minimised is the algebraic residual of the generalized epipolar
+constraint ``d2^T [t]x R d1 + d2^T R m1 + m2^T R d1`` in the normalised frame of
+Algorithm 2 step 1 (``residual_rms`` is its RMS, dimensionless).
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+from .. import _core
+from ..errors import DegenerateError
+from ..registry import register
+from ..types import RayPairs, RigMotion, ScaleVerdict
+
+__all__ = ["linear17"]
+
+_NEEDED = {"most-general": 17, "locally-central": 16, "axial": 16,
+           "locally-central-and-axial": 14, "central": 8}
+
+
+def _verdict(r: dict) -> ScaleVerdict:
+    if r["scale_observable"]:
+        reason = "scale fixed by the data (rotation or cross-camera rays)"
+    elif r["gc_case"] == "central":
+        reason = "central camera: all rays share one centre, the scale is not observable"
+    elif r["scale_conditioning"] < 1e-6:
+        reason = ("critical motion: the data leave |t| free (no rotation and only "
+                  "intra-camera correspondences, thesis ch. 7.3.2)")
+    else:
+        reason = (f"scale too uncertain: relative std {r['scale_rel_std']:.3g} "
+                  "(near-critical motion, too little rotation for the noise level)")
+    return ScaleVerdict(bool(r["scale_observable"]), reason,
+                        conditioning=float(r["scale_conditioning"]),
+                        rel_std=float(r["scale_rel_std"]))
+
+
+@register(
+    "linear17",
+    min_sample=17,
+    camera_kinds=("most-general", "locally-central", "axial", "locally-central-and-axial"),
+    family="linear",
+    needs_rotation=False,
+    recovers_scale=True,
+    description="linear 17-point generalized essential matrix with constrained SVD and "
+                "alternation (thesis ch. 8)",
+    options={"refine": "run the alternation of ch. 8.4.3 (default True)",
+             "max_iterations": "cap on alternation iterations (default 100)",
+             "tolerance": "relative cost decrease that stops the alternation (1e-10)",
+             "max_scale_rel_std": "relative std of |t| above which the scale is "
+                                  "reported unobservable (0.1)"},
+)
+def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[int] = None,
+             tolerance: Optional[float] = None, max_scale_rel_std: Optional[float] = None,
+             options: Optional[_core.Linear17Options] = None) -> RigMotion:
+    """Relative rig motion (R, t with metric scale) from >= 17 ray correspondences.
+
+    ``rays`` are in the rig frame (metres); origins must be the camera centres
+    for axial rigs. Returns ``RigMotion`` rig2_from_rig1 (``X2 = R X1 + t``);
+    ``info`` reports the detected generalized-camera kind, the ranks, the
+    alternation iterations and convergence. Raises ValueError on bad input
+    (NaN/inf, zero directions, fewer than 14 rays) and DegenerateError when the
+    data do not determine E (no translation, or too few rays for the kind).
+    """
+    if not isinstance(rays, RayPairs):
+        raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    n = len(rays)
+    if n < 14:
+        raise ValueError(f"too few correspondences: linear17 needs at least 17 "
+                         f"(16 locally-central or axial, 14 locally-central-and-axial), got {n}")
+    if options is None and (not refine or max_iterations is not None or tolerance is not None
+                            or max_scale_rel_std is not None):
+        options = _core.Linear17Options(refine=refine, max_iterations=max_iterations,
+                                        tolerance=tolerance, max_scale_rel_std=max_scale_rel_std)
+    st, r = _core.linear17(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, options)
+    if st != 0:
+        _raise(st, r, rays, n)
+    info = {
+        "camera_kind": r["gc_case"],
+        "rank_A_R": r["rank_ar"],
+        "rank_A": r["rank_a"],
+        "iterations": r["iterations"],
+        "converged": r["converged"],
+        "cost_linear": r["cost_linear"],
+        "t_metric": r["t_metric"],
+        "candidate_cost": r["candidate_cost"],
+        "n_in_front": r["n_in_front"],
+        "E_normalised": r["E"],
+        "schur_eig": r["schur_eig"],
+        "A_R_eig": r["ar_eig"],
+        "normalisation": (r["norm_origin"], r["norm_scale"]),
+    }
+    return RigMotion(r["R"], r["t"], _verdict(r), "linear17", r["cost_final"], None, info)
+
+
+def _raise(status: int, r: dict, rays: RayPairs, n: int) -> None:
+    """Turn a kernel failure into an exception that names the problem."""
+    import numpy as np
+
+    if status == 1:  # MCG_EINVAL: find which argument is at fault
+        for name in ("origins1", "dirs1", "origins2", "dirs2"):
+            if not np.isfinite(getattr(rays, name)).all():
+                raise ValueError(f"rays.{name} contains NaN or inf")
+        for name in ("dirs1", "dirs2"):
+            if (np.linalg.norm(getattr(rays, name), axis=1) == 0).any():
+                raise ValueError(f"rays.{name} contains a zero-length direction")
+        _core.raise_for(status, "linear17")
+    if status == 5:
+        kind = r["gc_case"]
+        if kind == "degenerate":
+            raise DegenerateError(
+                "linear17: degenerate data: the null space of the R-block A_R "
+                f"(rank {r['rank_ar']}) matches no generalized-camera kind; typical causes: "
+                "no translation (pure rotation or zero motion, E = 0) or too few distinct rays")
+        need = _NEEDED.get(kind, 17)
+        if n < need:
+            raise DegenerateError(f"linear17: too few correspondences for a {kind} camera: "
+                                  f"need {need}, got {n}")
+        raise DegenerateError(
+            f"linear17: E is not determined by the data ({kind} camera): the reduced system "
+            "has more than one null direction (no translation, or rays in a degenerate "
+            "configuration)")
+    _core.raise_for(status, "linear17")

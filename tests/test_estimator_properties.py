@@ -1,0 +1,131 @@
+"""The shared property suite: every registered estimator, every generalized
+camera kind it declares (DESIGN.md section 6). A third-party plugin registered
+through the ``mcgeom.estimators`` entry points is picked up automatically."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+import mcgeom
+from mcgeom import registry
+from problems import KIND_SETUPS, make, rigid, rot_err
+
+CASES = [(e.name, kind) for e in registry.list_estimators()
+         if e.family != "refinement" and not e.needs_rotation
+         for kind in e.camera_kinds if kind in KIND_SETUPS]
+SETTINGS = settings(max_examples=15, deadline=None,
+                    suppress_health_check=[HealthCheck.too_slow])
+seeds = st.integers(min_value=0, max_value=2**31 - 1)
+
+
+def _n(name):
+    return max(60, 3 * registry.get(name).min_sample)
+
+
+def test_every_estimator_is_covered():
+    assert {name for name, _ in CASES} >= {"linear17"}
+
+
+@pytest.mark.parametrize("name,kind", CASES)
+@SETTINGS
+@given(seed=seeds)
+def test_exact_recovery_noise_free(name, kind, seed):
+    p = make(kind, seed, n=_n(name))
+    m = mcgeom.estimate(p.rays, name)
+    assert rot_err(m.R, p.R) < 1e-8
+    assert np.linalg.norm(m.t - p.t) < 1e-8 * np.linalg.norm(p.t)
+    assert m.scale.observable
+
+
+@pytest.mark.parametrize("name,kind", CASES)
+@SETTINGS
+@given(seed=seeds)
+def test_invariant_to_rig_frame(name, kind, seed):
+    """Re-expressing the rig frame by F = (Rf, tf) conjugates the motion."""
+    p = make(kind, seed, n=_n(name), angular_noise=1e-3)
+    Rf, tf = rigid(np.random.default_rng(seed + 1))
+    m = mcgeom.estimate(p.rays, name)
+    mf = mcgeom.estimate(p.rays.in_frame(Rf, tf), name)
+    F = np.eye(4)
+    F[:3, :3], F[:3, 3] = Rf, tf
+    expect = F @ m.T @ np.linalg.inv(F)
+    assert rot_err(mf.R, expect[:3, :3]) < 1e-7
+    assert np.linalg.norm(mf.t - expect[:3, 3]) < 1e-6 * (1 + np.linalg.norm(expect[:3, 3]))
+
+
+@pytest.mark.parametrize("name,kind", CASES)
+@SETTINGS
+@given(seed=seeds)
+def test_invariant_to_permutation(name, kind, seed):
+    p = make(kind, seed, n=_n(name), angular_noise=1e-3)
+    perm = np.random.default_rng(seed).permutation(len(p.rays))
+    a = mcgeom.estimate(p.rays, name)
+    b = mcgeom.estimate(p.rays.take(perm), name)
+    assert rot_err(a.R, b.R) < 1e-9
+    assert np.linalg.norm(a.t - b.t) < 1e-8 * (1 + np.linalg.norm(a.t))
+
+
+@pytest.mark.parametrize("name,kind", CASES)
+@SETTINGS
+@given(seed=seeds)
+def test_swapping_frames_inverts_motion(name, kind, seed):
+    p = make(kind, seed, n=_n(name))
+    a = mcgeom.estimate(p.rays, name)
+    b = mcgeom.estimate(p.rays.swapped(), name)
+    inv = a.inverse()
+    assert rot_err(b.R, inv.R) < 1e-8
+    assert np.linalg.norm(b.t - inv.t) < 1e-8 * (1 + np.linalg.norm(inv.t))
+
+
+@pytest.mark.parametrize("name,kind", CASES)
+@SETTINGS
+@given(seed=seeds, log_s=st.floats(min_value=-3, max_value=3))
+def test_scaling_world_scales_t(name, kind, seed, log_s):
+    s = 10.0 ** log_s
+    p = make(kind, seed, n=_n(name), angular_noise=1e-3)
+    r = p.rays
+    scaled = mcgeom.RayPairs(s * r.origins1, r.dirs1, s * r.origins2, r.dirs2, r.cam1, r.cam2)
+    a = mcgeom.estimate(r, name)
+    b = mcgeom.estimate(scaled, name)
+    assert rot_err(a.R, b.R) < 1e-8
+    assert np.linalg.norm(b.t - s * a.t) < 1e-7 * s * (1 + np.linalg.norm(a.t))
+
+
+SCALE_CASES = [(e.name, kind) for e in registry.list_estimators()
+               if e.recovers_scale and e.family != "refinement" and not e.needs_rotation
+               for kind in ("locally-central", "locally-central-and-axial")
+               if kind in e.camera_kinds]
+
+
+@pytest.mark.parametrize("name,kind", SCALE_CASES)
+@SETTINGS
+@given(seed=seeds)
+def test_critical_motion_reported(name, kind, seed):
+    """No rotation and only intra-camera rays: |t| is not observable (ch. 7.3.2);
+    the rotation and the direction of t must still be right."""
+    rng = np.random.default_rng(seed)
+    t = rng.normal(size=3)
+    t *= 0.5 / np.linalg.norm(t)
+    p = make(kind, seed, n=_n(name), R=np.eye(3), t=t)
+    m = mcgeom.estimate(p.rays, name)
+    assert not m.scale.observable
+    assert "critical" in m.scale.reason or "scale" in m.scale.reason
+    assert rot_err(m.R, np.eye(3)) < 1e-8
+    assert abs(np.linalg.norm(m.t) - 1.0) < 1e-9
+    assert np.dot(m.t, t / np.linalg.norm(t)) > 1 - 1e-8
+
+
+@pytest.mark.parametrize("name", [e.name for e in registry.list_estimators()
+                                  if "most-general" in e.camera_kinds and e.recovers_scale])
+@SETTINGS
+@given(seed=seeds)
+def test_cross_camera_rays_fix_scale_without_rotation(name, seed):
+    rng = np.random.default_rng(seed)
+    t = rng.normal(size=3)
+    t *= 0.5 / np.linalg.norm(t)
+    p = make("most-general", seed, n=_n(name), R=np.eye(3), t=t)
+    m = mcgeom.estimate(p.rays, name)
+    assert m.scale.observable
+    assert np.linalg.norm(m.t - t) < 1e-8
