@@ -450,29 +450,62 @@ static int check_options(const mcg_linear17_options *o)
     return 1;
 }
 
+/* Most-general case (rank 17): the plain SVD solution, min |A x| with
+ * |x| = 1, is the eigenvector of the smallest eigenvalue of M. It is reached
+ * by inverse iteration started from the constrained solution (e, r), which is
+ * close to it; this avoids a full 18 x 18 eigen-decomposition. */
+static int plain_svd_refine(const double *m, double e[9], double r[9])
+{
+    double ms[NX * NX], x[NX], y[NX], tr = 0.0, nx = 0.0;
+    int i, it;
+    memcpy(ms, m, sizeof ms);
+    for (i = 0; i < NX; i++)
+        tr += m[i * NX + i];
+    for (i = 0; i < NX; i++)
+        ms[i * NX + i] += 1e-13 * tr; /* keeps the factorisation definite */
+    for (i = 0; i < 9; i++) {
+        x[i] = e[i];
+        x[9 + i] = r[i];
+    }
+    for (i = 0; i < NX; i++)
+        nx += x[i] * x[i];
+    nx = sqrt(nx);
+    for (i = 0; i < NX; i++)
+        x[i] /= nx;
+    for (it = 0; it < 50; it++) {
+        double ny = 0.0, dd = 0.0, sg;
+        if (mcg_spd_solve(NX, ms, x, y) != MCG_OK)
+            return MCG_ENUMERIC;
+        for (i = 0; i < NX; i++)
+            ny += y[i] * y[i];
+        ny = sqrt(ny);
+        if (!(ny > 0.0) || !isfinite(ny))
+            return MCG_ENUMERIC;
+        sg = 0.0;
+        for (i = 0; i < NX; i++)
+            sg += y[i] * x[i];
+        sg = sg < 0.0 ? -1.0 : 1.0;
+        for (i = 0; i < NX; i++) {
+            double v = sg * y[i] / ny;
+            dd += (v - x[i]) * (v - x[i]);
+            x[i] = v;
+        }
+        if (dd < 1e-30)
+            break;
+    }
+    for (i = 0; i < 9; i++) {
+        e[i] = x[i];
+        r[i] = x[9 + i];
+    }
+    return MCG_OK;
+}
+
 /* Linear step: the 9-vector e of E (and the R part r) minimising |A x|. */
 static int linear_step(const double *m, int gc_case, int nullity,
                        const double *wr, const double *vr, double rtol,
                        double e[9], double r[9], mcg_linear17_result *res)
 {
     int i, j, k;
-    if (gc_case == MCG_GC_MOST_GENERAL) {
-        /* plain SVD of A == smallest eigenvector of M, |x| = 1 */
-        double mc[NX * NX], w[NX], v[NX * NX];
-        memcpy(mc, m, sizeof mc);
-        if (mcg_sym_eig(NX, mc, w, v) != MCG_OK)
-            return MCG_ENUMERIC;
-        for (k = 0; k < 9; k++)
-            res->schur_eig[k] = w[8 + k] > 0.0 ? w[k] / w[NX - 1] : 0.0;
-        if (!(w[1] > rtol * w[NX - 1]))
-            return MCG_EDEGENERATE;
-        for (i = 0; i < 9; i++) {
-            e[i] = v[i * NX];
-            r[i] = v[(9 + i) * NX];
-        }
-        (void)nullity;
-        return MCG_OK;
-    }
     {
         /* Algorithm 4 / eq. 8.36: r = -M_RR^+ M_RE e, and e minimises
          * e^T (M_EE - M_ER M_RR^+ M_RE) e with |e| = 1 (the Schur complement
@@ -520,6 +553,9 @@ static int linear_step(const double *m, int gc_case, int nullity,
             r[i] = -acc;
         }
     }
+    if (gc_case == MCG_GC_MOST_GENERAL)
+        return plain_svd_refine(m, e, r);
+    (void)nullity;
     return MCG_OK;
 }
 

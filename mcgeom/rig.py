@@ -1,0 +1,646 @@
+"""Calibrated multi-camera rigs: pixels -> bearings -> Plücker rays, and rig files.
+
+Frames and units (DESIGN.md section 3):
+
+* Camera frame: OpenCV's (x right, y down, z forward), metres.
+* Rig frame: whatever frame the extrinsics are expressed in, metres.
+* Extrinsics of camera i are **cam_from_rig** ``(R_i, t_i)``: ``X_cam = R_i X_rig + t_i``;
+  the camera centre in the rig frame is ``c_i = -R_i^T t_i``.
+* Pixels follow OpenCV: ``(u, v)`` with the centre of the top-left pixel at ``(0, 0)``,
+  so the image covers ``[-0.5, width - 0.5) x [-0.5, height - 0.5)``.
+* The bearing of a pixel in the rig frame is ``d = R_i^T normalize([x, y, 1])`` where
+  ``(x, y)`` is the undistorted normalized image point; its Plücker ray is
+  ``(d, c_i x d)`` (see :class:`mcgeom.types.RayPairs`).
+
+Lens models are OpenCV's: ``"pinhole"`` (``cv2.projectPoints`` / ``cv2.undistortPoints``
+with 0, 4, 5, 8, 12 or 14 coefficients) and ``"fisheye"`` (``cv2.fisheye``, 4
+coefficients). The intrinsic matrix ``K`` may have a skew term ``K[0, 1]``: OpenCV's
+functions ignore skew, so they are called on normalized coordinates with an identity
+camera matrix and ``K`` is applied here, exactly.
+
+Rig file format (JSON, ``Rig.save_json`` / ``Rig.load_json``)::
+
+    {
+      "format": "mcgeom-rig",
+      "version": 1,
+      "cameras": [
+        {
+          "name": "front",                 # unique within the rig
+          "model": "pinhole",              # or "fisheye"
+          "width": 1024, "height": 768,    # pixels
+          "K": [[fx, s, cx], [0, fy, cy], [0, 0, 1]],
+          "dist": [k1, k2, p1, p2, k3],    # OpenCV order; fisheye: [k1, k2, k3, k4]
+          "R_cam_from_rig": [[...], [...], [...]],
+          "t_cam_from_rig": [tx, ty, tz]   # metres
+        }
+      ]
+    }
+
+Keys other than these are ignored (room for comments and metadata); a missing key, a
+wrong ``format``/``version`` or a malformed value is a ``ValueError`` that names it.
+"""
+
+from __future__ import annotations
+
+import json
+import operator
+import os
+from dataclasses import dataclass, replace
+from typing import Any, Literal, Sequence, Union
+
+import cv2
+import numpy as np
+
+from mcgeom.types import RayPairs
+
+__all__ = ["Camera", "Rig", "RIG_FORMAT", "RIG_FORMAT_VERSION"]
+
+RIG_FORMAT = "mcgeom-rig"
+RIG_FORMAT_VERSION = 1
+
+CameraModel = Literal["pinhole", "fisheye"]
+PathLike = Union[str, "os.PathLike[str]"]
+
+_DIST_LENGTHS = {"pinhole": (0, 4, 5, 8, 12, 14), "fisheye": (4,)}
+_ROTATION_TOL = 1e-6
+# OpenCV's default undistortion stops after 5 (pinhole) / 10 (fisheye) iterations, far
+# from double precision with real distortion; these criteria are in normalized units
+# because OpenCV is called with an identity camera matrix.
+_UNDISTORT_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
+# A projected pixel whose bearing differs from the point's direction by more than this
+# (radians) lies where the distortion polynomial folds over: not a real observation.
+_ROUND_TRIP_TOL = 1e-6
+_IDENTITY = np.eye(3)
+
+
+# --------------------------------------------------------------------------- helpers
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    """A read-only float64 C-contiguous copy (cameras are immutable values)."""
+    out = np.array(a, dtype=np.float64, order="C", copy=True)
+    out.setflags(write=False)
+    return out
+
+
+def _numeric(what: str, value: Any) -> np.ndarray:
+    """``value`` as a float64 array, refusing strings, booleans and ragged lists."""
+    try:
+        arr = np.asarray(value)
+    except (ValueError, TypeError) as exc:  # ragged nested lists
+        raise ValueError(f"{what} must be a numeric array ({exc})") from None
+    if arr.dtype.kind not in "iuf":
+        raise ValueError(f"{what} must be a numeric array, got dtype {arr.dtype}")
+    return arr.astype(np.float64)
+
+
+def _rotation_problem(R: np.ndarray) -> str | None:
+    """Why ``R`` (3x3 float64) is not a rotation, or None if it is one."""
+    if not np.all(np.isfinite(R)):
+        return "(non-finite entries)"
+    ortho = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    if ortho >= _ROTATION_TOL:
+        return f"(not orthonormal: max |R^T R - I| = {ortho:.3g})"
+    det = float(np.linalg.det(R))
+    if det <= 0:
+        return f"(det = {round(det, 6)})"
+    return None
+
+
+def _check_rotation(what: str, value: Any) -> np.ndarray:
+    """``value`` as a 3x3 rotation matrix or ValueError('<what> is not a rotation ...')."""
+    R = _numeric(what, value)
+    if R.shape != (3, 3):
+        raise ValueError(f"{what} must have shape (3, 3), got {R.shape}")
+    problem = _rotation_problem(R)
+    if problem is not None:
+        raise ValueError(f"{what} is not a rotation {problem}")
+    return R
+
+
+def _check_vector3(what: str, value: Any) -> np.ndarray:
+    """``value`` ((3,), (3, 1) or (1, 3)) as a finite (3,) vector."""
+    t = _numeric(what, value)
+    if t.size != 3 or t.ndim > 2 or (t.ndim == 2 and 1 not in t.shape):
+        raise ValueError(f"{what} must have 3 elements, got shape {t.shape}")
+    t = t.reshape(3)
+    if not np.all(np.isfinite(t)):
+        raise ValueError(f"{what} has non-finite entries")
+    return t
+
+
+def _check_pixels(what: str, pixels: Any, n: int | None = None) -> np.ndarray:
+    """``pixels`` as a finite (N, 2) float64 array or ValueError naming the problem."""
+    px = _numeric(what, pixels)
+    if px.ndim != 2 or px.shape[1] != 2:
+        raise ValueError(f"{what} must have shape (N, 2), got {px.shape}")
+    if n is not None and px.shape[0] != n:
+        raise ValueError(f"{what} has {px.shape[0]} rows, expected {n}")
+    bad = ~np.all(np.isfinite(px), axis=1)
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{what} has {int(bad.sum())} non-finite row(s) (first: row {k})")
+    return np.ascontiguousarray(px)
+
+
+def _check_points(what: str, points: Any) -> np.ndarray:
+    """``points`` as a finite (N, 3) float64 array or ValueError naming the problem."""
+    P = _numeric(what, points)
+    if P.ndim != 2 or P.shape[1] != 3:
+        raise ValueError(f"{what} must have shape (N, 3), got {P.shape}")
+    if not np.all(np.isfinite(P)):
+        raise ValueError(f"{what} has non-finite entries")
+    return np.ascontiguousarray(P)
+
+
+def _check_int(what: str, value: Any) -> int:
+    """A plain Python int from an int-like value (not bool, not float)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{what} must be an integer, got {value!r}")
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise ValueError(f"{what} must be an integer, got {value!r}") from None
+
+
+def _normalize_rows(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def _fisheye_poly(theta: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """OpenCV fisheye distortion ``theta_d = theta (1 + k1 theta^2 + ... + k4 theta^8)``."""
+    k1, k2, k3, k4 = D
+    t2 = theta * theta
+    return theta * (1 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))))
+
+
+def _fisheye_theta(theta_d: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """Invert the fisheye polynomial on its increasing branch, by bisection.
+
+    Used for the pixels OpenCV's fisheye undistortion cannot represent (angles of 90
+    degrees or more from the optical axis, where ``tan(theta)`` changes sign). Bisection
+    rather than Newton: it cannot jump to the decreasing branch past the polynomial's
+    peak. Returns NaN where ``theta_d`` exceeds the peak (no ray maps there).
+    """
+    grid = np.linspace(0.0, np.pi, 4097)
+    rising = np.diff(_fisheye_poly(grid, D)) > 0
+    top = grid[np.argmin(rising)] if not rising.all() else np.pi  # last point of the branch
+    lo, hi = np.zeros_like(theta_d), np.full_like(theta_d, top)
+    for _ in range(64):  # interval shrinks to ~1e-19 rad
+        mid = 0.5 * (lo + hi)
+        below = _fisheye_poly(mid, D) < theta_d
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    theta = 0.5 * (lo + hi)
+    ok = np.abs(_fisheye_poly(theta, D) - theta_d) <= 1e-12 * np.maximum(1.0, theta_d)
+    return np.where(ok, theta, np.nan)
+
+
+# --------------------------------------------------------------------------- Camera
+
+@dataclass(frozen=True, eq=False)
+class Camera:
+    """One calibrated camera of a rig (OpenCV lens model + cam_from_rig extrinsics).
+
+    Attributes:
+        name: unique name within the rig (used in messages and rig files).
+        K: 3x3 upper-triangular intrinsic matrix in pixels (``fx, fy > 0``, ``K[2,2] = 1``;
+            a skew ``K[0,1]`` is allowed).
+        dist: 1-D OpenCV distortion coefficients: pinhole 0, 4, 5, 8, 12 or 14 values
+            ``(k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx, ty]]]])``; fisheye exactly
+            4 values ``(k1, k2, k3, k4)``.
+        model: ``"pinhole"`` or ``"fisheye"``.
+        R: 3x3 rotation cam_from_rig.
+        t: (3,) translation cam_from_rig in metres: ``X_cam = R X_rig + t``.
+        width, height: image size in pixels.
+
+    Arrays are stored as read-only float64 C-contiguous copies; every check failure is
+    a ``ValueError`` naming the camera and the problem.
+    """
+
+    name: str
+    K: np.ndarray
+    dist: np.ndarray
+    model: CameraModel
+    R: np.ndarray
+    t: np.ndarray
+    width: int
+    height: int
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"camera name must be a non-empty string, got {self.name!r}")
+        who = f"camera {self.name!r}"
+        if self.model not in _DIST_LENGTHS:
+            raise ValueError(f"{who}: unknown model {self.model!r} (expected 'pinhole' or 'fisheye')")
+        set_ = lambda field, value: object.__setattr__(self, field, value)  # noqa: E731
+        set_("K", _frozen(self._checked_K(who)))
+        set_("dist", _frozen(self._checked_dist(who)))
+        set_("R", _frozen(_check_rotation(f"{who}: extrinsic R", self.R)))
+        set_("t", _frozen(_check_vector3(f"{who}: extrinsic t", self.t)))
+        for field in ("width", "height"):
+            value = _check_int(f"{who}: {field}", getattr(self, field))
+            if value <= 0:
+                raise ValueError(f"{who}: {field} must be positive, got {value}")
+            set_(field, value)
+
+    def _checked_K(self, who: str) -> np.ndarray:
+        K = _numeric(f"{who}: K", self.K)
+        if K.shape != (3, 3):
+            raise ValueError(f"{who}: K must have shape (3, 3), got {K.shape}")
+        if not np.all(np.isfinite(K)):
+            raise ValueError(f"{who}: K has non-finite entries")
+        if K[1, 0] != 0 or K[2, 0] != 0 or K[2, 1] != 0:
+            raise ValueError(f"{who}: K must be upper triangular (K[1,0], K[2,0], K[2,1] = 0)")
+        if not (K[0, 0] > 0 and K[1, 1] > 0):
+            raise ValueError(f"{who}: K must have positive focal lengths, got fx={K[0, 0]}, fy={K[1, 1]}")
+        if K[2, 2] != 1:
+            raise ValueError(f"{who}: K[2,2] must be 1, got {K[2, 2]}")
+        return K
+
+    def _checked_dist(self, who: str) -> np.ndarray:
+        # None is the common spelling of "no distortion" in OpenCV code.
+        dist = _numeric(f"{who}: dist", [] if self.dist is None else self.dist)
+        # calibrateCamera returns (1, n); accept row/column vectors, store 1-D.
+        if dist.ndim > 2 or (dist.ndim == 2 and 1 not in dist.shape):
+            raise ValueError(f"{who}: dist must be a 1-D array, got shape {dist.shape}")
+        dist = dist.reshape(-1)
+        if dist.size not in _DIST_LENGTHS[self.model]:
+            raise ValueError(f"{who}: a {self.model} camera needs {_DIST_LENGTHS[self.model]} "
+                             f"distortion coefficients, got {dist.size}")
+        if not np.all(np.isfinite(dist)):
+            raise ValueError(f"{who}: dist has non-finite entries")
+        return dist
+
+    # -- value semantics (ndarray fields defeat the dataclass-generated ones)
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Camera):
+            return NotImplemented
+        return (self.name == other.name and self.model == other.model
+                and self.width == other.width and self.height == other.height
+                and all(np.array_equal(getattr(self, f), getattr(other, f))
+                        for f in ("K", "dist", "R", "t")))
+
+    def __hash__(self) -> int:
+        return hash((self.name, self.model, self.width, self.height, self.K.tobytes(),
+                     self.dist.tobytes(), self.R.tobytes(), self.t.tobytes()))
+
+    # -- geometry
+    @property
+    def centre(self) -> np.ndarray:
+        """Camera centre in the rig frame, metres: ``-R^T t``, shape (3,)."""
+        return -self.R.T @ self.t
+
+    @property
+    def has_distortion(self) -> bool:
+        """True if any distortion coefficient is non-zero."""
+        return bool(np.any(self.dist != 0))
+
+    def pixels_to_bearings(self, pixels: Any) -> np.ndarray:
+        """Unit bearings in the RIG frame of pixels of this camera.
+
+        Args:
+            pixels: (N, 2) pixel coordinates (OpenCV convention), finite.
+
+        Returns:
+            (N, 3) float64 unit vectors ``d = R^T normalize([x, y, 1])`` in the rig frame,
+            where ``(x, y)`` is the undistorted normalized point (``cv2.undistortPoints``
+            or ``cv2.fisheye.undistortPoints``). Without distortion this is exactly
+            ``R^T normalize(K^-1 [u, v, 1])``.
+
+        Raises:
+            ValueError: bad shape or non-finite pixels; fisheye pixels outside the range
+                where the distortion polynomial can be inverted.
+        """
+        px = _check_pixels(f"camera {self.name!r}: pixels", pixels)
+        rays_cam = self._unproject(self._pixels_to_normalized(px), px)
+        return _normalize_rows(rays_cam @ self.R)  # row-wise R^T d
+
+    def project(self, points_rig: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Project points given in the rig frame into this camera.
+
+        Args:
+            points_rig: (N, 3) points in the rig frame, metres, finite.
+
+        Returns:
+            ``(pixels, visible)``: (N, 2) pixel coordinates (``cv2.projectPoints`` /
+            ``cv2.fisheye.projectPoints``; NaN for points not in front, ``z <= 0``) and
+            an (N,) bool mask: in front, inside the image ``[-0.5, width - 0.5) x
+            [-0.5, height - 0.5)``, and -- with distortion -- a pixel that unprojects
+            back to the point's direction (guards against the fold-over of the
+            distortion polynomial outside its calibrated range).
+        """
+        P = _check_points(f"camera {self.name!r}: points_rig", points_rig)
+        X = P @ self.R.T + self.t
+        pixels = np.full((P.shape[0], 2), np.nan)
+        front = X[:, 2] > 0
+        if np.any(front):
+            pixels[front] = self._normalized_to_pixels(self._distort(X[front]))
+        visible = front.copy()
+        visible[front] = self.in_image(pixels[front])
+        if self.has_distortion and np.any(visible):
+            visible[visible] = self._round_trip_ok(pixels[visible], X[visible])
+        return pixels, visible
+
+    def in_image(self, pixels: Any) -> np.ndarray:
+        """(N,) bool: pixel inside ``[-0.5, width - 0.5) x [-0.5, height - 0.5)``."""
+        px = np.asarray(pixels, dtype=np.float64).reshape(-1, 2)
+        return ((px[:, 0] >= -0.5) & (px[:, 0] < self.width - 0.5)
+                & (px[:, 1] >= -0.5) & (px[:, 1] < self.height - 0.5))
+
+    # -- internals: K is applied here so that skew is honoured (OpenCV ignores it)
+    def _pixels_to_normalized(self, px: np.ndarray) -> np.ndarray:
+        """Distorted normalized coordinates ``K^-1 [u, v, 1]`` (back substitution)."""
+        K = self.K
+        y = (px[:, 1] - K[1, 2]) / K[1, 1]
+        x = (px[:, 0] - K[0, 2] - K[0, 1] * y) / K[0, 0]
+        return np.stack([x, y], axis=1)
+
+    def _normalized_to_pixels(self, xy: np.ndarray) -> np.ndarray:
+        K = self.K
+        u = K[0, 0] * xy[:, 0] + K[0, 1] * xy[:, 1] + K[0, 2]
+        v = K[1, 1] * xy[:, 1] + K[1, 2]
+        return np.stack([u, v], axis=1)
+
+    def _distort(self, X_cam: np.ndarray) -> np.ndarray:
+        """Camera-frame points (z > 0) -> distorted normalized coordinates via OpenCV."""
+        obj = np.ascontiguousarray(X_cam).reshape(-1, 1, 3)
+        zero = np.zeros(3)
+        if self.model == "fisheye":
+            out, _ = cv2.fisheye.projectPoints(obj, zero, zero, _IDENTITY, self.dist)
+        else:
+            out, _ = cv2.projectPoints(obj, zero, zero, _IDENTITY, self.dist)
+        return out.reshape(-1, 2).astype(np.float64)
+
+    def _unproject(self, xy_d: np.ndarray, px: np.ndarray, strict: bool = True) -> np.ndarray:
+        """Distorted normalized coordinates -> (N, 3) camera-frame ray directions.
+
+        ``strict``: raise for fisheye pixels without a ray; otherwise return NaN rows.
+        """
+        n = xy_d.shape[0]
+        if n == 0:
+            return np.zeros((0, 3))
+        src = np.ascontiguousarray(xy_d).reshape(-1, 1, 2)
+        if self.model == "pinhole":
+            xy = cv2.undistortPoints(src, _IDENTITY, self.dist,
+                                     criteria=_UNDISTORT_CRITERIA).reshape(-1, 2)
+            return np.column_stack([xy, np.ones(n)])
+        xy = cv2.fisheye.undistortPoints(src, _IDENTITY, self.dist,
+                                         criteria=_UNDISTORT_CRITERIA).reshape(-1, 2)
+        return self._fisheye_rays(xy_d, xy, px, strict)
+
+    def _fisheye_rays(self, xy_d: np.ndarray, xy: np.ndarray, px: np.ndarray,
+                      strict: bool) -> np.ndarray:
+        """Fisheye rays from OpenCV's result, re-solved where OpenCV cannot be right.
+
+        OpenCV returns ``tan(theta)`` scaled points, which cannot represent rays at 90
+        degrees or more from the axis (it then returns a wrong point, silently). Each
+        result is checked against the forward model and re-solved by Newton otherwise.
+        """
+        theta_d = np.linalg.norm(xy_d, axis=1)
+        theta = np.arctan(np.linalg.norm(xy, axis=1))
+        back = _fisheye_poly(theta, self.dist)
+        bad = ~(np.abs(back - theta_d) <= 1e-9 * np.maximum(1.0, theta_d))
+        if np.any(bad):
+            theta[bad] = _fisheye_theta(theta_d[bad], self.dist)
+            if strict and np.any(np.isnan(theta)):
+                k = int(np.flatnonzero(np.isnan(theta))[0])
+                raise ValueError(
+                    f"camera {self.name!r}: {int(np.isnan(theta).sum())} pixel(s) lie outside "
+                    f"the range where the fisheye distortion can be inverted (first: "
+                    f"({px[k, 0]:.6g}, {px[k, 1]:.6g}))")
+        # direction = (sin(theta) * unit(xy_d), cos(theta)); unit(xy_d) is undefined at the
+        # principal point, where theta = 0 and the ray is the optical axis anyway.
+        scale = np.divide(np.sin(theta), theta_d, out=np.ones_like(theta), where=theta_d > 0)
+        return np.column_stack([xy_d * scale[:, None], np.cos(theta)])
+
+    def _round_trip_ok(self, pixels: np.ndarray, X_cam: np.ndarray) -> np.ndarray:
+        """(N,) bool: each pixel unprojects to the direction of its camera-frame point
+        (never raises: a pixel without a ray simply fails). Used by synth too."""
+        if pixels.shape[0] == 0:
+            return np.zeros(0, dtype=bool)
+        rays = self._unproject(self._pixels_to_normalized(pixels), pixels, strict=False)
+        cos = np.sum(_normalize_rows(rays) * _normalize_rows(X_cam), axis=1)
+        return cos > np.cos(_ROUND_TRIP_TOL)  # NaN rows compare False
+
+    # -- frames and serialisation
+    def in_frame(self, R: np.ndarray, t: np.ndarray) -> "Camera":
+        """The same camera with extrinsics w.r.t. a new rig frame ``X_new = R X_old + t``.
+
+        ``cam_from_new = cam_from_old o old_from_new``: ``R' = R_c R^T``,
+        ``t' = t_c - R_c R^T t``.
+        """
+        Rm = _check_rotation("in_frame: R", R)
+        tv = _check_vector3("in_frame: t", t)
+        R_new = self.R @ Rm.T
+        return replace(self, R=R_new, t=self.t - R_new @ tv)
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict of this camera (one entry of the rig file's ``cameras``)."""
+        return {
+            "name": self.name, "model": self.model,
+            "width": self.width, "height": self.height,
+            "K": self.K.tolist(), "dist": self.dist.tolist(),
+            "R_cam_from_rig": self.R.tolist(), "t_cam_from_rig": self.t.tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: Any, where: str = "camera") -> "Camera":
+        """Camera from a rig-file entry; ValueError naming ``where`` and the problem."""
+        if not isinstance(d, dict):
+            raise ValueError(f"{where} must be a JSON object, got {type(d).__name__}")
+        required = ("name", "model", "width", "height", "K", "dist",
+                    "R_cam_from_rig", "t_cam_from_rig")
+        missing = [k for k in required if k not in d]
+        if missing:
+            raise ValueError(f"{where}: missing key(s) {', '.join(map(repr, missing))}")
+        try:
+            return cls(name=d["name"], K=d["K"], dist=d["dist"], model=d["model"],
+                       R=d["R_cam_from_rig"], t=d["t_cam_from_rig"],
+                       width=d["width"], height=d["height"])
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
+
+
+# --------------------------------------------------------------------------- Rig
+
+@dataclass(frozen=True)
+class Rig:
+    """A calibrated multi-camera rig: cameras with extrinsics in one rig frame (metres).
+
+    Camera ids are the indices into ``cameras``. Names must be unique.
+    """
+
+    cameras: tuple[Camera, ...]
+
+    def __post_init__(self) -> None:
+        cams = self.cameras
+        if isinstance(cams, Camera) or not isinstance(cams, Sequence):
+            raise ValueError(f"cameras must be a sequence of Camera, got {type(cams).__name__}")
+        cams = tuple(cams)
+        if not cams:
+            raise ValueError("a rig needs at least one camera")
+        for i, cam in enumerate(cams):
+            if not isinstance(cam, Camera):
+                raise ValueError(f"cameras[{i}] is a {type(cam).__name__}, not a Camera")
+        names = [c.name for c in cams]
+        dupes = sorted({n for n in names if names.count(n) > 1})
+        if dupes:
+            raise ValueError(f"camera names must be unique; repeated: {', '.join(map(repr, dupes))}")
+        object.__setattr__(self, "cameras", cams)
+        object.__setattr__(self, "_centres", _frozen(np.array([c.centre for c in cams])))
+
+    def __len__(self) -> int:
+        return len(self.cameras)
+
+    @property
+    def centres(self) -> np.ndarray:
+        """(M, 3) camera centres in the rig frame, metres (read-only)."""
+        return self._centres  # type: ignore[attr-defined]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Camera names, in id order."""
+        return tuple(c.name for c in self.cameras)
+
+    def camera(self, i: int) -> Camera:
+        """Camera with id ``i`` (0-based); ValueError for unknown ids."""
+        if isinstance(i, (bool, np.bool_)):
+            raise ValueError(f"camera id must be an integer, got {i!r}")
+        try:
+            idx = operator.index(i)
+        except TypeError:
+            raise ValueError(f"camera id must be an integer, got {i!r}") from None
+        if not 0 <= idx < len(self.cameras):
+            raise ValueError(f"unknown camera id {idx}: rig has cameras 0..{len(self.cameras) - 1}")
+        return self.cameras[idx]
+
+    def _check_ids(self, what: str, ids: Any, n: int) -> np.ndarray:
+        arr = np.asarray(ids)
+        if arr.ndim == 0:  # one id for every pixel
+            if arr.dtype.kind not in "iu":
+                raise ValueError(f"{what} must hold integer camera ids, got {ids!r}")
+            self.camera(int(arr))  # ValueError for an unknown id
+            arr = np.full(n, int(arr), dtype=np.int64)
+        if arr.ndim != 1:
+            raise ValueError(f"{what} must have shape (N,), got {arr.shape}")
+        if arr.shape[0] != n:
+            raise ValueError(f"{what} has {arr.shape[0]} ids but there are {n} pixels")
+        if arr.size == 0:
+            return np.zeros(0, dtype=np.int64)
+        if arr.dtype.kind not in "iu":
+            if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
+                arr = arr.astype(np.int64)
+            else:
+                raise ValueError(f"{what} must hold integer camera ids, got dtype {arr.dtype}")
+        bad = (arr < 0) | (arr >= len(self.cameras))
+        if np.any(bad):
+            raise ValueError(f"{what}: unknown camera id {int(arr[bad][0])}: rig has cameras "
+                             f"0..{len(self.cameras) - 1}")
+        return np.ascontiguousarray(arr, dtype=np.int64)
+
+    def rays(self, cam_ids: Any, pixels: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Rays of pixels, in the rig frame.
+
+        Args:
+            cam_ids: (N,) integer camera ids (or one id for all pixels).
+            pixels: (N, 2) pixel coordinates of camera ``cam_ids[k]``.
+
+        Returns:
+            ``(origins, dirs)``: (N, 3) camera centres (metres) and (N, 3) unit bearings,
+            both in the rig frame. The Plücker moment is ``origins x dirs``.
+        """
+        px = _check_pixels("pixels", pixels)
+        ids = self._check_ids("cam_ids", cam_ids, px.shape[0])
+        dirs = np.empty((px.shape[0], 3))
+        for i in np.unique(ids):  # one OpenCV call per camera
+            sel = ids == i
+            dirs[sel] = self.cameras[i].pixels_to_bearings(px[sel])
+        return np.ascontiguousarray(self.centres[ids]), dirs
+
+    def ray_pairs(self, pixels1: Any, pixels2: Any, cam1: Any, cam2: Any = None) -> RayPairs:
+        """Ray correspondences from pixel correspondences.
+
+        Args:
+            pixels1: (N, 2) pixels at time 1, in cameras ``cam1``.
+            pixels2: (N, 2) pixels at time 2, in cameras ``cam2``.
+            cam1: (N,) camera ids at time 1.
+            cam2: (N,) camera ids at time 2; default ``cam1`` (same camera at both times).
+
+        Returns:
+            :class:`RayPairs` in the rig frame (metres, unit directions) with camera ids.
+        """
+        px1 = _check_pixels("pixels1", pixels1)
+        px2 = _check_pixels("pixels2", pixels2)
+        if px2.shape[0] != px1.shape[0]:
+            raise ValueError(f"pixels2 has {px2.shape[0]} rows but pixels1 has {px1.shape[0]}")
+        ids1 = self._check_ids("cam1", cam1, px1.shape[0])
+        ids2 = ids1 if cam2 is None else self._check_ids("cam2", cam2, px2.shape[0])
+        o1, d1 = self.rays(ids1, px1)
+        o2, d2 = self.rays(ids2, px2)
+        return RayPairs(o1, d1, o2, d2, ids1, ids2.copy())
+
+    def project(self, cam_id: int, points_rig: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Project rig-frame points into camera ``cam_id``; see :meth:`Camera.project`."""
+        return self.camera(cam_id).project(points_rig)
+
+    def in_frame(self, R: Any, t: Any) -> "Rig":
+        """The same physical rig described in a new rig frame ``X_new = R X_old + t``.
+
+        Each camera's extrinsics become ``cam_from_new = cam_from_old o old_from_new``;
+        rays of the new rig are the old rays mapped by ``(R, t)``.
+        """
+        Rm = _check_rotation("in_frame: R", R)  # checked once, not once per camera
+        tv = _check_vector3("in_frame: t", t)
+        return Rig(tuple(c.in_frame(Rm, tv) for c in self.cameras))
+
+    # -- serialisation (format in the module docstring)
+    def to_dict(self) -> dict:
+        """JSON-ready dict in the ``mcgeom-rig`` version 1 format."""
+        return {"format": RIG_FORMAT, "version": RIG_FORMAT_VERSION,
+                "cameras": [c.to_dict() for c in self.cameras]}
+
+    @classmethod
+    def from_dict(cls, d: Any) -> "Rig":
+        """Rig from an ``mcgeom-rig`` dict; ValueError naming what is wrong."""
+        if not isinstance(d, dict):
+            raise ValueError(f"a rig description must be a JSON object, got {type(d).__name__}")
+        for key in ("format", "version", "cameras"):
+            if key not in d:
+                raise ValueError(f"rig description: missing key {key!r}")
+        if d["format"] != RIG_FORMAT:
+            raise ValueError(f"rig description: format is {d['format']!r}, expected {RIG_FORMAT!r}")
+        if d["version"] != RIG_FORMAT_VERSION or isinstance(d["version"], bool):
+            raise ValueError(f"rig description: unsupported version {d['version']!r} "
+                             f"(this mcgeom reads version {RIG_FORMAT_VERSION})")
+        cams = d["cameras"]
+        if not isinstance(cams, list):
+            raise ValueError(f"rig description: 'cameras' must be a list, got {type(cams).__name__}")
+        return cls(tuple(Camera.from_dict(c, f"cameras[{i}]") for i, c in enumerate(cams)))
+
+    def save_json(self, path: PathLike) -> None:
+        """Write the rig to ``path`` as ``mcgeom-rig`` JSON (floats round-trip exactly)."""
+        with open(path, "w", encoding="utf-8") as fh:
+            json.dump(self.to_dict(), fh, indent=2)
+            fh.write("\n")
+
+    @classmethod
+    def load_json(cls, path: PathLike) -> "Rig":
+        """Read an ``mcgeom-rig`` JSON file.
+
+        Raises:
+            OSError: the file cannot be read.
+            ValueError: not JSON (truncated, malformed), or not a valid rig description;
+                the message names the file and the problem.
+        """
+        with open(path, "rb") as fh:
+            raw = fh.read()
+        try:
+            d = json.loads(raw.decode("utf-8"))
+        except UnicodeDecodeError as exc:
+            raise ValueError(f"{os.fspath(path)}: not UTF-8 text ({exc.reason})") from None
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"{os.fspath(path)}: not valid JSON ({exc.msg} at line "
+                             f"{exc.lineno} column {exc.colno})") from None
+        try:
+            return cls.from_dict(d)
+        except ValueError as exc:
+            raise ValueError(f"{os.fspath(path)}: {exc}") from None
