@@ -105,6 +105,37 @@ static void motion_vector(const double r[9], const double t[3], double x[NX])
 
 /* -------------------------------------------------- accumulation of M */
 
+/* Generalized epipolar row (eq. 8.16, row-major vec) of one ray pair in the
+ * normalised frame X' = s (X - o); 0 if a direction has zero length. */
+static int make_row(const double *o1, const double *d1, const double *o2,
+                    const double *d2, const double o[3], double s, double row[NX])
+{
+    double a[3], b[3], p[3], q[3], m1[3], m2[3], na, nb;
+    int i, j;
+    for (i = 0; i < 3; i++) {
+        a[i] = d1[i];
+        b[i] = d2[i];
+        p[i] = s * (o1[i] - o[i]);
+        q[i] = s * (o2[i] - o[i]);
+    }
+    na = sqrt(dot3(a, a));
+    nb = sqrt(dot3(b, b));
+    if (!(na > 0.0) || !(nb > 0.0) || !isfinite(na) || !isfinite(nb))
+        return 0;
+    for (i = 0; i < 3; i++) {
+        a[i] /= na;
+        b[i] /= nb;
+    }
+    cross3(p, a, m1);
+    cross3(q, b, m2);
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            row[3 * i + j] = b[i] * a[j];
+            row[9 + 3 * i + j] = b[i] * m1[j] + m2[i] * a[j];
+        }
+    return 1;
+}
+
 /* One pass over the rays: validate, normalise (Algorithm 2 step 1) and add
  * each generalized epipolar row (eq. 8.16) to the Gram matrix. */
 static int accumulate(int n, const double *o1, const double *d1,
@@ -137,28 +168,9 @@ static int accumulate(int n, const double *o1, const double *d1,
 
     memset(m, 0, NX * NX * sizeof(double));
     for (k = 0; k < n; k++) {
-        double a[3], b[3], p[3], q[3], m1[3], m2[3], row[NX], na, nb;
-        for (i = 0; i < 3; i++) {
-            a[i] = d1[3 * k + i];
-            b[i] = d2[3 * k + i];
-            p[i] = s * (o1[3 * k + i] - o[i]);
-            q[i] = s * (o2[3 * k + i] - o[i]);
-        }
-        na = sqrt(dot3(a, a));
-        nb = sqrt(dot3(b, b));
-        if (!(na > 0.0) || !(nb > 0.0) || !isfinite(na) || !isfinite(nb))
+        double row[NX];
+        if (!make_row(o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k, o, s, row))
             return MCG_EINVAL;
-        for (i = 0; i < 3; i++) {
-            a[i] /= na;
-            b[i] /= nb;
-        }
-        cross3(p, a, m1);
-        cross3(q, b, m2);
-        for (i = 0; i < 3; i++)
-            for (j = 0; j < 3; j++) {
-                row[3 * i + j] = b[i] * a[j];
-                row[9 + 3 * i + j] = b[i] * m1[j] + m2[i] * a[j];
-            }
         for (i = 0; i < NX; i++) {
             double ri = row[i];
             double *mi = m + i * NX;
@@ -387,6 +399,118 @@ static int step_r(const double *m, double r[9], const double t[3], double *cost)
     return MCG_OK;
 }
 
+/* Joint Gauss-Newton polish on (R, t) after the alternation: block
+ * coordinate descent converges linearly (and zig-zags when R and t are
+ * coupled), so a few joint steps take the estimate to the exact minimum of
+ * the same cost; the result is then reproducible to rounding whatever the
+ * frame, order or scale of the input. Returns the number of steps taken. */
+typedef struct {
+    int n;
+    const double *o1, *d1, *o2, *d2, *origin;
+    double scale;
+} raydata;
+
+/* M x computed as sum_i row_i (row_i . x) straight from the rays: near the
+ * solution the residuals row_i . x are tiny and exact to rounding, whereas
+ * M x from the Gram matrix carries the rounding of M (|M| eps), which limits
+ * weakly conditioned directions (the scale) to ~1e-8. */
+static void exact_mx(const raydata *rd, const double x[NX], double mx[NX])
+{
+    int k, i;
+    memset(mx, 0, NX * sizeof(double));
+    for (k = 0; k < rd->n; k++) {
+        double row[NX], r = 0.0;
+        if (!make_row(rd->o1 + 3 * k, rd->d1 + 3 * k, rd->o2 + 3 * k, rd->d2 + 3 * k,
+                      rd->origin, rd->scale, row))
+            continue;
+        for (i = 0; i < NX; i++)
+            r += row[i] * x[i];
+        for (i = 0; i < NX; i++)
+            mx[i] += row[i] * r;
+    }
+}
+
+static int polish(const double *m, double r[9], double t[3], double *cost,
+                  const raydata *rd)
+{
+    int it, k, l, i;
+    for (it = 0; it < 22; it++) {
+        /* the last steps use the exact gradient (iterative refinement) */
+        int exact = rd != NULL && it >= 20;
+        double x0[NX], j[6][NX], mj[6][NX], mx0[NX], a[36], rhs[6], d[6];
+        double step = 0.0, tr = 0.0, rn[9], tn[3], dr[9], xn[NX], cn;
+        double trm = 0.0;
+        motion_vector(r, t, x0);
+        if (exact)
+            exact_mx(rd, x0, mx0);
+        else
+            matvec(NX, m, x0, mx0);
+        for (k = 0; k < 3; k++) {
+            double e[3] = {0.0, 0.0, 0.0}, er[9];
+            e[k] = 1.0;
+            skew_times(e, r, er);
+            skew_times(t, er, j[k]);              /* d x / d w_k */
+            memcpy(j[k] + 9, er, sizeof er);
+            memcpy(j[3 + k], er, sizeof er);      /* d x / d t_k */
+            memset(j[3 + k] + 9, 0, 9 * sizeof(double));
+        }
+        for (k = 0; k < 6; k++)
+            matvec(NX, m, j[k], mj[k]);
+        for (k = 0; k < 6; k++) {
+            rhs[k] = 0.0;
+            for (i = 0; i < NX; i++)
+                rhs[k] -= j[k][i] * mx0[i];
+            for (l = 0; l < 6; l++) {
+                double acc = 0.0;
+                for (i = 0; i < NX; i++)
+                    acc += j[k][i] * mj[l][i];
+                a[6 * k + l] = acc;
+            }
+            tr += a[7 * k];
+        }
+        if (!(tr > 0.0))
+            break;
+        for (k = 0; k < NX; k++)
+            trm += m[k * NX + k];
+        for (k = 0; k < 6; k++)
+            a[7 * k] += 1e-14 * tr;
+        if (mcg_spd_solve(6, a, rhs, d) != MCG_OK)
+            break;
+        if (mcg_rot_from_angle_axis(d, dr) != MCG_OK)
+            return it;
+        mul33(dr, r, rn);
+        for (k = 0; k < 3; k++)
+            tn[k] = t[k] + d[3 + k];
+        motion_vector(rn, tn, xn);
+        cn = quad18(m, xn);
+        if (exact) {
+            memcpy(r, rn, sizeof rn);
+            memcpy(t, tn, sizeof tn);
+            *cost = cn > 0.0 ? cn : 0.0;
+            continue;
+        }
+        /* near the minimum the cost is flat to rounding (|M| eps) long before
+         * the parameters are: accept steps that do not raise it beyond that
+         * and stop on the step length, which the gradient fixes accurately */
+        if (!(cn <= *cost + 64.0 * DBL_EPSILON * trm)) {
+            if (rd == NULL)
+                break;
+            it = 19; /* at the minimum to rounding: finish with exact steps */
+            continue;
+        }
+        memcpy(r, rn, sizeof rn);
+        memcpy(t, tn, sizeof tn);
+        *cost = cn;
+        for (k = 0; k < 6; k++)
+            step += d[k] * d[k];
+        if (sqrt(step) <= 1e-15 * (1.0 + sqrt(dot3(t, t))))
+            it = (rd != NULL && it < 20) ? 19 : it; /* go to the exact steps */
+        if (rd == NULL && it == 19)
+            return it + 1;
+    }
+    return it;
+}
+
 /* ------------------------------------------------- cheirality */
 
 /* Number of correspondences whose rays, moved by (R, t) into the time-2 rig
@@ -605,8 +729,8 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
 {
     mcg_linear17_options o;
     double m[NX * NX], mrr[81], wr[9], vr[81], tr_m = 0.0;
-    double e[9], rpart[9], cand[4][9], rbest[9], tbest[3];
-    double cost, tiny;
+    double e[9], rpart[9], cand[4][9], rbest[9], tbest[3], rlin[9], tlin[3];
+    double cost, tiny, costlin;
     int st, i, k, nullity = 0, gc, ncand = 0, best = -1, unit_mode = 0;
     tsolve ts;
 
@@ -719,6 +843,9 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
         }
     }
     res->cost_linear = sqrt(cost / n);
+    memcpy(rlin, rbest, sizeof rlin);
+    memcpy(tlin, tbest, sizeof tlin);
+    costlin = cost;
 
     /* alternation (ch. 8.4.3): R given t, then t given R */
     res->converged = 0;
@@ -743,16 +870,37 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
                 break;
             }
         }
+        if (!unit_mode) {
+            raydata rd;
+            rd.n = n;
+            rd.o1 = origins1; rd.d1 = dirs1; rd.o2 = origins2; rd.d2 = dirs2;
+            rd.origin = res->norm_origin;
+            rd.scale = res->norm_scale;
+            res->polish_steps = polish(m, rbest, tbest, &cost, &rd);
+        }
+        /* Guard: for locally-central rigs (0, I) is in the null space of A,
+         * so the algebraic cost has a trivial zero at R = I, t = 0 and a
+         * descent from a poor start can slide towards it. The linear step
+         * minimised the cost with |E| = 1 fixed; a refinement that shrinks
+         * |t| (|E| = sqrt(2)|t|) by half or raises that normalised cost
+         * (f / |t|^2) fourfold went the wrong way: keep the linear estimate. */
+        if (!unit_mode) {
+            double nl = dot3(tlin, tlin), nr = dot3(tbest, tbest);
+            if (!(nr >= 0.25 * nl) || !(cost / nr <= 4.0 * costlin / nl)) {
+                memcpy(rbest, rlin, sizeof rlin);
+                memcpy(tbest, tlin, sizeof tlin);
+                cost = costlin;
+                res->converged = 0;
+                res->refine_rejected = 1;
+            }
+        }
     }
 
     /* scale observability: conditioning of the scale equation and the
      * first-order std of |t| from the residual (normalised frame) */
     if (solve_t(m, rbest, unit_mode, tbest, &ts) != MCG_OK)
         return MCG_ENUMERIC;
-    if (!unit_mode) {
-        memcpy(tbest, ts.t, sizeof tbest);
-        cost = ts.cost;
-    }
+    /* (t stays as refined: ts only supplies H for the evidence) */
     res->scale_conditioning = ts.cond;
     {
         double nt = sqrt(dot3(tbest, tbest)), var = 0.0, sigma2;

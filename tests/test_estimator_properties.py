@@ -44,7 +44,7 @@ def test_exact_recovery_noise_free(name, kind, seed):
 @given(seed=seeds)
 def test_invariant_to_rig_frame(name, kind, seed):
     """Re-expressing the rig frame by F = (Rf, tf) conjugates the motion."""
-    p = make(kind, seed, n=_n(name), angular_noise=1e-3)
+    p = make(kind, seed, n=_n(name), angular_noise=3e-4)
     Rf, tf = rigid(np.random.default_rng(seed + 1))
     m = mcgeom.estimate(p.rays, name)
     mf = mcgeom.estimate(p.rays.in_frame(Rf, tf), name)
@@ -52,14 +52,16 @@ def test_invariant_to_rig_frame(name, kind, seed):
     F[:3, :3], F[:3, 3] = Rf, tf
     expect = F @ m.T @ np.linalg.inv(F)
     assert rot_err(mf.R, expect[:3, :3]) < 1e-7
-    assert np.linalg.norm(mf.t - expect[:3, 3]) < 1e-6 * (1 + np.linalg.norm(expect[:3, 3]))
+    assert mf.scale.observable == m.scale.observable
+    if m.scale.observable:  # a unit direction of unknown scale does not conjugate
+        assert np.linalg.norm(mf.t - expect[:3, 3]) < 1e-6 * (1 + np.linalg.norm(expect[:3, 3]))
 
 
 @pytest.mark.parametrize("name,kind", CASES)
 @SETTINGS
 @given(seed=seeds)
 def test_invariant_to_permutation(name, kind, seed):
-    p = make(kind, seed, n=_n(name), angular_noise=1e-3)
+    p = make(kind, seed, n=_n(name), angular_noise=3e-4)
     perm = np.random.default_rng(seed).permutation(len(p.rays))
     a = mcgeom.estimate(p.rays, name)
     b = mcgeom.estimate(p.rays.take(perm), name)
@@ -84,13 +86,17 @@ def test_swapping_frames_inverts_motion(name, kind, seed):
 @given(seed=seeds, log_s=st.floats(min_value=-3, max_value=3))
 def test_scaling_world_scales_t(name, kind, seed, log_s):
     s = 10.0 ** log_s
-    p = make(kind, seed, n=_n(name), angular_noise=1e-3)
+    p = make(kind, seed, n=_n(name), angular_noise=3e-4)
     r = p.rays
     scaled = mcgeom.RayPairs(s * r.origins1, r.dirs1, s * r.origins2, r.dirs2, r.cam1, r.cam2)
     a = mcgeom.estimate(r, name)
     b = mcgeom.estimate(scaled, name)
     assert rot_err(a.R, b.R) < 1e-8
-    assert np.linalg.norm(b.t - s * a.t) < 1e-7 * s * (1 + np.linalg.norm(a.t))
+    assert a.scale.observable == b.scale.observable
+    if a.scale.observable:
+        assert np.linalg.norm(b.t - s * a.t) < 1e-7 * s * (1 + np.linalg.norm(a.t))
+    else:
+        assert np.linalg.norm(b.t - a.t) < 1e-7
 
 
 SCALE_CASES = [(e.name, kind) for e in registry.list_estimators()

@@ -189,6 +189,10 @@ typedef struct {
     double cost_final;      /* RMS algebraic residual at return */
     int iterations;         /* alternation iterations performed */
     int converged;          /* 1 if the alternation met the tolerance */
+    int polish_steps;       /* joint Gauss-Newton steps after the alternation
+                               (to the exact minimum of the same cost) */
+    int refine_rejected;    /* 1 if the refinement slid towards the trivial
+                               solution R = I, t = 0 and was discarded */
     int scale_observable;   /* 1 if the metric scale is determined */
     double scale_conditioning; /* how well the data fix |t| (0 = not at all) */
     double scale_rel_std;   /* first-order relative std of |t| */

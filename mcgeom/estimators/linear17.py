@@ -89,6 +89,8 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
         "rank_A": r["rank_a"],
         "iterations": r["iterations"],
         "converged": r["converged"],
+        "polish_steps": r["polish_steps"],
+        "refine_rejected": r["refine_rejected"],
         "cost_linear": r["cost_linear"],
         "t_metric": r["t_metric"],
         "candidate_cost": r["candidate_cost"],
