@@ -1,0 +1,1018 @@
+/*
+ * linalg.c -- small dense linear algebra of libmcgeom (no LAPACK, no BLAS).
+ *
+ * Implements the "linalg.c" section of mcgeom.h:
+ *   - thin Householder QR (Golub & Van Loan 5.2);
+ *   - SVD by Householder QR followed by one-sided (Hestenes) Jacobi on the
+ *     triangular factor, which keeps the small singular values of tall thin
+ *     matrices (the 17..n x 18 generalized epipolar systems of thesis ch. 8,
+ *     eq. 8.16, and the reduced system of eq. 8.36) accurate to working
+ *     precision relative to the largest one;
+ *   - Moore-Penrose pseudo-inverse (needed by Algorithms 3-4, eq. 8.36);
+ *   - cyclic Jacobi eigen-solver for symmetric matrices (the 9x9 and 18x18
+ *     normal matrices of the linear 17-point estimator, Algorithm 2);
+ *   - Cholesky solve of small SPD systems;
+ *   - 3x3 rotation helpers: Rodrigues angle-axis, Hamilton quaternions and the
+ *     projection onto SO(3) used after the E / R decomposition of ch. 8.4.
+ *
+ * All matrices are row-major. No globals, no allocation: scratch space comes
+ * from the caller's workspace (sizes from the *_work_size functions) or, for
+ * the fixed tiny sizes, from the stack. Every loop is bounded.
+ */
+#include "mcgeom.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* Size limits. They keep every work-size computation far from overflow and
+ * reject absurd sizes (usually a mix-up of arguments) up front. */
+#define MAX_ROWS ((size_t)1 << 20)
+#define MAX_COLS ((size_t)4096)
+/* Jacobi converges quadratically: a handful of sweeps in practice. The cap
+ * only turns a pathological input into MCG_ENUMERIC instead of a hang. */
+#define MAX_SWEEPS 60
+#define SPD_MAX 64
+/* Rotations of one Jacobi round whose parameters are computed together. */
+#define EIG_CHUNK 16
+/* A Jacobi column whose norm falls below DEAD_REL times the largest initial
+ * column norm (<= s_max) is "dead": it takes part in no further rotation and
+ * its singular value is reported as exactly 0 (its left singular vector is
+ * completed). Dropping dead columns perturbs R by at most sqrt(n) DEAD_REL
+ * s_max, the size of the backward error of the QR step itself, so the
+ * accuracy relative to s_max is unchanged. Without this, the noise-level
+ * columns of a rank-deficient matrix are orthogonalised among themselves at
+ * ever smaller scales (1e-16, 1e-32, ... down to underflow), which took up to
+ * 40 sweeps instead of 6-10 in tests. */
+#define DEAD_REL DBL_EPSILON
+/* Absolute floor of the dead threshold (squared): below it dot products
+ * would lose precision to underflow. Inputs are scaled so that max |a_ij|
+ * lies in [0.5, 1), so this only matters for an all-zero matrix. */
+#define TINY2 (DBL_MIN / DBL_EPSILON)
+/* Orthogonality threshold of one-sided Jacobi, in units of eps * sqrt(n):
+ * two columns count as orthogonal when |g_i . g_j| <= tol |g_i| |g_j|. A few
+ * ulps above the rounding noise of a dot product so that sweeps terminate. */
+#define JACOBI_TOL_FACTOR 4.0
+/* Deviation from orthogonality (max |R R^T - I|) accepted for a rotation. */
+#define ROT_TOL 1e-6
+
+/* ------------------------------------------------------------- helpers */
+
+static size_t mul_sz(size_t a, size_t b, int *ok)
+{
+    if (a != 0 && b > SIZE_MAX / a) {
+        *ok = 0;
+        return 0;
+    }
+    return a * b;
+}
+
+static size_t add_sz(size_t a, size_t b, int *ok)
+{
+    if (b > SIZE_MAX - a) {
+        *ok = 0;
+        return 0;
+    }
+    return a + b;
+}
+
+static int all_finite(const double *x, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!isfinite(x[i]))
+            return 0;
+    return 1;
+}
+
+static int dims_ok(int m, int n)
+{
+    return m >= 1 && n >= 1 && (size_t)m <= MAX_ROWS && (size_t)n <= MAX_COLS;
+}
+
+static double max_abs(const double *x, size_t n)
+{
+    double mx = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        double ax = fabs(x[i]);
+        if (ax > mx)
+            mx = ax;
+    }
+    return mx;
+}
+
+/* Exponent e with max_abs * 2^-e in [0.5, 1) (0 for a zero array). Scaling
+ * by a power of two is exact, and it keeps every sum of squares below away
+ * from overflow and harmful underflow whatever the magnitude of the input. */
+static int scale_exponent(double amax)
+{
+    int e = 0;
+    if (amax > 0.0)
+        (void)frexp(amax, &e);
+    return e;
+}
+
+static double dot(const double *x, const double *y, size_t n)
+{
+    double acc = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i)
+        acc += x[i] * y[i];
+    return acc;
+}
+
+/* Plane rotation of two rows: x <- c x - s y, y <- s x + c y. */
+static void rot_rows(double *x, double *y, size_t n, double c, double s)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        double xi = x[i], yi = y[i];
+        x[i] = c * xi - s * yi;
+        y[i] = s * xi + c * yi;
+    }
+}
+
+static void swap_rows(double *x, double *y, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        double t = x[i];
+        x[i] = y[i];
+        y[i] = t;
+    }
+}
+
+/* ------------------------------------------------------ Householder QR */
+
+/* Householder QR of the len x ncol matrix (len >= ncol) whose COLUMNS are
+ * stored as the rows of at: element (i, j) is at[j * len + i]. Storing the
+ * transpose makes every column operation a contiguous loop. On return R(i, j)
+ * (i <= j) is at[j * len + i], the essential part of reflector k (its first
+ * component is an implicit 1) is at[k * len + i] for i > k, and
+ * H_k = I - tau[k] v_k v_k^T (LAPACK dgeqr2 convention, tau = 0 for H = I). */
+static void house_qr(size_t len, size_t ncol, double *at, double *tau)
+{
+    size_t k, i, j;
+    for (k = 0; k < ncol; ++k) {
+        double *x = at + k * len + k;
+        size_t nk = len - k;
+        double alpha = x[0], xn2 = 0.0, beta, sc;
+        for (i = 1; i < nk; ++i)
+            xn2 += x[i] * x[i];
+        if (xn2 == 0.0) {
+            tau[k] = 0.0; /* already triangular in this column */
+            continue;
+        }
+        /* beta has the sign opposite to alpha so alpha - beta never cancels */
+        beta = -copysign(sqrt(alpha * alpha + xn2), alpha);
+        tau[k] = (beta - alpha) / beta;
+        sc = 1.0 / (alpha - beta);
+        for (i = 1; i < nk; ++i)
+            x[i] *= sc;
+        x[0] = beta;
+        for (j = k + 1; j < ncol; ++j) {
+            double *y = at + j * len + k;
+            double d = y[0];
+            for (i = 1; i < nk; ++i)
+                d += x[i] * y[i];
+            d *= tau[k];
+            y[0] -= d;
+            for (i = 1; i < nk; ++i)
+                y[i] -= d * x[i];
+        }
+    }
+}
+
+/* x (len x nc, row-major) <- H_0 H_1 ... H_{nref-1} x with the reflectors of
+ * house_qr. With from_identity, x is assumed to start as [I; 0] so that
+ * columns c < k are untouched by H_k (it only mixes rows >= k, where those
+ * columns are still zero): skipping them halves the cost of forming Q.
+ * tmp: nc doubles. */
+static void apply_q(size_t len, size_t nref, const double *at,
+                    const double *tau, double *x, size_t nc,
+                    int from_identity, double *tmp)
+{
+    size_t kk, i, c;
+    for (kk = nref; kk-- > 0;) {
+        const double *v = at + kk * len + kk;
+        size_t nk = len - kk, c0 = from_identity ? kk : 0;
+        double tk = tau[kk];
+        double *row = x + kk * nc;
+        if (tk == 0.0)
+            continue;
+        for (c = c0; c < nc; ++c)
+            tmp[c] = row[c];
+        for (i = 1; i < nk; ++i) {
+            const double *ri = x + (kk + i) * nc;
+            double vi = v[i];
+            for (c = c0; c < nc; ++c)
+                tmp[c] += vi * ri[c];
+        }
+        for (c = c0; c < nc; ++c) {
+            tmp[c] *= tk;
+            row[c] -= tmp[c];
+        }
+        for (i = 1; i < nk; ++i) {
+            double *ri = x + (kk + i) * nc;
+            double vi = v[i];
+            for (c = c0; c < nc; ++c)
+                ri[c] -= vi * tmp[c];
+        }
+    }
+}
+
+size_t mcg_qr_work_size(int m, int n)
+{
+    int ok = 1;
+    size_t mm, nn, ws;
+    if (!dims_ok(m, n) || m < n)
+        return 0;
+    mm = (size_t)m;
+    nn = (size_t)n;
+    /* at (n x m) + tau (n) + tmp (n) */
+    ws = add_sz(mul_sz(mm, nn, &ok), mul_sz(2, nn, &ok), &ok);
+    return ok ? ws : 0;
+}
+
+int mcg_qr(int m, int n, const double *a, double *q, double *r,
+           double *work, size_t lwork)
+{
+    size_t mm, nn, ws, i, j;
+    double *at, *tau, *tmp;
+    int e;
+
+    if (!dims_ok(m, n) || m < n)
+        return MCG_EINVAL;
+    if (a == NULL || r == NULL || work == NULL)
+        return MCG_EINVAL;
+    ws = mcg_qr_work_size(m, n);
+    if (ws == 0)
+        return MCG_EINVAL;
+    if (lwork < ws)
+        return MCG_ENOMEM;
+    mm = (size_t)m;
+    nn = (size_t)n;
+    if (!all_finite(a, mm * nn))
+        return MCG_EINVAL;
+
+    at = work;
+    tau = at + mm * nn;
+    tmp = tau + nn;
+    e = scale_exponent(max_abs(a, mm * nn));
+    for (i = 0; i < mm; ++i)
+        for (j = 0; j < nn; ++j)
+            at[j * mm + i] = ldexp(a[i * nn + j], -e);
+    house_qr(mm, nn, at, tau);
+
+    for (i = 0; i < nn; ++i)
+        for (j = 0; j < nn; ++j)
+            r[i * nn + j] = (j >= i) ? ldexp(at[j * mm + i], e) : 0.0;
+    if (!all_finite(r, nn * nn))
+        return MCG_ENUMERIC; /* |R| beyond the double range */
+
+    if (q != NULL) {
+        memset(q, 0, mm * nn * sizeof(double));
+        for (i = 0; i < nn; ++i)
+            q[i * nn + i] = 1.0;
+        apply_q(mm, nn, at, tau, q, nn, 1, tmp);
+    }
+    return MCG_OK;
+}
+
+/* ----------------------------------------------------------------- SVD */
+
+/* One-sided Jacobi on the nn rows of w (row k = column k of the n x n
+ * triangular factor R): rotate pairs of rows until all are mutually
+ * orthogonal to working precision, applying the same rotations to the rows
+ * of vt. Then W = (R V)^T = (U S)^T and vt = V^T. Returns 0 on convergence.
+ * Hestenes' method works on the columns directly (never forms R^T R), which
+ * is why it resolves singular values down to eps * s_max and below. */
+static int jacobi_rows(size_t nn, double *w, double *vt, double dead2)
+{
+    const double tol =
+        JACOBI_TOL_FACTOR * DBL_EPSILON * sqrt((double)nn);
+    int sweep;
+    size_t i, j;
+
+    for (sweep = 0; sweep < MAX_SWEEPS; ++sweep) {
+        int rotated = 0;
+        for (i = 0; i + 1 < nn; ++i) {
+            double *gi = w + i * nn;
+            double alpha = dot(gi, gi, nn);
+            for (j = i + 1; j < nn; ++j) {
+                double *gj = w + j * nn;
+                double beta, gamma, zeta, t, c, s;
+                if (alpha < dead2)
+                    break; /* dead column: nothing to orthogonalise */
+                beta = dot(gj, gj, nn);
+                if (beta < dead2)
+                    continue;
+                gamma = dot(gi, gj, nn);
+                if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta))
+                    continue;
+                rotated = 1;
+                /* Rutishauser's stable formulas: t = tan of the smaller of
+                 * the two angles annihilating gamma (|t| <= 1). */
+                zeta = (beta - alpha) / (2.0 * gamma);
+                if (fabs(zeta) > 1e150)
+                    t = 0.5 / zeta; /* zeta^2 would overflow */
+                else
+                    t = copysign(1.0, zeta) /
+                        (fabs(zeta) + sqrt(1.0 + zeta * zeta));
+                c = 1.0 / sqrt(1.0 + t * t);
+                s = c * t;
+                rot_rows(gi, gj, nn, c, s);
+                rot_rows(vt + i * nn, vt + j * nn, nn, c, s);
+                alpha = dot(gi, gi, nn);
+            }
+        }
+        if (!rotated)
+            return 0;
+    }
+    return -1;
+}
+
+/* After jacobi_rows: s[k] = |w_k|; sort descending (swapping rows of w and
+ * vt); normalise the rows of w (they become the left singular vectors of R)
+ * and complete those of zero singular values to an orthonormal basis of
+ * R^nn, so that U always has orthonormal columns. tmp: nn doubles. */
+static void finish_jacobi(size_t nn, double *w, double *vt, double *s,
+                          double *tmp, double dead2)
+{
+    size_t k, l, j, nz;
+
+    for (k = 0; k < nn; ++k) {
+        double a2 = dot(w + k * nn, w + k * nn, nn);
+        s[k] = (a2 < dead2) ? 0.0 : sqrt(a2);
+    }
+    /* selection sort: O(nn^2) comparisons, nn row swaps, no index array */
+    for (k = 0; k + 1 < nn; ++k) {
+        size_t best = k;
+        for (l = k + 1; l < nn; ++l)
+            if (s[l] > s[best])
+                best = l;
+        if (best != k) {
+            double t = s[k];
+            s[k] = s[best];
+            s[best] = t;
+            swap_rows(w + k * nn, w + best * nn, nn);
+            swap_rows(vt + k * nn, vt + best * nn, nn);
+        }
+    }
+    nz = 0;
+    for (k = 0; k < nn; ++k) {
+        if (s[k] > 0.0) {
+            double inv = 1.0 / s[k];
+            for (j = 0; j < nn; ++j)
+                w[k * nn + j] *= inv;
+            nz = k + 1;
+        }
+    }
+    if (nz == nn)
+        return;
+
+    /* Completion. tmp[j] = squared norm of row j of the current basis
+     * (= |projection of e_j|^2); the e_j with the smallest one is the best
+     * conditioned start for Gram-Schmidt: its residual is >= 1/nn since the
+     * tmp[j] sum to the number of basis vectors (< nn). */
+    for (j = 0; j < nn; ++j) {
+        double acc = 0.0;
+        for (l = 0; l < nz; ++l)
+            acc += w[l * nn + j] * w[l * nn + j];
+        tmp[j] = acc;
+    }
+    for (k = nz; k < nn; ++k) {
+        double *x = w + k * nn, nrm;
+        size_t jmin = 0;
+        int pass;
+        for (j = 1; j < nn; ++j)
+            if (tmp[j] < tmp[jmin])
+                jmin = j;
+        for (j = 0; j < nn; ++j)
+            x[j] = 0.0;
+        x[jmin] = 1.0;
+        for (pass = 0; pass < 2; ++pass) { /* twice is enough (Kahan) */
+            for (l = 0; l < k; ++l) {
+                const double *b = w + l * nn;
+                double d = dot(b, x, nn);
+                for (j = 0; j < nn; ++j)
+                    x[j] -= d * b[j];
+            }
+        }
+        nrm = sqrt(dot(x, x, nn));
+        for (j = 0; j < nn; ++j) {
+            x[j] /= nrm;
+            tmp[j] += x[j] * x[j];
+        }
+    }
+}
+
+size_t mcg_svd_work_size(int m, int n)
+{
+    int ok = 1;
+    size_t nn, pp, ws;
+    if (!dims_ok(m, n))
+        return 0;
+    nn = (size_t)(m < n ? m : n);
+    pp = (size_t)(m < n ? n : m);
+    /* at (nn x pp) + tau (nn) + w (nn x nn) + vt (nn x nn) + tmp (pp);
+     * <= p n + 3 n^2 + 4 p as promised by the header. */
+    ws = mul_sz(pp, nn, &ok);
+    ws = add_sz(ws, nn, &ok);
+    ws = add_sz(ws, mul_sz(2, mul_sz(nn, nn, &ok), &ok), &ok);
+    ws = add_sz(ws, pp, &ok);
+    return ok ? ws : 0;
+}
+
+int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
+            double *work, size_t lwork)
+{
+    size_t mm, nn, len, nq, ws, i, j, k;
+    double *at, *tau, *w, *vt, *tmp, dead2;
+    int e, tall;
+
+    if (!dims_ok(m, n))
+        return MCG_EINVAL;
+    if (a == NULL || s == NULL || v == NULL || work == NULL)
+        return MCG_EINVAL;
+    ws = mcg_svd_work_size(m, n);
+    if (ws == 0)
+        return MCG_EINVAL;
+    if (lwork < ws)
+        return MCG_ENOMEM;
+    mm = (size_t)m;
+    nn = (size_t)n;
+    if (!all_finite(a, mm * nn))
+        return MCG_EINVAL;
+
+    /* A wide matrix is handled through its transpose a^T = Q R, so the QR
+     * is always of a tall len x nq matrix (len >= nq). */
+    tall = (mm >= nn);
+    nq = tall ? nn : mm;
+    len = tall ? mm : nn;
+    at = work;
+    tau = at + nq * len;
+    w = tau + nq;
+    vt = w + nq * nq;
+    tmp = vt + nq * nq;
+
+    e = scale_exponent(max_abs(a, mm * nn));
+    if (tall) {
+        for (i = 0; i < mm; ++i)
+            for (j = 0; j < nn; ++j)
+                at[j * mm + i] = ldexp(a[i * nn + j], -e);
+    } else {
+        /* columns of a^T are the rows of a: a plain copy */
+        for (i = 0; i < mm * nn; ++i)
+            at[i] = ldexp(a[i], -e);
+    }
+    house_qr(len, nq, at, tau);
+
+    /* w = R^T: row j holds column j of R (zeros below the diagonal of R) */
+    for (j = 0; j < nq; ++j)
+        for (i = 0; i < nq; ++i)
+            w[j * nq + i] = (i <= j) ? at[j * len + i] : 0.0;
+    memset(vt, 0, nq * nq * sizeof(double));
+    for (i = 0; i < nq; ++i)
+        vt[i * nq + i] = 1.0;
+
+    {
+        double maxcol2 = 0.0;
+        for (j = 0; j < nq; ++j) {
+            double c2 = dot(w + j * nq, w + j * nq, nq);
+            if (c2 > maxcol2)
+                maxcol2 = c2;
+        }
+        dead2 = DEAD_REL * DEAD_REL * maxcol2;
+        if (dead2 < TINY2)
+            dead2 = TINY2;
+    }
+    if (jacobi_rows(nq, w, vt, dead2) != 0)
+        return MCG_ENUMERIC;
+    /* now R = U_R S V_R^T with U_R(i, k) = w[k nq + i], V_R(i, k) = vt[k nq + i] */
+    finish_jacobi(nq, w, vt, s, tmp, dead2);
+
+    for (k = 0; k < nq; ++k)
+        s[k] = ldexp(s[k], e);
+    for (k = nq; k < nn; ++k)
+        s[k] = 0.0;
+    if (!all_finite(s, nq))
+        return MCG_ENUMERIC; /* singular values beyond the double range */
+
+    if (tall) {
+        /* a = (Q U_R) S V_R^T */
+        for (i = 0; i < nn; ++i)
+            for (k = 0; k < nn; ++k)
+                v[i * nn + k] = vt[k * nn + i];
+        if (u != NULL) {
+            for (i = 0; i < mm; ++i)
+                for (k = 0; k < nn; ++k)
+                    u[i * nn + k] = (i < nn) ? w[k * nn + i] : 0.0;
+            apply_q(mm, nn, at, tau, u, nn, 0, tmp);
+        }
+    } else {
+        /* a^T = Q_full [R; 0], R = U_R S V_R^T, so a = V_R S (Q U_R)^T and
+         * the full V is Q_full blockdiag(U_R, I): its last n - m columns span
+         * the complement of range(a^T), i.e. the null space of a. */
+        if (u != NULL)
+            for (i = 0; i < mm; ++i)
+                for (k = 0; k < mm; ++k)
+                    u[i * mm + k] = vt[k * mm + i];
+        for (i = 0; i < nn; ++i)
+            for (k = 0; k < nn; ++k) {
+                double val;
+                if (i < mm && k < mm)
+                    val = w[k * mm + i];
+                else
+                    val = (i == k) ? 1.0 : 0.0;
+                v[i * nn + k] = val;
+            }
+        apply_q(nn, mm, at, tau, v, nn, 0, tmp);
+    }
+    return MCG_OK;
+}
+
+/* ------------------------------------------------------- pseudo-inverse */
+
+size_t mcg_pinv_work_size(int m, int n)
+{
+    int ok = 1;
+    size_t mm, nn, mn, ws;
+    if (!dims_ok(m, n))
+        return 0;
+    mm = (size_t)m;
+    nn = (size_t)n;
+    mn = mm < nn ? mm : nn;
+    /* u (m x min) + s (n) + v (n x n) + svd workspace */
+    ws = mcg_svd_work_size(m, n);
+    ws = add_sz(ws, mul_sz(mm, mn, &ok), &ok);
+    ws = add_sz(ws, nn, &ok);
+    ws = add_sz(ws, mul_sz(nn, nn, &ok), &ok);
+    return ok ? ws : 0;
+}
+
+int mcg_pinv(int m, int n, const double *a, double rcond, double *ainv,
+             int *rank, double *work, size_t lwork)
+{
+    size_t mm, nn, mn, ws, i, j, k, r;
+    double *u, *s, *v, *sw, tol;
+    int st;
+
+    if (!dims_ok(m, n))
+        return MCG_EINVAL;
+    if (a == NULL || ainv == NULL || work == NULL || !isfinite(rcond))
+        return MCG_EINVAL;
+    ws = mcg_pinv_work_size(m, n);
+    if (ws == 0)
+        return MCG_EINVAL;
+    if (lwork < ws)
+        return MCG_ENOMEM;
+    mm = (size_t)m;
+    nn = (size_t)n;
+    mn = mm < nn ? mm : nn;
+    u = work;
+    s = u + mm * mn;
+    v = s + nn;
+    sw = v + nn * nn;
+    st = mcg_svd(m, n, a, u, s, v, sw, lwork - (size_t)(sw - work));
+    if (st != MCG_OK)
+        return st;
+
+    if (rcond <= 0.0)
+        rcond = (double)(mm > nn ? mm : nn) * DBL_EPSILON;
+    tol = rcond * s[0];
+    r = 0;
+    while (r < mn && s[r] > tol)
+        ++r;
+    /* A^+ = V_r S_r^{-1} U_r^T; fold S_r^{-1} into U first */
+    for (i = 0; i < mm; ++i)
+        for (k = 0; k < r; ++k)
+            u[i * mn + k] /= s[k];
+    for (j = 0; j < nn; ++j)
+        for (i = 0; i < mm; ++i) {
+            double acc = 0.0;
+            for (k = 0; k < r; ++k)
+                acc += v[j * nn + k] * u[i * mn + k];
+            ainv[j * mm + i] = acc;
+        }
+    if (rank != NULL)
+        *rank = (int)r;
+    if (!all_finite(ainv, mm * nn))
+        return MCG_ENUMERIC; /* rcond so small that 1/s overflowed */
+    return MCG_OK;
+}
+
+/* -------------------------------------------------- symmetric eigen */
+
+int mcg_sym_eig(int n, double *a, double *w, double *v)
+{
+    size_t nn, np, i, j, p, q, r;
+    size_t rp_[EIG_CHUNK], rq_[EIG_CHUNK];
+    double rc_[EIG_CHUNK], rs_[EIG_CHUNK], rt_[EIG_CHUNK];
+    int sweep, e, converged = 0;
+    double off;
+
+    if (n < 1 || (size_t)n > MAX_COLS)
+        return MCG_EINVAL;
+    if (a == NULL || w == NULL || v == NULL || a == v)
+        return MCG_EINVAL;
+    nn = (size_t)n;
+    if (!all_finite(a, nn * nn))
+        return MCG_EINVAL;
+
+    /* Symmetric part, scaled so that max |a_ij| is in [0.5, 1): no overflow
+     * in (a_qq - a_pp) below, exact (power of two) and undone at the end.
+     * Only the upper triangle is used from here on: each rotation then
+     * updates n - 2 pairs of entries instead of mirroring 2 (n - 2). */
+    e = scale_exponent(max_abs(a, nn * nn));
+    for (i = 0; i < nn; ++i) {
+        a[i * nn + i] = ldexp(a[i * nn + i], -e);
+        for (j = i + 1; j < nn; ++j)
+            a[i * nn + j] = 0.5 * ldexp(a[i * nn + j], -e) +
+                            0.5 * ldexp(a[j * nn + i], -e);
+    }
+    /* v holds V^T during the iteration (rows = eigenvectors) so that the
+     * rotations touch contiguous memory; transposed at the end. */
+    memset(v, 0, nn * nn * sizeof(double));
+    for (i = 0; i < nn; ++i)
+        v[i * nn + i] = 1.0;
+
+    /* Cyclic Jacobi in the round-robin ("tournament") ordering: each sweep
+     * is np - 1 rounds of np / 2 disjoint pairs (np = n rounded up to even,
+     * pairs with the dummy index n skipped). The rotation parameters of a
+     * pair depend only on a_pp, a_qq, a_pq, which the other rotations of the
+     * same round do not touch, so they are computed in chunks before being
+     * applied: the square roots and divisions of a chunk overlap instead of
+     * forming one long dependency chain, which dominated the run time of the
+     * row-cyclic order at n = 9 and 18. Results equal applying the rotations
+     * one by one. */
+    np = nn + (nn & 1);
+    for (sweep = 0; sweep <= MAX_SWEEPS; ++sweep) {
+        double thresh;
+        size_t round;
+        off = 0.0;
+        for (p = 0; p + 1 < nn; ++p)
+            for (q = p + 1; q < nn; ++q)
+                off += fabs(a[p * nn + q]);
+        if (off == 0.0) {
+            converged = 1;
+            break;
+        }
+        if (sweep == MAX_SWEEPS)
+            break;
+        /* threshold Jacobi (Rutishauser): during the first sweeps skip the
+         * rotations that would gain little; saves work on dense matrices
+         * without changing the (quadratic) final convergence */
+        thresh = (sweep < 3) ? 0.2 * off / (double)(nn * nn) : 0.0;
+        for (round = 0; round + 1 < np; ++round) {
+            size_t pi = 0, half = np / 2;
+            while (pi < half) {
+                size_t cnt = 0, jj;
+                /* gather: parameters of up to EIG_CHUNK rotations */
+                for (; pi < half && cnt < EIG_CHUNK; ++pi) {
+                    size_t x0 = (pi == 0) ? 0 : 1 + (pi - 1 + round) % (np - 1);
+                    size_t y0 = 1 + (np - 2 - pi + round) % (np - 1);
+                    double apq, g, app, aqq, d, h, den, t, c;
+                    if (x0 >= nn || y0 >= nn)
+                        continue;
+                    p = x0 < y0 ? x0 : y0;
+                    q = x0 < y0 ? y0 : x0;
+                    apq = a[p * nn + q];
+                    g = fabs(apq);
+                    if (g == 0.0)
+                        continue;
+                    app = a[p * nn + p];
+                    aqq = a[q * nn + q];
+                    /* Relative criterion (Demmel & Veselic): zeroing a_pq
+                     * moves the eigenvalues by at most eps sqrt|a_pp a_qq|,
+                     * which keeps the small eigenvalues of graded PSD
+                     * matrices (A^T A near a null space) accurate, and
+                     * guarantees termination. Squared to save a square
+                     * root; g^2 underflows only for g < 1e-154 max|a|. */
+                    if (g * g <= DBL_EPSILON * DBL_EPSILON * fabs(app * aqq)) {
+                        a[p * nn + q] = 0.0;
+                        continue;
+                    }
+                    if (g <= thresh)
+                        continue;
+                    /* t = tan of the smaller angle that annihilates a_pq
+                     * (Rutishauser), as 2 a_pq sgn(d) / (|d| + h) with
+                     * d = a_qq - a_pp, h = sqrt(d^2 + 4 a_pq^2); no overflow
+                     * since |a_ij| <= n after scaling */
+                    d = aqq - app;
+                    h = sqrt(d * d + 4.0 * apq * apq);
+                    den = d + copysign(h, d);
+                    t = (den != 0.0) ? 2.0 * apq / den : copysign(1.0, apq);
+                    c = 1.0 / sqrt(1.0 + t * t);
+                    rp_[cnt] = p;
+                    rq_[cnt] = q;
+                    rc_[cnt] = c;
+                    rs_[cnt] = t * c;
+                    rt_[cnt] = t * apq;
+                    ++cnt;
+                }
+                /* apply */
+                for (jj = 0; jj < cnt; ++jj) {
+                    double c = rc_[jj], s = rs_[jj];
+                    p = rp_[jj];
+                    q = rq_[jj];
+                    a[p * nn + p] -= rt_[jj];
+                    a[q * nn + q] += rt_[jj];
+                    a[p * nn + q] = 0.0;
+#define MCG_JROT(x, y)                                                        \
+    do {                                                                      \
+        double xx_ = (x), yy_ = (y);                                          \
+        (x) = c * xx_ - s * yy_;                                              \
+        (y) = s * xx_ + c * yy_;                                              \
+    } while (0)
+                    for (r = 0; r < p; ++r)
+                        MCG_JROT(a[r * nn + p], a[r * nn + q]);
+                    for (r = p + 1; r < q; ++r)
+                        MCG_JROT(a[p * nn + r], a[r * nn + q]);
+                    for (r = q + 1; r < nn; ++r)
+                        MCG_JROT(a[p * nn + r], a[q * nn + r]);
+                    for (r = 0; r < nn; ++r)
+                        MCG_JROT(v[p * nn + r], v[q * nn + r]);
+#undef MCG_JROT
+                }
+            }
+        }
+    }
+    if (!converged)
+        return MCG_ENUMERIC;
+
+    for (i = 0; i < nn; ++i)
+        w[i] = a[i * nn + i];
+    /* ascending order, moving the eigenvector rows along */
+    for (i = 0; i + 1 < nn; ++i) {
+        size_t best = i;
+        for (j = i + 1; j < nn; ++j)
+            if (w[j] < w[best])
+                best = j;
+        if (best != i) {
+            double t = w[i];
+            w[i] = w[best];
+            w[best] = t;
+            swap_rows(v + i * nn, v + best * nn, nn);
+        }
+    }
+    for (i = 0; i < nn; ++i) {
+        w[i] = ldexp(w[i], e);
+        for (j = i + 1; j < nn; ++j) {
+            double t = v[i * nn + j];
+            v[i * nn + j] = v[j * nn + i];
+            v[j * nn + i] = t;
+        }
+    }
+    if (!all_finite(w, nn))
+        return MCG_ENUMERIC;
+    return MCG_OK;
+}
+
+/* ------------------------------------------------------------ Cholesky */
+
+int mcg_spd_solve(int n, const double *a, const double *b, double *x)
+{
+    double l[SPD_MAX * SPD_MAX], y[SPD_MAX];
+    double maxdiag = 0.0;
+    size_t nn, i, j, k;
+
+    if (n < 1 || n > SPD_MAX)
+        return MCG_EINVAL;
+    if (a == NULL || b == NULL || x == NULL)
+        return MCG_EINVAL;
+    nn = (size_t)n;
+    if (!all_finite(a, nn * nn) || !all_finite(b, nn))
+        return MCG_EINVAL;
+
+    for (i = 0; i < nn; ++i)
+        if (a[i * nn + i] > maxdiag)
+            maxdiag = a[i * nn + i];
+    if (!(maxdiag > 0.0))
+        return MCG_ENUMERIC;
+    /* L L^T of the symmetric part (lower triangle of l) */
+    for (j = 0; j < nn; ++j) {
+        double d = a[j * nn + j];
+        for (k = 0; k < j; ++k)
+            d -= l[j * nn + k] * l[j * nn + k];
+        /* a pivot at rounding level of the largest diagonal entry means the
+         * matrix is semi-definite or indefinite to working precision */
+        if (!(d > DBL_EPSILON * maxdiag))
+            return MCG_ENUMERIC;
+        d = sqrt(d);
+        l[j * nn + j] = d;
+        for (i = j + 1; i < nn; ++i) {
+            double acc = 0.5 * a[i * nn + j] + 0.5 * a[j * nn + i];
+            for (k = 0; k < j; ++k)
+                acc -= l[i * nn + k] * l[j * nn + k];
+            l[i * nn + j] = acc / d;
+        }
+    }
+    for (i = 0; i < nn; ++i) { /* L y = b */
+        double acc = b[i];
+        for (k = 0; k < i; ++k)
+            acc -= l[i * nn + k] * y[k];
+        y[i] = acc / l[i * nn + i];
+    }
+    for (i = nn; i-- > 0;) { /* L^T x = y */
+        double acc = y[i];
+        for (k = i + 1; k < nn; ++k)
+            acc -= l[k * nn + i] * x[k];
+        x[i] = acc / l[i * nn + i];
+    }
+    if (!all_finite(x, nn))
+        return MCG_ENUMERIC;
+    return MCG_OK;
+}
+
+/* ----------------------------------------------------------- rotations */
+
+/* |x| of a 3- or 4-vector without overflow or underflow */
+static double norm_small(const double *x, size_t n)
+{
+    double mx = max_abs(x, n), acc = 0.0;
+    size_t i;
+    if (mx == 0.0)
+        return 0.0;
+    for (i = 0; i < n; ++i) {
+        double t = x[i] / mx;
+        acc += t * t;
+    }
+    return mx * sqrt(acc);
+}
+
+/* Is r a rotation to ROT_TOL? Guards the conversions below, which would
+ * otherwise return a plausible-looking answer for any 3 x 3 matrix. */
+static int is_rotation(const double r[9])
+{
+    size_t i, j, k;
+    double det;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            double acc = 0.0;
+            for (k = 0; k < 3; ++k)
+                acc += r[i * 3 + k] * r[j * 3 + k];
+            if (fabs(acc - (i == j ? 1.0 : 0.0)) > ROT_TOL)
+                return 0;
+        }
+    det = r[0] * (r[4] * r[8] - r[5] * r[7]) -
+          r[1] * (r[3] * r[8] - r[5] * r[6]) +
+          r[2] * (r[3] * r[7] - r[4] * r[6]);
+    return det > 0.0;
+}
+
+int mcg_rot_from_angle_axis(const double w[3], double r[9])
+{
+    double theta, k[3], c, s, h;
+    size_t i, j;
+    if (w == NULL || r == NULL || !all_finite(w, 3))
+        return MCG_EINVAL;
+    theta = norm_small(w, 3);
+    if (theta == 0.0) {
+        for (i = 0; i < 9; ++i)
+            r[i] = (i % 4 == 0) ? 1.0 : 0.0;
+        return MCG_OK;
+    }
+    for (i = 0; i < 3; ++i)
+        k[i] = w[i] / theta; /* accurate unit axis even for tiny theta */
+    /* Rodrigues: R = cos t I + sin t [k]x + (1 - cos t) k k^T, with
+     * 1 - cos t = 2 sin^2(t/2) to avoid cancellation for small angles */
+    c = cos(theta);
+    s = sin(theta);
+    h = 2.0 * sin(0.5 * theta) * sin(0.5 * theta);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j)
+            r[i * 3 + j] = h * k[i] * k[j] + (i == j ? c : 0.0);
+    r[1] -= s * k[2];
+    r[2] += s * k[1];
+    r[3] += s * k[2];
+    r[5] -= s * k[0];
+    r[6] -= s * k[1];
+    r[7] += s * k[0];
+    return MCG_OK;
+}
+
+/* Quaternion of a rotation by Shepperd's / Markley's method: build the
+ * candidate from the largest of (trace, r00, r11, r22), which is never small,
+ * so the result is accurate for every angle including 0 and pi. */
+static void quat_of_rotation(const double r[9], double q[4])
+{
+    double tr = r[0] + r[4] + r[8], nq;
+    size_t i;
+    if (tr >= r[0] && tr >= r[4] && tr >= r[8]) {
+        q[0] = 1.0 + tr;
+        q[1] = r[7] - r[5];
+        q[2] = r[2] - r[6];
+        q[3] = r[3] - r[1];
+    } else if (r[0] >= r[4] && r[0] >= r[8]) {
+        q[0] = r[7] - r[5];
+        q[1] = 1.0 + 2.0 * r[0] - tr;
+        q[2] = r[1] + r[3];
+        q[3] = r[2] + r[6];
+    } else if (r[4] >= r[8]) {
+        q[0] = r[2] - r[6];
+        q[1] = r[1] + r[3];
+        q[2] = 1.0 + 2.0 * r[4] - tr;
+        q[3] = r[5] + r[7];
+    } else {
+        q[0] = r[3] - r[1];
+        q[1] = r[2] + r[6];
+        q[2] = r[5] + r[7];
+        q[3] = 1.0 + 2.0 * r[8] - tr;
+    }
+    nq = norm_small(q, 4); /* >= 1 for a rotation: the chosen entry is */
+    if (q[0] < 0.0)
+        nq = -nq;
+    for (i = 0; i < 4; ++i)
+        q[i] /= nq;
+}
+
+int mcg_angle_axis_from_rot(const double r[9], double w[3])
+{
+    double q[4], nv, f;
+    size_t i;
+    if (r == NULL || w == NULL || !all_finite(r, 9))
+        return MCG_EINVAL;
+    if (!is_rotation(r))
+        return MCG_EINVAL;
+    quat_of_rotation(r, q);
+    /* angle = 2 atan2(|v|, q0) is well conditioned everywhere (unlike acos
+     * near 0 or asin near pi); q0 >= 0 gives angle in [0, pi] */
+    nv = norm_small(q + 1, 3);
+    if (nv == 0.0) {
+        w[0] = w[1] = w[2] = 0.0;
+        return MCG_OK;
+    }
+    f = 2.0 * atan2(nv, q[0]) / nv;
+    for (i = 0; i < 3; ++i)
+        w[i] = f * q[i + 1];
+    return MCG_OK;
+}
+
+int mcg_rot_from_quat(const double q[4], double r[9])
+{
+    double nq, w, x, y, z;
+    if (q == NULL || r == NULL || !all_finite(q, 4))
+        return MCG_EINVAL;
+    nq = norm_small(q, 4);
+    if (nq == 0.0)
+        return MCG_EINVAL;
+    w = q[0] / nq;
+    x = q[1] / nq;
+    y = q[2] / nq;
+    z = q[3] / nq;
+    r[0] = 1.0 - 2.0 * (y * y + z * z);
+    r[1] = 2.0 * (x * y - w * z);
+    r[2] = 2.0 * (x * z + w * y);
+    r[3] = 2.0 * (x * y + w * z);
+    r[4] = 1.0 - 2.0 * (x * x + z * z);
+    r[5] = 2.0 * (y * z - w * x);
+    r[6] = 2.0 * (x * z - w * y);
+    r[7] = 2.0 * (y * z + w * x);
+    r[8] = 1.0 - 2.0 * (x * x + y * y);
+    return MCG_OK;
+}
+
+int mcg_quat_from_rot(const double r[9], double q[4])
+{
+    if (r == NULL || q == NULL || !all_finite(r, 9))
+        return MCG_EINVAL;
+    if (!is_rotation(r))
+        return MCG_EINVAL;
+    quat_of_rotation(r, q);
+    return MCG_OK;
+}
+
+static double det3(const double a[9])
+{
+    return a[0] * (a[4] * a[8] - a[5] * a[7]) -
+           a[1] * (a[3] * a[8] - a[5] * a[6]) +
+           a[2] * (a[3] * a[7] - a[4] * a[6]);
+}
+
+int mcg_project_so3(const double m[9], double r[9])
+{
+    double u[9], s[3], v[9], work[64], d;
+    size_t i, j;
+    int st;
+    if (m == NULL || r == NULL || !all_finite(m, 9))
+        return MCG_EINVAL;
+    if (mcg_svd_work_size(3, 3) > sizeof work / sizeof work[0])
+        return MCG_ENOMEM; /* cannot happen; keeps the stack bound honest */
+    st = mcg_svd(3, 3, m, u, s, v, work, sizeof work / sizeof work[0]);
+    if (st != MCG_OK)
+        return st;
+    /* With rank >= 2 the polar factor with det +1, U diag(1, 1, d) V^T, is
+     * unique; with rank <= 1 a whole family of rotations is equally near. */
+    if (!(s[1] > 4.0 * DBL_EPSILON * s[0]))
+        return MCG_EDEGENERATE;
+    d = (det3(u) * det3(v) < 0.0) ? -1.0 : 1.0;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j)
+            r[i * 3 + j] = u[i * 3 + 0] * v[j * 3 + 0] +
+                           u[i * 3 + 1] * v[j * 3 + 1] +
+                           d * u[i * 3 + 2] * v[j * 3 + 2];
+    return MCG_OK;
+}
