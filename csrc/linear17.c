@@ -265,6 +265,7 @@ typedef struct {
     double cost;        /* x^T M x at (R, t) */
     double cond;        /* lambda_min(H) / lambda_max(H) */
     double h[3], hv[9]; /* eigen-decomposition of H */
+    double hm[9], g[3], c0; /* the quadratic t^T H t + 2 g^T t + c0 */
 } tsolve;
 
 /* Cost in t for fixed R is t^T H t + 2 g^T t + c0 with
@@ -302,6 +303,9 @@ static int solve_t(const double *m, const double r[9], int unit_mode,
             h[3 * k + l] = acc;
         }
     }
+    memcpy(out->hm, h, sizeof out->hm);
+    memcpy(out->g, g, sizeof out->g);
+    out->c0 = c0;
     {
         double hc[9];
         memcpy(hc, h, sizeof hc);
@@ -918,6 +922,24 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
                     var = HUGE_VAL;
             }
             res->scale_rel_std = sqrt(sigma2 * var) / nt;
+            /* Errors-in-variables check: along u = t/|t|, eq. 8.15 reads
+             * (J u) s = b. Regressing b on J u (least squares, what we do)
+             * and J u on b bracket the true s when both are noisy; their
+             * ratio is rho^2 = (g.u)^2 / ((u^T H u) c0). 1 - rho^2 bounds the
+             * relative bias of |t| that the first-order std cannot see. */
+            {
+                double u[3], hu[3], uhu, gu, rho2;
+                for (i = 0; i < 3; i++)
+                    u[i] = tbest[i] / nt;
+                matvec(3, ts.hm, u, hu);
+                uhu = dot3(u, hu);
+                gu = dot3(ts.g, u);
+                rho2 = (uhu > 0.0 && ts.c0 > 0.0) ? gu * gu / (uhu * ts.c0) : 1.0;
+                if (rho2 > 1.0)
+                    rho2 = 1.0;
+                if (1.0 - rho2 > res->scale_rel_std)
+                    res->scale_rel_std = 1.0 - rho2;
+            }
         }
     }
     res->scale_observable = !unit_mode &&

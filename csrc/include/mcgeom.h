@@ -195,7 +195,9 @@ typedef struct {
                                solution R = I, t = 0 and was discarded */
     int scale_observable;   /* 1 if the metric scale is determined */
     double scale_conditioning; /* how well the data fix |t| (0 = not at all) */
-    double scale_rel_std;   /* first-order relative std of |t| */
+    double scale_rel_std;   /* relative uncertainty of |t|: the larger of the
+                               first-order std and the errors-in-variables
+                               bias bound 1 - rho^2 of eq. 8.15 */
     int n_in_front;         /* correspondences triangulated in front of both
                                rays with the returned motion */
     double norm_origin[3];  /* normalisation (Algorithm 2 step 1): */
