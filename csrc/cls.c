@@ -144,12 +144,14 @@ static void apply_neg_pinv(size_t m, size_t n2, const double *u, size_t ldu,
                            const double *y, double *out, double *tmp)
 {
     size_t i, k;
-    for (k = 0; k < r; ++k) {
-        double acc = 0.0;
-        for (i = 0; i < m; ++i)
-            acc += u[i * ldu + k] * y[i];
-        tmp[k] = acc / s[k];
-    }
+    /* row-wise accumulation: r independent sums, contiguous rows of u */
+    for (k = 0; k < r; ++k)
+        tmp[k] = 0.0;
+    for (i = 0; i < m; ++i)
+        for (k = 0; k < r; ++k)
+            tmp[k] += u[i * ldu + k] * y[i];
+    for (k = 0; k < r; ++k)
+        tmp[k] /= s[k];
     for (i = 0; i < n2; ++i) {
         double acc = 0.0;
         for (k = 0; k < r; ++k)

@@ -3,8 +3,9 @@
  *
  * Implements the "linalg.c" section of mcgeom.h:
  *   - thin Householder QR (Golub & Van Loan 5.2);
- *   - SVD by Householder QR followed by one-sided (Hestenes) Jacobi on the
- *     triangular factor, which keeps the small singular values of tall thin
+ *   - SVD by Householder QR with column pivoting followed by one-sided
+ *     (Hestenes) Jacobi on the triangular factor (Drmac & Veselic's
+ *     preconditioned Jacobi), which keeps the small singular values of tall thin
  *     matrices (the 17..n x 18 generalized epipolar systems of thesis ch. 8,
  *     eq. 8.16, and the reduced system of eq. 8.36) accurate to working
  *     precision relative to the largest one;
@@ -36,15 +37,15 @@
 #define SPD_MAX 64
 /* Rotations of one Jacobi round whose parameters are computed together. */
 #define EIG_CHUNK 16
-/* A Jacobi column whose norm falls below DEAD_REL times the largest initial
- * column norm (<= s_max) is "dead": it takes part in no further rotation and
- * its singular value is reported as exactly 0 (its left singular vector is
- * completed). Dropping dead columns perturbs R by at most sqrt(n) DEAD_REL
+/* A Jacobi vector whose norm falls below DEAD_REL times the largest initial
+ * one (<= s_max) is "dead": it takes part in no further rotation and its
+ * singular value is reported as exactly 0 (its singular vector is
+ * completed). Dropping dead vectors perturbs R by at most sqrt(n) DEAD_REL
  * s_max, the size of the backward error of the QR step itself, so the
  * accuracy relative to s_max is unchanged. Without this, the noise-level
  * columns of a rank-deficient matrix are orthogonalised among themselves at
  * ever smaller scales (1e-16, 1e-32, ... down to underflow), which took up to
- * 40 sweeps instead of 6-10 in tests. */
+ * 40 sweeps instead of 5-8 in tests. */
 #define DEAD_REL DBL_EPSILON
 /* Absolute floor of the dead threshold (squared): below it dot products
  * would lose precision to underflow. Inputs are scaled so that max |a_ij|
@@ -114,13 +115,43 @@ static int scale_exponent(double amax)
     return e;
 }
 
+/* Dot product with four independent partial sums: a single running sum is
+ * bound by the latency of the floating-point add (the compiler may not
+ * reassociate it), which made this the bottleneck of the QR and Jacobi
+ * loops. The rounding error bound is unchanged (slightly smaller). */
 static double dot(const double *x, const double *y, size_t n)
 {
-    double acc = 0.0;
-    size_t i;
-    for (i = 0; i < n; ++i)
-        acc += x[i] * y[i];
-    return acc;
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        a0 += x[i] * y[i];
+        a1 += x[i + 1] * y[i + 1];
+        a2 += x[i + 2] * y[i + 2];
+        a3 += x[i + 3] * y[i + 3];
+    }
+    for (; i < n; ++i)
+        a0 += x[i] * y[i];
+    return (a0 + a1) + (a2 + a3);
+}
+
+/* Both y . y and x . y in one pass (the Jacobi inner loop). */
+static void dot2(const double *x, const double *y, size_t n, double *yy,
+                 double *xy)
+{
+    double b0 = 0.0, b1 = 0.0, g0 = 0.0, g1 = 0.0;
+    size_t i = 0;
+    for (; i + 2 <= n; i += 2) {
+        b0 += y[i] * y[i];
+        b1 += y[i + 1] * y[i + 1];
+        g0 += x[i] * y[i];
+        g1 += x[i + 1] * y[i + 1];
+    }
+    for (; i < n; ++i) {
+        b0 += y[i] * y[i];
+        g0 += x[i] * y[i];
+    }
+    *yy = b0 + b1;
+    *xy = g0 + g1;
 }
 
 /* Plane rotation of two rows: x <- c x - s y, y <- s x + c y. */
@@ -151,36 +182,89 @@ static void swap_rows(double *x, double *y, size_t n)
  * transpose makes every column operation a contiguous loop. On return R(i, j)
  * (i <= j) is at[j * len + i], the essential part of reflector k (its first
  * component is an implicit 1) is at[k * len + i] for i > k, and
- * H_k = I - tau[k] v_k v_k^T (LAPACK dgeqr2 convention, tau = 0 for H = I). */
-static void house_qr(size_t len, size_t ncol, double *at, double *tau)
+ * H_k = I - tau[k] v_k v_k^T (LAPACK dgeqr2 convention, tau = 0 for H = I).
+ *
+ * With perm != NULL, columns are pivoted (Businger-Golub, as LAPACK dgeqp3):
+ * at step k the remaining column of largest norm is moved to position k, so
+ * a P = Q R with perm[k] = original index of column k (stored as a double:
+ * the workspace is all doubles). vn: 2 ncol doubles for the partial column
+ * norms, downdated with the safeguard of Drmac & Bujanovic (LAPACK 3.x).
+ * Pivoting makes R graded (|R(k,k)| non-increasing), the preconditioning
+ * under which one-sided Jacobi on R^T converges in a few sweeps
+ * (Drmac & Veselic 2008) and which orders numerically zero columns last. */
+static void house_qr(size_t len, size_t ncol, double *at, double *tau,
+                     double *perm, double *vn)
 {
+    const double tol3z = sqrt(DBL_EPSILON);
+    double *vn1 = vn, *vn2 = (vn != NULL) ? vn + ncol : NULL;
     size_t k, i, j;
+
+    if (perm != NULL) {
+        for (j = 0; j < ncol; ++j) {
+            perm[j] = (double)j;
+            vn1[j] = sqrt(dot(at + j * len, at + j * len, len));
+            vn2[j] = vn1[j];
+        }
+    }
     for (k = 0; k < ncol; ++k) {
         double *x = at + k * len + k;
         size_t nk = len - k;
-        double alpha = x[0], xn2 = 0.0, beta, sc;
-        for (i = 1; i < nk; ++i)
-            xn2 += x[i] * x[i];
+        double alpha, xn2, beta, sc;
+        if (perm != NULL) {
+            size_t best = k;
+            for (j = k + 1; j < ncol; ++j)
+                if (vn1[j] > vn1[best])
+                    best = j;
+            if (best != k) {
+                double t;
+                swap_rows(at + k * len, at + best * len, len);
+                t = perm[k];
+                perm[k] = perm[best];
+                perm[best] = t;
+                vn1[best] = vn1[k];
+                vn2[best] = vn2[k];
+            }
+        }
+        alpha = x[0];
+        xn2 = dot(x + 1, x + 1, nk - 1);
         if (xn2 == 0.0) {
             tau[k] = 0.0; /* already triangular in this column */
-            continue;
+        } else {
+            /* beta has the sign opposite to alpha: alpha - beta never
+             * cancels */
+            beta = -copysign(sqrt(alpha * alpha + xn2), alpha);
+            tau[k] = (beta - alpha) / beta;
+            sc = 1.0 / (alpha - beta);
+            for (i = 1; i < nk; ++i)
+                x[i] *= sc;
+            x[0] = beta;
+            for (j = k + 1; j < ncol; ++j) {
+                double *y = at + j * len + k;
+                double d = (y[0] + dot(x + 1, y + 1, nk - 1)) * tau[k];
+                y[0] -= d;
+                for (i = 1; i < nk; ++i)
+                    y[i] -= d * x[i];
+            }
         }
-        /* beta has the sign opposite to alpha so alpha - beta never cancels */
-        beta = -copysign(sqrt(alpha * alpha + xn2), alpha);
-        tau[k] = (beta - alpha) / beta;
-        sc = 1.0 / (alpha - beta);
-        for (i = 1; i < nk; ++i)
-            x[i] *= sc;
-        x[0] = beta;
-        for (j = k + 1; j < ncol; ++j) {
-            double *y = at + j * len + k;
-            double d = y[0];
-            for (i = 1; i < nk; ++i)
-                d += x[i] * y[i];
-            d *= tau[k];
-            y[0] -= d;
-            for (i = 1; i < nk; ++i)
-                y[i] -= d * x[i];
+        if (perm != NULL) {
+            /* norms of the remaining parts (rows > k) of columns j > k */
+            for (j = k + 1; j < ncol; ++j) {
+                double t, t2;
+                if (vn1[j] == 0.0)
+                    continue;
+                t = fabs(at[j * len + k]) / vn1[j];
+                t = 1.0 - t * t;
+                if (t < 0.0)
+                    t = 0.0;
+                t2 = t * (vn1[j] / vn2[j]) * (vn1[j] / vn2[j]);
+                if (t2 <= tol3z) { /* cancellation: recompute */
+                    const double *y = at + j * len + k + 1;
+                    vn1[j] = sqrt(dot(y, y, len - k - 1));
+                    vn2[j] = vn1[j];
+                } else {
+                    vn1[j] *= sqrt(t);
+                }
+            }
         }
     }
 }
@@ -264,7 +348,7 @@ int mcg_qr(int m, int n, const double *a, double *q, double *r,
     for (i = 0; i < mm; ++i)
         for (j = 0; j < nn; ++j)
             at[j * mm + i] = ldexp(a[i * nn + j], -e);
-    house_qr(mm, nn, at, tau);
+    house_qr(mm, nn, at, tau, NULL, NULL);
 
     for (i = 0; i < nn; ++i)
         for (j = 0; j < nn; ++j)
@@ -283,12 +367,14 @@ int mcg_qr(int m, int n, const double *a, double *q, double *r,
 
 /* ----------------------------------------------------------------- SVD */
 
-/* One-sided Jacobi on the nn rows of w (row k = column k of the n x n
- * triangular factor R): rotate pairs of rows until all are mutually
- * orthogonal to working precision, applying the same rotations to the rows
- * of vt. Then W = (R V)^T = (U S)^T and vt = V^T. Returns 0 on convergence.
- * Hestenes' method works on the columns directly (never forms R^T R), which
- * is why it resolves singular values down to eps * s_max and below. */
+/* One-sided Jacobi (Hestenes) on the columns of M = w^T, i.e. on the nn
+ * rows of w: rotate pairs of rows until all are mutually orthogonal to
+ * working precision, applying the same rotations to the rows of vt (which
+ * starts as I). Then M J = G with J = vt^T orthogonal and G = w^T with
+ * orthogonal columns, so M = U_G S J^T. Returns 0 on convergence. Working on
+ * the vectors themselves (never forming M^T M) is what resolves singular
+ * values down to eps * s_max. Rows with squared norm below dead2 are
+ * skipped (see DEAD_REL). */
 static int jacobi_rows(size_t nn, double *w, double *vt, double dead2)
 {
     const double tol =
@@ -306,10 +392,9 @@ static int jacobi_rows(size_t nn, double *w, double *vt, double dead2)
                 double beta, gamma, zeta, t, c, s;
                 if (alpha < dead2)
                     break; /* dead column: nothing to orthogonalise */
-                beta = dot(gj, gj, nn);
+                dot2(gi, gj, nn, &beta, &gamma);
                 if (beta < dead2)
                     continue;
-                gamma = dot(gi, gj, nn);
                 if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta))
                     continue;
                 rotated = 1;
@@ -334,10 +419,10 @@ static int jacobi_rows(size_t nn, double *w, double *vt, double dead2)
     return -1;
 }
 
-/* After jacobi_rows: s[k] = |w_k|; sort descending (swapping rows of w and
- * vt); normalise the rows of w (they become the left singular vectors of R)
- * and complete those of zero singular values to an orthonormal basis of
- * R^nn, so that U always has orthonormal columns. tmp: nn doubles. */
+/* After jacobi_rows: s[k] = |w_k| (0 if dead); sort descending (swapping
+ * rows of w and vt); normalise the rows of w (the columns of U_G) and
+ * complete those of zero singular values to an orthonormal basis of R^nn,
+ * so that U_G is always orthogonal. tmp: nn doubles. */
 static void finish_jacobi(size_t nn, double *w, double *vt, double *s,
                           double *tmp, double dead2)
 {
@@ -417,10 +502,11 @@ size_t mcg_svd_work_size(int m, int n)
         return 0;
     nn = (size_t)(m < n ? m : n);
     pp = (size_t)(m < n ? n : m);
-    /* at (nn x pp) + tau (nn) + w (nn x nn) + vt (nn x nn) + tmp (pp);
-     * <= p n + 3 n^2 + 4 p as promised by the header. */
+    /* at (nn x pp) + tau, perm (nn each) + vn (2 nn) + w, vt (nn x nn each)
+     * + tmp (pp) = pp nn + 4 nn + 2 nn^2 + pp <= p n + 3 n^2 + 4 p as
+     * promised by the header (4 nn <= n^2 + 3 p since p >= n or nn < n). */
     ws = mul_sz(pp, nn, &ok);
-    ws = add_sz(ws, nn, &ok);
+    ws = add_sz(ws, mul_sz(4, nn, &ok), &ok);
     ws = add_sz(ws, mul_sz(2, mul_sz(nn, nn, &ok), &ok), &ok);
     ws = add_sz(ws, pp, &ok);
     return ok ? ws : 0;
@@ -430,7 +516,7 @@ int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
             double *work, size_t lwork)
 {
     size_t mm, nn, len, nq, ws, i, j, k;
-    double *at, *tau, *w, *vt, *tmp, dead2;
+    double *at, *tau, *perm, *vn, *w, *vt, *tmp, dead2, maxrow2;
     int e, tall;
 
     if (!dims_ok(m, n))
@@ -447,14 +533,16 @@ int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
     if (!all_finite(a, mm * nn))
         return MCG_EINVAL;
 
-    /* A wide matrix is handled through its transpose a^T = Q R, so the QR
-     * is always of a tall len x nq matrix (len >= nq). */
+    /* A wide matrix is handled through its transpose, so the QR is always
+     * of a tall len x nq matrix b (len >= nq): b = a (tall) or a^T (wide). */
     tall = (mm >= nn);
     nq = tall ? nn : mm;
     len = tall ? mm : nn;
     at = work;
     tau = at + nq * len;
-    w = tau + nq;
+    perm = tau + nq;
+    vn = perm + nq;
+    w = vn + 2 * nq;
     vt = w + nq * nq;
     tmp = vt + nq * nq;
 
@@ -468,30 +556,33 @@ int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
         for (i = 0; i < mm * nn; ++i)
             at[i] = ldexp(a[i], -e);
     }
-    house_qr(len, nq, at, tau);
+    /* b P = Q R with column pivoting */
+    house_qr(len, nq, at, tau, perm, vn);
 
-    /* w = R^T: row j holds column j of R (zeros below the diagonal of R) */
-    for (j = 0; j < nq; ++j)
+    /* One-sided Jacobi on the columns of R^T, i.e. on the rows of R, which
+     * w holds (row j = row j of R): the preconditioned Jacobi of Drmac &
+     * Veselic. It converges in fewer sweeps than Jacobi on the columns of R
+     * (graded and Hilbert-like matrices in particular). */
+    maxrow2 = 0.0;
+    for (j = 0; j < nq; ++j) {
+        double r2;
         for (i = 0; i < nq; ++i)
-            w[j * nq + i] = (i <= j) ? at[j * len + i] : 0.0;
+            w[j * nq + i] = (j <= i) ? at[i * len + j] : 0.0;
+        r2 = dot(w + j * nq, w + j * nq, nq);
+        if (r2 > maxrow2)
+            maxrow2 = r2;
+    }
     memset(vt, 0, nq * nq * sizeof(double));
     for (i = 0; i < nq; ++i)
         vt[i * nq + i] = 1.0;
-
-    {
-        double maxcol2 = 0.0;
-        for (j = 0; j < nq; ++j) {
-            double c2 = dot(w + j * nq, w + j * nq, nq);
-            if (c2 > maxcol2)
-                maxcol2 = c2;
-        }
-        dead2 = DEAD_REL * DEAD_REL * maxcol2;
-        if (dead2 < TINY2)
-            dead2 = TINY2;
-    }
+    dead2 = DEAD_REL * DEAD_REL * maxrow2;
+    if (dead2 < TINY2)
+        dead2 = TINY2;
     if (jacobi_rows(nq, w, vt, dead2) != 0)
         return MCG_ENUMERIC;
-    /* now R = U_R S V_R^T with U_R(i, k) = w[k nq + i], V_R(i, k) = vt[k nq + i] */
+    /* R^T J = G = U_G S with J = vt^T, so R = J S U_G^T and
+     * b = (Q J) S (P U_G)^T, where U_G(l, k) = w[k nq + l] after
+     * finish_jacobi and (P U_G)(perm[l], k) = U_G(l, k). */
     finish_jacobi(nq, w, vt, s, tmp, dead2);
 
     for (k = 0; k < nq; ++k)
@@ -502,29 +593,33 @@ int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
         return MCG_ENUMERIC; /* singular values beyond the double range */
 
     if (tall) {
-        /* a = (Q U_R) S V_R^T */
-        for (i = 0; i < nn; ++i)
+        /* a = (Q J) S (P U_G)^T: v = P U_G, u = Q J */
+        for (i = 0; i < nn; ++i) {
+            size_t row = (size_t)perm[i];
             for (k = 0; k < nn; ++k)
-                v[i * nn + k] = vt[k * nn + i];
+                v[row * nn + k] = w[k * nn + i];
+        }
         if (u != NULL) {
             for (i = 0; i < mm; ++i)
                 for (k = 0; k < nn; ++k)
-                    u[i * nn + k] = (i < nn) ? w[k * nn + i] : 0.0;
+                    u[i * nn + k] = (i < nn) ? vt[k * nn + i] : 0.0;
             apply_q(mm, nn, at, tau, u, nn, 0, tmp);
         }
     } else {
-        /* a^T = Q_full [R; 0], R = U_R S V_R^T, so a = V_R S (Q U_R)^T and
-         * the full V is Q_full blockdiag(U_R, I): its last n - m columns span
+        /* a^T = (Q J) S (P U_G)^T, so a = (P U_G) S (Q J)^T: u = P U_G and
+         * the full V = Q_full blockdiag(J, I), whose last n - m columns span
          * the complement of range(a^T), i.e. the null space of a. */
         if (u != NULL)
-            for (i = 0; i < mm; ++i)
+            for (i = 0; i < mm; ++i) {
+                size_t row = (size_t)perm[i];
                 for (k = 0; k < mm; ++k)
-                    u[i * mm + k] = vt[k * mm + i];
+                    u[row * mm + k] = w[k * mm + i];
+            }
         for (i = 0; i < nn; ++i)
             for (k = 0; k < nn; ++k) {
                 double val;
                 if (i < mm && k < mm)
-                    val = w[k * mm + i];
+                    val = vt[k * mm + i];
                 else
                     val = (i == k) ? 1.0 : 0.0;
                 v[i * nn + k] = val;
