@@ -63,12 +63,12 @@ def linear17_numpy(o1, d1, o2, d2, refine=True, max_iterations=100, tolerance=1e
     sv = np.linalg.svd(AR, compute_uv=False)
     nullity = int(np.sum(sv ** 2 <= rank_rtol * sv[0] ** 2))
     if nullity == 0:
-        x = np.linalg.svd(A)[2][-1]          # plain SVD, most-general case
+        x = np.linalg.svd(A, full_matrices=False)[2][-1]          # plain SVD, most-general case
         e = x[:9]
     else:                                    # Algorithm 4 / eq. 8.36
         # (A_R A_R^+ - I) A_E, applied without forming the N x N projector
         App = AR @ (np.linalg.pinv(AR, rcond=np.sqrt(rank_rtol)) @ AE) - AE
-        e = np.linalg.svd(App)[2][-1]
+        e = np.linalg.svd(App, full_matrices=False)[2][-1]
     U, _, Vt = np.linalg.svd(e.reshape(3, 3))
     cands = []
     for W in (_W, _W.T):
