@@ -25,6 +25,18 @@
  * problem size take a caller-provided workspace `work` of `lwork` doubles
  * whose required size is returned by the matching *_work_size() function.
  * All functions are re-entrant and thread-safe on distinct output buffers.
+ *
+ * Limits and edge cases common to the kernels:
+ *   - sizes: rows (and rays) <= 2^20, columns (and sym_eig's n) <= 4096;
+ *     *_work_size() returns 0 for invalid sizes and the entry point then
+ *     returns MCG_EINVAL. mcg_linear17 accepts up to 2^26 rays.
+ *   - angle_axis_from_rot / quat_from_rot return MCG_EINVAL when the input is
+ *     not a rotation (max |R R^T - I| > 1e-6 or det <= 0).
+ *   - mcg_svd reports singular values below ~eps * (largest row norm of R) as
+ *     exactly 0 (accuracy is relative to s_max, not to each value).
+ *   - mcg_cls_range with G = 0 returns MCG_EDEGENERATE (as cls_general, C = 0).
+ *   - mcg_sym_eig rejects v aliasing a; mcg_spd_solve uses the symmetric part
+ *     and fails when a pivot is <= eps * max diagonal.
  */
 #ifndef MCGEOM_H
 #define MCGEOM_H
