@@ -20,47 +20,15 @@
  * Scratch space comes only from the caller's workspace; SVDs from linalg.c.
  */
 #include "mcgeom.h"
+#include "internal.h"
 
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
-/* Same limits as linalg.c (rows of A or C; columns = unknowns). */
-#define MAX_ROWS ((size_t)1 << 20)
-#define MAX_COLS ((size_t)4096)
 #define PARTIAL_RCOND_DEFAULT 1e-10
 #define RANGE_RCOND_DEFAULT 1e-12
-
-static size_t mul_sz(size_t a, size_t b, int *ok)
-{
-    if (a != 0 && b > SIZE_MAX / a) {
-        *ok = 0;
-        return 0;
-    }
-    return a * b;
-}
-
-static size_t add_sz(size_t a, size_t b, int *ok)
-{
-    if (b > SIZE_MAX - a) {
-        *ok = 0;
-        return 0;
-    }
-    return a + b;
-}
-
-static size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
-static size_t min_sz(size_t a, size_t b) { return a < b ? a : b; }
-
-static int all_finite(const double *x, size_t n)
-{
-    size_t i;
-    for (i = 0; i < n; ++i)
-        if (!isfinite(x[i]))
-            return 0;
-    return 1;
-}
 
 /* svd work size for an m x n matrix, 0 columns allowed (no SVD needed) */
 static size_t svd_ws0(size_t m, size_t n)

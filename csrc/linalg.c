@@ -21,16 +21,13 @@
  * the fixed tiny sizes, from the stack. Every loop is bounded.
  */
 #include "mcgeom.h"
+#include "internal.h"
 
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
-/* Size limits. They keep every work-size computation far from overflow and
- * reject absurd sizes (usually a mix-up of arguments) up front. */
-#define MAX_ROWS ((size_t)1 << 20)
-#define MAX_COLS ((size_t)4096)
 /* Jacobi converges quadratically: a handful of sweeps in practice. The cap
  * only turns a pathological input into MCG_ENUMERIC instead of a hang. */
 #define MAX_SWEEPS 60
@@ -59,33 +56,6 @@
 #define ROT_TOL 1e-6
 
 /* ------------------------------------------------------------- helpers */
-
-static size_t mul_sz(size_t a, size_t b, int *ok)
-{
-    if (a != 0 && b > SIZE_MAX / a) {
-        *ok = 0;
-        return 0;
-    }
-    return a * b;
-}
-
-static size_t add_sz(size_t a, size_t b, int *ok)
-{
-    if (b > SIZE_MAX - a) {
-        *ok = 0;
-        return 0;
-    }
-    return a + b;
-}
-
-static int all_finite(const double *x, size_t n)
-{
-    size_t i;
-    for (i = 0; i < n; ++i)
-        if (!isfinite(x[i]))
-            return 0;
-    return 1;
-}
 
 static int dims_ok(int m, int n)
 {

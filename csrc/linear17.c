@@ -20,6 +20,7 @@
  * assume. A motion (R, t') there is (R, t'/s + o - R o) in the rig frame.
  */
 #include "mcgeom.h"
+#include "internal.h"
 
 #include <float.h>
 #include <math.h>
@@ -145,11 +146,9 @@ static int accumulate(int n, const double *o1, const double *d1,
     double o[3] = {0.0, 0.0, 0.0}, ss = 0.0, s;
     int k, i, j;
 
-    for (k = 0; k < 3 * n; k++) {
-        if (!isfinite(o1[k]) || !isfinite(o2[k]) || !isfinite(d1[k]) ||
-            !isfinite(d2[k]))
-            return MCG_EINVAL;
-    }
+    if (!all_finite(o1, 3 * (size_t)n) || !all_finite(o2, 3 * (size_t)n) ||
+        !all_finite(d1, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
+        return MCG_EINVAL;
     for (k = 0; k < n; k++)
         for (i = 0; i < 3; i++)
             o[i] += o1[3 * k + i] + o2[3 * k + i];
@@ -629,7 +628,7 @@ static int plain_svd_refine(const double *m, double e[9], double r[9])
 }
 
 /* Linear step: the 9-vector e of E (and the R part r) minimising |A x|. */
-static int linear_step(const double *m, int gc_case, int nullity,
+static int linear_step(const double *m, int gc_case,
                        const double *wr, const double *vr, double rtol,
                        double e[9], double r[9], mcg_linear17_result *res)
 {
@@ -683,7 +682,6 @@ static int linear_step(const double *m, int gc_case, int nullity,
     }
     if (gc_case == MCG_GC_MOST_GENERAL)
         return plain_svd_refine(m, e, r);
-    (void)nullity;
     return MCG_OK;
 }
 
@@ -779,7 +777,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
     if (n < res->rank_a)
         return MCG_EDEGENERATE; /* too few rays for the detected kind */
 
-    st = linear_step(m, gc, nullity, wr, vr, o.rank_rtol, e, rpart, res);
+    st = linear_step(m, gc, wr, vr, o.rank_rtol, e, rpart, res);
     if (st != MCG_OK)
         return st;
     {

@@ -12,21 +12,10 @@
  *     writes vec() column-major; only the ordering of the unknowns differs.)
  */
 #include "mcgeom.h"
+#include "internal.h"
 
 #include <math.h>
 #include <stddef.h>
-
-/* Same row limit as linalg.c: keeps n * 18 far from size_t overflow. */
-#define MAX_ROWS ((size_t)1 << 20)
-
-static int all_finite(const double *x, size_t n)
-{
-    size_t i;
-    for (i = 0; i < n; ++i)
-        if (!isfinite(x[i]))
-            return 0;
-    return 1;
-}
 
 int mcg_plucker_from_points(int n, const double *origins, const double *dirs,
                             double *rays)

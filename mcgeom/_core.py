@@ -35,6 +35,12 @@ GC_CASE_NAMES = {
 }
 
 
+#: status codes of mcgeom.h, for callers that inspect a returned status
+STATUS_OK = lib.MCG_OK
+STATUS_EINVAL = lib.MCG_EINVAL
+STATUS_EDEGENERATE = lib.MCG_EDEGENERATE
+
+
 def _message(status: int) -> str:
     return ffi.string(lib.mcg_status_message(status)).decode()
 
@@ -153,44 +159,37 @@ def spd_solve(a: Any, b: Any) -> np.ndarray:
     return x
 
 
+def _fixed(fn, what: str, name: str, x: Any, shape_in: tuple, shape_out: tuple) -> np.ndarray:
+    """Call a fixed-size kernel ``fn(in, out)`` (rotation helpers)."""
+    x = _arr(name, x, shape_in)
+    out = np.empty(shape_out)
+    _check(fn(_p(x), _p(out)), what)
+    return out
+
+
 def rot_from_angle_axis(w: Any) -> np.ndarray:
     """Rotation matrix of an angle-axis vector (radians)."""
-    w = _arr("w", w, (3,))
-    r = np.empty((3, 3))
-    _check(lib.mcg_rot_from_angle_axis(_p(w), _p(r)), "rot_from_angle_axis")
-    return r
+    return _fixed(lib.mcg_rot_from_angle_axis, "rot_from_angle_axis", "w", w, (3,), (3, 3))
 
 
 def angle_axis_from_rot(R: Any) -> np.ndarray:
     """Angle-axis vector (radians, angle in [0, pi]) of a rotation matrix."""
-    R = _arr("R", R, (3, 3))
-    w = np.empty(3)
-    _check(lib.mcg_angle_axis_from_rot(_p(R), _p(w)), "angle_axis_from_rot")
-    return w
+    return _fixed(lib.mcg_angle_axis_from_rot, "angle_axis_from_rot", "R", R, (3, 3), (3,))
 
 
 def rot_from_quat(q: Any) -> np.ndarray:
     """Rotation matrix of a quaternion (w, x, y, z), normalised first."""
-    q = _arr("q", q, (4,))
-    r = np.empty((3, 3))
-    _check(lib.mcg_rot_from_quat(_p(q), _p(r)), "rot_from_quat")
-    return r
+    return _fixed(lib.mcg_rot_from_quat, "rot_from_quat", "q", q, (4,), (3, 3))
 
 
 def quat_from_rot(R: Any) -> np.ndarray:
     """Unit quaternion (w, x, y, z) with w >= 0 of a rotation matrix."""
-    R = _arr("R", R, (3, 3))
-    q = np.empty(4)
-    _check(lib.mcg_quat_from_rot(_p(R), _p(q)), "quat_from_rot")
-    return q
+    return _fixed(lib.mcg_quat_from_rot, "quat_from_rot", "R", R, (3, 3), (4,))
 
 
 def project_so3(M: Any) -> np.ndarray:
     """Nearest rotation (Frobenius norm) to a 3x3 matrix."""
-    M = _arr("M", M, (3, 3))
-    r = np.empty((3, 3))
-    _check(lib.mcg_project_so3(_p(M), _p(r)), "project_so3")
-    return r
+    return _fixed(lib.mcg_project_so3, "project_so3", "M", M, (3, 3), (3, 3))
 
 
 # ----------------------------------------------------------------- plucker.c

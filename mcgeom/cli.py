@@ -5,11 +5,10 @@ Printing and files only; the work is done by mcgeom.demo and mcgeom.bench."""
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Optional, Sequence
-
-import numpy as np
 
 from . import registry
 
@@ -43,15 +42,13 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         print(f"{f.index:5d} {f.n_rays:5d} {f.rot_err_deg:9.4f} {f.dir_err_deg:9.3f} "
               f"{f.scale_ratio:7.3f} {1000 * f.t_err_m:9.2f} {'yes' if f.scale_observable else 'NO':>4} "
               f"{f.iterations:5d}")
-    rot = np.array([f.rot_err_deg for f in res.frames])
-    dire = np.array([f.dir_err_deg for f in res.frames])
-    sc = np.array([f.scale_ratio for f in res.frames])
-    print(f"median rotation error {np.median(rot):.4f} deg, translation direction "
-          f"{np.median(dire):.3f} deg, |1 - scale| {np.median(np.abs(1 - sc)):.4f}; "
-          f"scale observable in {sum(f.scale_observable for f in res.frames)}/{len(res.frames)}")
+    sm = res.summary()
+    print(f"median rotation error {sm['rot_deg']:.4f} deg, translation direction "
+          f"{sm['dir_deg']:.3f} deg, |1 - scale| {sm['scale_err']:.4f}; "
+          f"scale observable in {sm['n_observable']}/{len(res.frames)}")
     print(f"loop closure gap: {1000 * res.loop_gap_m:.1f} mm "
           f"({100 * res.loop_gap_m / res.path_length_m:.2f} % of the path), "
-          f"{np.degrees(res.loop_gap_rad):.3f} deg")
+          f"{math.degrees(res.loop_gap_rad):.3f} deg")
     write_trajectory_csv(out / "trajectory_true.csv", res.true_poses)
     write_trajectory_csv(out / "trajectory_estimated.csv", res.est_poses)
     plot_trajectories_png(out / "trajectory.png",

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import estimate, synth
-from .odometry import chain, loop_closure_error, motion_errors, relative_motion
+from .odometry import chain, loop_closure_error, motion_errors, to_matrix
 
 __all__ = ["DemoFrame", "DemoResult", "run_demo"]
 
@@ -41,6 +41,16 @@ class DemoResult:
     loop_gap_rad: float
     path_length_m: float
 
+    def summary(self) -> dict:
+        """Medians over the frames: rotation and direction errors (deg), |1 - scale|,
+        and the number of frames whose scale was reported observable."""
+        return {
+            "rot_deg": float(np.median([f.rot_err_deg for f in self.frames])),
+            "dir_deg": float(np.median([f.dir_err_deg for f in self.frames])),
+            "scale_err": float(np.median([abs(1 - f.scale_ratio) for f in self.frames])),
+            "n_observable": sum(f.scale_observable for f in self.frames),
+        }
+
 
 def run_demo(method: str = "linear17", pixel_noise: float = 0.3, points_per_camera: int = 60,
              n_positions: int = 108, seed: int = 0) -> DemoResult:
@@ -56,17 +66,16 @@ def run_demo(method: str = "linear17", pixel_noise: float = 0.3, points_per_came
     frames, motions = [], []
     for k in range(len(poses)):
         T1, T2 = poses[k], poses[(k + 1) % len(poses)]
-        M_true = relative_motion(T1, T2)
-        prob = synth.make_problem(rig, M_true[:3, :3], M_true[:3, 3],
+        R_true, t_true = synth.relative_motion(T1, T2)
+        M_true = to_matrix(R_true, t_true)
+        prob = synth.make_problem(rig, R_true, t_true,
                                   points_per_camera * len(rig.cameras), rng,
                                   pixel_noise=pixel_noise, depth_range=(0.6, 3.0))
         m = estimate(prob.rays, method)
-        M = np.eye(4)
-        M[:3, :3] = m.R
         t = m.t
         if not m.scale.observable and "t_metric" in m.info and np.any(m.info["t_metric"]):
             t = m.info["t_metric"]
-        M[:3, 3] = t
+        M = to_matrix(m.R, t)
         motions.append(M)
         e = motion_errors(M, M_true)
         frames.append(DemoFrame(k, len(prob.rays), np.degrees(e["rot_err"]),

@@ -31,9 +31,9 @@ F_VIRTUAL = 500.0
 
 
 def _errors(R, t, R_true, t_true):
-    rot = np.degrees(2 * np.arcsin(min(1.0, np.linalg.norm(R - R_true) / (2 * np.sqrt(2)))))
-    c = np.dot(t, t_true) / (np.linalg.norm(t) * np.linalg.norm(t_true))
-    return rot, np.degrees(np.arccos(np.clip(c, -1, 1))), abs(1 - np.linalg.norm(t) / np.linalg.norm(t_true))
+    """(rotation error deg, direction error deg, |1 - scale ratio|)"""
+    d, ratio = synth.translation_errors(t, t_true)
+    return np.degrees(synth.rotation_error(R, R_true)), np.degrees(d), abs(1 - ratio)
 
 
 def _poselib(prob):

@@ -40,7 +40,4 @@ def rigid(rng: np.random.Generator):
     return R, rng.normal(size=3)
 
 
-def rot_err(Ra, Rb) -> float:
-    """Angle (rad) between two rotations, accurate near zero (unlike acos of the trace)."""
-    s = np.linalg.norm(np.asarray(Ra) - np.asarray(Rb)) / (2 * np.sqrt(2))
-    return float(2 * np.arcsin(min(s, 1.0)))
+rot_err = synth.rotation_error  # angle (rad) between two rotations, accurate near zero

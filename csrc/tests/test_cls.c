@@ -18,6 +18,9 @@
  */
 #include "mcgeom.h"
 
+#define TEST_SEED 0x13198a2e03707344ULL
+#include "testutil.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -29,64 +32,8 @@
 #define MAXN 20
 #define NRAND 3000
 
-static int n_checks = 0, n_failed = 0;
 static double work[200000];
 static const size_t LWORK = sizeof work / sizeof work[0];
-
-static void check(int ok, const char *what, double val, double tol)
-{
-    ++n_checks;
-    if (!ok)
-        ++n_failed;
-    printf("%s  %-60s  %.3e (tol %.1e)\n", ok ? "ok  " : "FAIL", what, val,
-           tol);
-}
-
-static void check_status(int got, int want, const char *what)
-{
-    ++n_checks;
-    if (got != want)
-        ++n_failed;
-    printf("%s  %-60s  status %d (want %d)\n", got == want ? "ok  " : "FAIL",
-           what, got, want);
-}
-
-static uint64_t rng_state = 0x13198a2e03707344ULL;
-static uint64_t rng_next(void)
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-static double urand(void)
-{
-    return ((double)(rng_next() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-}
-static double nrand(void)
-{
-    return sqrt(-2.0 * log(urand())) * cos(6.283185307179586 * urand());
-}
-
-static void randn(double *a, int n)
-{
-    int i;
-    for (i = 0; i < n; ++i)
-        a[i] = nrand();
-}
-
-static void matmul(int m, int k, int n, const double *a, const double *b,
-                   double *c)
-{
-    int i, j, l;
-    for (i = 0; i < m; ++i)
-        for (j = 0; j < n; ++j) {
-            double acc = 0.0;
-            for (l = 0; l < k; ++l)
-                acc += a[i * k + l] * b[l * n + j];
-            c[i * n + j] = acc;
-        }
-}
 
 /* y = a^T x, a m x n */
 static void matvec_t(int m, int n, const double *a, const double *x,
@@ -644,7 +591,6 @@ static void test_invalid(void)
     check_status(mcg_cls_range(5, 3, 2, a, c, 0.0, x, &resid, work, LWORK),
                  MCG_EDEGENERATE, "range G = 0 -> EDEGENERATE");
 }
-
 
 /* ---------------------------------------------- exact-size workspaces */
 

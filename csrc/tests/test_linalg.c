@@ -9,6 +9,9 @@
  */
 #include "mcgeom.h"
 
+#define TEST_SEED 0x9e3779b97f4a7c15ULL
+#include "testutil.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -21,68 +24,8 @@
 #define MAXN 64
 #define BIG (MAXM * MAXM)
 
-static int n_checks = 0, n_failed = 0;
-
-static void check(int ok, const char *what, double val, double tol)
-{
-    ++n_checks;
-    if (!ok)
-        ++n_failed;
-    printf("%s  %-58s  %.3e (tol %.1e)\n", ok ? "ok  " : "FAIL", what, val,
-           tol);
-}
-
-static void check_status(int got, int want, const char *what)
-{
-    ++n_checks;
-    if (got != want)
-        ++n_failed;
-    printf("%s  %-58s  status %d (want %d)\n", got == want ? "ok  " : "FAIL",
-           what, got, want);
-}
-
-/* ---- deterministic PRNG (splitmix64) */
-static uint64_t rng_state = 0x9e3779b97f4a7c15ULL;
-static uint64_t rng_next(void)
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-static double urand(void) /* (0, 1) */
-{
-    return ((double)(rng_next() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-}
-static double nrand(void)
-{
-    const double two_pi = 6.283185307179586;
-    return sqrt(-2.0 * log(urand())) * cos(two_pi * urand());
-}
-
 /* ---- small helpers */
 static double work[4 * BIG + 64 * MAXM];
-
-static void randn(double *a, int n)
-{
-    int i;
-    for (i = 0; i < n; ++i)
-        a[i] = nrand();
-}
-
-/* c (m x n) = a (m x k) b (k x n) */
-static void matmul(int m, int k, int n, const double *a, const double *b,
-                   double *c)
-{
-    int i, j, l;
-    for (i = 0; i < m; ++i)
-        for (j = 0; j < n; ++j) {
-            double acc = 0.0;
-            for (l = 0; l < k; ++l)
-                acc += a[i * k + l] * b[l * n + j];
-            c[i * n + j] = acc;
-        }
-}
 
 static void transpose(int m, int n, const double *a, double *at)
 {
@@ -946,7 +889,6 @@ static void test_invalid(void)
     check_status(mcg_project_so3(b, c), MCG_EINVAL, "project_so3 NaN");
     check_status(mcg_project_so3(NULL, c), MCG_EINVAL, "project_so3 NULL");
 }
-
 
 /* ---------------------------------------------- exact-size workspaces */
 

@@ -14,49 +14,15 @@
  */
 #include "mcgeom.h"
 
+#define TEST_SEED 0x243f6a8885a308d3ULL
+#include "testutil.h"
+
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
 #define NPTS 30
-
-static int n_checks = 0, n_failed = 0;
-
-static void check(int ok, const char *what, double val, double tol)
-{
-    ++n_checks;
-    if (!ok)
-        ++n_failed;
-    printf("%s  %-58s  %.3e (tol %.1e)\n", ok ? "ok  " : "FAIL", what, val,
-           tol);
-}
-
-static void check_status(int got, int want, const char *what)
-{
-    ++n_checks;
-    if (got != want)
-        ++n_failed;
-    printf("%s  %-58s  status %d (want %d)\n", got == want ? "ok  " : "FAIL",
-           what, got, want);
-}
-
-static uint64_t rng_state = 0x243f6a8885a308d3ULL;
-static uint64_t rng_next(void)
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-static double urand(void)
-{
-    return ((double)(rng_next() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-}
-static double nrand(void)
-{
-    return sqrt(-2.0 * log(urand())) * cos(6.283185307179586 * urand());
-}
 
 static void cross(const double a[3], const double b[3], double c[3])
 {

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from typing import Optional
 
+import numpy as np
+
 from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
@@ -81,7 +83,7 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
         options = _core.Linear17Options(refine=refine, max_iterations=max_iterations,
                                         tolerance=tolerance, max_scale_rel_std=max_scale_rel_std)
     st, r = _core.linear17(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, options)
-    if st != 0:
+    if st != _core.STATUS_OK:
         _raise(st, r, rays, n)
     info = {
         "camera_kind": r["gc_case"],
@@ -105,9 +107,7 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
 
 def _raise(status: int, r: dict, rays: RayPairs, n: int) -> None:
     """Turn a kernel failure into an exception that names the problem."""
-    import numpy as np
-
-    if status == 1:  # MCG_EINVAL: find which argument is at fault
+    if status == _core.STATUS_EINVAL:  # find which argument is at fault
         for name in ("origins1", "dirs1", "origins2", "dirs2"):
             if not np.isfinite(getattr(rays, name)).all():
                 raise ValueError(f"rays.{name} contains NaN or inf")
@@ -115,7 +115,7 @@ def _raise(status: int, r: dict, rays: RayPairs, n: int) -> None:
             if (np.linalg.norm(getattr(rays, name), axis=1) == 0).any():
                 raise ValueError(f"rays.{name} contains a zero-length direction")
         _core.raise_for(status, "linear17")
-    if status == 5:
+    if status == _core.STATUS_EDEGENERATE:
         kind = r["gc_case"]
         if kind == "degenerate":
             raise DegenerateError(

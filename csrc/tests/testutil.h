@@ -1,0 +1,75 @@
+/* testutil.h -- shared by the plain-C kernel tests: check counters that print
+ * one line per check, and a deterministic splitmix64 generator. Define
+ * TEST_SEED before including to give each test its own stream. */
+#ifndef MCGEOM_TESTUTIL_H
+#define MCGEOM_TESTUTIL_H
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#ifndef TEST_SEED
+#define TEST_SEED 0x9e3779b97f4a7c15ULL
+#endif
+
+static int n_checks = 0, n_failed = 0;
+
+static inline void check(int ok, const char *what, double val, double tol)
+{
+    ++n_checks;
+    if (!ok)
+        ++n_failed;
+    printf("%s  %-60s  %.3e (tol %.1e)\n", ok ? "ok  " : "FAIL", what, val,
+           tol);
+}
+
+static inline void check_status(int got, int want, const char *what)
+{
+    ++n_checks;
+    if (got != want)
+        ++n_failed;
+    printf("%s  %-60s  status %d (want %d)\n", got == want ? "ok  " : "FAIL",
+           what, got, want);
+}
+
+static uint64_t rng_state = TEST_SEED;
+static inline uint64_t rng_next(void)
+{
+    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static inline double urand(void) /* uniform in (0, 1) */
+{
+    return ((double)(rng_next() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
+}
+
+static inline double nrand(void) /* standard normal (Box-Muller) */
+{
+    return sqrt(-2.0 * log(urand())) * cos(6.283185307179586 * urand());
+}
+
+static inline void randn(double *a, int n) /* n standard normal values */
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        a[i] = nrand();
+}
+
+/* c (m x n) = a (m x k) b (k x n), row-major, the textbook triple loop */
+static inline void matmul(int m, int k, int n, const double *a, const double *b,
+                   double *c)
+{
+    int i, j, l;
+    for (i = 0; i < m; ++i)
+        for (j = 0; j < n; ++j) {
+            double acc = 0.0;
+            for (l = 0; l < k; ++l)
+                acc += a[i * k + l] * b[l * n + j];
+            c[i * n + j] = acc;
+        }
+}
+
+#endif /* MCGEOM_TESTUTIL_H */
