@@ -836,6 +836,188 @@ int mcg_sym_eig(int n, double *a, double *w, double *v)
     return MCG_OK;
 }
 
+/* ------------------------------------- symmetric eigen, tridiagonal QR */
+
+/* Householder reduction of the symmetric n x n matrix a (upper triangle
+ * holding the symmetric part, overwritten) to tridiagonal form
+ * Q^T A Q = T: diagonal d[0..n-1], sub-diagonal e[0..n-2]; q (n x n,
+ * row-major) accumulates Q. Each reflector H = I - v v^T 2 / (v^T v)
+ * annihilates column k below the sub-diagonal and is applied to the
+ * trailing block as A - v w^T - w v^T with w = p - (v^T p / v^T v) v,
+ * p = 2 A v / (v^T v) (Golub & Van Loan, ch. 8.3.1). */
+static void tridiagonalize(size_t n, double *a, double *d, double *e, double *q)
+{
+    double v[SPD_MAX], p[SPD_MAX];
+    size_t i, j, k;
+    for (i = 0; i < n; ++i) /* full symmetric storage from the upper triangle */
+        for (j = 0; j < i; ++j)
+            a[i * n + j] = a[j * n + i];
+    memset(q, 0, n * n * sizeof(double));
+    for (i = 0; i < n; ++i)
+        q[i * n + i] = 1.0;
+    for (k = 0; k + 2 < n; ++k) {
+        size_t m = n - k - 1; /* length of the column part below the diagonal */
+        double norm2 = 0.0, alpha, beta, vp = 0.0, kk;
+        for (i = 0; i < m; ++i) {
+            v[i] = a[(k + 1 + i) * n + k];
+            norm2 += v[i] * v[i];
+        }
+        if (norm2 == 0.0) {
+            e[k] = 0.0;
+            continue;
+        }
+        /* alpha has the sign opposite to v0: no cancellation in v0 - alpha */
+        alpha = -copysign(sqrt(norm2), v[0]);
+        v[0] -= alpha;
+        beta = 2.0 * (norm2 - alpha * (v[0] + alpha)); /* v^T v */
+        e[k] = alpha;
+        for (i = 0; i < m; ++i) { /* p = 2 A22 v / beta */
+            double acc = 0.0;
+            const double *row = a + (k + 1 + i) * n + (k + 1);
+            for (j = 0; j < m; ++j)
+                acc += row[j] * v[j];
+            p[i] = 2.0 * acc / beta;
+            vp += v[i] * p[i];
+        }
+        kk = vp / beta;
+        for (i = 0; i < m; ++i) /* w = p - K v, stored in p */
+            p[i] -= kk * v[i];
+        for (i = 0; i < m; ++i) {
+            double *row = a + (k + 1 + i) * n + (k + 1);
+            for (j = 0; j < m; ++j)
+                row[j] -= v[i] * p[j] + p[i] * v[j];
+        }
+        for (i = 0; i < n; ++i) { /* Q <- Q H on columns k+1.. */
+            double *row = q + i * n + (k + 1), acc = 0.0;
+            for (j = 0; j < m; ++j)
+                acc += row[j] * v[j];
+            acc *= 2.0 / beta;
+            for (j = 0; j < m; ++j)
+                row[j] -= acc * v[j];
+        }
+    }
+    for (i = 0; i < n; ++i)
+        d[i] = a[i * n + i];
+    if (n >= 2)
+        e[n - 2] = a[(n - 1) * n + (n - 2)];
+}
+
+/* Implicit symmetric QR with Wilkinson shift on the tridiagonal (d, e),
+ * rotations accumulated into the columns of q (Golub & Van Loan,
+ * Algorithm 8.3.3). Returns 0 if the iteration budget ran out. */
+static int tridiagonal_qr(size_t n, double *d, double *e, double *q)
+{
+    size_t hi = n - 1, budget = 40 * n, i;
+    while (hi > 0) {
+        size_t lo, k;
+        double delta, b, mu, x, z;
+        /* deflate negligible couplings at the bottom */
+        if (fabs(e[hi - 1]) <= DBL_EPSILON * (fabs(d[hi - 1]) + fabs(d[hi]))) {
+            e[hi - 1] = 0.0;
+            --hi;
+            continue;
+        }
+        if (budget-- == 0)
+            return 0;
+        lo = hi - 1;
+        while (lo > 0 && fabs(e[lo - 1]) > DBL_EPSILON * (fabs(d[lo - 1]) + fabs(d[lo])))
+            --lo;
+        if (lo > 0)
+            e[lo - 1] = 0.0;
+        /* Wilkinson shift: the eigenvalue of the trailing 2 x 2 nearer d[hi] */
+        delta = 0.5 * (d[hi - 1] - d[hi]);
+        b = e[hi - 1];
+        mu = d[hi] - b * b / (delta + copysign(sqrt(delta * delta + b * b), delta));
+        x = d[lo] - mu;
+        z = e[lo];
+        for (k = lo; k < hi; ++k) {
+            /* rotation G = [c s; -s c] on (k, k+1) with s x + c z = 0 */
+            /* sqrt of squares unless they could underflow (hypot is slow) */
+            double r = sqrt(x * x + z * z), c, s, a0, b0, c0;
+            if (r < 1e-150)
+                r = hypot(x, z);
+            if (r == 0.0) {
+                c = 1.0;
+                s = 0.0;
+            } else {
+                double inv = 1.0 / r;
+                c = x * inv;
+                s = -z * inv;
+            }
+            if (k > lo)
+                e[k - 1] = c * x - s * z; /* the bulge is annihilated */
+            a0 = d[k];
+            b0 = e[k];
+            c0 = d[k + 1];
+            /* the 2 x 2 block of G^T T G */
+            d[k] = c * c * a0 - 2.0 * c * s * b0 + s * s * c0;
+            d[k + 1] = s * s * a0 + 2.0 * c * s * b0 + c * c * c0;
+            e[k] = c * s * (a0 - c0) + (c * c - s * s) * b0;
+            if (k + 1 < hi) {
+                z = -s * e[k + 1]; /* new bulge at (k, k+2) */
+                e[k + 1] *= c;
+                x = e[k];
+            }
+            for (i = 0; i < n; ++i) {
+                double qk = q[i * n + k], ql = q[i * n + k + 1];
+                q[i * n + k] = c * qk - s * ql;
+                q[i * n + k + 1] = s * qk + c * ql;
+            }
+        }
+    }
+    return 1;
+}
+
+int mcg_sym_eig_tridiag(int n, double *a, double *w, double *v)
+{
+    double e[SPD_MAX];
+    size_t nn, i, j;
+    int ex;
+    if (n < 1 || n > SPD_MAX)
+        return MCG_EINVAL;
+    if (a == NULL || w == NULL || v == NULL || a == v)
+        return MCG_EINVAL;
+    nn = (size_t)n;
+    if (!all_finite(a, nn * nn))
+        return MCG_EINVAL;
+    /* symmetric part scaled by a power of two (exact) so that max |a_ij| is
+     * in [0.5, 1): no overflow or harmful underflow in the rotations */
+    ex = scale_exponent(max_abs(a, nn * nn));
+    {
+        double f = 0.5 * ldexp(1.0, -ex); /* |ex| <= 1074: f is normal or... */
+        int exact = f >= DBL_MIN && f <= 1e300; /* ...then multiplying is exact */
+        for (i = 0; i < nn; ++i)
+            for (j = i; j < nn; ++j)
+                a[i * nn + j] = exact ? f * a[i * nn + j] + f * a[j * nn + i]
+                                      : 0.5 * ldexp(a[i * nn + j], -ex) +
+                                            0.5 * ldexp(a[j * nn + i], -ex);
+    }
+    tridiagonalize(nn, a, w, e, v);
+    if (!tridiagonal_qr(nn, w, e, v))
+        return MCG_ENUMERIC;
+    for (i = 0; i + 1 < nn; ++i) { /* ascending, columns of v along */
+        size_t best = i;
+        for (j = i + 1; j < nn; ++j)
+            if (w[j] < w[best])
+                best = j;
+        if (best != i) {
+            double t = w[i];
+            w[i] = w[best];
+            w[best] = t;
+            for (j = 0; j < nn; ++j) {
+                t = v[j * nn + i];
+                v[j * nn + i] = v[j * nn + best];
+                v[j * nn + best] = t;
+            }
+        }
+    }
+    for (i = 0; i < nn; ++i)
+        w[i] = ldexp(w[i], ex);
+    if (!all_finite(w, nn) || !all_finite(v, nn * nn))
+        return MCG_ENUMERIC;
+    return MCG_OK;
+}
+
 /* ------------------------------------------------------------ Cholesky */
 
 int mcg_spd_solve(int n, const double *a, const double *b, double *x)

@@ -87,6 +87,20 @@ static void matvec(int n, const double *m, const double *x, double *y)
     }
 }
 
+/* y (+)= M[:, c0:c0+9] x for the 18 x 18 Gram matrix M. */
+static void matvec_cols(const double *m, int c0, const double x[9], double y[NX],
+                        int add)
+{
+    int i, k;
+    for (i = 0; i < NX; i++) {
+        const double *mi = m + i * NX + c0;
+        double acc = add ? y[i] : 0.0;
+        for (k = 0; k < 9; k++)
+            acc += mi[k] * x[k];
+        y[i] = acc;
+    }
+}
+
 static double quad18(const double *m, const double *x)
 {
     double y[NX], acc = 0.0;
@@ -123,9 +137,11 @@ static int make_row(const double *o1, const double *d1, const double *o2,
     nb = sqrt(dot3(b, b));
     if (!(na > 0.0) || !(nb > 0.0) || !isfinite(na) || !isfinite(nb))
         return 0;
+    na = 1.0 / na;
+    nb = 1.0 / nb;
     for (i = 0; i < 3; i++) {
-        a[i] /= na;
-        b[i] /= nb;
+        a[i] *= na;
+        b[i] *= nb;
     }
     cross3(p, a, m1);
     cross3(q, b, m2);
@@ -165,16 +181,27 @@ static int accumulate(int n, const double *o1, const double *d1,
     memcpy(origin, o, sizeof o);
     *scale = s;
 
+    /* rank-4 updates of the upper triangle: a quarter of the loads and
+     * stores of M per row, the products of 4 rows summed in registers */
     memset(m, 0, NX * NX * sizeof(double));
-    for (k = 0; k < n; k++) {
-        double row[NX];
-        if (!make_row(o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k, o, s, row))
-            return MCG_EINVAL;
+    for (k = 0; k < n; k += 4) {
+        double rows[4][NX];
+        int r, nb = n - k < 4 ? n - k : 4;
+        for (r = 0; r < 4; r++) {
+            if (r >= nb) {
+                memset(rows[r], 0, sizeof rows[r]);
+                continue;
+            }
+            if (!make_row(o1 + 3 * (k + r), d1 + 3 * (k + r), o2 + 3 * (k + r),
+                          d2 + 3 * (k + r), o, s, rows[r]))
+                return MCG_EINVAL;
+        }
         for (i = 0; i < NX; i++) {
-            double ri = row[i];
+            double a0 = rows[0][i], a1 = rows[1][i], a2 = rows[2][i], a3 = rows[3][i];
             double *mi = m + i * NX;
             for (j = i; j < NX; j++)
-                mi[j] += ri * row[j];
+                mi[j] += a0 * rows[0][j] + a1 * rows[1][j] + a2 * rows[2][j] +
+                         a3 * rows[3][j];
         }
     }
     for (i = 0; i < NX; i++)
@@ -270,7 +297,7 @@ typedef struct {
 /* Cost in t for fixed R is t^T H t + 2 g^T t + c0 with
  * H_kl = b_k^T M_EE b_l, b_k = vec([e_k]x R), g_k = b_k^T M_ER vec R. */
 static int solve_t(const double *m, const double r[9], int unit_mode,
-                   const double tprev[3], tsolve *out)
+                   const double tprev[3], int want_eig, tsolve *out)
 {
     double b[3][9], mb[3][9], mee[81], mer[81], mervr[9], h[9], g[3];
     double c0 = 0.0, hmax;
@@ -305,6 +332,22 @@ static int solve_t(const double *m, const double r[9], int unit_mode,
     memcpy(out->hm, h, sizeof out->hm);
     memcpy(out->g, g, sizeof out->g);
     out->c0 = c0;
+    if (!unit_mode && !want_eig) {
+        /* Fast path (candidate costs, alternation): Cholesky solve of
+         * H t = -g; the eigen-decomposition (for the scale evidence) is only
+         * needed for the final estimate. cond/h/hv are left unset (-1). */
+        double mg[3] = {-g[0], -g[1], -g[2]};
+        if (mcg_spd_solve(3, h, mg, out->t) == MCG_OK) {
+            double ht[3];
+            out->cond = -1.0;
+            matvec(3, h, out->t, ht);
+            out->cost = dot3(out->t, ht) + 2.0 * dot3(g, out->t) + c0;
+            if (out->cost < 0.0)
+                out->cost = 0.0;
+            return MCG_OK;
+        }
+        /* H (numerically) singular: the eigen route truncates its null space */
+    }
     {
         double hc[9];
         memcpy(hc, h, sizeof hc);
@@ -433,85 +476,103 @@ static void exact_mx(const raydata *rd, const double x[NX], double mx[NX])
     }
 }
 
+/* One joint Gauss-Newton step on (R, t), R <- exp([d_w]x) R, t <- t + d_t.
+ * With rd the gradient J^T M x is computed exactly from the rays (an
+ * iterative-refinement step, always taken); otherwise from the Gram matrix
+ * and the step is taken only if it does not raise the cost beyond the
+ * rounding of M (trm = trace M). Returns 1 if taken, 0 if not, and the step
+ * length in *len. */
+static int gn_step(const double *m, const raydata *rd, double trm, double r[9],
+                   double t[3], double *cost, double *len)
+{
+    double x0[NX], j[6][NX], mj[6][NX], mx0[NX], a[36], rhs[6], d[6];
+    double tr = 0.0, rn[9], tn[3], dr[9], xn[NX], cn;
+    int k, l, i;
+    motion_vector(r, t, x0);
+    if (rd)
+        exact_mx(rd, x0, mx0);
+    else
+        matvec(NX, m, x0, mx0);
+    for (k = 0; k < 3; k++) {
+        double e[3] = {0.0, 0.0, 0.0}, er[9];
+        e[k] = 1.0;
+        skew_times(e, r, er);
+        skew_times(t, er, j[k]);              /* d x / d w_k */
+        memcpy(j[k] + 9, er, sizeof er);
+        memcpy(j[3 + k], er, sizeof er);      /* d x / d t_k */
+        memset(j[3 + k] + 9, 0, 9 * sizeof(double));
+    }
+    /* M j with the zero R-part of the t-columns skipped: M [q; p] =
+     * M_:E q + M_:R p and M [p; 0] = M_:E p */
+    for (k = 0; k < 3; k++) {
+        matvec_cols(m, 0, j[k], mj[k], 0);
+        matvec_cols(m, 9, j[k] + 9, mj[k], 1);
+        matvec_cols(m, 0, j[3 + k], mj[3 + k], 0);
+    }
+    for (k = 0; k < 6; k++) {
+        rhs[k] = 0.0;
+        for (i = 0; i < NX; i++)
+            rhs[k] -= j[k][i] * mx0[i];
+        for (l = k; l < 6; l++) { /* J^T M J is symmetric */
+            double acc = 0.0;
+            for (i = 0; i < NX; i++)
+                acc += j[k][i] * mj[l][i];
+            a[6 * k + l] = acc;
+            a[6 * l + k] = acc;
+        }
+        tr += a[7 * k];
+    }
+    *len = 0.0;
+    if (!(tr > 0.0))
+        return 0;
+    for (k = 0; k < 6; k++)
+        a[7 * k] += 1e-14 * tr;
+    if (mcg_spd_solve(6, a, rhs, d) != MCG_OK)
+        return 0;
+    if (mcg_rot_from_angle_axis(d, dr) != MCG_OK)
+        return 0;
+    mul33(dr, r, rn);
+    for (k = 0; k < 3; k++)
+        tn[k] = t[k] + d[3 + k];
+    motion_vector(rn, tn, xn);
+    cn = quad18(m, xn);
+    /* near the minimum the cost is flat to rounding (|M| eps) long before
+     * the parameters are: accept steps that do not raise it beyond that */
+    if (!rd && !(cn <= *cost + 64.0 * DBL_EPSILON * trm))
+        return 0;
+    memcpy(r, rn, sizeof rn);
+    memcpy(t, tn, sizeof tn);
+    *cost = cn > 0.0 ? cn : 0.0;
+    for (k = 0; k < 6; k++)
+        *len += d[k] * d[k];
+    *len = sqrt(*len);
+    return 1;
+}
+
+#define POLISH_MAX_STEPS 20
+#define POLISH_EXACT_STEPS 1
+
 static int polish(const double *m, double r[9], double t[3], double *cost,
                   const raydata *rd)
 {
-    int it, k, l, i;
-    for (it = 0; it < 22; it++) {
-        /* the last steps use the exact gradient (iterative refinement) */
-        int exact = rd != NULL && it >= 20;
-        double x0[NX], j[6][NX], mj[6][NX], mx0[NX], a[36], rhs[6], d[6];
-        double step = 0.0, tr = 0.0, rn[9], tn[3], dr[9], xn[NX], cn;
-        double trm = 0.0;
-        motion_vector(r, t, x0);
-        if (exact)
-            exact_mx(rd, x0, mx0);
-        else
-            matvec(NX, m, x0, mx0);
-        for (k = 0; k < 3; k++) {
-            double e[3] = {0.0, 0.0, 0.0}, er[9];
-            e[k] = 1.0;
-            skew_times(e, r, er);
-            skew_times(t, er, j[k]);              /* d x / d w_k */
-            memcpy(j[k] + 9, er, sizeof er);
-            memcpy(j[3 + k], er, sizeof er);      /* d x / d t_k */
-            memset(j[3 + k] + 9, 0, 9 * sizeof(double));
-        }
-        for (k = 0; k < 6; k++)
-            matvec(NX, m, j[k], mj[k]);
-        for (k = 0; k < 6; k++) {
-            rhs[k] = 0.0;
-            for (i = 0; i < NX; i++)
-                rhs[k] -= j[k][i] * mx0[i];
-            for (l = 0; l < 6; l++) {
-                double acc = 0.0;
-                for (i = 0; i < NX; i++)
-                    acc += j[k][i] * mj[l][i];
-                a[6 * k + l] = acc;
-            }
-            tr += a[7 * k];
-        }
-        if (!(tr > 0.0))
+    double trm = 0.0, len, prev = HUGE_VAL;
+    int k, steps = 0;
+    for (k = 0; k < NX; k++)
+        trm += m[k * NX + k];
+    /* Gauss-Newton on the Gram matrix contracts the step geometrically until
+     * the rounding of M is reached; past that the steps only wander at the
+     * noise floor. Stop when a step is refused, tiny or no longer shrinking. */
+    while (steps < POLISH_MAX_STEPS) {
+        int taken = gn_step(m, NULL, trm, r, t, cost, &len);
+        steps++;
+        if (!taken || len <= 1e-15 * (1.0 + sqrt(dot3(t, t))) || len > 0.5 * prev)
             break;
-        for (k = 0; k < NX; k++)
-            trm += m[k * NX + k];
-        for (k = 0; k < 6; k++)
-            a[7 * k] += 1e-14 * tr;
-        if (mcg_spd_solve(6, a, rhs, d) != MCG_OK)
-            break;
-        if (mcg_rot_from_angle_axis(d, dr) != MCG_OK)
-            return it;
-        mul33(dr, r, rn);
-        for (k = 0; k < 3; k++)
-            tn[k] = t[k] + d[3 + k];
-        motion_vector(rn, tn, xn);
-        cn = quad18(m, xn);
-        if (exact) {
-            memcpy(r, rn, sizeof rn);
-            memcpy(t, tn, sizeof tn);
-            *cost = cn > 0.0 ? cn : 0.0;
-            continue;
-        }
-        /* near the minimum the cost is flat to rounding (|M| eps) long before
-         * the parameters are: accept steps that do not raise it beyond that
-         * and stop on the step length, which the gradient fixes accurately */
-        if (!(cn <= *cost + 64.0 * DBL_EPSILON * trm)) {
-            if (rd == NULL)
-                break;
-            it = 19; /* at the minimum to rounding: finish with exact steps */
-            continue;
-        }
-        memcpy(r, rn, sizeof rn);
-        memcpy(t, tn, sizeof tn);
-        *cost = cn;
-        for (k = 0; k < 6; k++)
-            step += d[k] * d[k];
-        if (sqrt(step) <= 1e-15 * (1.0 + sqrt(dot3(t, t))))
-            it = (rd != NULL && it < 20) ? 19 : it; /* go to the exact steps */
-        if (rd == NULL && it == 19)
-            return it + 1;
+        prev = len;
     }
-    return it;
+    /* then exact-gradient steps reach the minimum to rounding of the rays */
+    for (k = 0; k < POLISH_EXACT_STEPS; k++, steps++)
+        gn_step(m, rd, trm, r, t, cost, &len);
+    return steps;
 }
 
 /* ------------------------------------------------- cheirality */
@@ -665,7 +726,7 @@ static int linear_step(const double *m, int gc_case,
                     acc += mer[9 * i + k] * q[9 * k + j];
                 s[9 * i + j] -= acc;
             }
-        if (mcg_sym_eig(9, s, ws, vs) != MCG_OK)
+        if (mcg_sym_eig_tridiag(9, s, ws, vs) != MCG_OK)
             return MCG_ENUMERIC;
         for (k = 0; k < 9; k++)
             res->schur_eig[k] = ws[8] > 0.0 ? ws[k] / ws[8] : 0.0;
@@ -764,7 +825,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
 
     /* generalized camera kind from the structural null space of A_R */
     block(m, 9, 9, mrr);
-    if (mcg_sym_eig(9, mrr, wr, vr) != MCG_OK)
+    if (mcg_sym_eig_tridiag(9, mrr, wr, vr) != MCG_OK)
         return MCG_ENUMERIC;
     for (k = 0; k < 9; k++)
         res->ar_eig[k] = wr[8] > 0.0 ? (wr[k] > 0.0 ? wr[k] / wr[8] : 0.0) : 0.0;
@@ -797,7 +858,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
     {
         double bestcost = HUGE_VAL;
         for (k = 0; k < ncand; k++) {
-            if (solve_t(m, cand[k], 0, NULL, &ts) != MCG_OK)
+            if (solve_t(m, cand[k], 0, NULL, 0, &ts) != MCG_OK)
                 return MCG_ENUMERIC;
             res->candidate_cost[k] = ts.cost;
             if (ts.cost < bestcost) {
@@ -806,7 +867,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
             }
         }
         memcpy(rbest, cand[best], sizeof rbest);
-        if (solve_t(m, rbest, 0, NULL, &ts) != MCG_OK)
+        if (solve_t(m, rbest, 0, NULL, 1, &ts) != MCG_OK)
             return MCG_ENUMERIC;
         memcpy(tbest, ts.t, sizeof tbest);
         cost = ts.cost;
@@ -820,7 +881,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
                 int sg;
                 if (res->candidate_cost[k] > 10.0 * bestcost + tiny)
                     continue;
-                if (solve_t(m, cand[k], 1, NULL, &ts) != MCG_OK)
+                if (solve_t(m, cand[k], 1, NULL, 1, &ts) != MCG_OK)
                     return MCG_ENUMERIC;
                 for (sg = -1; sg <= 1; sg += 2) {
                     double tt[3], tr[3], rc[3];
@@ -860,7 +921,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
             }
             if (step_r(m, rbest, tbest, &cost) != MCG_OK)
                 return MCG_ENUMERIC;
-            if (solve_t(m, rbest, unit_mode, tbest, &ts) != MCG_OK)
+            if (solve_t(m, rbest, unit_mode, tbest, 0, &ts) != MCG_OK)
                 return MCG_ENUMERIC;
             if (ts.cost <= cost || !unit_mode) {
                 memcpy(tbest, ts.t, sizeof tbest);
@@ -900,7 +961,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
 
     /* scale observability: conditioning of the scale equation and the
      * first-order std of |t| from the residual (normalised frame) */
-    if (solve_t(m, rbest, unit_mode, tbest, &ts) != MCG_OK)
+    if (solve_t(m, rbest, unit_mode, tbest, 1, &ts) != MCG_OK)
         return MCG_ENUMERIC;
     /* (t stays as refined: ts only supplies H for the evidence) */
     res->scale_conditioning = ts.cond;

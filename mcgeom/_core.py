@@ -133,8 +133,15 @@ def pinv(a: Any, rcond: float = 0.0) -> tuple[np.ndarray, int]:
     return out, int(rank[0])
 
 
-def sym_eig(a: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Eigenvalues (ascending) and eigenvectors (columns) of a symmetric matrix."""
+def sym_eig(a: Any, method: str = "jacobi") -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (ascending) and eigenvectors (columns) of a symmetric matrix.
+
+    ``method`` "jacobi" (``mcg_sym_eig``, relatively accurate small eigenvalues)
+    or "tridiag" (``mcg_sym_eig_tridiag``, faster, absolute accuracy, n <= 64).
+    """
+    fns = {"jacobi": lib.mcg_sym_eig, "tridiag": lib.mcg_sym_eig_tridiag}
+    if method not in fns:
+        raise ValueError(f"method must be one of {sorted(fns)}, got {method!r}")
     a = _arr("a", a, (-1, -1)).copy()
     _nonempty("a", a)
     n = a.shape[0]
@@ -142,7 +149,7 @@ def sym_eig(a: Any) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"a must be square, got shape {a.shape}")
     w = np.empty(n)
     v = np.empty((n, n))
-    _check(lib.mcg_sym_eig(n, _p(a), _p(w), _p(v)), "sym_eig")
+    _check(fns[method](n, _p(a), _p(w), _p(v)), f"sym_eig ({method})")
     return w, v
 
 
@@ -305,6 +312,8 @@ _DEFAULT_L17 = Linear17Options()
 _L17_DOUBLES = {name: ffi.offsetof("mcg_linear17_result", name) // 8
                 for name in ("R", "t", "t_metric", "E", "ar_eig", "schur_eig", "candidate_cost",
                              "norm_origin")}
+# the struct holds only doubles and ints, so it is 8-byte aligned
+_L17_NDOUBLES = -(-ffi.sizeof("mcg_linear17_result") // 8)
 
 
 def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
@@ -316,23 +325,24 @@ def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
     The caller decides how to report a non-OK status (``raise_for``).
     """
     n = origins1.shape[0]
-    res = ffi.new("mcg_linear17_result *")
+    # The result struct lives in a fresh numpy buffer: the array fields below
+    # are views of it (no per-field copies; the buffer is owned by the result).
+    f64 = np.empty(_L17_NDOUBLES, dtype=np.float64)
+    res = ffi.cast("mcg_linear17_result *", ffi.from_buffer(f64))
     opt = (options or _DEFAULT_L17)._c
     st = lib.mcg_linear17(n, _p(origins1), _p(dirs1), _p(origins2), _p(dirs2), opt, res)
-    raw = np.frombuffer(ffi.buffer(res), dtype=np.uint8)
     d = _L17_DOUBLES
-    f64 = raw[: (ffi.sizeof("mcg_linear17_result") // 8) * 8].view(np.float64)
     out = {
-        "R": f64[d["R"]:d["R"] + 9].reshape(3, 3).copy(),
-        "t": f64[d["t"]:d["t"] + 3].copy(),
-        "t_metric": f64[d["t_metric"]:d["t_metric"] + 3].copy(),
-        "E": f64[d["E"]:d["E"] + 9].reshape(3, 3).copy(),
+        "R": f64[d["R"]:d["R"] + 9].reshape(3, 3),
+        "t": f64[d["t"]:d["t"] + 3],
+        "t_metric": f64[d["t_metric"]:d["t_metric"] + 3],
+        "E": f64[d["E"]:d["E"] + 9].reshape(3, 3),
         "gc_case": GC_CASE_NAMES.get(res.gc_case, "degenerate"),
         "rank_ar": res.rank_ar,
         "rank_a": res.rank_a,
-        "ar_eig": f64[d["ar_eig"]:d["ar_eig"] + 9].copy(),
-        "schur_eig": f64[d["schur_eig"]:d["schur_eig"] + 9].copy(),
-        "candidate_cost": f64[d["candidate_cost"]:d["candidate_cost"] + res.n_candidates].copy(),
+        "ar_eig": f64[d["ar_eig"]:d["ar_eig"] + 9],
+        "schur_eig": f64[d["schur_eig"]:d["schur_eig"] + 9],
+        "candidate_cost": f64[d["candidate_cost"]:d["candidate_cost"] + res.n_candidates],
         "cost_linear": res.cost_linear,
         "cost_final": res.cost_final,
         "iterations": res.iterations,
@@ -343,7 +353,7 @@ def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
         "scale_conditioning": res.scale_conditioning,
         "scale_rel_std": res.scale_rel_std,
         "n_in_front": res.n_in_front,
-        "norm_origin": f64[d["norm_origin"]:d["norm_origin"] + 3].copy(),
+        "norm_origin": f64[d["norm_origin"]:d["norm_origin"] + 3],
         "norm_scale": res.norm_scale,
     }
     return st, out

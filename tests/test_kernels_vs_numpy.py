@@ -193,8 +193,9 @@ def test_pinv_matches_numpy(m, n, seed, deficient):
 # ------------------------------------------------------------------- sym_eig
 
 @SETTINGS
-@given(n=st.integers(1, 20), seed=seeds, kind=st.sampled_from(["gauss", "psd", "clustered"]))
-def test_sym_eig_matches_eigh(n, seed, kind):
+@given(n=st.integers(1, 20), seed=seeds, kind=st.sampled_from(["gauss", "psd", "clustered"]),
+       method=st.sampled_from(["jacobi", "tridiag"]))
+def test_sym_eig_matches_eigh(n, seed, kind, method):
     rng = _rng(seed)
     if kind == "gauss":
         b = rng.standard_normal((n, n))
@@ -207,7 +208,7 @@ def test_sym_eig_matches_eigh(n, seed, kind):
         q = _orth(rng, n)
         a = (q * w0) @ q.T
         a = 0.5 * (a + a.T)
-    w, v = _core.sym_eig(a)
+    w, v = _core.sym_eig(a, method)
     w_np, v_np = np.linalg.eigh(a)
     na = np.abs(a).max()
     assert np.all(np.diff(w) >= 0)
@@ -222,10 +223,11 @@ def test_sym_eig_matches_eigh(n, seed, kind):
             assert _same_up_to_sign(v[:, j], v_np[:, j]) <= 1e-13 * n * na / gap
 
 
-def test_sym_eig_uses_the_symmetric_part():
+@pytest.mark.parametrize("method", ["jacobi", "tridiag"])
+def test_sym_eig_uses_the_symmetric_part(method):
     rng = _rng(5)
     b = rng.standard_normal((9, 9))
-    w, _ = _core.sym_eig(b)
+    w, _ = _core.sym_eig(b, method)
     assert np.allclose(w, np.linalg.eigvalsh(0.5 * (b + b.T)), atol=1e-13)
 
 

@@ -432,7 +432,9 @@ static void test_pinv(void)
 
 /* ------------------------------------------------------------ sym_eig */
 
-static void eig_case(int n, const double *a0, const double *w_true,
+typedef int (*eig_fn)(int, double *, double *, double *);
+
+static void eig_case(eig_fn eig, int n, const double *a0, const double *w_true,
                      const char *label)
 {
     static double a[MAXN * MAXN], v[MAXN * MAXN], av[MAXN * MAXN];
@@ -440,7 +442,7 @@ static void eig_case(int n, const double *a0, const double *w_true,
     char what[160];
     int i, k, st, asc = 1;
     memcpy(a, a0, (size_t)(n * n) * sizeof(double));
-    st = mcg_sym_eig(n, a, w, v);
+    st = eig(n, a, w, v);
     snprintf(what, sizeof what, "sym_eig %s n=%d status", label, n);
     check_status(st, MCG_OK, what);
     na = max_abs(a0, n * n);
@@ -476,8 +478,11 @@ static void eig_case(int n, const double *a0, const double *w_true,
     }
 }
 
-static void test_sym_eig(void)
+/* Both symmetric eigen-solvers (cyclic Jacobi and tridiagonal QR) pass the
+ * same checks; label carries the solver's name. */
+static void test_sym_eig_with(eig_fn eig, const char *name)
 {
+    char label[64];
     static double a[MAXN * MAXN], q[MAXN * MAXN], b[MAXN * MAXN];
     double w_true[MAXN];
     static const int sizes[] = {1, 2, 3, 9, 18, 40, 64};
@@ -491,7 +496,8 @@ static void test_sym_eig(void)
                 double s = 0.5 * (a[i * n + j] + a[j * n + i]);
                 a[i * n + j] = a[j * n + i] = s;
             }
-        eig_case(n, a, NULL, "gauss");
+        snprintf(label, sizeof label, "%s gauss", name);
+        eig_case(eig, n, a, NULL, label);
         /* known spectrum with repeats and a wide range, in random basis */
         for (k = 0; k < n; ++k)
             w_true[k] = (k < n / 3) ? -1.0 : (k < n / 2 ? 1e-9 : (double)k);
@@ -506,7 +512,8 @@ static void test_sym_eig(void)
         for (i = 0; i < n; ++i) /* exact symmetry */
             for (j = 0; j < i; ++j)
                 a[i * n + j] = a[j * n + i];
-        eig_case(n, a, w_true, "known");
+        snprintf(label, sizeof label, "%s known", name);
+        eig_case(eig, n, a, w_true, label);
     }
     /* PSD rank 5: B^T B with B 5 x 18 -> 13 eigenvalues ~ 0 */
     randn(b, 5 * 18);
@@ -517,17 +524,18 @@ static void test_sym_eig(void)
                 acc += b[k * 18 + i] * b[k * 18 + j];
             a[i * 18 + j] = acc;
         }
-    eig_case(18, a, NULL, "psd-rank5");
+    snprintf(label, sizeof label, "%s psd-rank5", name);
+    eig_case(eig, 18, a, NULL, label);
     {
         double w[18], e = 0.0;
         memcpy(q, a, sizeof(double) * 18 * 18);
-        mcg_sym_eig(18, q, w, b);
+        eig(18, q, w, b);
         for (k = 0; k < 13; ++k)
             if (fabs(w[k]) > e)
                 e = fabs(w[k]);
         e /= w[17];
-        check(e < 1e-14, "sym_eig psd-rank5: 13 null eigenvalues / w_max",
-              e, 1e-14);
+        snprintf(label, sizeof label, "%s psd-rank5: 13 null eigenvalues / w_max", name);
+        check(e < 1e-14, label, e, 1e-14);
     }
     /* diagonal input: immediate exit, exact */
     memset(a, 0, sizeof(double) * 81);
@@ -535,7 +543,8 @@ static void test_sym_eig(void)
         a[i * 9 + i] = (double)(9 - i);
     for (i = 0; i < 9; ++i)
         w_true[i] = (double)(i + 1);
-    eig_case(9, a, w_true, "diagonal");
+    snprintf(label, sizeof label, "%s diagonal", name);
+    eig_case(eig, 9, a, w_true, label);
     /* timing (information only): n = 9 and 18 */
     {
         double w[18];
@@ -554,12 +563,18 @@ static void test_sym_eig(void)
             c0 = clock();
             for (rep = 0; rep < reps; ++rep) {
                 memcpy(q, a, sizeof(double) * (size_t)(nn * nn));
-                mcg_sym_eig(nn, q, w, b);
+                eig(nn, q, w, b);
             }
             us = 1e6 * (double)(clock() - c0) / CLOCKS_PER_SEC / reps;
-            printf("info  sym_eig n=%d: %.2f us per call\n", nn, us);
+            printf("info  %s n=%d: %.2f us per call\n", name, nn, us);
         }
     }
+}
+
+static void test_sym_eig(void)
+{
+    test_sym_eig_with(mcg_sym_eig, "sym_eig");
+    test_sym_eig_with(mcg_sym_eig_tridiag, "sym_eig_tridiag");
 }
 
 /* ---------------------------------------------------------- spd_solve */
@@ -865,6 +880,11 @@ static void test_invalid(void)
     b[2] = 0;
     b[3] = 1;
     check_status(mcg_sym_eig(2, b, w, v), MCG_EINVAL, "sym_eig NaN");
+    check_status(mcg_sym_eig_tridiag(2, b, w, v), MCG_EINVAL, "sym_eig_tridiag NaN");
+    check_status(mcg_sym_eig_tridiag(0, a, w, v), MCG_EINVAL, "sym_eig_tridiag n = 0");
+    check_status(mcg_sym_eig_tridiag(65, a, w, v), MCG_EINVAL, "sym_eig_tridiag n = 65");
+    check_status(mcg_sym_eig_tridiag(2, NULL, w, v), MCG_EINVAL, "sym_eig_tridiag a = NULL");
+    check_status(mcg_sym_eig_tridiag(2, a, w, a), MCG_EINVAL, "sym_eig_tridiag v aliases a");
     b[1] = 0;
     check_status(mcg_spd_solve(2, b, NULL, x), MCG_EINVAL, "spd_solve b NULL");
     c[0] = NAN;
