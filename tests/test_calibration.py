@@ -638,7 +638,7 @@ def test_rig_frame_imu_needs_T_cam_imu():
     ("deep.yml", "%YAML:1.0\n---\na: " + "[" * 100000 + "]" * 100000 + "\n"),
     ("deep.xml", '<?xml version="1.0"?>\n<opencv_storage>\n' + "<a>" * 100000 + "1" + "</a>" * 100000
      + "</opencv_storage>\n"),
-])
+], ids=["yaml-flow", "yaml-block", "json-list", "json-object", "opencv-yaml", "opencv-xml"])
 def test_pathological_nesting_is_a_value_error_not_a_crash(tmp_path, name, text):
     # OpenCV's FileStorage parsers recurse without limit (they segfault on these files) and
     # Python's json raises RecursionError: both are refused as ValueError
