@@ -23,6 +23,7 @@ __all__ = [
     "project_so3", "plucker_from_points", "gec_rows",
     "cls_general", "cls_partial", "cls_range",
     "Linear17Options", "linear17", "GC_CASE_NAMES",
+    "gec_residuals", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
 ]
 
 GC_CASE_NAMES = {
@@ -362,3 +363,173 @@ def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
 def raise_for(status: int, what: str) -> None:
     """Raise the exception matching a C status code (no-op for MCG_OK)."""
     _check(status, what)
+
+
+# ----------------------------------------------------------------- refine.c
+
+#: robust losses of :func:`refine_motion` (``mcg_refine_options.loss``)
+LOSS_NAMES = {
+    "none": lib.MCG_LOSS_NONE,
+    "huber": lib.MCG_LOSS_HUBER,
+    "cauchy": lib.MCG_LOSS_CAUCHY,
+    "soft_l1": lib.MCG_LOSS_SOFT_L1,
+}
+#: why :func:`refine_motion` stopped (``mcg_refine_result.reason``)
+REFINE_STOP_NAMES = {
+    lib.MCG_REFINE_STOP_COST: "cost_tolerance",
+    lib.MCG_REFINE_STOP_STEP: "step_tolerance",
+    lib.MCG_REFINE_STOP_GRADIENT: "zero_gradient",
+    lib.MCG_REFINE_STOP_MAX_ITERATIONS: "max_iterations",
+    lib.MCG_REFINE_STOP_STALLED: "stalled",
+}
+
+
+def _f64(name: str, a: Any, shape: tuple) -> np.ndarray:
+    """:func:`_arr` without the finiteness pass (the kernels check it), with a
+    fast path for arrays that are already float64, C-contiguous and shaped."""
+    if (type(a) is np.ndarray and a.dtype == np.float64 and a.flags.c_contiguous
+            and a.ndim == len(shape)
+            and all(s == -1 or s == d for s, d in zip(shape, a.shape))):
+        return a
+    return _arr(name, a, shape, check_finite=False)
+
+
+def _ray_arrays(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any,
+                min_rows: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The four (N, 3) ray arrays as float64 C-contiguous (shape and dtype checked).
+
+    Finiteness and zero-length directions are checked by the kernel in its own
+    pass (no extra passes here); :func:`_ray_error` names the culprit.
+    """
+    o1 = _f64("origins1", origins1, (-1, 3))
+    n = o1.shape[0]
+    if n < min_rows:
+        raise ValueError(f"origins1 has {n} rows, at least {min_rows} correspondences needed")
+    if n > 1 << 26:
+        raise ValueError(f"origins1 has {n} rows, at most 2^26 correspondences supported")
+    return (o1, _f64("dirs1", dirs1, (n, 3)), _f64("origins2", origins2, (n, 3)),
+            _f64("dirs2", dirs2, (n, 3)))
+
+
+def _ray_error(status: int, what: str, arrays: tuple, extra: tuple = ()) -> None:
+    """Raise for a failed ray kernel; for MCG_EINVAL first name the bad argument
+    (``extra``: more (name, array) pairs to check for NaN/inf)."""
+    if status == lib.MCG_EINVAL:
+        named = tuple(zip(("origins1", "dirs1", "origins2", "dirs2"), arrays)) + tuple(extra)
+        for name, a in named:
+            if not np.isfinite(a).all():
+                raise ValueError(f"{what}: {name} contains NaN or inf")
+        for name, a in (("dirs1", arrays[1]), ("dirs2", arrays[3])):
+            if not (np.einsum("ij,ij->i", a, a) >= 1e-100).all():
+                raise ValueError(f"{what}: {name} contains a zero-length direction "
+                                 "(|d| < 1e-50)")
+        raise ValueError(f"{what}: coordinates so large that the computation overflows")
+    _check(status, what)
+
+
+def gec_residuals(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any,
+                  t: Any) -> np.ndarray:
+    """Signed Sampson angular residuals (radians) of the generalized epipolar constraint.
+
+    Ray k: origin ``origins1[k]`` / direction ``dirs1[k]`` in the rig frame at
+    time 1, and likewise at time 2 (metres; directions of any non-zero
+    length). ``(R, t)`` is rig2_from_rig1, ``X2 = R X1 + t``. Returns the (N,)
+    first-order angular errors ``e / sqrt(|P(d1) F^T d2|^2 + |P(d2) F d1|^2)``
+    with ``F = [t + R o1 - o2]x R``, capped at +-pi/2 and 0 where the camera
+    centre does not move (``mcg_gec_residuals`` in mcgeom.h).
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    R = _f64("R", R, (3, 3))
+    t = _f64("t", t, (3,))
+    out = np.empty(rays[0].shape[0])
+    st = lib.mcg_gec_residuals(out.shape[0], _p(rays[0]), _p(rays[1]), _p(rays[2]),
+                               _p(rays[3]), _p(R), _p(t), _p(out))
+    if st != lib.MCG_OK:
+        _ray_error(st, "gec_residuals", rays, (("R", R), ("t", t)))
+    return out
+
+
+def _not_rotation(R: np.ndarray) -> bool:
+    return bool(np.abs(R @ R.T - np.eye(3)).max() > 1e-6 or np.linalg.det(R) <= 0)
+
+
+def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any, t0: Any,
+                  *, weights: Any = None, loss: str = "none", loss_scale: float = 1e-3,
+                  max_iterations: int = 50, fix_scale: bool = False,
+                  cost_tolerance: float = 1e-10, step_tolerance: float = 1e-10,
+                  initial_lambda: float = 1e-4) -> dict:
+    """Levenberg-Marquardt refinement of rig2_from_rig1 ``(R0, t0)`` (``mcg_refine_motion``).
+
+    Minimises ``sum_i w_i rho(r_i^2)`` over the rotation (left increments) and
+    the translation, ``r_i`` the residuals of :func:`gec_residuals` (radians).
+    ``loss`` is one of ``LOSS_NAMES`` ("none", "huber", "cauchy", "soft_l1")
+    with scale ``loss_scale`` (radians); ``weights`` are N values >= 0;
+    ``fix_scale`` keeps ``|t| = |t0|`` (for motions whose metric scale is not
+    observable). At least 6 correspondences.
+
+    Returns a dict: ``R`` (3, 3), ``t`` (3,) (metres), ``initial_cost``,
+    ``final_cost`` (the robust cost), ``rms`` (weighted RMS residual, radians),
+    ``iterations``, ``converged``, ``reason`` (a name of
+    ``REFINE_STOP_NAMES``), ``n_used``, ``information`` (6, 6) = J^T W J at the
+    solution, order [dw (rad), dt (m)], ``sigma2`` (residual variance, rad^2),
+    ``scale_rel_std`` (first-order relative std of |t|, inf if unobservable),
+    ``info_cond`` (conditioning of the t-block Schur complement, in [0, 1]).
+    Raises ValueError on bad input, DegenerateError if nothing constrains the
+    motion at the start (e.g. every weight zero).
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+    n = rays[0].shape[0]
+    R = _arr("R0", R0, (3, 3)).copy()  # small: checked here, refined in place
+    t = _arr("t0", t0, (3,)).copy()
+    if not isinstance(loss, str) or loss not in LOSS_NAMES:
+        raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
+    opt = ffi.new("mcg_refine_options *")
+    lib.mcg_refine_default_options(opt)
+    opt.loss = LOSS_NAMES[loss]
+    for name, val, ok, want in (
+            ("loss_scale", loss_scale, lambda v: v > 0, "a finite number > 0 (radians)"),
+            ("cost_tolerance", cost_tolerance, lambda v: v >= 0, "a finite number >= 0"),
+            ("step_tolerance", step_tolerance, lambda v: v >= 0, "a finite number >= 0"),
+            ("initial_lambda", initial_lambda, lambda v: 0 <= v <= 1e16, "in [0, 1e16]")):
+        try:
+            v = float(val)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be {want}, got {val!r}") from None
+        if not (np.isfinite(v) and ok(v)):
+            raise ValueError(f"{name} must be {want}, got {val!r}")
+        setattr(opt, name, v)
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
+            or not 0 <= int(max_iterations) <= 10000:
+        raise ValueError(f"max_iterations must be an integer in 0..10000, got {max_iterations!r}")
+    opt.max_iterations = int(max_iterations)
+    opt.fix_scale = 1 if fix_scale else 0
+    if fix_scale and not np.linalg.norm(t) > 0:
+        raise ValueError("fix_scale needs a non-zero t0 (the sphere |t| = |t0| to stay on)")
+    w_ptr = ffi.NULL
+    if weights is not None:
+        w = _arr("weights", weights, (n,))
+        if (w < 0).any():
+            raise ValueError("weights must be >= 0")
+        w_ptr = _p(w)
+    res = ffi.new("mcg_refine_result *")
+    st = lib.mcg_refine_motion(n, *map(_p, rays), w_ptr, opt, _p(R), _p(t), res)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL and _not_rotation(R):
+            raise ValueError("refine_motion: R0 is not a rotation matrix "
+                             "(|R R^T - I| > 1e-6 or det R <= 0)")
+        _ray_error(st, "refine_motion", rays)
+    return {
+        "R": R,
+        "t": t,
+        "initial_cost": res.initial_cost,
+        "final_cost": res.final_cost,
+        "rms": res.rms,
+        "iterations": res.iterations,
+        "converged": bool(res.converged),
+        "reason": REFINE_STOP_NAMES.get(res.reason, "unknown"),
+        "n_used": res.n_used,
+        "information": np.frombuffer(ffi.buffer(res.info), dtype=np.float64).reshape(6, 6).copy(),
+        "sigma2": res.sigma2,
+        "scale_rel_std": res.scale_rel_std,
+        "info_cond": res.info_cond,
+    }

@@ -1,5 +1,6 @@
 """Built-in estimator plugins; importing this package registers them all."""
 
 from . import linear17  # noqa: F401  (registers "linear17")
+from . import refine  # noqa: F401  (registers "refine")
 
-__all__ = ["linear17"]
+__all__ = ["linear17", "refine"]

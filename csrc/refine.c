@@ -1,0 +1,771 @@
+/*
+ * refine.c -- nonlinear refinement of the relative motion of a generalized
+ * camera (multi-camera rig): Levenberg-Marquardt on SO(3) x R^3 minimising a
+ * robust function of the Sampson (first-order geometric) angular error of the
+ * generalized epipolar constraint (thesis eq. 8.15). The thesis uses its
+ * linear method (ch. 8, Algorithm 2) as the initial estimate of such a
+ * non-linear refinement (ch. 8.5); this file is that refinement.
+ *
+ * Residual. A correspondence is a ray (o1, d1) in the rig frame at time 1 and
+ * a ray (o2, d2) in the rig frame at time 2; the motion is rig2_from_rig1,
+ * X2 = R X1 + t. With unit bearings and m = o x d, eq. 8.15 reads
+ *     e = d2^T [t]x R d1 + d2^T R m1 + m2^T R d1 = d2^T F d1,
+ *     F = [c]x R,   c = t + R o1 - o2,
+ * i.e. the ordinary epipolar constraint of the camera pair whose baseline c
+ * (in the time-2 rig frame) joins camera 2's centre to camera 1's moved one.
+ * Its Sampson angular error, with the tangent projector P(d) = I - d d^T, is
+ *     r = e / sqrt(D),   D = |P(d1) F^T d2|^2 + |P(d2) F d1|^2.
+ * In the time-2 frame, with a = R d1, q = F d1 = c x a, h = R F^T d2 = d2 x c
+ * and e = d2.q = a.h, D = |q|^2 + |h|^2 - 2 e^2. r is in radians: to first
+ * order it is the smallest root-sum-square rotation of the two bearings that
+ * satisfies the constraint. The kernels evaluate it on the raw directions
+ * A = R d1, B = d2 (r is homogeneous of degree 0 in them), which needs one
+ * square root and one division per pair:
+ *     E = B.(c x A),  den = |B|^2 |c x A|^2 + |A|^2 |B x c|^2 - 2 E^2,
+ *     r = E / sqrt(den).
+ * The subtraction is harmless where it matters: for a small residual E^2 is
+ * negligible against den.
+ *
+ * Where D vanishes: D = 0 iff both gradients of e on the bearing spheres
+ * vanish. Either c = 0 (the camera centre does not move: F = 0, no epipolar
+ * constraint, e = 0 too) or e is stationary at its extreme |e| = |c| (d2
+ * normal to the epipolar plane): no first-order error exists. Hence
+ *     r = e / sqrt(max(D, (2/pi)^2 e^2, DBL_MIN)),
+ * the Sampson error while it is below pi/2 (the largest angle a bearing ever
+ * has to turn to reach the epipolar plane), then +-pi/2, and 0 when
+ * e = D = 0: continuous except at e = D = 0, never inf/NaN. A residual on the
+ * cap (or from e = D = 0) has a zero Jacobian row and is not "used".
+ *
+ * Jacobian (left perturbation R <- exp([dw]x) R, t <- t + dt, as in
+ * linear17.c): derived on the raw form, see block_rows().
+ *
+ * Optimisation: minimise C = sum_i w_i rho(r_i^2) by Gauss-Newton with IRLS
+ * weights omega_i = w_i rho'(r_i^2) and Marquardt damping
+ * (J^T W J + lambda diag(J^T W J)) dx = -J^T W r, lambda updated by the gain
+ * ratio (Nielsen's rule), inside a trust region (a step turns R by at most
+ * 0.5 rad and moves t by at most max(|t|, L) / 2, L the rig size) that keeps
+ * steps along a weakly observable |t| from overshooting. Each evaluation
+ * loops once over the rays in blocks of BLK pairs and accumulates the 6 x 6
+ * normal equations directly (no caller workspace, 2.3 KB of stack). fix_scale
+ * keeps |t| = |t0|: t moves on that sphere through a 2-dof tangent basis and
+ * the retraction t <- |t0| (t + B u) / |t + B u|.
+ *
+ * Uncertainty at the solution: the information matrix H = J^T W J (6 x 6,
+ * [dw, dt]); sigma2 = sum omega r^2 / (sum omega - p) (p = 6, or 5 with
+ * fix_scale); the t-block of H^-1 is the inverse of the Schur complement
+ * S = H_tt - H_tw H_ww^-1 H_wt, so var|t| = sigma2 u^T S^-1 u with u = t/|t|.
+ */
+#include "mcgeom.h"
+#include "internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#define MAX_RAYS (1 << 26)
+#define HALF_PI 1.5707963267948966
+#define INV_HALF_PI2 0.40528473456935109 /* (2 / pi)^2 */
+#define ROT_TOL 1e-6                     /* |R R^T - I| accepted as a rotation */
+#define LAMBDA_MAX 1e32                  /* damping beyond: no descent exists */
+#define SING_RTOL 1e-10                  /* eigenvalue ratio treated as singular */
+#define MAX_TURN 0.5                     /* largest rotation step, radians */
+/* smallest accepted squared length of a direction (|d| >= 1e-50): shorter
+ * ones count as zero-length; keeps the products of the residual far from
+ * underflow (overflow is detected) */
+#define DIR2_MIN 1e-100
+
+/* ---------------------------------------------------------- small helpers */
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double c[3])
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void mul33(const double *a, const double *b, double *c)
+{
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] +
+                           a[3 * i + 2] * b[6 + j];
+}
+
+/* 1 if r is a rotation to ROT_TOL (orthonormal rows, det > 0) */
+static int is_rotation(const double r[9])
+{
+    int i, j;
+    double det;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            double acc = r[3 * i] * r[3 * j] + r[3 * i + 1] * r[3 * j + 1] +
+                         r[3 * i + 2] * r[3 * j + 2];
+            if (!(fabs(acc - (i == j ? 1.0 : 0.0)) <= ROT_TOL))
+                return 0;
+        }
+    det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+          r[2] * (r[3] * r[7] - r[4] * r[6]);
+    return det > 0.0;
+}
+
+/* ------------------------------------------------------------- residuals */
+
+int mcg_gec_residuals(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2, const double R[9],
+                      const double t[3], double *res)
+{
+    double r0, r1, r2, r3, r4, r5, r6, r7, r8, t0, t1, t2;
+    int k, bad = 0;
+
+    if (!o1 || !d1 || !o2 || !d2 || !R || !t || !res)
+        return MCG_EINVAL;
+    if (n < 0 || n > MAX_RAYS)
+        return MCG_EINVAL;
+    if (!all_finite(R, 9) || !all_finite(t, 3))
+        return MCG_EINVAL;
+    r0 = R[0]; r1 = R[1]; r2 = R[2];
+    r3 = R[3]; r4 = R[4]; r5 = R[5];
+    r6 = R[6]; r7 = R[7]; r8 = R[8];
+    t0 = t[0]; t1 = t[1]; t2 = t[2];
+
+    /* One branch-free pass in the raw form of the header comment: one
+     * square root and one division per pair, validation folded in. */
+    for (k = 0; k < n; k++) {
+        const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k;
+        const double *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
+        double b0 = u2[0], b1 = u2[1], b2 = u2[2];
+        double n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2];
+        double n2 = b0 * b0 + b1 * b1 + b2 * b2;
+        double a0 = r0 * u1[0] + r1 * u1[1] + r2 * u1[2];
+        double a1 = r3 * u1[0] + r4 * u1[1] + r5 * u1[2];
+        double a2 = r6 * u1[0] + r7 * u1[1] + r8 * u1[2];
+        double c0 = t0 + r0 * p1[0] + r1 * p1[1] + r2 * p1[2] - p2[0];
+        double c1 = t1 + r3 * p1[0] + r4 * p1[1] + r5 * p1[2] - p2[1];
+        double c2 = t2 + r6 * p1[0] + r7 * p1[1] + r8 * p1[2] - p2[2];
+        double q0 = c1 * a2 - c2 * a1, q1 = c2 * a0 - c0 * a2, q2 = c0 * a1 - c1 * a0;
+        double h0 = b1 * c2 - b2 * c1, h1 = b2 * c0 - b0 * c2, h2 = b0 * c1 - b1 * c0;
+        double e = b0 * q0 + b1 * q1 + b2 * q2, ee = e * e;
+        double dd = n2 * (q0 * q0 + q1 * q1 + q2 * q2) +
+                    n1 * (h0 * h0 + h1 * h1 + h2 * h2) - 2.0 * ee;
+        /* r = e / sqrt(max(dd, (2/pi)^2 e^2, DBL_MIN)) (max as selects) */
+        double cap = ee * INV_HALF_PI2, m = dd > cap ? dd : cap;
+        m = m > DBL_MIN ? m : DBL_MIN;
+        /* validation folded in as a NaN marker, which keeps the loop
+         * branch-free and vectorisable: n1, n2 >= DIR2_MIN rules out zero
+         * directions, and 0 * x is NaN iff x is not finite, where a NaN/inf
+         * in any input or an overflow makes x = n1 + n2 + dd NaN or inf.
+         * (Vectorised only with -fno-math-errno, see meson.build.) */
+        double x = n1 + n2 + dd;
+        double mm = n1 < n2 ? n1 : n2;
+        res[k] = e / sqrt(m) + 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+    }
+    for (k = 0; k < n; k++) /* the markers (a short contiguous scan) */
+        bad |= res[k] != res[k];
+    if (bad)
+        return MCG_EINVAL;
+    return MCG_OK;
+}
+
+/* ------------------------------------------------------ one evaluation */
+
+typedef struct {
+    double cost;   /* sum w rho(r^2) */
+    double h[36];  /* J^T W J, W = w rho'(r^2) */
+    double g[6];   /* J^T W r */
+    double sw;     /* sum of the user weights */
+    double swr2;   /* sum w r^2 */
+    double som;    /* sum of the IRLS weights omega = w rho'(r^2) */
+    double somr2;  /* sum omega r^2 */
+    int n_used;    /* w > 0 and a non-zero Jacobian row */
+    int bad;       /* some input non-finite, zero direction or overflow */
+} accum;
+
+typedef struct {
+    int loss;
+    double s, s2, inv_s2; /* loss scale, its square and inverse square */
+} lossfn;
+
+/* Pairs per block of an evaluation: residuals and Jacobian rows of a block
+ * go to small stack arrays (structure of arrays) so that the per-pair loop
+ * is branch-free and vectorises; the normal equations are then summed from
+ * them. 32 pairs = 2.3 KB of stack, no caller workspace. */
+#define BLK 32
+/* independent partial sums of the normal equations (SIMD lanes) */
+#define LANES 4
+
+/* Residuals and Jacobian rows [dr/dw, dr/dt] of nb <= BLK pairs, in the raw
+ * form of mcg_gec_residuals (A = R d1, B = d2 unnormalised, p = R o1,
+ * c = t + p - o2, Q = c x A, H = B x c, E = B.Q,
+ * den = |B|^2 |Q|^2 + |A|^2 |H|^2 - 2 E^2, r = E den^-1/2 = E s; r is
+ * homogeneous of degree 0 in A and B, and |A|, |B| do not change with
+ * (R, t)). With K = A x B and V = 2 |A|^2 |B|^2 c - |B|^2 (A.c) A
+ * - |A|^2 (B.c) B:
+ *     dE/dt = K,                dE/dw = p x K + A x H,
+ *     dden/dt = 2 V - 4 E K,    dden/dw = 2 p x V + 2 |B|^2 (A.c) Q - 4 E dE/dw,
+ *     dr/dt = s (1 + 2 r^2) K - r s^2 V,
+ *     dr/dw = p x dr/dt + s (1 + 2 r^2) A x H - r s^2 |B|^2 (A.c) Q.
+ * On the cap (or e = den = 0) the row is 0 and ok[k] = 0 (else 1). An invalid pair
+ * (zero direction, NaN/inf, overflow) gets r = NaN. */
+static void block_rows(int nb, const double *o1, const double *d1,
+                       const double *o2, const double *d2, const double *rm,
+                       const double *tv, double *rb, double (*jb)[BLK], double *ok)
+{
+    const double r0 = rm[0], r1 = rm[1], r2 = rm[2], r3 = rm[3], r4 = rm[4];
+    const double r5 = rm[5], r6 = rm[6], r7 = rm[7], r8 = rm[8];
+    const double t0 = tv[0], t1 = tv[1], t2 = tv[2];
+    int k;
+    for (k = 0; k < nb; k++) {
+        const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k;
+        const double *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
+        double b0 = u2[0], b1 = u2[1], b2 = u2[2];
+        double n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2];
+        double n2 = b0 * b0 + b1 * b1 + b2 * b2;
+        double a0 = r0 * u1[0] + r1 * u1[1] + r2 * u1[2];
+        double a1 = r3 * u1[0] + r4 * u1[1] + r5 * u1[2];
+        double a2 = r6 * u1[0] + r7 * u1[1] + r8 * u1[2];
+        double pp0 = r0 * p1[0] + r1 * p1[1] + r2 * p1[2];
+        double pp1 = r3 * p1[0] + r4 * p1[1] + r5 * p1[2];
+        double pp2 = r6 * p1[0] + r7 * p1[1] + r8 * p1[2];
+        double c0 = t0 + pp0 - p2[0], c1 = t1 + pp1 - p2[1], c2 = t2 + pp2 - p2[2];
+        double q0 = c1 * a2 - c2 * a1, q1 = c2 * a0 - c0 * a2, q2 = c0 * a1 - c1 * a0;
+        double h0 = b1 * c2 - b2 * c1, h1 = b2 * c0 - b0 * c2, h2 = b0 * c1 - b1 * c0;
+        double e = b0 * q0 + b1 * q1 + b2 * q2, ee = e * e;
+        double dd = n2 * (q0 * q0 + q1 * q1 + q2 * q2) +
+                    n1 * (h0 * h0 + h1 * h1 + h2 * h2) - 2.0 * ee;
+        double cap = ee * INV_HALF_PI2, lo = cap > DBL_MIN ? cap : DBL_MIN;
+        double m = dd > lo ? dd : lo, s, rr, f1, f2;
+        double ac, bc, k0, k1, k2, v0, v1, v2, jt0, jt1, jt2, x, mm, f3;
+        /* 1 on the Sampson branch (a select, not a branch: vectorisable) */
+        double on = dd > lo ? 1.0 : 0.0;
+        s = 1.0 / sqrt(m);
+        rr = e * s;
+        /* the NaN marker of mcg_gec_residuals */
+        x = n1 + n2 + dd;
+        mm = n1 < n2 ? n1 : n2;
+        rb[k] = rr + 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+        ok[k] = on;
+        f1 = on * s * (1.0 + 2.0 * rr * rr);
+        f2 = on * rr * s * s;
+        ac = a0 * c0 + a1 * c1 + a2 * c2;
+        bc = b0 * c0 + b1 * c1 + b2 * c2;
+        k0 = a1 * b2 - a2 * b1; k1 = a2 * b0 - a0 * b2; k2 = a0 * b1 - a1 * b0;
+        v0 = 2.0 * n1 * n2 * c0 - n2 * ac * a0 - n1 * bc * b0;
+        v1 = 2.0 * n1 * n2 * c1 - n2 * ac * a1 - n1 * bc * b1;
+        v2 = 2.0 * n1 * n2 * c2 - n2 * ac * a2 - n1 * bc * b2;
+        jt0 = f1 * k0 - f2 * v0;
+        jt1 = f1 * k1 - f2 * v1;
+        jt2 = f1 * k2 - f2 * v2;
+        f3 = f2 * n2 * ac;
+        /* dr/dw = p x dr/dt + f1 A x H - f3 Q */
+        jb[0][k] = pp1 * jt2 - pp2 * jt1 + f1 * (a1 * h2 - a2 * h1) - f3 * q0;
+        jb[1][k] = pp2 * jt0 - pp0 * jt2 + f1 * (a2 * h0 - a0 * h2) - f3 * q1;
+        jb[2][k] = pp0 * jt1 - pp1 * jt0 + f1 * (a0 * h1 - a1 * h0) - f3 * q2;
+        jb[3][k] = jt0;
+        jb[4][k] = jt1;
+        jb[5][k] = jt2;
+    }
+}
+
+/* rho(z) and rho'(z) of the squared residual z */
+static void loss_eval(const lossfn *l, double z, double *rho, double *drho)
+{
+    switch (l->loss) {
+    case MCG_LOSS_HUBER:
+        if (z <= l->s2) {
+            *rho = z;
+            *drho = 1.0;
+        } else {
+            double sq = sqrt(z);
+            *rho = 2.0 * l->s * sq - l->s2;
+            *drho = l->s / sq;
+        }
+        break;
+    case MCG_LOSS_CAUCHY: {
+        double u = z * l->inv_s2;
+        *rho = l->s2 * log1p(u);
+        *drho = 1.0 / (1.0 + u);
+        break;
+    }
+    case MCG_LOSS_SOFT_L1: {
+        double sq = sqrt(1.0 + z * l->inv_s2);
+        *rho = 2.0 * l->s2 * (sq - 1.0);
+        *drho = 1.0 / sq;
+        break;
+    }
+    default:
+        *rho = z;
+        *drho = 1.0;
+        break;
+    }
+}
+
+/* One pass over the rays at (R, t): robust cost and normal equations. */
+static void evaluate(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const double *wts, const lossfn *l,
+                     const double r[9], const double t[3], accum *acc)
+{
+    /* hs[p][lane]: LANES independent partial sums of the upper triangle of
+     * [J r]^T W [J r] without its corner, row by row: the 21 entries of
+     * J^T W J and, last in each row, the 6 of J^T W r */
+    double hs[27][LANES], cost = 0.0, sw = 0.0, swr2 = 0.0, som = 0.0, somr2 = 0.0;
+    double rb[BLK], jb[6][BLK], ob[BLK], okb[BLK], oj[6][BLK];
+    int k0, k, i, m, p, used_n = 0;
+    memset(hs, 0, sizeof hs);
+    for (k0 = 0; k0 < n; k0 += BLK) {
+        int nb = n - k0 < BLK ? n - k0 : BLK;
+        block_rows(nb, o1 + 3 * k0, d1 + 3 * k0, o2 + 3 * k0, d2 + 3 * k0, r, t,
+                   rb, jb, okb);
+        /* weights: ob = omega = w rho'(r^2) */
+        for (k = 0; k < nb; k++) {
+            double w = wts ? wts[k0 + k] : 1.0, z = rb[k] * rb[k], rho, drho;
+            if (l->loss == MCG_LOSS_NONE) {
+                rho = z;
+                drho = 1.0;
+            } else {
+                loss_eval(l, z, &rho, &drho);
+            }
+            ob[k] = w * drho;
+            cost += w * rho;
+            sw += w;
+            swr2 += w * z;
+            som += ob[k];
+            somr2 += ob[k] * z;
+            used_n += okb[k] != 0.0 && w > 0.0;
+        }
+        /* zero-pad the block to a multiple of LANES (BLK is one) */
+        for (k = nb; k < BLK && k % LANES != 0; k++) {
+            ob[k] = 0.0;
+            rb[k] = 0.0;
+            for (i = 0; i < 6; i++)
+                jb[i][k] = 0.0;
+        }
+        /* normal equations: for each entry, LANES partial sums over the
+         * block (vectorisable; the sums stay in registers) */
+        nb = (nb + LANES - 1) / LANES * LANES;
+        for (i = 0; i < 6; i++)
+            for (k = 0; k < nb; k++)
+                oj[i][k] = ob[k] * jb[i][k];
+        p = 0;
+        for (i = 0; i < 6; i++)
+            for (m = i; m < 7; m++, p++) {
+                const double *x = oj[i], *y = m < 6 ? jb[m] : rb;
+                double sl[LANES];
+                int ln;
+                for (ln = 0; ln < LANES; ln++)
+                    sl[ln] = 0.0;
+                for (k = 0; k < nb; k += LANES)
+                    for (ln = 0; ln < LANES; ln++)
+                        sl[ln] += x[k + ln] * y[k + ln];
+                for (ln = 0; ln < LANES; ln++)
+                    hs[p][ln] += sl[ln];
+            }
+    }
+    memset(acc, 0, sizeof *acc);
+    p = 0;
+    for (i = 0; i < 6; i++)
+        for (m = i; m < 7; m++, p++) {
+            double v = 0.0;
+            int ln;
+            for (ln = 0; ln < LANES; ln++)
+                v += hs[p][ln];
+            if (m < 6)
+                acc->h[6 * i + m] = acc->h[6 * m + i] = v;
+            else
+                acc->g[i] = v;
+        }
+    acc->cost = cost;
+    acc->sw = sw;
+    acc->swr2 = swr2;
+    acc->som = som;
+    acc->somr2 = somr2;
+    acc->n_used = used_n;
+    /* a NaN marker (or an overflow) reaches the sums */
+    acc->bad = !isfinite(cost) || !isfinite(swr2);
+}
+
+/* ------------------------------------------------------------- driver */
+
+void mcg_refine_default_options(mcg_refine_options *opt)
+{
+    if (!opt)
+        return;
+    opt->loss = MCG_LOSS_NONE;
+    opt->loss_scale = 1e-3;
+    opt->max_iterations = 50;
+    opt->cost_tolerance = 1e-10;
+    opt->step_tolerance = 1e-10;
+    opt->initial_lambda = 1e-4;
+    opt->fix_scale = 0;
+}
+
+static int check_options(const mcg_refine_options *o)
+{
+    if (o->loss < MCG_LOSS_NONE || o->loss > MCG_LOSS_SOFT_L1)
+        return 0;
+    if (!isfinite(o->loss_scale) || !(o->loss_scale > 0.0))
+        return 0;
+    if (o->max_iterations < 0 || o->max_iterations > 10000)
+        return 0;
+    if (!isfinite(o->cost_tolerance) || o->cost_tolerance < 0.0)
+        return 0;
+    if (!isfinite(o->step_tolerance) || o->step_tolerance < 0.0)
+        return 0;
+    if (!isfinite(o->initial_lambda) || o->initial_lambda < 0.0 ||
+        o->initial_lambda > 1e16)
+        return 0;
+    if (o->fix_scale != 0 && o->fix_scale != 1)
+        return 0;
+    return 1;
+}
+
+/* Orthonormal basis (columns b[:, 0], b[:, 1], stored as two 3-vectors) of
+ * the plane orthogonal to u (unit). */
+static void tangent_basis(const double u[3], double b1[3], double b2[3])
+{
+    double ax[3] = {0.0, 0.0, 0.0}, nb;
+    int i, k = 0;
+    for (i = 1; i < 3; i++)
+        if (fabs(u[i]) < fabs(u[k]))
+            k = i;
+    ax[k] = 1.0;
+    cross3(u, ax, b1);
+    nb = sqrt(dot3(b1, b1));
+    for (i = 0; i < 3; i++)
+        b1[i] /= nb;
+    cross3(u, b1, b2);
+}
+
+/* Evidence on |t| from H at (R, t): info_cond = lambda_min / lambda_max of
+ * the Schur complement S of the t-block, and var = u^T S^-1 u, u = t / |t|
+ * (HUGE_VAL when S is singular along u). */
+static void scale_evidence(const double *h, const double t[3], double *cond,
+                           double *var)
+{
+    double hww[9], hwt[9], z[3], col[3], s[9], w[3], v[9], nt, u[3];
+    int i, k, st;
+    *cond = 0.0;
+    *var = HUGE_VAL;
+    for (i = 0; i < 3; i++)
+        for (k = 0; k < 3; k++) {
+            hww[3 * i + k] = h[6 * i + k];
+            hwt[3 * i + k] = h[6 * i + 3 + k];
+            s[3 * i + k] = h[6 * (3 + i) + 3 + k];
+        }
+    for (k = 0; k < 3; k++) { /* S -= H_tw H_ww^-1 H_wt, column by column */
+        for (i = 0; i < 3; i++)
+            col[i] = hwt[3 * i + k];
+        if (mcg_spd_solve(3, hww, col, z) != MCG_OK)
+            return;
+        for (i = 0; i < 3; i++)
+            s[3 * i + k] -= hwt[0 + i] * z[0] + hwt[3 + i] * z[1] + hwt[6 + i] * z[2];
+    }
+    for (i = 0; i < 3; i++) /* symmetrise the rounding */
+        for (k = 0; k < i; k++)
+            s[3 * i + k] = s[3 * k + i] = 0.5 * (s[3 * i + k] + s[3 * k + i]);
+    st = mcg_sym_eig(3, s, w, v);
+    if (st != MCG_OK || !(w[2] > 0.0))
+        return;
+    *cond = w[0] > 0.0 ? w[0] / w[2] : 0.0;
+    nt = sqrt(dot3(t, t));
+    if (!(nt > 0.0))
+        return;
+    for (i = 0; i < 3; i++)
+        u[i] = t[i] / nt;
+    {
+        double acc = 0.0;
+        for (k = 0; k < 3; k++) {
+            double pk = v[k] * u[0] + v[3 + k] * u[1] + v[6 + k] * u[2];
+            if (w[k] <= SING_RTOL * w[2]) {
+                if (pk * pk > 1e-8)
+                    return; /* |t| lies (partly) in the null space */
+                continue;
+            }
+            acc += pk * pk / w[k];
+        }
+        *var = acc;
+    }
+}
+
+int mcg_refine_motion(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2, const double *weights,
+                      const mcg_refine_options *opt, double R[9], double t[3],
+                      mcg_refine_result *res)
+{
+    mcg_refine_options o;
+    lossfn lf;
+    accum cur, trial;
+    double r[9], tv[3], rho0 = 0.0, lambda, nu = 2.0, ell, pdim;
+    int i, k, it, fix, reason = MCG_REFINE_STOP_MAX_ITERATIONS, converged = 0;
+
+    if (!res)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    res->sigma2 = HUGE_VAL;
+    res->scale_rel_std = HUGE_VAL;
+    if (!o1 || !d1 || !o2 || !d2 || !R || !t)
+        return MCG_EINVAL;
+    if (n < 6 || n > MAX_RAYS)
+        return MCG_EINVAL;
+    if (opt) {
+        if (!check_options(opt))
+            return MCG_EINVAL;
+        o = *opt;
+    } else {
+        mcg_refine_default_options(&o);
+    }
+    if (!all_finite(R, 9) || !all_finite(t, 3) || !is_rotation(R))
+        return MCG_EINVAL;
+    if (weights) {
+        if (!all_finite(weights, (size_t)n))
+            return MCG_EINVAL;
+        for (k = 0; k < n; k++)
+            if (weights[k] < 0.0)
+                return MCG_EINVAL;
+    }
+    if (mcg_project_so3(R, r) != MCG_OK) /* exact rotation from here on */
+        return MCG_EINVAL;
+    memcpy(tv, t, sizeof tv);
+    fix = o.fix_scale;
+    if (fix) {
+        rho0 = sqrt(dot3(tv, tv));
+        if (!(rho0 > 0.0))
+            return MCG_EINVAL; /* no sphere to stay on */
+    }
+    pdim = fix ? 5.0 : 6.0;
+    lf.loss = o.loss;
+    lf.s = o.loss_scale;
+    lf.s2 = o.loss_scale * o.loss_scale;
+    lf.inv_s2 = 1.0 / lf.s2;
+    if (!(lf.s2 > 0.0) || !isfinite(lf.inv_s2))
+        return MCG_EINVAL;
+
+    evaluate(n, o1, d1, o2, d2, weights, &lf, r, tv, &cur);
+    if (cur.bad)
+        return MCG_EINVAL;
+    res->initial_cost = cur.cost;
+    res->final_cost = cur.cost;
+    res->n_used = cur.n_used;
+    if (!(cur.sw > 0.0))
+        return MCG_EDEGENERATE; /* every weight is zero */
+    {
+        double tr = 0.0;
+        for (i = 0; i < 6; i++)
+            tr += cur.h[7 * i];
+        if (!(tr > 0.0))
+            return MCG_EDEGENERATE; /* no ray constrains the motion here */
+    }
+    {
+        /* characteristic length L of the rig: RMS distance of the ray
+         * origins from their centroid (independent of the rig frame) */
+        double c[3] = {0.0, 0.0, 0.0}, so2 = 0.0;
+        for (k = 0; k < n; k++)
+            for (i = 0; i < 3; i++)
+                c[i] += o1[3 * k + i] + o2[3 * k + i];
+        for (i = 0; i < 3; i++)
+            c[i] /= 2.0 * n;
+        for (k = 0; k < n; k++)
+            for (i = 0; i < 3; i++) {
+                double a1 = o1[3 * k + i] - c[i], a2 = o2[3 * k + i] - c[i];
+                so2 += a1 * a1 + a2 * a2;
+            }
+        ell = sqrt(so2 / (2.0 * n));
+    }
+    lambda = o.initial_lambda;
+
+    for (it = 0; it < o.max_iterations; it++) {
+        double pm[6][6], a[36], hm[36], gm[6], dx[6], dfull[6], dmp[6];
+        double b1[3] = {0, 0, 0}, b2[3] = {0, 0, 0}, rn[9], tn[3], dr[9];
+        double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual;
+        int m = fix ? 5 : 6, accepted, small;
+
+        /* parametrisation P (6 x m): identity, or [dw; B u] with fix_scale */
+        memset(pm, 0, sizeof pm);
+        for (i = 0; i < 3; i++)
+            pm[i][i] = 1.0;
+        if (fix) {
+            double u[3];
+            for (i = 0; i < 3; i++)
+                u[i] = tv[i] / rho0;
+            tangent_basis(u, b1, b2);
+            for (i = 0; i < 3; i++) {
+                pm[3 + i][3] = b1[i];
+                pm[3 + i][4] = b2[i];
+            }
+        } else {
+            for (i = 3; i < 6; i++)
+                pm[i][i] = 1.0;
+        }
+        if (!fix) {
+            memcpy(hm, cur.h, sizeof hm);
+            memcpy(gm, cur.g, sizeof gm);
+        } else { /* hm = P^T H P, gm = P^T g */
+            double hp[6][5];
+            int jj, p;
+            for (p = 0; p < 6; p++)
+                for (jj = 0; jj < m; jj++) {
+                    double acc = 0.0;
+                    for (i = 0; i < 6; i++)
+                        acc += cur.h[6 * p + i] * pm[i][jj];
+                    hp[p][jj] = acc;
+                }
+            for (i = 0; i < m; i++) {
+                gm[i] = 0.0;
+                for (p = 0; p < 6; p++)
+                    gm[i] += pm[p][i] * cur.g[p];
+                for (jj = 0; jj < m; jj++) {
+                    double acc = 0.0;
+                    for (p = 0; p < 6; p++)
+                        acc += pm[p][i] * hp[p][jj];
+                    hm[m * i + jj] = acc;
+                }
+            }
+        }
+        for (i = 0; i < m; i++) {
+            if (hm[m * i + i] > maxd)
+                maxd = hm[m * i + i];
+            if (fabs(gm[i]) > gmax)
+                gmax = fabs(gm[i]);
+        }
+        if (gmax == 0.0) { /* exact stationary point (e.g. zero cost) */
+            converged = 1;
+            reason = MCG_REFINE_STOP_GRADIENT;
+            break;
+        }
+        if (!(maxd > 0.0)) {
+            reason = MCG_REFINE_STOP_STALLED;
+            break;
+        }
+        /* Marquardt damping lambda diag(H), floored so that directions the
+         * data do not constrain at all still get a finite step */
+        memcpy(a, hm, sizeof a);
+        for (i = 0; i < m; i++) {
+            dmp[i] = hm[m * i + i] > 1e-12 * maxd ? hm[m * i + i] : 1e-12 * maxd;
+            a[m * i + i] += lambda * dmp[i];
+        }
+        for (i = 0; i < m; i++)
+            gm[i] = -gm[i];
+        res->iterations = it + 1;
+        if (mcg_spd_solve(m, a, gm, dx) != MCG_OK) {
+            lambda = lambda > 0.0 ? lambda * nu : 1e-12;
+            nu *= 2.0;
+            if (lambda > LAMBDA_MAX) {
+                reason = MCG_REFINE_STOP_STALLED;
+                break;
+            }
+            continue;
+        }
+        for (i = 0; i < 6; i++) {
+            int jj;
+            dfull[i] = 0.0;
+            for (jj = 0; jj < m; jj++)
+                dfull[i] += pm[i][jj] * dx[jj];
+        }
+        /* trust region on top of the damping: a step may turn R by at most
+         * MAX_TURN and move t by at most max(|t|, L) / 2 (L = rig size). In
+         * weakly scale-observable configurations a step along the flat |t|
+         * direction otherwise overshoots, even through t = 0. */
+        {
+            double nw0 = sqrt(dot3(dfull, dfull)), nt0 = sqrt(dot3(dfull + 3, dfull + 3));
+            double ntv = sqrt(dot3(tv, tv)), alpha = 1.0;
+            double lim = 0.5 * (ntv > ell ? ntv : ell);
+            if (nw0 > MAX_TURN)
+                alpha = MAX_TURN / nw0;
+            if (lim > 0.0 && nt0 * alpha > lim)
+                alpha = lim / nt0;
+            for (i = 0; i < m; i++)
+                dx[i] *= alpha;
+            for (i = 0; i < 6; i++)
+                dfull[i] *= alpha;
+        }
+        /* predicted decrease of the IRLS model, -2 g.dx - dx^T H dx
+         * (gm holds -g) */
+        pred = 0.0;
+        for (i = 0; i < m; i++) {
+            int jj;
+            double acc = 0.0;
+            for (jj = 0; jj < m; jj++)
+                acc += hm[m * i + jj] * dx[jj];
+            pred += 2.0 * gm[i] * dx[i] - dx[i] * acc;
+        }
+        /* candidate: R <- exp([dw]x) R, t <- t + dt (or the sphere retraction) */
+        if (mcg_rot_from_angle_axis(dfull, dr) != MCG_OK) {
+            reason = MCG_REFINE_STOP_STALLED;
+            break;
+        }
+        mul33(dr, r, rn);
+        for (i = 0; i < 3; i++)
+            tn[i] = tv[i] + dfull[3 + i];
+        if (fix) {
+            double nn = sqrt(dot3(tn, tn));
+            for (i = 0; i < 3; i++)
+                tn[i] *= rho0 / nn;
+        }
+        evaluate(n, o1, d1, o2, d2, weights, &lf, rn, tn, &trial);
+        actual = cur.cost - trial.cost;
+        nw = sqrt(dot3(dfull, dfull));
+        ndt = sqrt(dot3(dfull + 3, dfull + 3));
+        nt = sqrt(dot3(tv, tv));
+        small = nw <= o.step_tolerance &&
+                ndt <= o.step_tolerance * (nt + ell > 0.0 ? nt + ell : 1.0);
+        accepted = !trial.bad && trial.cost <= cur.cost;
+        if (accepted) {
+            double gain = pred > 0.0 ? actual / pred : 0.0, f;
+            double c0 = cur.cost;
+            memcpy(r, rn, sizeof r);
+            memcpy(tv, tn, sizeof tv);
+            cur = trial;
+            f = 2.0 * gain - 1.0;
+            f = 1.0 - f * f * f;
+            lambda *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
+            nu = 2.0;
+            if (small) {
+                converged = 1;
+                reason = MCG_REFINE_STOP_STEP;
+                break;
+            }
+            if (actual <= o.cost_tolerance * c0) {
+                converged = 1;
+                reason = MCG_REFINE_STOP_COST;
+                break;
+            }
+        } else {
+            if (small) { /* even a negligible step does not help: at the floor */
+                converged = 1;
+                reason = MCG_REFINE_STOP_STEP;
+                break;
+            }
+            lambda = lambda > 0.0 ? lambda * nu : 1e-12;
+            nu *= 2.0;
+            if (lambda > LAMBDA_MAX) {
+                reason = MCG_REFINE_STOP_STALLED;
+                break;
+            }
+        }
+    }
+
+    /* statistics at the solution */
+    res->final_cost = cur.cost;
+    res->converged = converged;
+    res->reason = reason;
+    res->n_used = cur.n_used;
+    memcpy(res->info, cur.h, sizeof res->info);
+    res->rms = sqrt(cur.swr2 / cur.sw);
+    res->sigma2 = cur.som > pdim ? cur.somr2 / (cur.som - pdim) : HUGE_VAL;
+    {
+        double var, nt = sqrt(dot3(tv, tv));
+        scale_evidence(cur.h, tv, &res->info_cond, &var);
+        if (isfinite(var) && isfinite(res->sigma2) && nt > 0.0)
+            res->scale_rel_std = sqrt(res->sigma2 * var) / nt;
+        else
+            res->scale_rel_std = HUGE_VAL;
+    }
+    memcpy(R, r, sizeof r);
+    memcpy(t, tv, sizeof tv);
+    return MCG_OK;
+}

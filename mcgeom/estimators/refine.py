@@ -1,0 +1,199 @@
+"""``refine``: non-linear refinement of a rig motion on the Sampson angular error.
+
+Levenberg-Marquardt over the rotation (left increments, ``R <- exp([dw]x) R``)
+and the translation, minimising a robust function of the Sampson (first-order
+geometric) angular error of the generalized epipolar constraint (thesis
+eq. 8.15): for each correspondence, with the per-pair essential matrix
+``F = [t + R o1 - o2]x R`` and unit bearings,
+
+    r = d2^T F d1 / sqrt(|P(d1) F^T d2|^2 + |P(d2) F d1|^2),   P(d) = I - d d^T,
+
+in radians. The thesis uses its linear method (ch. 8) as the initial estimate
+of such a refinement (ch. 8.5); so does this estimator by default. The whole
+optimisation runs in one C call (``csrc/refine.c``); this module chooses the
+start, converts and builds the scale verdict from the refined evidence.
+
+Frames and units: rays in the rig frame (metres), motion rig2_from_rig1
+(``X2 = R X1 + t``), residuals and loss scale in radians.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Union
+
+import numpy as np
+
+from .. import _core
+from ..registry import get, register
+from ..types import RayPairs, RigMotion, ScaleVerdict
+
+__all__ = ["refine", "MAX_SCALE_REL_STD"]
+
+#: relative std of |t| above which the refined scale is reported unobservable
+MAX_SCALE_REL_STD = 0.1
+_MIN_PAIRS = 6
+
+InitialLike = Union[RigMotion, tuple, list, None]
+
+
+def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarray, Optional[bool],
+                                                            str]:
+    """(R0, t0, observable-or-None, source) of the starting motion."""
+    if initial is None:
+        m = get("linear17")(rays)
+        return m.R, m.t, bool(m.scale.observable), "linear17"
+    if isinstance(initial, RigMotion):
+        return initial.R, initial.t, bool(initial.scale.observable), initial.method
+    if isinstance(initial, (tuple, list)) and len(initial) == 2:
+        R0 = np.asarray(initial[0], dtype=np.float64) if _numeric(initial[0]) else None
+        t0 = np.asarray(initial[1], dtype=np.float64) if _numeric(initial[1]) else None
+        if R0 is None or R0.shape != (3, 3):
+            raise ValueError("initial: R must be a 3x3 rotation matrix, got "
+                             f"{np.shape(initial[0])}")
+        if t0 is None or t0.shape != (3,):
+            raise ValueError(f"initial: t must be a 3-vector, got shape {np.shape(initial[1])}")
+        return R0, t0, None, "given"
+    raise ValueError("initial must be None, a RigMotion or an (R, t) pair, got "
+                     f"{type(initial).__name__}")
+
+
+def _numeric(a: Any) -> bool:
+    try:
+        return np.asarray(a).dtype.kind in "fiu"
+    except Exception:  # ragged input and the like
+        return False
+
+
+def _verdict(r: dict, fixed: bool, initial_observable: Optional[bool]) -> ScaleVerdict:
+    rel = float(r["scale_rel_std"])
+    cond = float(r["info_cond"])
+    if fixed:
+        why = ("the initial estimate reported it unobservable" if initial_observable is False
+               else "fix_scale was requested")
+        reason = (f"scale not estimated: |t| kept fixed during the refinement ({why}); "
+                  "t is a unit direction")
+    elif not np.isfinite(rel):
+        reason = ("critical motion: the refined information matrix leaves |t| unconstrained "
+                  "(e.g. no rotation and only intra-camera correspondences, thesis ch. 7.3.2)")
+    elif rel > MAX_SCALE_REL_STD:
+        reason = (f"scale too uncertain: relative std {rel:.3g} of |t| after refinement "
+                  "(near-critical motion, too little rotation for the noise level)")
+    else:
+        reason = f"scale fixed by the data: relative std {rel:.2g} of |t| after refinement"
+    observable = (not fixed) and np.isfinite(rel) and rel <= MAX_SCALE_REL_STD
+    return ScaleVerdict(bool(observable), reason, conditioning=cond, rel_std=rel)
+
+
+def _covariance(info: np.ndarray, sigma2: float) -> Optional[np.ndarray]:
+    """sigma2 * info^-1, or None when info is singular (a direction is unconstrained)."""
+    if not np.isfinite(sigma2):
+        return None
+    d = np.sqrt(np.diag(info))
+    if not (d > 0).all():
+        return None
+    scaled = info / np.outer(d, d)  # Jacobi scaling: rotation and metres commensurate
+    w = np.linalg.eigvalsh(scaled)
+    if not w[0] > 1e-12 * w[-1]:
+        return None
+    return sigma2 * (np.linalg.inv(scaled) / np.outer(d, d))
+
+
+@register(
+    "refine",
+    min_sample=_MIN_PAIRS,
+    camera_kinds=("most-general", "locally-central", "axial", "locally-central-and-axial"),
+    family="refinement",
+    needs_rotation=False,
+    recovers_scale=True,
+    description="Levenberg-Marquardt refinement of R, t (with metric scale) on the robust "
+                "Sampson angular error of the generalized epipolar constraint",
+    options={"initial": "start: RigMotion or (R, t); default: the linear17 estimate",
+             "loss": "robust loss: 'cauchy' (default), 'huber', 'soft_l1' or 'none'",
+             "loss_scale": "scale of the loss, radians (default 5e-3)",
+             "max_iterations": "Levenberg-Marquardt trial steps (default 50)",
+             "fix_scale": "keep |t| fixed; default: when the start reports the scale "
+                          "unobservable",
+             "weights": "per-correspondence weights >= 0 (default all 1)"},
+)
+def refine(rays: RayPairs, *, initial: InitialLike = None, loss: str = "cauchy",
+           loss_scale: float = 5e-3, max_iterations: int = 50, fix_scale: Optional[bool] = None,
+           weights: Any = None) -> RigMotion:
+    """Refine a rig motion on the robust Sampson angular error (radians).
+
+    ``rays`` are ray correspondences in the rig frame (metres). ``initial`` is
+    the starting rig2_from_rig1 motion: a :class:`RigMotion` or an ``(R, t)``
+    pair (``X2 = R X1 + t``); by default the ``linear17`` estimate. When
+    ``fix_scale`` is None it is set from the start's verdict: a start whose
+    scale is unobservable (a unit ``t``) is refined with ``|t|`` kept fixed.
+    Otherwise the refinement runs in two stages: rotation and direction of
+    ``t`` with ``|t|`` held, then all six degrees of freedom (the free problem
+    is flat along ``|t|`` where the scale is weakly observable, and a poor start
+    can slide along that valley).
+
+    Returns a :class:`RigMotion`. Its scale verdict comes from the refined
+    evidence: observable iff the first-order relative std of ``|t|`` (from the
+    covariance ``sigma2 (J^T W J)^-1``, rotation marginalised out) is at most
+    0.1 and the scale was not fixed; otherwise ``t`` is returned as a unit
+    direction (the metric one stays in ``info["t_metric"]``).
+    ``residual_rms`` is the weighted RMS Sampson residual over all
+    correspondences (radians, outliers included). ``info`` holds
+    ``iterations`` (both stages), ``converged``, ``stop_reason``, ``initial_cost``,
+    ``final_cost`` (robust cost ``sum w rho(r^2)``), ``sigma`` (residual std,
+    radians), ``information`` (6x6 J^T W J, order [dw (rad), dt (m)]),
+    ``covariance`` (``sigma^2`` times its inverse, None when singular),
+    ``n_used``, ``scale_rel_std``, ``info_cond``, ``fix_scale``, ``loss``,
+    ``loss_scale``, ``initial_method`` and ``t_metric``.
+
+    Raises ValueError on bad input (naming it), DegenerateError when the start
+    constrains nothing (or linear17 cannot start).
+    """
+    if not isinstance(rays, RayPairs):
+        raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    n = len(rays)
+    if n < _MIN_PAIRS:
+        raise ValueError(f"too few correspondences: refine needs at least {_MIN_PAIRS}, got {n}")
+    if not isinstance(loss, str) or loss not in _core.LOSS_NAMES:
+        raise ValueError(f"loss must be one of {sorted(_core.LOSS_NAMES)}, got {loss!r}")
+    R0, t0, start_observable, source = _initial(rays, initial)
+    fixed = bool(fix_scale) if fix_scale is not None else start_observable is False
+    if fixed and not np.linalg.norm(t0) > 0:
+        raise ValueError("fix_scale needs a non-zero initial t")
+    args = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
+    kw = dict(weights=weights, loss=loss, loss_scale=loss_scale, max_iterations=max_iterations)
+    if fixed or not np.linalg.norm(t0) > 0:
+        r = _core.refine_motion(*args, R0, t0, fix_scale=fixed, **kw)
+        first = r
+    else:
+        # Two stages: rotation and direction of t with |t| held, then all six.
+        # Where the scale is weakly observable (locally-central rigs, small
+        # rotations) the free problem is flat along |t| and a poor start can
+        # slide along it (to t -> 0 or to the central-camera asymptote
+        # |t| -> inf); from a converged direction it does not.
+        first = _core.refine_motion(*args, R0, t0, fix_scale=True, **kw)
+        r = _core.refine_motion(*args, first["R"], first["t"], **kw)
+    verdict = _verdict(r, fixed, start_observable)
+    t_metric = r["t"].copy()
+    t = r["t"]
+    if not verdict.observable:
+        nt = np.linalg.norm(t)
+        if nt > 0:
+            t = t / nt
+    info = {
+        "iterations": r["iterations"] + (first["iterations"] if first is not r else 0),
+        "converged": r["converged"],
+        "stop_reason": r["reason"],
+        "initial_cost": first["initial_cost"],
+        "final_cost": r["final_cost"],
+        "sigma": float(np.sqrt(r["sigma2"])) if np.isfinite(r["sigma2"]) else float("inf"),
+        "information": r["information"],
+        "covariance": _covariance(r["information"], r["sigma2"]),
+        "n_used": r["n_used"],
+        "scale_rel_std": r["scale_rel_std"],
+        "info_cond": r["info_cond"],
+        "fix_scale": fixed,
+        "loss": loss,
+        "loss_scale": float(loss_scale),
+        "initial_method": source,
+        "t_metric": None if fixed else t_metric,
+    }
+    return RigMotion(r["R"], t, verdict, "refine", float(r["rms"]), None, info)
