@@ -11,6 +11,10 @@ from . import registry
 from .errors import DegenerateError, InfeasibleError, McgeomError, NumericalError
 from .types import RayPairs, RigMotion, ScaleVerdict
 from . import estimators as _estimators  # noqa: F401  (registers the built-ins)
+from . import robust
+from .calibration import load_rig
+from .cv import (RIG_5P1_DIRECT, RIG_5P1_RANSAC, RIG_LINEAR17, RIG_LINEAR17_RANSAC,
+                 estimateRigMotion)
 
 __version__ = "0.1.0"
 
@@ -25,6 +29,8 @@ def estimate(rays: RayPairs, method: str = "linear17", **options) -> RigMotion:
 
 
 __all__ = [
-    "RayPairs", "RigMotion", "ScaleVerdict", "estimate", "registry",
+    "RayPairs", "RigMotion", "ScaleVerdict", "estimate", "registry", "robust",
+    "estimateRigMotion", "RIG_5P1_RANSAC", "RIG_5P1_DIRECT", "RIG_LINEAR17",
+    "RIG_LINEAR17_RANSAC", "load_rig",
     "McgeomError", "NumericalError", "InfeasibleError", "DegenerateError", "__version__",
 ]

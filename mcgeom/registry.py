@@ -45,6 +45,17 @@ class EstimatorInfo:
     recovers_scale: bool = True
     description: str = ""
     options: dict = field(default_factory=dict)
+    #: ``solver(sample: RayPairs) -> list[(R, t)]``: every motion consistent with a
+    #: minimal sample (``min_sample`` rays), for the robust layer; None if the
+    #: estimator cannot be driven by minimal samples
+    minimal_solver: Optional[Callable] = None
+    #: ``sampler(rays: RayPairs, rng) -> index array`` drawing one minimal sample;
+    #: None = the robust layer's default (spread across cameras)
+    sampler: Optional[Callable] = None
+    #: ``proposer(rays, threshold, prob, rng) -> list[(R, t)]``: a method-specific
+    #: robust search giving a few good hypotheses fast (e.g. the two-stage RANSAC
+    #: of thesis ch. 7.4); the robust layer scores and refines them
+    proposer: Optional[Callable] = None
 
     def __call__(self, rays, **options):
         return self.func(rays, **options)
@@ -57,10 +68,13 @@ _plugins_loaded = False
 def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family: str,
              needs_rotation: bool = False, recovers_scale: bool = True,
              description: str = "", options: Optional[dict] = None,
-             replace: bool = False) -> Callable[[Callable], Callable]:
+             minimal_solver: Optional[Callable] = None, sampler: Optional[Callable] = None,
+             proposer: Optional[Callable] = None, replace: bool = False) -> Callable[[Callable], Callable]:
     """Decorator registering ``fn(rays, **options) -> RigMotion`` under ``name``.
 
     ``options`` documents the keyword options (name -> short description).
+    ``minimal_solver``, ``sampler`` and ``proposer`` (see :class:`EstimatorInfo`) let
+    :mod:`mcgeom.robust` drive the estimator with minimal samples.
     Registering an existing name raises ValueError unless ``replace=True``.
     """
     kinds = tuple(camera_kinds)
@@ -80,7 +94,8 @@ def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family:
         _REGISTRY[name] = EstimatorInfo(name, fn, int(min_sample), kinds, family,
                                         bool(needs_rotation), bool(recovers_scale),
                                         description or (fn.__doc__ or "").strip().split("\n")[0],
-                                        dict(options or {}))
+                                        dict(options or {}), minimal_solver, sampler,
+                                        proposer)
         return fn
 
     return deco

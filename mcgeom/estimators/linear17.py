@@ -59,6 +59,7 @@ def _verdict(r: dict) -> ScaleVerdict:
              "tolerance": "relative cost decrease that stops the alternation (1e-10)",
              "max_scale_rel_std": "relative std of |t| above which the scale is "
                                   "reported unobservable (0.1)"},
+    minimal_solver=lambda sample: _minimal(sample),
 )
 def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[int] = None,
              tolerance: Optional[float] = None, max_scale_rel_std: Optional[float] = None,
@@ -103,6 +104,15 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
         "normalisation": (r["norm_origin"], r["norm_scale"]),
     }
     return RigMotion(r["R"], r["t"], _verdict(r), "linear17", r["cost_final"], None, info)
+
+
+def _minimal(sample: RayPairs) -> list:
+    """The motion of a 17-ray sample for RANSAC (none if the sample is degenerate)."""
+    try:
+        m = linear17(sample, refine=False)
+    except DegenerateError:
+        return []
+    return [(m.R, m.t if m.scale.observable else m.info["t_metric"])]
 
 
 def _raise(status: int, r: dict, rays: RayPairs, n: int) -> None:

@@ -1,0 +1,146 @@
+"""OpenCV-style façade: rig motion from pixel correspondences, like ``cv2.findEssentialMat``.
+
+``estimateRigMotion`` takes pixels of a calibrated rig (the cameras of
+:class:`mcgeom.rig.Rig`), a ``prob``/``threshold`` (pixels)/``maxIters`` triple
+and an optional input mask, and returns ``retval, R, t, mask`` in the
+``cv2.recoverPose`` convention: ``X2 = R X1 + t`` maps rig coordinates at time 1
+to time 2, ``t`` is a 3x1 column in metres (the unit of the rig extrinsics; unit
+length when the scale is not observable), ``mask`` an N x 1 ``uint8`` array
+with 1 for inliers, ``retval`` the number of inliers. :func:`estimate` runs the
+same and returns the full :class:`mcgeom.RigMotion` (scale verdict, residuals,
+diagnostics).
+
+Method flags are module constants naming registered estimators; any registered
+name may be passed as a string instead. Estimators that can drive RANSAC
+(a minimal solver or a proposer) run robustly unless the ``*_DIRECT`` flag (or
+``robust=False``) is used.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Union
+
+import numpy as np
+
+from . import registry
+from . import robust as _robust
+from .rig import Rig
+from .types import RigMotion
+
+__all__ = [
+    "RIG_5P1_RANSAC", "RIG_LINEAR17", "RIG_LINEAR17_RANSAC", "RIG_5P1_DIRECT",
+    "estimateRigMotion", "estimate",
+]
+
+#: 5+1 method (thesis ch. 7) inside LO-RANSAC: the default
+RIG_5P1_RANSAC = "five_plus_one"
+#: linear 17-point generalized essential matrix (thesis ch. 8) on all correspondences
+RIG_LINEAR17 = "linear17"
+#: linear 17-point inside LO-RANSAC (17-point samples spread across cameras)
+RIG_LINEAR17_RANSAC = "ransac:linear17"
+#: 5+1 on all correspondences (no outlier rejection)
+RIG_5P1_DIRECT = "direct:five_plus_one"
+
+
+def _points(name: str, p: Any) -> np.ndarray:
+    a = np.asarray(p)
+    if a.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must be numeric, got dtype {a.dtype}")
+    if a.ndim == 3 and a.shape[1:] == (1, 2):      # OpenCV's (N, 1, 2)
+        a = a.reshape(-1, 2)
+    if a.ndim != 2 or a.shape[1] != 2:
+        raise ValueError(f"{name} must have shape (N, 2) or (N, 1, 2), got {a.shape}")
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} contains NaN or inf")
+    return a
+
+
+def _ids(name: str, ids: Any, n: int, rig: Rig) -> np.ndarray:
+    a = np.asarray(ids).reshape(-1) if np.ndim(ids) else np.full(n, ids)
+    if a.shape[0] != n:
+        raise ValueError(f"{name} has {a.shape[0]} entries, expected {n} (one per point)")
+    if a.dtype.kind not in "iu":
+        raise ValueError(f"{name} must hold integer camera ids, got dtype {a.dtype}")
+    bad = (a < 0) | (a >= len(rig.cameras))
+    if bad.any():
+        raise ValueError(f"{name} holds camera id {int(a[bad][0])}, but the rig has cameras "
+                         f"0..{len(rig.cameras) - 1}")
+    return a.astype(np.int64)
+
+
+def _resolve(method: str, robust_flag: Optional[bool]) -> tuple[str, bool]:
+    if not isinstance(method, str):
+        raise ValueError(f"method must be a flag of mcgeom.cv or a registered estimator name, "
+                         f"got {method!r}")
+    if method.startswith("ransac:"):
+        return method[7:], True
+    if method.startswith("direct:"):
+        return method[7:], False
+    info = registry.get(method)
+    can = info.minimal_solver is not None or info.proposer is not None
+    if robust_flag is None:
+        return method, can and method != RIG_LINEAR17
+    return method, bool(robust_flag)
+
+
+def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
+             method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
+             maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
+             robust: Optional[bool] = None, **options: Any) -> RigMotion:
+    """Full :class:`RigMotion` rig2_from_rig1 from pixel correspondences of ``rig``.
+
+    ``points1[k]`` (pixels, camera ``cameraIds1[k]``, time 1) and ``points2[k]``
+    (camera ``cameraIds2[k]``, time 2; ``None`` = the same cameras) see the same
+    scene point. ``threshold`` is in pixels (Sampson angular error times the
+    mean focal length of the two cameras), ``prob`` the RANSAC confidence,
+    ``maxIters`` its iteration cap, ``mask`` (N, N x 1, nonzero = use) selects
+    the correspondences to consider. The returned ``inliers`` mask has N entries
+    (False for masked-out correspondences).
+    """
+    if not isinstance(rig, Rig):
+        raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
+    p1, p2 = _points("points1", points1), _points("points2", points2)
+    n = p1.shape[0]
+    if p2.shape[0] != n:
+        raise ValueError(f"points2 has {p2.shape[0]} points but points1 has {n}")
+    ids1 = _ids("cameraIds1", cameraIds1, n, rig)
+    ids2 = ids1 if cameraIds2 is None else _ids("cameraIds2", cameraIds2, n, rig)
+    use = np.ones(n, bool)
+    if mask is not None:
+        m = np.asarray(mask).reshape(-1)
+        if m.shape[0] != n:
+            raise ValueError(f"mask has {m.shape[0]} entries, expected {n}")
+        use = m != 0
+    name, run_robust = _resolve(method, robust)
+    rays_all = rig.ray_pairs(p1, p2, ids1, ids2)
+    rays = rays_all.take(np.flatnonzero(use))
+    if run_robust:
+        focal = np.array([0.5 * (c.K[0, 0] + c.K[1, 1]) for c in rig.cameras])
+        f = 0.5 * (focal[rays.cam1] + focal[rays.cam2])
+        m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
+                          seed=seed, focal=f, **options)
+        inl = np.zeros(n, bool)
+        inl[np.flatnonzero(use)] = m.inliers
+    else:
+        m = registry.get(name)(rays, **options)
+        inl = use.copy()
+    return RigMotion(m.R, m.t, m.scale, m.method, m.residual_rms, inl, m.info)
+
+
+def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
+                      method: str = RIG_5P1_RANSAC, prob: float = 0.999,
+                      threshold: float = 1.0, maxIters: int = 1000,
+                      mask: Any = None) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """OpenCV-style rig motion: ``retval, R, t, mask`` (see the module docstring).
+
+    Same arguments as :func:`estimate`. ``R`` (3x3) and ``t`` (3x1, metres) map
+    rig coordinates at time 1 to time 2 (``X2 = R X1 + t``, as
+    ``cv2.recoverPose``); ``mask`` is N x 1 ``uint8`` (1 = inlier); ``retval``
+    the number of inliers. ``t`` has unit length when the scale is not
+    observable: call :func:`estimate` for the verdict.
+    """
+    m = estimate(points1, points2, cameraIds1, cameraIds2, rig, method=method, prob=prob,
+                 threshold=threshold, maxIters=maxIters, mask=mask)
+    out_mask = m.inliers.astype(np.uint8).reshape(-1, 1)
+    return int(out_mask.sum()), np.array(m.R), np.array(m.t).reshape(3, 1), out_mask

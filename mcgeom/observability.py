@@ -1,0 +1,164 @@
+"""Is the metric scale of a rig motion observable? Evidence and verdict (thesis ch. 7.3.2).
+
+Two pieces of evidence are combined:
+
+* geometry: the critical angle of ch. 7.5.2. A camera centre ``c`` moves, seen
+  from the time-1 rig frame, by ``delta(c) = R^T (c - t) - c``. Intra-camera
+  correspondences of two cameras fix the scale only if their displacements are
+  not parallel (Theorem 3); the critical angle of a pair is the angle between
+  them, and the rig's is the largest over the cameras that have inliers.
+  Cross-camera correspondences (one camera at time 1, another at time 2) fix
+  the scale whatever the motion.
+* statistics: the relative standard deviation of ``|t|`` from the covariance of
+  the final nonlinear refinement (residual variance times the inverse
+  information matrix), which accounts for the noise, the number of inliers and
+  the rotation uncertainty together.
+
+The verdict is "observable" when the statistics say so (relative std at most
+``max_rel_std``); the critical angle and the cross-camera count explain it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .types import RayPairs, ScaleVerdict
+
+__all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_only_fit",
+           "count_in_front", "orient_by_cheirality"]
+
+
+def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """``R^T (c - t) - c`` for each centre (rows), metres in the time-1 rig frame."""
+    return (np.asarray(centres) - t) @ np.asarray(R) - centres
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if not (na > 0 and nb > 0):
+        return 0.0
+    return float(np.arctan2(np.linalg.norm(np.cross(a, b)), float(a @ b)))
+
+
+def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> float:
+    """Largest critical angle (radians, in [0, pi]) over pairs of the given centres.
+
+    The angle between the displacement directions is folded to [0, pi/2]: a
+    displacement and its opposite are equally critical (Theorem 3 asks for
+    parallel lines, whatever their sense). 0 for fewer than two centres.
+    """
+    d = displacements(R, t, centres)
+    best = 0.0
+    for i in range(len(d)):
+        for j in range(i + 1, len(d)):
+            a = _angle(d[i], d[j])
+            best = max(best, min(a, np.pi - a))
+    return best
+
+
+def _centres_with_intra(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, int]:
+    """Centres of cameras with intra-camera inliers, and the number of cross-camera inliers."""
+    if rays.cam1 is not None and rays.cam2 is not None:
+        intra = mask & (rays.cam1 == rays.cam2)
+        cross = int((mask & (rays.cam1 != rays.cam2)).sum())
+        ids = np.unique(rays.cam1[intra])
+        centres = np.array([rays.origins1[intra & (rays.cam1 == k)][0] for k in ids])
+        return centres.reshape(-1, 3), cross
+    same = np.all(rays.origins1 == rays.origins2, axis=1)
+    intra = mask & same
+    cross = int((mask & ~same).sum())
+    centres = np.unique(rays.origins1[intra], axis=0) if intra.any() else np.zeros((0, 3))
+    return centres, cross
+
+
+def count_in_front(rays: RayPairs, R: np.ndarray, t: np.ndarray,
+                   mask: np.ndarray | None = None) -> int:
+    """Correspondences whose two rays meet (mid-point) in front of both origins
+    when the time-1 ray is moved by (R, t) into the time-2 rig frame."""
+    sel = slice(None) if mask is None else np.asarray(mask, bool)
+    p = rays.origins1[sel] @ R.T + t
+    a = rays.dirs1[sel] @ R.T
+    b = rays.dirs2[sel]
+    w = rays.origins2[sel] - p
+    aa, bb, ab = (np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", b, b),
+                  np.einsum("ij,ij->i", a, b))
+    aw, bw = np.einsum("ij,ij->i", a, w), np.einsum("ij,ij->i", b, w)
+    den = aa * bb - ab * ab
+    ok = den > 1e-14 * aa * bb
+    den = np.where(ok, den, 1.0)
+    s1 = (aw * bb - bw * ab) / den
+    s2 = (aw * ab - bw * aa) / den
+    return int(np.sum(ok & (s1 > 0) & (s2 > 0)))
+
+
+def orient_by_cheirality(rays: RayPairs, R: np.ndarray, t: np.ndarray,
+                         mask: np.ndarray | None = None) -> np.ndarray:
+    """``t`` or ``-t``, whichever puts more triangulated points in front of the
+    cameras: the sign of a translation direction whose length is unknown."""
+    return t if count_in_front(rays, R, t, mask) >= count_in_front(rays, R, -t, mask) else -t
+
+
+def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Best pure rotation for the masked intra-camera correspondences, and their angles.
+
+    Wahba's problem: ``R = argmin sum |d2 - R d1|^2`` over unit directions (SVD of
+    ``sum d2 d1^T``). If the residual angles (radians) are at the noise level the
+    data show no parallax: the rig did not translate measurably (static rig,
+    pure rotation, or everything at infinity) and neither the direction nor the
+    scale of ``t`` is determined.
+    """
+    same = (rays.cam1 == rays.cam2) if rays.cam1 is not None and rays.cam2 is not None \
+        else np.all(rays.origins1 == rays.origins2, axis=1)
+    sel = np.asarray(mask, bool) & same
+    if sel.sum() < 2:
+        return np.eye(3), np.zeros(0)
+    d1 = rays.dirs1[sel] / np.linalg.norm(rays.dirs1[sel], axis=1, keepdims=True)
+    d2 = rays.dirs2[sel] / np.linalg.norm(rays.dirs2[sel], axis=1, keepdims=True)
+    u, _, vt = np.linalg.svd(d2.T @ d1)
+    R = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+    rd1 = d1 @ R.T
+    ang = np.arctan2(np.linalg.norm(np.cross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
+    return R, ang
+
+
+def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndarray,
+                  rel_std: float, max_rel_std: float = 0.1,
+                  direction_only: bool = False,
+                  noise_level: float = float("nan"),
+                  residual_median: float = float("nan")) -> ScaleVerdict:
+    """The scale verdict of a motion estimated from the ``inliers`` of ``rays``.
+
+    ``rel_std`` is the relative std of ``|t|`` from the refinement;
+    ``direction_only`` says that the refinement already had to fix ``|t|``;
+    ``noise_level`` (radians, e.g. the inlier threshold) and ``residual_median``
+    (median Sampson residual of the motion on its inliers, radians) enable the
+    no-parallax test of :func:`rotation_only_fit`: when a pure rotation explains
+    the intra-camera inliers about as well as the full motion (median angle
+    under 3x the median Sampson residual, which is ~1.75x under noise alone for
+    the 2-dof angle against the 1-dof Sampson distance) and within twice the
+    noise level, no translation was detected at all.
+    """
+    if np.isfinite(noise_level) and np.isfinite(residual_median):
+        _, ang = rotation_only_fit(rays, inliers)
+        med = float(np.median(ang)) if ang.size else float("inf")
+        if ang.size >= 5 and med < 3.0 * residual_median and med < 2.0 * noise_level:
+            return ScaleVerdict(False, "no translation detected: a pure rotation explains the "
+                                       f"correspondences (median residual "
+                                       f"{np.degrees(np.median(ang)) * 3600:.3g} arcsec); static "
+                                       "rig, pure rotation or scene at infinity: neither the "
+                                       "direction nor the scale of t is determined",
+                                0.0, float("inf"), 0.0)
+    centres, n_cross = _centres_with_intra(rays, np.asarray(inliers, bool))
+    crit = rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
+    evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {np.degrees(crit):.3g} deg "
+                f"over {len(centres)} cameras, {n_cross} cross-camera inliers")
+    if direction_only or not np.isfinite(rel_std) or rel_std > max_rel_std:
+        if n_cross == 0 and len(centres) < 2:
+            why = "one camera only and no cross-camera correspondence"
+        elif n_cross == 0 and crit < np.radians(0.05):
+            why = ("critical motion: camera displacements parallel (no rotation, thesis "
+                   "ch. 7.3.2, Theorem 3)")
+        else:
+            why = "scale too uncertain for the noise (near-critical motion)"
+        return ScaleVerdict(False, f"{why}; {evidence}", float("nan"), float(rel_std), crit)
+    return ScaleVerdict(True, f"scale observable: {evidence}", float("nan"), float(rel_std), crit)

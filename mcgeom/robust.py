@@ -1,0 +1,302 @@
+"""Robust rig motion: LO-RANSAC with MSAC scoring, driven by any registered estimator.
+
+Hypotheses come from the estimator's minimal solver on samples drawn across
+the cameras of the rig (the estimator's own ``sampler``, else one correspondence
+per camera pair in turn), or from its ``proposer`` (a method-specific robust
+search such as the two-stage RANSAC of thesis ch. 7.4). Every hypothesis is
+scored on all correspondences with the truncated quadratic (MSAC) of the
+residual below; each new best one is locally optimised (re-estimated from its
+inliers by nonlinear least squares, repeated while it improves); the number of
+iterations adapts to the inlier ratio found (``prob``); the final motion is
+refined on all its inliers with a robust loss.
+
+Residual: the Sampson (first-order) angular error of the generalized epipolar
+constraint (``_core.gec_residuals``), in radians on the unit sphere. With
+``focal`` given (pixels, one value or one per correspondence) thresholds and
+residuals are in pixels: radians x focal, the usual pinhole approximation.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Optional, Union
+
+import numpy as np
+
+from . import _core, registry
+from .errors import DegenerateError
+from .observability import orient_by_cheirality, scale_verdict
+from .types import RayPairs, RigMotion, ScaleVerdict
+
+__all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
+
+
+@dataclass(frozen=True)
+class RansacOptions:
+    """Options of :func:`ransac` (units: radians, or pixels when ``focal`` is given)."""
+
+    threshold: float = 1e-3
+    prob: float = 0.999
+    max_iters: int = 1000
+    min_iters: int = 0
+    seed: Optional[int] = 0
+    local_optimization: bool = True
+    lo_max_rounds: int = 4
+    refine: bool = True
+    loss: str = "cauchy"
+    max_scale_rel_std: float = 0.1
+    strategy: str = "auto"          # "auto" | "proposer" | "minimal"
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.threshold) and self.threshold > 0):
+            raise ValueError(f"threshold must be a positive number, got {self.threshold}")
+        if not (0.0 < self.prob < 1.0):
+            raise ValueError(f"prob must be in (0, 1), got {self.prob}")
+        if int(self.max_iters) < 1:
+            raise ValueError(f"maxIters must be >= 1, got {self.max_iters}")
+        if self.strategy not in ("auto", "proposer", "minimal"):
+            raise ValueError(f"strategy must be 'auto', 'proposer' or 'minimal', got "
+                             f"{self.strategy!r}")
+
+
+def _focal_array(focal: Union[None, float, np.ndarray], n: int) -> Optional[np.ndarray]:
+    if focal is None:
+        return None
+    f = np.asarray(focal, dtype=np.float64)
+    if f.ndim == 0:
+        f = np.full(n, float(f))
+    if f.shape != (n,) or not np.all(np.isfinite(f)) or np.any(f <= 0):
+        raise ValueError(f"focal must be a positive number or {n} positive numbers")
+    return f
+
+
+def residuals(rays: RayPairs, R: np.ndarray, t: np.ndarray,
+              focal: Union[None, float, np.ndarray] = None) -> np.ndarray:
+    """Absolute Sampson angular residual of every correspondence for motion (R, t).
+
+    Radians on the unit sphere, or pixels (radians x ``focal``) when ``focal``
+    is given.
+    """
+    r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                   np.asarray(R, dtype=np.float64),
+                                   np.asarray(t, dtype=np.float64)))
+    f = _focal_array(focal, len(rays))
+    return r if f is None else r * f
+
+
+def adaptive_iterations(inlier_ratio: float, sample_size: int, prob: float,
+                        max_iters: int) -> int:
+    """Iterations after which an all-inlier sample was drawn with probability ``prob``."""
+    w = float(np.clip(inlier_ratio, 0.0, 1.0)) ** sample_size
+    if w <= 0.0:
+        return int(max_iters)
+    if w >= 1.0:
+        return 1
+    k = np.log1p(-prob) / np.log1p(-w)
+    return int(min(max_iters, np.ceil(k)))
+
+
+def sample_across_cameras(rays: RayPairs, size: int, rng: np.random.Generator) -> np.ndarray:
+    """``size`` distinct correspondences spread over the camera pairs.
+
+    Camera pairs (cam1, cam2) are visited in a random order, one correspondence
+    each, round after round, so that no camera dominates the sample (drawing
+    uniformly from all correspondences would give samples from the one camera
+    that has most of them).
+    """
+    n = len(rays)
+    if size > n:
+        raise ValueError(f"too few correspondences: a sample needs {size}, got {n}")
+    if rays.cam1 is None or rays.cam2 is None:
+        return rng.choice(n, size, replace=False)
+    key = rays.cam1 * (int(rays.cam2.max(initial=0)) + 1) + rays.cam2
+    groups = [rng.permutation(np.flatnonzero(key == k)) for k in np.unique(key)]
+    order = rng.permutation(len(groups))
+    out: list[int] = []
+    depth = 0
+    while len(out) < size:
+        for g in order:
+            if depth < len(groups[g]):
+                out.append(int(groups[g][depth]))
+                if len(out) == size:
+                    break
+        depth += 1
+    return np.asarray(out, dtype=np.int64)
+
+
+def _msac(r: np.ndarray, thr: float) -> float:
+    return float(np.minimum(r * r, thr * thr).sum())
+
+
+class _Scorer:
+    """Scores motions on all correspondences and runs the local optimisation."""
+
+    def __init__(self, rays: RayPairs, thr: float, focal: Optional[np.ndarray],
+                 opts: RansacOptions):
+        self.rays, self.thr, self.focal, self.opts = rays, thr, focal, opts
+        self.best: Optional[tuple[np.ndarray, np.ndarray]] = None
+        self.best_score = np.inf
+        self.best_inliers = np.zeros(len(rays), bool)
+        self.n_hyp = 0
+        self.n_lo = 0
+
+    def residuals(self, R: np.ndarray, t: np.ndarray) -> np.ndarray:
+        return residuals(self.rays, R, t, self.focal)
+
+    def offer(self, R: np.ndarray, t: np.ndarray) -> bool:
+        """Score a hypothesis; keep (and locally optimise) it if it is the best so far."""
+        self.n_hyp += 1
+        if not (np.all(np.isfinite(R)) and np.all(np.isfinite(t))):
+            return False
+        r = self.residuals(R, t)
+        score = _msac(r, self.thr)
+        if score >= self.best_score:
+            return False
+        self.best, self.best_score, self.best_inliers = (R, t), score, r < self.thr
+        if self.opts.local_optimization:
+            self._local_optimise()
+        return True
+
+    def _local_optimise(self) -> None:
+        """Re-estimate from the inliers by robust least squares while the score improves."""
+        for _ in range(self.opts.lo_max_rounds):
+            inl = self.best_inliers
+            if inl.sum() < 6:
+                return
+            R, t = self.best
+            self.n_lo += 1
+            try:
+                out = _refine(self.rays.take(inl), R, t, self._loss_scale(), "cauchy")
+            except (ValueError, ArithmeticError):
+                return
+            r = self.residuals(out["R"], out["t"])
+            score = _msac(r, self.thr)
+            if not score < self.best_score * (1.0 - 1e-9):
+                return
+            self.best, self.best_score, self.best_inliers = (out["R"], out["t"]), score, r < self.thr
+
+    def _loss_scale(self) -> float:
+        """Loss scale in radians (the threshold, converted from pixels if needed)."""
+        if self.focal is None:
+            return self.thr
+        return self.thr / float(np.median(self.focal))
+
+
+def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
+            fix_scale: bool = False) -> dict:
+    return _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
+                               loss=loss, loss_scale=loss_scale, fix_scale=fix_scale)
+
+
+def ransac(rays: RayPairs, method: str = "five_plus_one", *,
+           threshold: Optional[float] = None, prob: float = 0.999, max_iters: int = 1000,
+           seed: Optional[int] = 0, focal: Union[None, float, np.ndarray] = None,
+           options: Optional[RansacOptions] = None, **kw: Any) -> RigMotion:
+    """Robust rig motion rig2_from_rig1 from correspondences with outliers.
+
+    ``method`` is a registered estimator with a minimal solver or a proposer.
+    ``threshold`` is the inlier threshold on the Sampson angular residual
+    (radians; pixels when ``focal`` gives the focal length in pixels, one value
+    or one per correspondence); ``prob`` the confidence of the adaptive stop;
+    ``max_iters`` caps the number of samples; ``seed`` makes the run
+    deterministic. Further ``RansacOptions`` fields may be passed as keywords.
+
+    Returns a ``RigMotion`` with the boolean ``inliers`` mask, the scale verdict
+    (from the covariance of the final refinement, plus the estimator's own
+    evidence such as the critical angle of ch. 7) and ``info`` with the number
+    of iterations, hypotheses, local optimisations, the inlier ratio and the time.
+    Raises ValueError for bad input or when no hypothesis could be formed
+    (e.g. too few correspondences), DegenerateError when no motion explains
+    enough correspondences.
+    """
+    t_start = time.perf_counter()
+    if not isinstance(rays, RayPairs):
+        raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    if options is None:
+        thr = threshold if threshold is not None else (1.0 if focal is not None else 1e-3)
+        options = RansacOptions(threshold=thr, prob=prob, max_iters=max_iters, seed=seed, **kw)
+    info_est = registry.get(method)
+    n = len(rays)
+    if n < info_est.min_sample:
+        raise ValueError(f"too few correspondences: {method} needs at least "
+                         f"{info_est.min_sample}, got {n}")
+    for name in ("origins1", "dirs1", "origins2", "dirs2"):
+        if not np.all(np.isfinite(getattr(rays, name))):
+            raise ValueError(f"rays.{name} contains NaN or inf")
+    f = _focal_array(focal, n)
+    rng = np.random.default_rng(options.seed)
+    scorer = _Scorer(rays, options.threshold, f, options)
+
+    use_proposer = info_est.proposer is not None and options.strategy in ("auto", "proposer")
+    if options.strategy == "proposer" and info_est.proposer is None:
+        raise ValueError(f"estimator {method!r} has no proposer")
+    if not use_proposer and info_est.minimal_solver is None:
+        raise ValueError(f"estimator {method!r} has no minimal solver: it cannot drive RANSAC")
+    iterations = 0
+    if use_proposer:
+        for R, t in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
+            scorer.offer(R, t)
+        iterations = 1
+    else:
+        sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
+        k_needed = options.max_iters
+        failures = 0
+        while iterations < max(k_needed, options.min_iters) and iterations < options.max_iters:
+            iterations += 1
+            try:
+                idx = sampler(rays, rng)
+                sols = info_est.minimal_solver(rays.take(idx))
+            except DegenerateError:
+                failures += 1
+                continue
+            for R, t in sols:
+                if scorer.offer(R, t):
+                    ratio = scorer.best_inliers.mean()
+                    k_needed = adaptive_iterations(ratio, info_est.min_sample, options.prob,
+                                                   options.max_iters)
+    if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
+        raise DegenerateError(f"{method}: no motion found that explains at least "
+                              f"{max(6, info_est.min_sample)} correspondences "
+                              f"({scorer.n_hyp} hypotheses from {iterations} samples)")
+    return _finish(rays, scorer, options, method, iterations, t_start)
+
+
+def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str,
+            iterations: int, t_start: float) -> RigMotion:
+    """Final robust refinement on the inliers, verdict and diagnostics."""
+    R, t = scorer.best
+    inl = scorer.best_inliers
+    info: dict = {"iterations": iterations, "hypotheses": scorer.n_hyp,
+                  "local_optimizations": scorer.n_lo}
+    rel_std = float("inf")
+    fixed = False
+    if options.refine:
+        sub = rays.take(inl)
+        out = _refine(sub, R, t, scorer._loss_scale(), options.loss)
+        R, t = out["R"], out["t"]
+        rel_std = float(out["scale_rel_std"])
+        if not rel_std <= options.max_scale_rel_std:
+            # scale not determined: keep the direction, refine on the sphere
+            info["t_free"] = np.array(t)     # |t| as the free refinement left it
+            out = _refine(sub, R, t, scorer._loss_scale(), options.loss, fix_scale=True)
+            R, t, fixed = out["R"], out["t"], True
+        r = scorer.residuals(R, t)
+        inl = r < options.threshold
+        info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
+    r = scorer.residuals(R, t)
+    info.update(inlier_ratio=float(inl.mean()), time_s=time.perf_counter() - t_start,
+                score=scorer.best_score)
+    r_rad = residuals(rays, R, t)
+    verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std, fixed,
+                            noise_level=scorer._loss_scale(),
+                            residual_median=float(np.median(r_rad[inl])) if inl.any() else 0.0)
+    info["translation_detected"] = not verdict.reason.startswith("no translation")
+    info["t_metric"] = np.array(t)   # the metric estimate, whatever the verdict
+    if not verdict.observable:
+        nt = np.linalg.norm(t)
+        if nt > 0:
+            t = orient_by_cheirality(rays, R, t / nt, inl)
+    return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
+                     float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan"),
+                     inl, info)

@@ -1,0 +1,124 @@
+"""Robust rig motion from pixels: mcgeom's default pipeline against PoseLib, same problems.
+
+Cases (issue 3): a Ladybug2-like 6-camera head with 300 correspondences, 30 %
+outliers and 0.5 px noise; a 2-camera non-overlapping head with 200
+correspondences and 0.5 px noise; a 4-camera ring with 4 x 50 points at 0.1,
+0.3 and 0.5 px. Both methods get the same pixels, the same calibration and the
+same 1 px epipolar threshold; PoseLib runs ``estimate_generalized_relative_pose``
+with its default RANSAC and bundle options. Printed per case: median and 90th
+percentile of rotation error (deg), translation-direction error (deg) and scale
+error |(|t_est| / |t_true|) - 1| (the metric estimate, whatever the verdict),
+failure rate (rotation error > 1 deg or direction error > 10 deg), median time
+and the time ratio PoseLib / mcgeom.
+``python tests/bench_robust_vs_poselib.py 100``
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import Callable
+
+import numpy as np
+
+from mcgeom import synth
+from mcgeom.cv import estimate
+from mcgeom.rig import Rig
+
+
+def ring4(radius: float = 0.25, f: float = 500.0) -> Rig:
+    """4 cameras on a horizontal ring looking outward every 90 deg (1024 x 768 px)."""
+    cams = []
+    for k in range(4):
+        yaw = np.radians(90.0 * k)
+        h = np.array([np.cos(yaw), np.sin(yaw), 0.0])
+        cams.append(synth.look_at_camera(f"ring{k}", radius * h, h, f=f, width=1024, height=768))
+    return Rig(tuple(cams))
+
+
+CASES: dict[str, tuple[Callable[[], Rig], int, float, float]] = {
+    # name: (rig, correspondences, outlier fraction, pixel noise)
+    "ladybug6 300c 30%out 0.5px": (synth.ladybug2, 300, 0.3, 0.5),
+    "stereo2 200c 0.5px": (lambda: synth.stereo_head(0.5), 200, 0.0, 0.5),
+    "ring4 4x50 0.1px": (ring4, 200, 0.0, 0.1),
+    "ring4 4x50 0.3px": (ring4, 200, 0.0, 0.3),
+    "ring4 4x50 0.5px": (ring4, 200, 0.0, 0.5),
+}
+
+
+def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
+    import poselib
+    exts, cams = [], []
+    for c in rig.cameras:
+        pose = poselib.CameraPose()
+        pose.R, pose.t = c.R, c.t
+        exts.append(pose)
+        K = c.K
+        cams.append({"model": "PINHOLE", "width": int(c.width), "height": int(c.height),
+                     "params": [K[0, 0], K[1, 1], K[0, 2], K[1, 2]]})
+    matches = []
+    m = len(rig.cameras)
+    for i in range(m):
+        for j in range(m):
+            sel = (p.cam1 == i) & (p.cam2 == j)
+            if sel.any():
+                pm = poselib.PairwiseMatches()
+                pm.cam_id1, pm.cam_id2 = i, j
+                pm.x1, pm.x2 = p.pixels1[sel], p.pixels2[sel]
+                matches.append(pm)
+    pose, _ = poselib.estimate_generalized_relative_pose(matches, exts, cams, exts, cams,
+                                                         {"max_epipolar_error": 1.0}, {})
+    return np.asarray(pose.R), np.asarray(pose.t)
+
+
+def _mcgeom(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
+    m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0)
+    return m.R, m.info.get("t_free", m.info.get("t_metric", m.t))
+
+
+def _errors(R, t, Rt, tt) -> tuple[float, float, float]:
+    rot = np.degrees(synth.rotation_error(R, Rt))
+    cosang = np.clip(t @ tt / (np.linalg.norm(t) * np.linalg.norm(tt) + 1e-300), -1, 1)
+    return rot, float(np.degrees(np.arccos(cosang))), abs(np.linalg.norm(t) / np.linalg.norm(tt) - 1)
+
+
+def run(trials: int = 50, seed: int = 0, cases=None) -> dict:
+    out = {}
+    for name, (make_rig, n, outl, noise) in (cases or CASES).items():
+        rng = np.random.default_rng(seed)
+        rig = make_rig()
+        res = {"mcgeom": ([], []), "poselib": ([], [])}
+        for _ in range(trials):
+            R = synth.random_rotation(rng, 0.3)
+            while synth.rotation_error(R, np.eye(3)) < 0.05:
+                R = synth.random_rotation(rng, 0.3)
+            t = rng.normal(size=3)
+            t /= np.linalg.norm(t)
+            p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
+            for meth, fn in (("mcgeom", _mcgeom), ("poselib", _poselib)):
+                t0 = time.perf_counter()
+                Re, te = fn(rig, p)
+                res[meth][1].append(time.perf_counter() - t0)
+                res[meth][0].append(_errors(Re, te, R, t))
+        out[name] = {k: (np.array(e), np.array(s)) for k, (e, s) in res.items()}
+    return out
+
+
+def table(res: dict) -> str:
+    lines = [f"{'case':<28} {'method':<8} {'rot med/p90 deg':>17} {'dir med/p90 deg':>17} "
+             f"{'scale med/p90':>15} {'fail':>6} {'ms med':>8} {'speedup':>8}"]
+    for case, methods in res.items():
+        t_pl = np.median(methods["poselib"][1])
+        for meth, (e, secs) in methods.items():
+            med, p90 = np.median(e, 0), np.percentile(e, 90, axis=0)
+            fail = np.mean((e[:, 0] > 1.0) | (e[:, 1] > 10.0))
+            ratio = t_pl / np.median(secs)
+            lines.append(f"{case:<28} {meth:<8} {med[0]:7.4f}/{p90[0]:<9.4f} {med[1]:7.3f}/{p90[1]:<9.3f} "
+                         f"{med[2]:6.3f}/{p90[2]:<8.3f} {fail:6.3f} {1e3 * np.median(secs):8.2f} "
+                         f"{ratio:7.2f}x")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    n = int(sys.argv[1]) if len(sys.argv) > 1 else 50
+    print(table(run(n)))

@@ -1,0 +1,146 @@
+"""LO-RANSAC (mcgeom.robust) and the OpenCV-style façade (mcgeom.cv)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mcgeom
+from mcgeom import robust, synth
+from mcgeom.cv import estimate as cv_estimate
+from problems import rot_err
+
+
+def _ladybug_problem(seed, n=300, outliers=0.3, noise=0.5):
+    rng = np.random.default_rng(seed)
+    rig = synth.ladybug2()
+    R = synth.random_rotation(rng, 0.3)
+    while synth.rotation_error(R, np.eye(3)) < 0.1:
+        R = synth.random_rotation(rng, 0.3)
+    t = rng.normal(size=3)
+    t *= 1.0 / np.linalg.norm(t)
+    return synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outliers)
+
+
+def _vehicle_problem(seed, n=400, outliers=0.2, noise=0.5, yaw_deg=10.0, cross=0.0):
+    rng = np.random.default_rng(seed)
+    rig = synth.vehicle8()
+    yaw = np.radians(yaw_deg)
+    Rw = synth.rotation_about([0, 0, 1], yaw)            # rig2 in rig1's frame
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    return synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outliers,
+                              cross_fraction=cross)
+
+
+def test_adaptive_iterations():
+    assert robust.adaptive_iterations(1.0, 6, 0.99, 1000) == 1
+    assert robust.adaptive_iterations(0.0, 6, 0.99, 1000) == 1000
+    k = robust.adaptive_iterations(0.5, 6, 0.99, 10**6)
+    assert k == int(np.ceil(np.log(0.01) / np.log(1 - 0.5**6)))
+
+
+def test_samples_are_spread_across_cameras():
+    p = _ladybug_problem(0, outliers=0.0)
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        idx = robust.sample_across_cameras(p.rays, 6, rng)
+        assert len(set(idx.tolist())) == 6
+        assert len(set(p.rays.cam1[idx].tolist())) == 6   # one per camera of the head
+
+
+@pytest.mark.parametrize("strategy", ["proposer", "minimal"])
+def test_ransac_finds_the_motion_among_outliers(strategy):
+    p = _vehicle_problem(1)
+    focal = 800.0
+    m = robust.ransac(p.rays, "five_plus_one", threshold=1.0, focal=focal, seed=0,
+                      strategy=strategy, max_iters=500)
+    assert rot_err(m.R, p.R) < np.radians(0.1)
+    tp = p.t if m.scale.observable else p.t / np.linalg.norm(p.t)
+    assert np.linalg.norm(m.t - tp) < 0.1 * np.linalg.norm(tp)
+    # the inlier mask agrees with the truth for nearly all correspondences
+    agree = np.mean(m.inliers == p.inlier)
+    assert agree > 0.95
+    assert m.info["iterations"] >= 1
+
+
+def test_ransac_is_deterministic_with_a_seed():
+    p = _vehicle_problem(2)
+    a = robust.ransac(p.rays, "five_plus_one", threshold=1.0, focal=800.0, seed=3,
+                      strategy="minimal", max_iters=200)
+    b = robust.ransac(p.rays, "five_plus_one", threshold=1.0, focal=800.0, seed=3,
+                      strategy="minimal", max_iters=200)
+    assert np.array_equal(a.R, b.R) and np.array_equal(a.t, b.t)
+    assert np.array_equal(a.inliers, b.inliers)
+
+
+def test_ransac_with_linear17_samples():
+    p = _vehicle_problem(3, outliers=0.1, noise=0.2)
+    m = robust.ransac(p.rays, "linear17", threshold=1.0, focal=800.0, seed=0, max_iters=300)
+    assert rot_err(m.R, p.R) < np.radians(0.2)
+
+
+def test_ransac_bad_input():
+    p = _vehicle_problem(4)
+    with pytest.raises(ValueError, match="too few"):
+        robust.ransac(p.rays.take(np.arange(4)), "five_plus_one")
+    with pytest.raises(ValueError, match="prob"):
+        robust.ransac(p.rays, "five_plus_one", prob=1.5)
+    with pytest.raises(ValueError, match="threshold"):
+        robust.ransac(p.rays, "five_plus_one", threshold=-1.0)
+    with pytest.raises(ValueError, match="unknown estimator"):
+        robust.ransac(p.rays, "no_such_method")
+
+
+# ------------------------------------------------------------------ façade
+
+def test_estimate_rig_motion_opencv_convention():
+    p = _vehicle_problem(5)
+    retval, R, t, mask = mcgeom.estimateRigMotion(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    assert R.shape == (3, 3) and t.shape == (3, 1)
+    assert mask.shape == (len(p), 1) and mask.dtype == np.uint8
+    assert retval == int(mask.sum())
+    assert rot_err(R, p.R) < np.radians(0.1)
+    m = cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    if m.scale.observable:
+        assert np.linalg.norm(t.ravel() - p.t) < 0.05 * np.linalg.norm(p.t)
+
+
+def test_estimate_rig_motion_accepts_opencv_shapes_and_input_mask():
+    p = _vehicle_problem(6)
+    pts1 = p.pixels1.reshape(-1, 1, 2).astype(np.float32)
+    pts2 = p.pixels2.reshape(-1, 1, 2).astype(np.float32)
+    use = np.ones((len(p), 1), np.uint8)
+    use[:50] = 0
+    retval, R, t, mask = mcgeom.estimateRigMotion(pts1, pts2, p.cam1, p.cam2, p.rig, mask=use)
+    assert not mask[:50].any()
+    assert rot_err(R, p.R) < np.radians(0.15)
+
+
+@pytest.mark.parametrize("method", [mcgeom.RIG_LINEAR17, mcgeom.RIG_5P1_DIRECT, "linear17"])
+def test_any_registered_method_runs_through_the_facade(method):
+    p = _vehicle_problem(7, outliers=0.0, noise=0.1)
+    retval, R, t, mask = mcgeom.estimateRigMotion(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig,
+                                                  method=method)
+    assert rot_err(R, p.R) < np.radians(0.2)
+
+
+@pytest.mark.parametrize("bad,match", [
+    ("shape", "shape"), ("nan", "NaN"), ("length", "points"), ("camid", "camera id"),
+    ("method", "unknown estimator")])
+def test_facade_bad_input(bad, match):
+    p = _vehicle_problem(8)
+    a1, a2, c1, c2, kw = p.pixels1, p.pixels2, p.cam1, p.cam2, {}
+    if bad == "shape":
+        a1 = np.zeros((len(p), 3))
+    elif bad == "nan":
+        a1 = a1.copy()
+        a1[0, 0] = np.nan
+    elif bad == "length":
+        a2 = a2[:-1]
+    elif bad == "camid":
+        c1 = c1.copy()
+        c1[0] = 99
+    else:
+        kw["method"] = "no_such_method"
+    with pytest.raises(ValueError, match=match):
+        mcgeom.estimateRigMotion(a1, a2, c1, c2, p.rig, **kw)
