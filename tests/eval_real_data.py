@@ -1,0 +1,714 @@
+"""Evaluation of the robust rig-motion pipeline on the real recordings in ../shared/data.
+
+Run from the repository root (the data are read in place, never copied)::
+
+    python -P tests/eval_real_data.py                 # every data set, every pair
+    python -P tests/eval_real_data.py --sets kitti_raw euroc --max-pairs 3
+
+For every data set (``/work/shared/data/<dir>/load.py``, imported from its path) the
+script builds an :class:`mcgeom.rig.Rig` from the calibration, detects and matches
+features with OpenCV (SIFT, else ORB; Lowe ratio test; mutual check) -- or takes the
+tracked correspondences of the tracks-only set --, forms pixel correspondences between
+consecutive frames
+
+* intra-camera: camera i at frame k  <->  camera i at frame k+1,
+* cross-camera: camera i at frame k  <->  camera j at frame k+1, for the camera pairs
+  whose views overlap (found from the calibration, see :func:`overlapping_pairs`),
+
+and runs :func:`mcgeom.cv.estimate` (default method) twice: on the intra-camera
+correspondences only, and with the cross-camera ones added. The estimate is compared
+with the ground truth.
+
+Ground truth convention. The loaders give ``relative_pose(d, i, j)`` = pose of rig j in
+rig i, ``X_rig_i = T X_rig_j``. mcgeom's motion is rig2_from_rig1, ``X_rig2 = R X_rig1 +
+t`` (DESIGN.md section 3), i.e. ``inv(relative_pose(d, k, k+1))``. This is checked on
+every pair by the Sampson error of the correspondences under the ground-truth motion,
+computed here with an independent numpy implementation of the generalized epipolar
+constraint (:func:`gec_sampson`), and compared with the error under the opposite
+convention (which must be clearly larger on the moving sets).
+
+Importable: :func:`load_sequences`, :func:`correspondences`, :func:`evaluate_pair`,
+:func:`run` are used by ``tests/test_real_data.py``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+try:
+    import cv2
+except ImportError:  # pragma: no cover - opencv is a runtime dependency of mcgeom
+    cv2 = None
+
+#: ../shared/data relative to the repository (MCGEOM_REAL_DATA overrides it)
+DATA_ROOT = Path(os.environ.get("MCGEOM_REAL_DATA",
+                                Path(__file__).resolve().parents[1].parent / "shared" / "data"))
+
+#: default inlier threshold of the robust pipeline, pixels
+THRESHOLD_PX = 1.5
+#: below this GT translation (metres) a pair is "static": the direction of t is noise
+STATIC_T = 0.02
+#: camera pairs whose views overlap by at least this fraction get cross-camera matches
+MIN_OVERLAP = 0.05
+
+
+def data_available(root: Path = DATA_ROOT) -> bool:
+    """True if the real data sets are present (the evaluation skips cleanly otherwise)."""
+    return (root / "README.md").is_file()
+
+
+# ------------------------------------------------------------------ geometry helpers
+
+def rot_angle_deg(R: np.ndarray) -> float:
+    """Rotation angle of R in degrees (robust near 0 and 180 deg)."""
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    return float(np.degrees(np.arctan2(0.5 * np.linalg.norm(w), 0.5 * (np.trace(R) - 1.0))))
+
+
+def angle_deg(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle between two vectors, degrees (NaN if one is zero)."""
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if not (na > 0 and nb > 0):
+        return float("nan")
+    return float(np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b)), float(a @ b))))
+
+
+def gec_sampson(o1: np.ndarray, d1: np.ndarray, o2: np.ndarray, d2: np.ndarray,
+                R: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """First-order (Sampson) angular error, radians, of the generalized epipolar constraint.
+
+    Own numpy implementation (independent of the C kernels) of DESIGN.md section 3:
+    ``e = d2^T [t]x R d1 + d2^T R m1 + m2^T R d1`` with ``m = c x d``, divided by the
+    norm of its gradient with respect to tangent perturbations of the unit bearings
+    ``d1`` and ``d2`` (camera centres fixed). For one pinhole camera this is the usual
+    Sampson distance in normalized units; times the focal length it is in pixels.
+    """
+    d1 = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
+    d2 = d2 / np.linalg.norm(d2, axis=1, keepdims=True)
+    Rd1 = d1 @ R.T
+    m1 = np.cross(o1, d1)
+    m2 = np.cross(o2, d2)
+    e = (np.einsum("ij,ij->i", d2, np.cross(t, Rd1)) + np.einsum("ij,ij->i", d2, m1 @ R.T)
+         + np.einsum("ij,ij->i", m2, Rd1))
+    # de/dd1 = R^T (d2 x t) + (R^T d2) x c1 + R^T (c2 x d2)
+    Rtd2 = d2 @ R
+    g1 = np.cross(d2, t) @ R + np.cross(Rtd2, o1) + m2 @ R
+    # de/dd2 = t x R d1 + R m1 + (R d1) x c2
+    g2 = np.cross(t, Rd1) + m1 @ R.T + np.cross(Rd1, o2)
+    g1 -= np.einsum("ij,ij->i", g1, d1)[:, None] * d1
+    g2 -= np.einsum("ij,ij->i", g2, d2)[:, None] * d2
+    den = np.sqrt(np.einsum("ij,ij->i", g1, g1) + np.einsum("ij,ij->i", g2, g2))
+    return np.abs(e) / np.maximum(den, 1e-300)
+
+
+def front_fraction(o1: np.ndarray, d1: np.ndarray, o2: np.ndarray, d2: np.ndarray,
+                   R: np.ndarray, t: np.ndarray, min_parallax: float = 1e-4) -> float:
+    """Cheirality: fraction of correspondences triangulated in front of both cameras.
+
+    The midpoint triangulation ``a R d1 - b d2 = o2 - R o1 - t`` (rig frames, metres)
+    must have ``a, b > 0``. Pairs with parallax below ``min_parallax`` (radians; points
+    at infinity, where the sign is noise) are left out; NaN if none is left. A motion
+    whose translation has the wrong sign -- which the epipolar residual alone cannot see
+    when the rotation is small -- puts most points behind the cameras.
+    """
+    d1 = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
+    d2 = d2 / np.linalg.norm(d2, axis=1, keepdims=True)
+    A = d1 @ R.T
+    rhs = o2 - (o1 @ R.T + t)
+    c = np.einsum("ij,ij->i", A, d2)
+    det = 1.0 - c * c
+    ok = det > min_parallax ** 2
+    if not ok.any():
+        return float("nan")
+    p = np.einsum("ij,ij->i", A, rhs)[ok]
+    q = -np.einsum("ij,ij->i", d2, rhs)[ok]
+    b = (q + c[ok] * p) / det[ok]
+    a = p + c[ok] * b
+    return float(np.mean((a > 0) & (b > 0)))
+
+
+# ------------------------------------------------------------------ data sets
+
+def _import_loader(dirname: str, root: Path = DATA_ROOT):
+    """Import ``<root>/<dirname>/load.py`` under a private module name."""
+    path = root / dirname / "load.py"
+    spec = importlib.util.spec_from_file_location(f"_mcgeom_realdata_{dirname}", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def rig_from_calib(d: dict):
+    """mcgeom Rig (camera id = index in ``d['cameras']``) from a loader's calibration.
+
+    The loaders give cam_from_rig ``X_cam = R_cam_rig X_rig + t_cam_rig`` -- mcgeom's own
+    convention -- and distortion in OpenCV order (pinhole model).
+    """
+    from mcgeom.rig import Camera, Rig
+    cams = []
+    for name in d["cameras"]:
+        c = d["calib"][name]
+        cams.append(Camera(name=name, K=c["K"], dist=np.asarray(c["dist"], float).ravel(),
+                           model="pinhole", R=c["R_cam_rig"], t=c["t_cam_rig"],
+                           width=int(c["width"]), height=int(c["height"])))
+    return Rig(tuple(cams))
+
+
+def overlapping_pairs(rig, min_frac: float = MIN_OVERLAP,
+                      depths: tuple = (5.0, 15.0, 40.0)) -> list[tuple[int, int, float]]:
+    """Camera pairs (i, j), i < j, whose fields of view overlap (from the calibration only).
+
+    A grid of pixels of camera i is back-projected to a few depths and projected into
+    camera j; the overlap is the larger of the two visible fractions (i in j, j in i).
+    """
+    def frac(i: int, j: int) -> float:
+        ci = rig.cameras[i]
+        u, v = np.meshgrid(np.linspace(0, ci.width - 1, 24), np.linspace(0, ci.height - 1, 16))
+        px = np.c_[u.ravel(), v.ravel()]
+        o, dirs = rig.rays(np.full(len(px), i), px)
+        vis = []
+        for z in depths:
+            # depth along the optical axis of camera i: scale the bearing accordingly
+            cos = dirs @ ci.R[2]
+            _, ok = rig.project(j, o + dirs * (z / cos)[:, None])
+            vis.append(ok.mean())
+        return float(np.mean(vis))
+
+    out = []
+    n = len(rig.cameras)
+    for i in range(n):
+        for j in range(i + 1, n):
+            f = max(frac(i, j), frac(j, i))
+            if f >= min_frac:
+                out.append((i, j, f))
+    return out
+
+
+@dataclass
+class Sequence:
+    """One evaluated recording: loaded data, rig, ground truth and the pairs to evaluate."""
+
+    key: str                 # short name used on the command line
+    name: str                # printed name
+    d: dict                  # what the data set's load() returned
+    mod: Any                 # its load module
+    rig: Any                 # mcgeom Rig
+    pairs: list              # [(k, k+1), ...] frame pairs to evaluate
+    kind: str = "images"     # "images" or "tracks"
+    static: bool = False     # the GT motion is ~0 (direction of t meaningless)
+    cross_pairs: list = field(default_factory=list)   # [(i, j, overlap)]
+    nfeatures: int = 3000
+    note: str = ""
+    alt_gt: Optional[Callable] = None   # (i, j) -> 4x4 second GT (relative_pose convention)
+    alt_gt_name: str = ""
+
+    def gt_motion(self, i: int, j: int, alt: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Ground truth rig2_from_rig1 (R, t): inv(relative_pose(d, i, j))."""
+        T = self.alt_gt(i, j) if alt else self.mod.relative_pose(self.d, i, j)
+        Tinv = np.linalg.inv(T)
+        return Tinv[:3, :3].copy(), Tinv[:3, 3].copy()
+
+    def gt_relative_pose(self, i: int, j: int) -> tuple[np.ndarray, np.ndarray]:
+        """The loader's relative_pose as (R, t) -- the *opposite* convention, for the check."""
+        T = self.mod.relative_pose(self.d, i, j)
+        return T[:3, :3].copy(), T[:3, 3].copy()
+
+
+SET_KEYS = ("dgp_scene_02", "dgp_scene_01", "kitti_raw", "euroc", "kitti00_tracks")
+
+
+def load_sequences(keys=SET_KEYS, root: Path = DATA_ROOT, max_pairs: Optional[int] = None,
+                   pairs: Optional[dict] = None) -> list[Sequence]:
+    """Load the requested data sets (keys of :data:`SET_KEYS`).
+
+    ``pairs`` may map a key to an explicit list of frame pairs; ``max_pairs`` keeps the
+    first pairs of each set.
+    """
+    seqs = []
+    for key in keys:
+        if key not in SET_KEYS:
+            raise ValueError(f"unknown data set {key!r}; known: {', '.join(SET_KEYS)}")
+        seqs.append(_load_one(key, root))
+    for s in seqs:
+        if pairs and s.key in pairs:
+            s.pairs = list(pairs[s.key])
+        if max_pairs is not None:
+            s.pairs = s.pairs[:max_pairs]
+    return seqs
+
+
+def _consecutive(frames: list) -> list[tuple[int, int]]:
+    have = [k for k, f in enumerate(frames) if f.get("T_world_rig") is not None]
+    return [(a, b) for a, b in zip(have, have[1:]) if b == a + 1]
+
+
+def _load_one(key: str, root: Path) -> Sequence:
+    if key.startswith("dgp_"):
+        mod = _import_loader("dgp_ddad_testscene", root)
+        scene = key[4:]
+        d = mod.load(scene)
+        s = Sequence(key, d["name"], d, mod, rig_from_calib(d), _consecutive(d["frames"]),
+                     nfeatures=4000, static=(scene == "scene_01"))
+        s.note = ("parked car: GT motion 0, translation direction meaningless"
+                  if s.static else "6-camera surround rig, 1.27 m / 0.1 deg per pair")
+    elif key == "kitti_raw":
+        mod = _import_loader("kitti_raw_0023_tiny", root)
+        d = mod.load()
+        s = Sequence(key, d["name"], d, mod, rig_from_calib(d), _consecutive(d["frames"]),
+                     nfeatures=3000)
+        s.alt_gt = lambda i, j, m=mod, dd=d: m.relative_pose_ins(dd, i, j)
+        s.alt_gt_name = "OXTS velocity integral"
+        s.note = ("GT = OXTS poses, ~5 cm per-step position jitter (~5 % of |t|); the scale "
+                  "error against the integrated INS velocity is given too")
+    elif key == "euroc":
+        mod = _import_loader("euroc_v101_kimera", root)
+        d = mod.load("micro")
+        s = Sequence(key, d["name"], d, mod, rig_from_calib(d), _consecutive(d["frames"]),
+                     nfeatures=2000, static=True)
+        s.note = ("MAV standing still (GT |t| ~1 mm per pair): translation direction and "
+                  "scale error are meaningless here; what matters is the verdict / |t|")
+    elif key == "kitti00_tracks":
+        mod = _import_loader("kitti00_gtsam_stereo_tracks", root)
+        d = mod.load()
+        # the KITTI GT of frames 0..12 disagrees with the images (data README): skip them
+        allp = _consecutive(d["frames"])
+        s = Sequence(key, d["name"], d, mod, rig_from_calib(d), [p for p in allp if p[0] >= 13],
+                     kind="tracks")
+        s.note = ("GTSAM tracked stereo correspondences (no images); frames 0-12 skipped "
+                  "(suspect GT)")
+    else:  # pragma: no cover
+        raise ValueError(key)
+    s.cross_pairs = overlapping_pairs(s.rig)
+    return s
+
+
+# ------------------------------------------------------------------ features
+
+class Features:
+    """Keypoints + descriptors per image path, computed once (SIFT, else ORB)."""
+
+    def __init__(self, nfeatures: int = 3000, detector: str = "auto"):
+        if cv2 is None:
+            raise RuntimeError("OpenCV (cv2) is needed for the image data sets")
+        use_sift = detector == "sift" or (detector == "auto" and hasattr(cv2, "SIFT_create"))
+        self.name = "SIFT" if use_sift else "ORB"
+        self.nfeatures = nfeatures
+        self._det = cv2.SIFT_create(nfeatures=nfeatures) if use_sift else \
+            cv2.ORB_create(nfeatures=nfeatures)
+        self.norm = cv2.NORM_L2 if use_sift else cv2.NORM_HAMMING
+        self._cache: dict = {}
+        self.seconds = 0.0
+
+    def __call__(self, path: str) -> tuple[np.ndarray, np.ndarray]:
+        if path not in self._cache:
+            t0 = time.perf_counter()
+            img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+            if img is None:
+                raise OSError(f"cannot read image {path}")
+            kps, desc = self._det.detectAndCompute(img, None)
+            pts = np.array([k.pt for k in kps], dtype=np.float64).reshape(-1, 2)
+            if desc is None:
+                desc = np.zeros((0, 128), np.float32)
+            self._cache[path] = (pts, desc)
+            self.seconds += time.perf_counter() - t0
+        return self._cache[path]
+
+
+def match_descriptors(desc1: np.ndarray, desc2: np.ndarray, norm: int,
+                      ratio: float = 0.8) -> tuple[np.ndarray, np.ndarray]:
+    """Indices (i1, i2) of mutual nearest neighbours that pass Lowe's ratio test both ways."""
+    if len(desc1) < 2 or len(desc2) < 2:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    bf = cv2.BFMatcher(norm, crossCheck=False)
+
+    def best(a, b):
+        nn = bf.knnMatch(a, b, k=2)
+        idx = np.full(len(a), -1, np.int64)
+        for q, m in enumerate(nn):
+            if len(m) == 2 and m[0].distance < ratio * m[1].distance:
+                idx[q] = m[0].trainIdx
+        return idx
+
+    f = best(desc1, desc2)
+    b = best(desc2, desc1)
+    i1 = np.flatnonzero(f >= 0)
+    i2 = f[i1]
+    keep = b[i2] == i1
+    return i1[keep], i2[keep]
+
+
+# ------------------------------------------------------------------ correspondences
+
+@dataclass
+class Corr:
+    """Pixel correspondences between frames k (1) and k+1 (2)."""
+
+    p1: np.ndarray
+    p2: np.ndarray
+    c1: np.ndarray
+    c2: np.ndarray
+    seconds: float = 0.0
+
+    @property
+    def intra(self) -> np.ndarray:
+        return self.c1 == self.c2
+
+    def subset(self, mask: np.ndarray) -> "Corr":
+        return Corr(self.p1[mask], self.p2[mask], self.c1[mask], self.c2[mask], self.seconds)
+
+
+def _empty_corr() -> Corr:
+    return Corr(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, np.int64), np.zeros(0, np.int64))
+
+
+def _concat(parts: list) -> Corr:
+    if not parts:
+        return _empty_corr()
+    return Corr(np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
+                np.concatenate([np.full(len(p[0]), p[2], np.int64) for p in parts]),
+                np.concatenate([np.full(len(p[0]), p[3], np.int64) for p in parts]))
+
+
+def correspondences(seq: Sequence, k1: int, k2: int, feats: Optional[Features] = None) -> Corr:
+    """Intra-camera and (for overlapping cameras) cross-camera correspondences k1 -> k2."""
+    t0 = time.perf_counter()
+    if seq.kind == "tracks":
+        out = _track_correspondences(seq, k1, k2)
+    else:
+        feats = feats or Features(seq.nfeatures)
+        f1, f2 = seq.d["frames"][k1], seq.d["frames"][k2]
+        names = seq.d["cameras"]
+        combos = [(i, i) for i in range(len(names))]
+        for i, j, _ in seq.cross_pairs:
+            combos += [(i, j), (j, i)]
+        parts = []
+        for i, j in combos:
+            pts1, de1 = feats(f1["images"][names[i]])
+            pts2, de2 = feats(f2["images"][names[j]])
+            a, b = match_descriptors(de1, de2, feats.norm)
+            parts.append((pts1[a], pts2[b], i, j))
+        out = _concat(parts)
+    out.seconds = time.perf_counter() - t0
+    return out
+
+
+def _track_correspondences(seq: Sequence, k1: int, k2: int) -> Corr:
+    o1, o2 = seq.d["frames"][k1]["obs"], seq.d["frames"][k2]["obs"]
+    common = sorted(set(o1) & set(o2))
+    names = seq.d["cameras"]
+    parts = []
+    combos = [(i, i) for i in range(len(names))]
+    for i, j, _ in seq.cross_pairs:
+        combos += [(i, j), (j, i)]
+    for i, j in combos:
+        a = np.array([o1[l][names[i]] for l in common], float).reshape(-1, 2)
+        b = np.array([o2[l][names[j]] for l in common], float).reshape(-1, 2)
+        parts.append((a, b, i, j))
+    return _concat(parts)
+
+
+# ------------------------------------------------------------------ GT check
+
+def _focal(rig, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
+    f = np.array([0.5 * (c.K[0, 0] + c.K[1, 1]) for c in rig.cameras])
+    return 0.5 * (f[c1] + f[c2])
+
+
+def sampson_px(seq: Sequence, corr: Corr, R: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Sampson error (pixels) of every correspondence under the motion (R, t)."""
+    if len(corr.p1) == 0:
+        return np.zeros(0)
+    rays = seq.rig.ray_pairs(corr.p1, corr.p2, corr.c1, corr.c2)
+    r = gec_sampson(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t)
+    return r * _focal(seq.rig, corr.c1, corr.c2)
+
+
+def rotation_transfer_px(seq: Sequence, corr: Corr, R: np.ndarray) -> np.ndarray:
+    """Angle (pixels) between d2 and R d1 -- the check for static pairs, where the
+    epipolar constraint of one camera is undefined (no translation)."""
+    if len(corr.p1) == 0:
+        return np.zeros(0)
+    rays = seq.rig.ray_pairs(corr.p1, corr.p2, corr.c1, corr.c2)
+    a = rays.dirs1 @ R.T
+    b = rays.dirs2
+    ang = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+    return ang * _focal(seq.rig, corr.c1, corr.c2)
+
+
+def gt_check(seq: Sequence, corr: Corr, k1: int, k2: int) -> dict:
+    """Errors of the correspondences under the GT motion (and the opposite convention)."""
+    R, t = seq.gt_motion(k1, k2)
+    Rw, tw = seq.gt_relative_pose(k1, k2)
+    intra = corr.intra
+    out: dict = {}
+    s = sampson_px(seq, corr, R, t)
+    sw = sampson_px(seq, corr, Rw, tw)
+    for tag, m in (("intra", intra), ("cross", ~intra)):
+        if m.any():
+            out[f"{tag}_med"] = float(np.median(s[m]))
+            out[f"{tag}_lt2"] = float(np.mean(s[m] < 2.0))
+            out[f"{tag}_med_wrong"] = float(np.median(sw[m]))
+    if seq.static and intra.any():
+        tr = rotation_transfer_px(seq, corr.subset(intra), R)
+        out["intra_rot_transfer_med"] = float(np.median(tr))
+        out["intra_rot_transfer_lt2"] = float(np.mean(tr < 2.0))
+    return out
+
+
+def format_gt_check(g: dict, static: bool) -> str:
+    parts = []
+    if static and "intra_rot_transfer_med" in g:
+        parts.append("intra rotation-transfer median %.2f px (%.0f%% < 2 px)" % (
+            g["intra_rot_transfer_med"], 100 * g["intra_rot_transfer_lt2"]))
+    elif "intra_med" in g:
+        parts.append("intra Sampson median %.2f px (%.0f%% < 2 px; opposite convention %.2f px)"
+                     % (g["intra_med"], 100 * g["intra_lt2"], g["intra_med_wrong"]))
+    if "cross_med" in g:
+        parts.append("cross Sampson median %.2f px (%.0f%% < 2 px; opposite convention %.2f px)"
+                     % (g["cross_med"], 100 * g["cross_lt2"], g["cross_med_wrong"]))
+    return "; ".join(parts) if parts else "no correspondences"
+
+
+# ------------------------------------------------------------------ evaluation
+
+MODES = ("intra", "intra+cross")
+
+
+def metric_t(m) -> np.ndarray:
+    """The metric translation of an estimate, whatever the verdict."""
+    if m.scale.observable:
+        return np.asarray(m.t, float).ravel()
+    return np.asarray(m.info.get("t_free", m.info.get("t_metric", m.t)), float).ravel()
+
+
+def evaluate_pair(seq: Sequence, corr: Corr, k1: int, k2: int, mode: str,
+                  threshold: float = THRESHOLD_PX, **options: Any) -> dict:
+    """Run mcgeom.cv.estimate on one pair and mode; errors against the GT."""
+    from mcgeom.cv import estimate
+    use = corr if mode == "intra+cross" else corr.subset(corr.intra)
+    R_gt, t_gt = seq.gt_motion(k1, k2)
+    res = {"set": seq.name, "key": seq.key, "pair": (k1, k2), "mode": mode,
+           "n_intra": int(use.intra.sum()), "n_cross": int((~use.intra).sum()),
+           "t_gt": float(np.linalg.norm(t_gt)), "static": seq.static}
+    t0 = time.perf_counter()
+    try:
+        m = estimate(use.p1, use.p2, use.c1, use.c2, seq.rig, threshold=threshold, **options)
+    except Exception as exc:  # report, do not hide: the row says FAILED
+        res.update(ok=False, error=f"{type(exc).__name__}: {exc}", time=time.perf_counter() - t0)
+        return res
+    res["time"] = time.perf_counter() - t0
+    tm = metric_t(m)
+    res.update(
+        ok=True, motion=m, inliers=int(np.count_nonzero(m.inliers)),
+        inliers_cross=int(np.count_nonzero(m.inliers & ~use.intra)),
+        rot_err=rot_angle_deg(m.R @ R_gt.T), tdir_err=angle_deg(np.asarray(m.t).ravel(), t_gt),
+        t_est=float(np.linalg.norm(tm)),
+        scale_err=abs(np.linalg.norm(tm) / np.linalg.norm(t_gt) - 1.0)
+        if np.linalg.norm(t_gt) >= STATIC_T else float("nan"),
+        observable=bool(m.scale.observable), reason=m.scale.reason,
+        crit=float(np.degrees(m.scale.critical_angle)),
+        gt_rot=rot_angle_deg(R_gt),
+    )
+    if seq.alt_gt is not None:
+        _, t_alt = seq.gt_motion(k1, k2, alt=True)
+        res["scale_err_alt"] = abs(np.linalg.norm(tm) / np.linalg.norm(t_alt) - 1.0)
+    # cheirality of the returned motion on its inliers: direction of m.t, metric length
+    # (the length the inliers were fitted with)
+    t_dir = np.asarray(m.t, float).ravel()
+    t_info = np.asarray(m.info.get("t_metric", t_dir), float).ravel()
+    res["info_t_opposite"] = bool(t_info @ t_dir < 0)   # info's metric t vs returned t
+    inl = use.subset(m.inliers)
+    if len(inl.p1) and not seq.static and np.linalg.norm(t_dir) > 0:
+        rays = seq.rig.ray_pairs(inl.p1, inl.p2, inl.c1, inl.c2)
+        t_fit = t_dir * (np.linalg.norm(t_info) / np.linalg.norm(t_dir))
+        res["front"] = front_fraction(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                      np.asarray(m.R), t_fit)
+    else:
+        res["front"] = float("nan")   # static: no parallax, the sign is noise
+    return res
+
+
+HEADER = ("%-6s %-11s %6s %6s %6s %6s %8s %8s %8s %7s %7s %5s %-5s %8s %7s  %s" % (
+    "pair", "mode", "#intra", "#cross", "#inl", "#inlX", "rot(deg)", "tdir(deg)", "scale_err",
+    "|t_gt|", "|t_est|", "front", "verd", "crit(deg)", "time(s)", "reason"))
+
+
+def format_row(r: dict) -> str:
+    pair = "%d-%d" % r["pair"]
+    if not r["ok"]:
+        return "%-6s %-11s %6d %6d %6s %6s  FAILED after %.2f s: %s" % (
+            pair, r["mode"], r["n_intra"], r["n_cross"], "-", "-", r["time"], r["error"])
+    tdir = "%8.2f" % r["tdir_err"] if not r["static"] else "%8s" % "n/a*"
+    if np.isfinite(r["scale_err"]):
+        scale = "%8.3f" % r["scale_err"]
+        if "scale_err_alt" in r:
+            scale += " (%.3f)" % r["scale_err_alt"]
+    else:
+        scale = "%8s" % "n/a*"
+    front = "%4.0f%%" % (100 * r["front"]) if np.isfinite(r["front"]) else "%5s" % "n/a"
+    return "%-6s %-11s %6d %6d %6d %6d %8.3f %8s %8s %7.4f %7.4f %5s %-5s %8.3f %7.2f  %s" % (
+        pair, r["mode"], r["n_intra"], r["n_cross"], r["inliers"], r["inliers_cross"],
+        r["rot_err"], tdir, scale, r["t_gt"], r["t_est"], front,
+        "OBS" if r["observable"] else "unobs", r["crit"], r["time"], r["reason"]) + (
+        "  [info['t_metric'] points opposite to t]" if r["info_t_opposite"] else "")
+
+
+def summarize(seq: Sequence, results: list, out=print) -> list[dict]:
+    rows = []
+    for mode in MODES:
+        rs = [r for r in results if r["mode"] == mode]
+        ok = [r for r in rs if r["ok"]]
+        row = {"set": seq.name, "key": seq.key, "mode": mode, "pairs": len(rs),
+               "failed": len(rs) - len(ok)}
+        if ok:
+            def med(k, sel=ok):
+                v = [r[k] for r in sel if np.isfinite(r[k])]
+                return float(np.median(v)) if v else float("nan")
+            obs = [r for r in ok if r["observable"]]
+            row.update(rot=med("rot_err"), tdir=med("tdir_err"), scale=med("scale_err"),
+                       scale_obs=med("scale_err", obs) if obs else float("nan"),
+                       t_est=med("t_est"), obs_frac=len(obs) / len(ok), time=med("time"),
+                       inl=med("inliers"), crit=med("crit"))
+            if any("scale_err_alt" in r for r in ok):
+                row["scale_alt"] = med("scale_err_alt")
+        rows.append(row)
+        if not ok:
+            out("  %-11s %d pairs, all FAILED" % (mode, len(rs)))
+            continue
+        if seq.static:
+            kinds: dict = {}
+            for r in ok:
+                k = "observable" if r["observable"] else r["reason"].split(":")[0].split(";")[0]
+                kinds[k] = kinds.get(k, 0) + 1
+            t_obs = [r["t_est"] for r in ok if r["observable"]]
+            desc = ("median rot err %.3f deg | tdir n/a (static) | median |t_est| %.4f m, max "
+                    "%s over observable verdicts (GT ~0) | observable %d/%d | verdicts: %s" % (
+                        row["rot"], row["t_est"], "%.4f m" % max(t_obs) if t_obs else "-",
+                        round(row["obs_frac"] * len(ok)), len(ok),
+                        ", ".join("%d x %s" % (v, k) for k, v in sorted(kinds.items()))))
+        else:
+            alt = (" (vs %s %.3f)" % (seq.alt_gt_name, row["scale_alt"])
+                   if "scale_alt" in row else "")
+            desc = ("median rot err %.3f deg | tdir %.2f deg | scale err %.3f%s, over observable "
+                    "verdicts %s | observable %d/%d" % (
+                        row["rot"], row["tdir"], row["scale"], alt,
+                        "%.3f" % row["scale_obs"] if np.isfinite(row["scale_obs"]) else "-",
+                        round(row["obs_frac"] * len(ok)), len(ok)))
+        out("  %-11s %2d pairs%s: %s | median crit %.3f deg | median inliers %.0f | "
+            "median time %.2f s" % (mode, len(rs), (", %d FAILED" % row["failed"]) if row["failed"]
+                                    else "", desc, row["crit"], row["inl"], row["time"]))
+    return rows
+
+
+def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
+        detector: str = "auto", nfeatures: Optional[int] = None, **options: Any) -> dict:
+    """Evaluate every pair of every sequence in both modes; print rows and summaries."""
+    all_results: dict = {}
+    summary = []
+    for seq in seqs:
+        feats = None
+        if seq.kind == "images":
+            feats = Features(nfeatures or seq.nfeatures, detector)
+        out("")
+        out("=" * 100)
+        cams = ", ".join("%d=%s" % (i, n) for i, n in enumerate(seq.rig.names))
+        out("%s  [%s]  cameras: %s" % (seq.name, seq.key, cams))
+        out("  %s" % seq.note)
+        if seq.cross_pairs:
+            out("  cross-camera pairs (overlap from calibration): " + ", ".join(
+                "%s-%s %.0f%%" % (seq.rig.names[i], seq.rig.names[j], 100 * f)
+                for i, j, f in seq.cross_pairs))
+        else:
+            out("  no overlapping cameras: the intra+cross mode equals intra")
+        if feats is not None:
+            out("  features: %s, %d per image, ratio 0.8 + mutual check; threshold %.2f px"
+                % (feats.name, feats.nfeatures, threshold))
+        else:
+            out("  correspondences: tracked landmarks; threshold %.2f px" % threshold)
+        out(HEADER)
+        results = []
+        for k1, k2 in seq.pairs:
+            corr = correspondences(seq, k1, k2, feats)
+            g = gt_check(seq, corr, k1, k2)
+            R_gt, t_gt = seq.gt_motion(k1, k2)
+            out("%-6s GT |t| %.3f m, rot %.3f deg; GT check: %s" % (
+                "%d-%d" % (k1, k2), np.linalg.norm(t_gt), rot_angle_deg(R_gt),
+                format_gt_check(g, seq.static)))
+            for mode in MODES:
+                r = evaluate_pair(seq, corr, k1, k2, mode, threshold, **options)
+                r["gt_check"] = g
+                results.append(r)
+                out(format_row(r))
+        if feats is not None:
+            out("  feature detection %.1f s in total (%d images)" % (feats.seconds,
+                                                                     len(feats._cache)))
+        out("-- summary %s" % seq.name)
+        summary += summarize(seq, results, out)
+        all_results[seq.key] = results
+    out("")
+    out("(*) n/a: the GT motion is ~0 (static rig), so the translation direction and the "
+        "relative scale error are meaningless; judge the verdict and |t_est| instead.")
+    out("scale_err = | |t_est| / |t_gt| - 1 |, with t_est the metric estimate (info['t_free'] / "
+        "info['t_metric'] when the verdict is unobservable); in brackets for KITTI raw: against "
+        "the OXTS velocity integral.")
+    all_results["_summary"] = summary
+    return all_results
+
+
+def print_summary_table(summary: list, out=print) -> None:
+    out("")
+    out("=" * 100)
+    out("SUMMARY (medians over pairs)")
+    out("%-16s %-11s %5s %8s %9s %9s %8s %6s %8s" % (
+        "data set", "mode", "pairs", "rot(deg)", "tdir(deg)", "scale_err", "|t_est|", "obs",
+        "time(s)"))
+    for r in summary:
+        if "rot" not in r:
+            out("%-16s %-11s %5d  all FAILED" % (r["key"], r["mode"], r["pairs"]))
+            continue
+        static = r["key"] in ("euroc", "dgp_scene_01")
+        out("%-16s %-11s %5d %8.3f %9s %9s %8.4f %6s %8.2f%s" % (
+            r["key"], r["mode"], r["pairs"], r["rot"],
+            "n/a*" if static else "%.2f" % r["tdir"],
+            "n/a*" if static else "%.3f" % r["scale"], r["t_est"],
+            "%d%%" % round(100 * r["obs_frac"]), r["time"],
+            ("  (%d failed)" % r["failed"]) if r["failed"] else ""))
+
+
+def main(argv: Optional[list] = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--sets", nargs="*", default=list(SET_KEYS), choices=SET_KEYS)
+    ap.add_argument("--max-pairs", type=int, default=None)
+    ap.add_argument("--threshold", type=float, default=THRESHOLD_PX, help="pixels")
+    ap.add_argument("--detector", choices=("auto", "sift", "orb"), default="auto")
+    ap.add_argument("--nfeatures", type=int, default=None)
+    ap.add_argument("--data", type=Path, default=DATA_ROOT)
+    args = ap.parse_args(argv)
+    if not data_available(args.data):
+        print(f"real data not found under {args.data}: nothing to evaluate (skipped)")
+        return 0
+    if cv2 is not None:
+        cv2.setNumThreads(2)
+    import mcgeom
+    print("mcgeom %s from %s; OpenCV %s; data %s" % (
+        mcgeom.__version__, os.path.dirname(mcgeom.__file__),
+        getattr(cv2, "__version__", "-"), args.data))
+    t0 = time.perf_counter()
+    seqs = load_sequences(args.sets, args.data, args.max_pairs)
+    res = run(seqs, args.threshold, detector=args.detector, nfeatures=args.nfeatures)
+    print_summary_table(res["_summary"])
+    print("total %.1f s" % (time.perf_counter() - t0))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
