@@ -1,22 +1,23 @@
 """The robust pipeline on a few real frame pairs (tests/eval_real_data.py does them all).
 
 Skipped when the recordings (../shared/data relative to the repository) are absent.
-The pairs, features and threshold are those of the evaluation script, so a failure here
+The pairs, features and threshold are those of the evaluation script, so every case here
 is a row of its table. Only what must hold is asserted:
 
 * rotations within 1 deg of the ground truth on KITTI (raw stereo and the GTSAM tracks)
-  and on the moving DGP surround-rig scene; the direction of travel within 10 deg;
+  and on the moving DGP surround-rig scene; the direction of travel within 10 deg
+  (the returned unit ``t`` is documented as meaningful also when the scale is not);
 * with the stereo (cross-camera) correspondences the KITTI scale is observable and
   within 10 % of the ground truth (the OXTS poses jitter by ~5 %);
 * a critical motion is never a confident wrong scale: an "observable" verdict from
   intra-camera correspondences only must be within 10 % too;
-* a static rig (EuRoC clip with the MAV standing still, DGP parked car) is never
-  reported as a confident metric translation: the verdict is "unobservable", or the
-  metric |t| is below a few centimetres.
+* a static rig (EuRoC clip with the MAV standing still, DGP parked car) keeps its
+  rotation and is never reported as a confident metric translation: the verdict is
+  "unobservable", or the metric |t| is below a few centimetres.
 
-Known weaknesses of the estimator found on these data are marked ``xfail`` with the
-diagnosis: they stay visible in the summary (``-ra``: XFAIL, or XPASS once fixed -- then
-remove the marker so that a regression fails again).
+Known weaknesses of the estimator found on these data are marked ``xfail`` on exactly
+the failing rows, with the diagnosis: they stay visible in the summary (``-ra``: XFAIL,
+or XPASS once fixed -- then remove the marker so that a regression fails again).
 """
 
 from __future__ import annotations
@@ -33,13 +34,14 @@ if ev.cv2 is None:  # pragma: no cover
 
 #: a few pairs per data set (about 30 s on two cores, mostly SIFT on the DGP images)
 SUBSET = {
-    "kitti_raw": [(0, 1), (3, 4)],
+    "kitti_raw": [(0, 1), (2, 3), (3, 4)],
     "kitti00_tracks": [(20, 21), (50, 51)],
     "dgp_scene_02": [(0, 1)],
     "euroc": [(0, 1), (12, 13), (22, 23)],
     "dgp_scene_01": [(0, 1)],
 }
 MOVING = ("kitti_raw", "kitti00_tracks", "dgp_scene_02")
+STATIC = ("euroc", "dgp_scene_01")
 STEREO = ("kitti_raw", "kitti00_tracks")
 MAX_ROT_ERR_DEG = 1.0
 MAX_TDIR_ERR_DEG = 10.0
@@ -47,14 +49,38 @@ MAX_SCALE_ERR = 0.10
 #: a static rig may come out "observable" only with |t| below this (metres)
 MAX_STATIC_T = 0.03
 
+_COLLAPSED_T = (
+    "known weakness: KITTI raw 2-3, intra-camera correspondences only (near-pure forward "
+    "translation, critical). The free refinement collapses to |t| = 4.5 mm, where the "
+    "rotation-induced displacement of the camera centres (R - I) c (~3 mm) supplies the "
+    "forward motion each camera sees; the rig direction is then 131 deg off. The verdict "
+    "is 'unobservable' but the returned unit t keeps that direction (at |t| = 1 the "
+    "inliers have 2.8 px median residual).")
 _PARKED = (
     "known weakness: parked car, 3 cameras with overlap. Intra-camera data show no "
     "parallax (pure rotation fits to 0.2-0.4 px) but the no-parallax test compares with "
     "the Sampson residual of a free translation (0.03 px, ratio 6-16 > 3) and does not "
-    "fire; the verdict then trusts ~200-330 cross-camera inliers with 1-10 px model error "
-    "(no distortion in the DGP calibration): 'observable', |t| ~1 m, relative std 1-2 %. "
-    "With intra-camera correspondences only the rotation comes out 180 deg off "
-    "(twisted pair, |t| ~ 5e4 m, no cheirality check).")
+    "fire. With cross-camera correspondences the verdict then trusts ~330 cross-camera "
+    "inliers with 1-10 px model error (no distortion in the DGP calibration): "
+    "'observable', |t| = 0.98 m, relative std 1 %. With intra-camera correspondences "
+    "only the rotation comes out 180 deg off (twisted pair, |t| ~ 5e4 m).")
+KNOWN = {
+    ("kitti_raw", (2, 3), "intra", "direction"): _COLLAPSED_T,
+    ("dgp_scene_01", (0, 1), "intra", "static"): _PARKED,
+    ("dgp_scene_01", (0, 1), "intra+cross", "static"): _PARKED,
+}
+
+
+def _cases(keys, modes, check):
+    out = []
+    for key in keys:
+        for pair in SUBSET[key]:
+            for mode in modes:
+                why = KNOWN.get((key, pair, mode, check))
+                marks = [pytest.mark.xfail(strict=False, reason=why)] if why else []
+                out.append(pytest.param(key, pair, mode, marks=marks,
+                                        id="%s-%d-%d-%s" % (key, *pair, mode)))
+    return out
 
 
 @pytest.fixture(scope="module")
@@ -64,71 +90,59 @@ def results() -> dict:
     out = {}
     for seq in seqs:
         feats = ev.Features(seq.nfeatures) if seq.kind == "images" else None
-        rows = []
         for k1, k2 in seq.pairs:
             corr = ev.correspondences(seq, k1, k2, feats)
             for mode in ev.MODES:
-                rows.append(ev.evaluate_pair(seq, corr, k1, k2, mode))
-        out[seq.key] = rows
+                out[seq.key, (k1, k2), mode] = ev.evaluate_pair(seq, corr, k1, k2, mode)
     return out
 
 
 def _describe(r: dict) -> str:
     if not r["ok"]:
         return "%s %d-%d %s: FAILED %s" % (r["key"], *r["pair"], r["mode"], r["error"])
-    return ("%s %d-%d %s: rot err %.3f deg, t dir err %.2f deg, |t_est| %.3f m (GT %.3f), "
+    return ("%s %d-%d %s: rot err %.3f deg, t dir err %.2f deg, |t_est| %.4f m (GT %.4f), "
             "%s" % (r["key"], *r["pair"], r["mode"], r["rot_err"], r["tdir_err"], r["t_est"],
                     r["t_gt"], r["reason"]))
 
 
-def _rows(results: dict, key: str, mode: str | None = None) -> list:
-    rows = [r for r in results[key] if mode is None or r["mode"] == mode]
-    assert rows
-    failed = [_describe(r) for r in rows if not r["ok"]]
-    assert not failed, "\n".join(failed)
-    return rows
+def _row(results: dict, key: str, pair: tuple, mode: str) -> dict:
+    r = results[key, pair, mode]
+    assert r["ok"], _describe(r)
+    return r
 
 
-def _check(rows: list, bad) -> None:
-    """Assert that no row is bad; the message lists every bad row, not just the first."""
-    problems = [f"{why}: {_describe(r)}" for r in rows for why in [bad(r)] if why]
-    assert not problems, "\n".join(problems)
+@pytest.mark.parametrize("key, pair, mode", _cases(MOVING, ev.MODES, "rotation"))
+def test_rotation_close_to_ground_truth(results, key, pair, mode):
+    r = _row(results, key, pair, mode)
+    assert r["rot_err"] < MAX_ROT_ERR_DEG, _describe(r)
 
 
-@pytest.mark.parametrize("key", MOVING)
-def test_rotation_close_to_ground_truth(results, key):
-    _check(_rows(results, key),
-           lambda r: r["rot_err"] >= MAX_ROT_ERR_DEG and "rotation error")
+@pytest.mark.parametrize("key, pair, mode", _cases(MOVING, ev.MODES, "direction"))
+def test_direction_of_travel(results, key, pair, mode):
+    r = _row(results, key, pair, mode)
+    assert r["tdir_err"] < MAX_TDIR_ERR_DEG, _describe(r)
 
 
-@pytest.mark.parametrize("mode", ev.MODES)
-@pytest.mark.parametrize("key", MOVING)
-def test_direction_of_travel(results, key, mode):
-    _check(_rows(results, key, mode),
-           lambda r: not r["tdir_err"] < MAX_TDIR_ERR_DEG and "translation direction error")
+@pytest.mark.parametrize("key, pair, mode", _cases(STEREO, ["intra+cross"], "scale"))
+def test_stereo_rig_gives_metric_scale(results, key, pair, mode):
+    r = _row(results, key, pair, mode)
+    assert r["observable"], _describe(r)
+    assert r["scale_err"] < MAX_SCALE_ERR, _describe(r)
 
 
-@pytest.mark.parametrize("key", STEREO)
-def test_stereo_rig_gives_metric_scale(results, key):
-    _check(_rows(results, key, "intra+cross"),
-           lambda r: (not r["observable"] and "scale not observable")
-           or (not r["scale_err"] < MAX_SCALE_ERR and "scale error"))
+@pytest.mark.parametrize("key, pair, mode", _cases(MOVING, ["intra"], "critical"))
+def test_critical_motion_is_not_a_confident_wrong_scale(results, key, pair, mode):
+    r = _row(results, key, pair, mode)
+    if r["observable"]:
+        assert r["scale_err"] < MAX_SCALE_ERR, _describe(r)
 
 
-@pytest.mark.parametrize("key", MOVING)
-def test_critical_motion_is_not_a_confident_wrong_scale(results, key):
-    _check(_rows(results, key, "intra"),
-           lambda r: r["observable"] and not r["scale_err"] < MAX_SCALE_ERR
-           and "confident wrong scale")
-
-
-@pytest.mark.parametrize("key", [
-    "euroc", pytest.param("dgp_scene_01", marks=pytest.mark.xfail(strict=False, reason=_PARKED))])
-def test_static_rig_is_not_a_confident_metric_translation(results, key):
-    _check(_rows(results, key),
-           lambda r: (r["rot_err"] >= MAX_ROT_ERR_DEG and "rotation error")
-           or (r["observable"] and not np.linalg.norm(r["motion"].t) < MAX_STATIC_T
-               and "confident metric translation of a static rig"))
+@pytest.mark.parametrize("key, pair, mode", _cases(STATIC, ev.MODES, "static"))
+def test_static_rig_is_not_a_confident_metric_translation(results, key, pair, mode):
+    r = _row(results, key, pair, mode)
+    assert r["rot_err"] < MAX_ROT_ERR_DEG, _describe(r)
+    if r["observable"]:
+        assert np.linalg.norm(r["motion"].t) < MAX_STATIC_T, _describe(r)
 
 
 def test_ground_truth_convention():
