@@ -84,6 +84,25 @@ def _resolve(method: str, robust_flag: Optional[bool]) -> tuple[str, bool]:
     return method, bool(robust_flag)
 
 
+def _effective_focal(rig: Rig, rays) -> np.ndarray:
+    """Pixels per radian of Sampson residual, per correspondence.
+
+    A pixel error at angle theta from a pinhole camera's axis moves the bearing
+    by cos^2(theta) / f radians radially and cos(theta) / f tangentially; the
+    mean variance of the two bearings of a correspondence, (cos^4 + cos^2) / 2
+    per bearing, gives f_eff = f / sqrt(mean). Thresholds in pixels then mean
+    pixels across the whole image, and the refinement weights residuals by
+    their pixel-noise variance.
+    """
+    focal = np.array([0.5 * (c.K[0, 0] + c.K[1, 1]) for c in rig.cameras])
+    Rs = np.stack([c.R for c in rig.cameras])
+    var = np.zeros(len(rays))
+    for ids, d in ((rays.cam1, rays.dirs1), (rays.cam2, rays.dirs2)):
+        cz = np.clip(np.einsum("ij,ij->i", Rs[ids][:, 2, :], d), 1e-3, 1.0)
+        var += 0.5 * (cz ** 4 + cz ** 2) / focal[ids] ** 2
+    return 1.0 / np.sqrt(0.5 * var)
+
+
 def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
@@ -116,8 +135,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     rays_all = rig.ray_pairs(p1, p2, ids1, ids2)
     rays = rays_all.take(np.flatnonzero(use))
     if run_robust:
-        focal = np.array([0.5 * (c.K[0, 0] + c.K[1, 1]) for c in rig.cameras])
-        f = 0.5 * (focal[rays.cam1] + focal[rays.cam2])
+        f = _effective_focal(rig, rays)
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                           seed=seed, focal=f, **options)
         inl = np.zeros(n, bool)

@@ -22,22 +22,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
 from .types import RayPairs, ScaleVerdict
 
 __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_only_fit",
-           "count_in_front", "orient_by_cheirality"]
+           "count_in_front", "orient_by_cheirality", "scale_profile"]
 
 
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
     """``R^T (c - t) - c`` for each centre (rows), metres in the time-1 rig frame."""
     return (np.asarray(centres) - t) @ np.asarray(R) - centres
-
-
-def _angle(a: np.ndarray, b: np.ndarray) -> float:
-    na, nb = np.linalg.norm(a), np.linalg.norm(b)
-    if not (na > 0 and nb > 0):
-        return 0.0
-    return float(np.arctan2(np.linalg.norm(np.cross(a, b)), float(a @ b)))
 
 
 def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> float:
@@ -48,12 +42,15 @@ def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> flo
     parallel lines, whatever their sense). 0 for fewer than two centres.
     """
     d = displacements(R, t, centres)
-    best = 0.0
-    for i in range(len(d)):
-        for j in range(i + 1, len(d)):
-            a = _angle(d[i], d[j])
-            best = max(best, min(a, np.pi - a))
-    return best
+    n = np.linalg.norm(d, axis=1)
+    d = d[n > 0] / n[n > 0, None]
+    if len(d) < 2:
+        return 0.0
+    # |cos| folds an angle and its supplement; the smallest |cos| over pairs is
+    # the largest folded angle (arctan2 of |cross| and |dot| keeps it accurate)
+    cos = np.abs(d @ d.T)
+    i, j = np.unravel_index(np.argmin(cos + 2.0 * np.eye(len(d))), cos.shape)
+    return float(np.arctan2(np.linalg.norm(np.cross(d[i], d[j])), cos[i, j]))
 
 
 def _centres_with_intra(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, int]:
@@ -69,6 +66,32 @@ def _centres_with_intra(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, i
     cross = int((mask & ~same).sum())
     centres = np.unique(rays.origins1[intra], axis=0) if intra.any() else np.zeros((0, 3))
     return centres, cross
+
+
+def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sigma2: float,
+                  factors: tuple = (1.0 / 1.3, 1.3), loss: str = "none",
+                  loss_scale: float = 1e-3, weights: np.ndarray | None = None) -> float:
+    """How strongly the data exclude ``|t|`` scaled by each of ``factors``.
+
+    For each factor the motion is re-optimised with ``|t|`` held at ``factor
+    |t|`` (rotation and direction free); the returned value is the smallest cost
+    increase over the free optimum ``cost``, in units of the residual variance
+    ``sigma2`` (a likelihood-ratio statistic: ~chi^2 with 1 dof). Unlike the
+    first-order standard deviation it sees the non-linearity of near-critical
+    motions, where the cost is flat on one side of the estimate.
+    """
+    if not (np.isfinite(sigma2) and sigma2 > 0):
+        return 0.0
+    worst = np.inf
+    for f in factors:
+        try:
+            out = _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R,
+                                      np.asarray(t) * f, loss=loss, loss_scale=loss_scale,
+                                      fix_scale=True, weights=weights)
+        except (ValueError, ArithmeticError):
+            return 0.0
+        worst = min(worst, (out["final_cost"] - cost) / sigma2)
+    return float(max(worst, 0.0))
 
 
 def count_in_front(rays: RayPairs, R: np.ndarray, t: np.ndarray,
@@ -125,11 +148,16 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
                   rel_std: float, max_rel_std: float = 0.1,
                   direction_only: bool = False,
                   noise_level: float = float("nan"),
-                  residual_median: float = float("nan")) -> ScaleVerdict:
+                  residual_median: float = float("nan"),
+                  profile: float = float("nan")) -> ScaleVerdict:
     """The scale verdict of a motion estimated from the ``inliers`` of ``rays``.
 
     ``rel_std`` is the relative std of ``|t|`` from the refinement;
     ``direction_only`` says that the refinement already had to fix ``|t|``;
+    ``profile`` is the statistic of :func:`scale_profile` for the factors
+    ``1 +- 3 max_rel_std``: the scale is observable only if both are excluded
+    at 3 sigma (profile >= 9), i.e. a first-order "3 sigma within 30 %" that
+    also holds for the non-linear cost;
     ``noise_level`` (radians, e.g. the inlier threshold) and ``residual_median``
     (median Sampson residual of the motion on its inliers, radians) enable the
     no-parallax test of :func:`rotation_only_fit`: when a pure rotation explains
@@ -152,7 +180,10 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     crit = rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
     evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {np.degrees(crit):.3g} deg "
                 f"over {len(centres)} cameras, {n_cross} cross-camera inliers")
-    if direction_only or not np.isfinite(rel_std) or rel_std > max_rel_std:
+    if np.isfinite(profile):
+        evidence += f", |t| x/ {1 + 3 * max_rel_std:.2g} excluded at {np.sqrt(profile):.2g} sigma"
+    if (direction_only or not np.isfinite(rel_std) or rel_std > max_rel_std
+            or (np.isfinite(profile) and profile < 9.0)):
         if n_cross == 0 and len(centres) < 2:
             why = "one camera only and no cross-camera correspondence"
         elif n_cross == 0 and crit < np.radians(0.05):

@@ -52,9 +52,10 @@ class EstimatorInfo:
     #: ``sampler(rays: RayPairs, rng) -> index array`` drawing one minimal sample;
     #: None = the robust layer's default (spread across cameras)
     sampler: Optional[Callable] = None
-    #: ``proposer(rays, threshold, prob, rng) -> list[(R, t)]``: a method-specific
-    #: robust search giving a few good hypotheses fast (e.g. the two-stage RANSAC
-    #: of thesis ch. 7.4); the robust layer scores and refines them
+    #: ``proposer(rays, threshold, prob, rng)``: an iterable of ``(R, t)`` or
+    #: ``(R, t, expected_inlier_ratio)`` from a method-specific robust search
+    #: (e.g. the two-stage RANSAC of thesis ch. 7.4); the robust layer scores and
+    #: refines them and stops once one explains the expected inlier ratio
     proposer: Optional[Callable] = None
 
     def __call__(self, rays, **options):

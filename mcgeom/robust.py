@@ -13,7 +13,9 @@ refined on all its inliers with a robust loss.
 Residual: the Sampson (first-order) angular error of the generalized epipolar
 constraint (``_core.gec_residuals``), in radians on the unit sphere. With
 ``focal`` given (pixels, one value or one per correspondence) thresholds and
-residuals are in pixels: radians x focal, the usual pinhole approximation.
+residuals are in pixels: radians x focal, the usual pinhole approximation;
+per-correspondence values also weight the refinements (variance ~ 1/focal^2),
+e.g. the effective focal length at each pixel that :mod:`mcgeom.cv` computes.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import numpy as np
 
 from . import _core, registry
 from .errors import DegenerateError
-from .observability import orient_by_cheirality, scale_verdict
+from .observability import orient_by_cheirality, scale_profile, scale_verdict
 from .types import RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
@@ -42,9 +44,9 @@ class RansacOptions:
     min_iters: int = 0
     seed: Optional[int] = 0
     local_optimization: bool = True
-    lo_max_rounds: int = 4
+    lo_max_rounds: int = 3
     refine: bool = True
-    loss: str = "cauchy"
+    loss: str = "none"              # final refinement on the inliers (LO uses cauchy)
     max_scale_rel_std: float = 0.1
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
 
@@ -135,6 +137,12 @@ class _Scorer:
     def __init__(self, rays: RayPairs, thr: float, focal: Optional[np.ndarray],
                  opts: RansacOptions):
         self.rays, self.thr, self.focal, self.opts = rays, thr, focal, opts
+        # Per-correspondence focal lengths (pixels per radian of residual)
+        # also weight the least squares: a residual of r radians is r * f_i
+        # pixels, so its variance under pixel noise is ~ 1 / f_i^2.
+        self.weights = None if focal is None or np.ptp(focal) == 0 else \
+            (focal / np.median(focal)) ** 2
+        self.loss_scale = thr if focal is None else thr / float(np.median(focal))
         self.best: Optional[tuple[np.ndarray, np.ndarray]] = None
         self.best_score = np.inf
         self.best_inliers = np.zeros(len(rays), bool)
@@ -167,7 +175,8 @@ class _Scorer:
             R, t = self.best
             self.n_lo += 1
             try:
-                out = _refine(self.rays.take(inl), R, t, self._loss_scale(), "cauchy")
+                out = _refine(self.rays.take(inl), R, t, self._loss_scale(), "cauchy",
+                              self._w(inl))
             except (ValueError, ArithmeticError):
                 return
             r = self.residuals(out["R"], out["t"])
@@ -176,17 +185,18 @@ class _Scorer:
                 return
             self.best, self.best_score, self.best_inliers = (out["R"], out["t"]), score, r < self.thr
 
+    def _w(self, mask: np.ndarray) -> Optional[np.ndarray]:
+        return None if self.weights is None else self.weights[mask]
+
     def _loss_scale(self) -> float:
         """Loss scale in radians (the threshold, converted from pixels if needed)."""
-        if self.focal is None:
-            return self.thr
-        return self.thr / float(np.median(self.focal))
+        return self.loss_scale
 
 
 def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
-            fix_scale: bool = False) -> dict:
+            weights: Optional[np.ndarray] = None) -> dict:
     return _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
-                               loss=loss, loss_scale=loss_scale, fix_scale=fix_scale)
+                               loss=loss, loss_scale=loss_scale, weights=weights)
 
 
 def ransac(rays: RayPairs, method: str = "five_plus_one", *,
@@ -235,9 +245,14 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         raise ValueError(f"estimator {method!r} has no minimal solver: it cannot drive RANSAC")
     iterations = 0
     if use_proposer:
-        for R, t in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
-            scorer.offer(R, t)
-        iterations = 1
+        for prop in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
+            iterations += 1
+            scorer.offer(prop[0], prop[1])
+            # a proposer may say which inlier ratio to expect (e.g. the one of
+            # its own robust search): stop once a motion explains about that
+            if len(prop) > 2 and scorer.best is not None and \
+                    scorer.best_inliers.mean() >= 0.9 * prop[2]:
+                break
     else:
         sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
         k_needed = options.max_iters
@@ -272,15 +287,14 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     rel_std = float("inf")
     fixed = False
     if options.refine:
-        sub = rays.take(inl)
-        out = _refine(sub, R, t, scorer._loss_scale(), options.loss)
+        # All six degrees of freedom are refined even when |t| turns out to be
+        # unobservable: where the cost is flat in |t| the refinement may move it
+        # far, but R and the direction stay right, whereas holding |t| at a
+        # wrong value bends R and the direction to compensate (measured: 0.03
+        # -> 0.2 deg on the Ladybug head). The verdict then reports the direction.
+        out = _refine(rays.take(inl), R, t, scorer._loss_scale(), options.loss, scorer._w(inl))
         R, t = out["R"], out["t"]
         rel_std = float(out["scale_rel_std"])
-        if not rel_std <= options.max_scale_rel_std:
-            # scale not determined: keep the direction, refine on the sphere
-            info["t_free"] = np.array(t)     # |t| as the free refinement left it
-            out = _refine(sub, R, t, scorer._loss_scale(), options.loss, fix_scale=True)
-            R, t, fixed = out["R"], out["t"], True
         r = scorer.residuals(R, t)
         inl = r < options.threshold
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
@@ -288,15 +302,26 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     info.update(inlier_ratio=float(inl.mean()), time_s=time.perf_counter() - t_start,
                 score=scorer.best_score)
     r_rad = residuals(rays, R, t)
+    profile = float("nan")
+    if options.refine and rel_std <= options.max_scale_rel_std:
+        k = 1.0 + 3.0 * options.max_scale_rel_std
+        profile = scale_profile(rays.take(inl), R, t, out["final_cost"], out["sigma2"],
+                                (1.0 / k, k), options.loss, scorer._loss_scale(),
+                                scorer._w(inl))
+        info["scale_profile"] = profile
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std, fixed,
                             noise_level=scorer._loss_scale(),
-                            residual_median=float(np.median(r_rad[inl])) if inl.any() else 0.0)
+                            residual_median=float(np.median(r_rad[inl])) if inl.any() else 0.0,
+                            profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
-    info["t_metric"] = np.array(t)   # the metric estimate, whatever the verdict
+    # the metric estimate whatever the verdict (meaningless when unobservable:
+    # the free refinement may have slid |t| far, even through zero)
+    info["t_metric"] = np.array(t)
     if not verdict.observable:
         nt = np.linalg.norm(t)
         if nt > 0:
             t = orient_by_cheirality(rays, R, t / nt, inl)
+            info["t_metric"] = nt * t
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
                      float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan"),
                      inl, info)

@@ -73,7 +73,7 @@ def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
 
 def _mcgeom(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
     m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0)
-    return m.R, m.info.get("t_free", m.info.get("t_metric", m.t))
+    return m.R, m.info["t_metric"]
 
 
 def _errors(R, t, Rt, tt) -> tuple[float, float, float]:

@@ -19,16 +19,17 @@ from mcgeom.cv import estimate
 
 
 def trial(rng: np.random.Generator, noise_px: float = 1.0, n: int = 400,
-          outliers: float = 0.1, max_yaw_deg: float = 2.0) -> dict:
+          outliers: float = 0.1, max_yaw_deg: float = 2.0, cross: float = 0.0) -> dict:
     rig = synth.vehicle8()
     yaw = np.radians(rng.uniform(-max_yaw_deg, max_yaw_deg))
     dist = rng.uniform(0.5, 2.0)
     Rw = synth.rotation_about([0, 0, 1], yaw)          # rig2 pose in the rig1 frame
     R, t = Rw.T, -Rw.T @ np.array([dist, 0.0, 0.0])
-    p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise_px, outlier_fraction=outliers)
+    p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise_px, outlier_fraction=outliers,
+                           cross_fraction=cross)
     m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=2.0 * noise_px + 0.5,
                  seed=int(rng.integers(1 << 31)))
-    t_metric = m.info.get("t_free", m.info.get("t_metric", m.t))
+    t_metric = m.info["t_metric"]
     return {"yaw_deg": np.degrees(yaw), "scale_err": abs(np.linalg.norm(t_metric) / dist - 1.0),
             "observable": m.scale.observable, "rel_std": m.scale.rel_std,
             "critical_deg": np.degrees(m.scale.critical_angle),

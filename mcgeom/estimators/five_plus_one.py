@@ -38,7 +38,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..observability import orient_by_cheirality
+from ..observability import orient_by_cheirality, scale_profile
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
 
@@ -111,6 +111,36 @@ def _project(Q: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 LEAST_SQUARES = -1
 
 
+def _decompose(E: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> tuple[int, np.ndarray, np.ndarray]:
+    """The (R, t) of E's four decompositions (``cv2.decomposeEssentialMat``) that puts
+    most points in front of both cameras (mid-point triangulation, ``X2 = R X1 + t``),
+    with that count. Same choice as ``cv2.recoverPose`` without its distance cut,
+    vectorised over the four candidates."""
+    import cv2
+    R1, R2, t = cv2.decomposeEssentialMat(E)
+    t = t.ravel()
+    h1 = np.c_[x1, np.ones(len(x1))]
+    h2 = np.c_[x2, np.ones(len(x2))]
+    best = (0, R1, t)
+    for R in (R1, R2):
+        a = h1 @ R.T                                   # R x1, in camera 2
+        aa = np.einsum("ij,ij->i", a, a)
+        bb = np.einsum("ij,ij->i", h2, h2)
+        ab = np.einsum("ij,ij->i", a, h2)
+        den = aa * bb - ab * ab
+        ok = den > 1e-14 * aa * bb
+        den = np.where(ok, den, 1.0)
+        for tt in (t, -t):
+            # s1 R x1 + tt = s2 x2 (least squares): w = -tt
+            aw, bw = -(a @ tt), -(h2 @ tt)
+            s1 = (aw * bb - bw * ab) / den
+            s2 = (aw * ab - bw * aa) / den
+            cnt = int(np.sum(ok & (s1 > 0) & (s2 > 0)))
+            if cnt > best[0]:
+                best = (cnt, R, tt)
+    return best
+
+
 def _sampson_sq(E: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> np.ndarray:
     """Squared Sampson distances of normalised image points under E."""
     h1 = np.c_[x1, np.ones(len(x1))]
@@ -138,7 +168,9 @@ def _least_squares_essential(x1: np.ndarray, x2: np.ndarray,
     if m == 5:
         E, _ = cv2.findEssentialMat(x1, x2, np.eye(3), method=cv2.RANSAC, threshold=1e-3)
         return [] if E is None else list(E.reshape(-1, 3, 3))
-    order = np.lexsort((x2[:, 1], x2[:, 0], x1[:, 1], x1[:, 0]))
+    # an order invariant to the rig frame (the local image plane's in-plane
+    # rotation depends on it): by distance from the image centre
+    order = np.lexsort((np.einsum("ij,ij->i", x2, x2), np.einsum("ij,ij->i", x1, x1)))
     step = max(1, m // 5)
     best, best_cost = None, np.inf
     for j in range(min(subsets, m)):
@@ -159,7 +191,8 @@ def _least_squares_essential(x1: np.ndarray, x2: np.ndarray,
 
 def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
                       method: int = LEAST_SQUARES, threshold: float = 1e-3,
-                      prob: float = 0.999) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+                      prob: float = 0.999, stats: Optional[dict] = None
+                      ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Rig rotations and scale lines from the 5-point solver on one camera's rays.
 
     ``index`` selects intra-camera correspondences of one camera whose centre
@@ -169,6 +202,7 @@ def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
     normalised image units, ``prob``) picks one.
     Returns a list of ``(R, t0, w)``: rig rotation and the line ``t(lam) = t0 +
     lam w`` of rig translations (metres per unit ``lam``, ``|w| = 1``).
+    ``stats`` (a dict) receives the robust search's ``inlier_ratio``.
     """
     d1, d2 = rays.dirs1[index], rays.dirs2[index]
     Q = _local_frame(np.concatenate([d1, d2]))
@@ -181,14 +215,16 @@ def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
     if method == LEAST_SQUARES or len(x1) == 5:
         Es = _least_squares_essential(x1, x2)
     else:
-        E, _ = cv2.findEssentialMat(x1, x2, np.eye(3), method=method, prob=prob,
-                                    threshold=threshold)
+        E, mask = cv2.findEssentialMat(x1, x2, np.eye(3), method=method, prob=prob,
+                                       threshold=threshold)
         if E is None or E.shape[0] % 3 or not np.all(np.isfinite(E)):
             return []
         Es = list(E.reshape(-1, 3, 3))
+        if stats is not None and mask is not None:
+            stats["inlier_ratio"] = float(np.count_nonzero(mask)) / len(x1)
     out = []
     for Ek in Es:
-        n_front, Ra, u, _ = cv2.recoverPose(Ek, x1, x2, np.eye(3))
+        n_front, Ra, u = _decompose(Ek, x1, x2)
         if n_front == 0:
             continue
         R = Q.T @ Ra @ Q
@@ -384,6 +420,22 @@ def _verdict(sol: dict, rel_std: float, max_rel_std: float, fixed: bool) -> Scal
                               f"{np.degrees(crit):.3g} deg", float("nan"), rel_std, crit)
 
 
+def _from_camera(rays: RayPairs, a: int, refine: bool) -> tuple[float, dict, Optional[dict]]:
+    """The linear 5+1 solution with camera ``a`` as the 5-point camera, refined
+    on all correspondences; returns (final cost, linear solution, refinement)."""
+    sol = solve(rays, a)
+    if not refine:
+        return sol["cost"], sol, None
+    # all six degrees of freedom even if |t| is not observable: holding a wrong
+    # |t| would bend R and the direction (see mcgeom.robust._finish); with 6
+    # rays the square system polishes the minimal solution
+    try:
+        out = _refine_all(rays, sol["R"], sol["t"], False)
+    except DegenerateError:
+        out = _refine_all(rays, sol["R"], sol["t"], True)
+    return float(out["final_cost"]), sol, out
+
+
 def _refine_all(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool) -> dict:
     return _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
                                loss="none", fix_scale=fix_scale)
@@ -428,55 +480,84 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     for name in ("origins1", "dirs1", "origins2", "dirs2"):
         if not np.all(np.isfinite(getattr(rays, name))):
             raise ValueError(f"rays.{name} contains NaN or inf")
-    sol = solve(rays, five_camera)
+    if five_camera is None:
+        # every camera that can be the 5-point camera, best final cost wins: the
+        # refinement from a single camera's start can stop in a local minimum,
+        # and the choice must not depend on the rig frame or the order of rays
+        cam1, cam2, _ = camera_ids(rays)
+        counts = np.bincount(cam1[cam1 == cam2], minlength=int(max(cam1.max(), cam2.max())) + 1)
+        cams = [int(k) for k in np.argsort(-counts, kind="stable") if counts[k] >= 5]
+        if not cams:
+            raise ValueError("too few correspondences: five_plus_one needs 5 intra-camera "
+                             f"correspondences in one camera, most found: {int(counts.max())}")
+    else:
+        cams = [five_camera]
+    best, err = None, None
+    for a in cams:
+        try:
+            cand = _from_camera(rays, a, refine)
+        except DegenerateError as e:
+            err = e
+            continue
+        if best is None or cand[0] < best[0]:
+            best = cand
+    if best is None:
+        raise err if err is not None else DegenerateError("five_plus_one: no motion found")
+    _, sol, out = best
     R, t, rel = sol["R"], sol["t"], sol["scale_rel_std"]
     info = {"five_camera": sol["five_camera"], "critical_angles": sol["critical_angles"],
             "scale_linear": sol["lam"], "scale_rel_std_linear": rel,
-            "n_scale_correspondences": sol["n_scale"]}
-    fixed = sol["n_scale"] == 0 or not sol["scale_determined"]
-    if refine and len(rays) > 6:
-        out = _refine_all(rays, R, t, fixed)
-        if not fixed and not out["scale_rel_std"] <= max_scale_rel_std:
-            out2 = _refine_all(rays, out["R"], out["t"], True)
-            info["refinement_unfixed"] = out
-            out, fixed = out2, True
+            "n_scale_correspondences": sol["n_scale"], "cameras_tried": cams}
+    # the verdict rests on the refined evidence only (not on which camera's
+    # linear start won: several converge to the same minimum)
+    fixed = sol["n_scale"] == 0 or (out is None and not sol["scale_determined"])
+    if out is not None:
         R, t = out["R"], out["t"]
-        rel = float(out["scale_rel_std"]) if not fixed else float("inf")
-        info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
-    elif refine:
-        out = _refine_all(rays, R, t, fixed)  # square system: polish the minimal solution
-        R, t = out["R"], out["t"]
+        if len(rays) > 6:
+            rel = float(out["scale_rel_std"]) if not fixed else float("inf")
+            info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
+            if rel <= max_scale_rel_std:
+                k = 1.0 + 3.0 * max_scale_rel_std
+                info["scale_profile"] = scale_profile(rays, R, t, out["final_cost"],
+                                                      out["sigma2"], (1.0 / k, k))
+                if info["scale_profile"] < 9.0:
+                    rel = float("inf")
     sol["critical_angles"] = critical_angles(R, t, camera_ids(rays)[2], sol["five_camera"])
     info["critical_angles"] = sol["critical_angles"]
     verdict = _verdict(sol, rel, max_scale_rel_std, fixed)
+    info["t_metric"] = np.array(t)   # metric estimate, whatever the verdict
     if not verdict.observable:
-        t = orient_by_cheirality(rays, R, t / np.linalg.norm(t))
+        nt = np.linalg.norm(t)
+        t = orient_by_cheirality(rays, R, t / nt)
+        info["t_metric"] = nt * t
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
     return RigMotion(R, t, verdict, "five_plus_one", float(np.sqrt(np.mean(r ** 2))), None, info)
 
 
 def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Generator,
-            max_cameras: int = 2, scale_samples: int = 64) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Two-stage robust hypotheses of thesis ch. 7.4 (Fig. 7.6), spread over cameras.
+            max_cameras: int = 3, scale_samples: int = 64):
+    """Two-stage robust hypotheses of thesis ch. 7.4 (Fig. 7.6), camera after camera.
 
-    For each of the ``max_cameras`` cameras with most intra-camera
-    correspondences: the essential matrix by OpenCV's robust 5-point search
+    For the cameras in decreasing number of intra-camera correspondences (up
+    to ``max_cameras``): the essential matrix by OpenCV's robust 5-point search
     (USAC, ``threshold`` radians ~ normalised image units), then the scale by a
-    1-point RANSAC over the correspondences of all other cameras (eq. 7.4 from
-    each of up to ``scale_samples`` of them, scored by MSAC on all of them).
-    Returns the motions found (the caller scores and refines them).
+    1-point RANSAC over the correspondences of all other cameras (eq. 7.4). A
+    generator of ``(R, t, expected_inlier_ratio)``, the last being the inlier
+    ratio the 5-point search found in its camera: the caller scores each
+    motion on all correspondences and stops asking once one explains about
+    that fraction everywhere (the usual case: one camera is enough).
     """
-    import cv2  # noqa: F401  (documented dependency of this path)
+    import cv2
     cam1, cam2, centres = camera_ids(rays)
     intra = cam1 == cam2
     counts = np.bincount(cam1[intra], minlength=len(centres))
     order = [int(k) for k in np.argsort(-counts, kind="stable") if counts[k] >= 8][:max_cameras]
-    out = []
     for a in order:
         own = np.flatnonzero(intra & (cam1 == a))
+        stats: dict = {}
         try:
             cands = essential_motions(rays, own, centres[a], method=cv2.USAC_DEFAULT,
-                                      threshold=threshold, prob=prob)
+                                      threshold=threshold, prob=prob, stats=stats)
         except (DegenerateError, cv2.error):
             continue
         others = np.flatnonzero(~(intra & (cam1 == a)))
@@ -484,18 +565,83 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
             continue
         sub = rays.take(others)
         for R, t0, w in cands:
-            sa, sb = scale_terms(sub, R, t0, w)
-            ok = np.flatnonzero(np.abs(sb) > 1e-9 * (1.0 + np.abs(sa)))
-            if ok.size == 0:
-                continue
-            pick = rng.choice(ok, min(scale_samples, ok.size), replace=False)
-            best, best_score = None, np.inf
-            for i in pick:
-                lam = -sa[i] / sb[i]
-                r = np.abs(_core.gec_residuals(sub.origins1, sub.dirs1, sub.origins2, sub.dirs2,
-                                               R, t0 + lam * w))
-                score = float(np.minimum(r * r, threshold * threshold).sum())
-                if score < best_score:
-                    best, best_score = lam, score
-            out.append((R, t0 + best * w))
-    return out
+            lam = scale_one_point_ransac(sub, R, t0, w, threshold, rng, scale_samples, prob)
+            if lam is not None:
+                yield R, t0 + lam * w, stats.get("inlier_ratio", 1.0)
+
+
+def _sampson_in_scale(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.ndarray):
+    """Per correspondence, the Sampson angular residual as a function of the scale:
+    ``r(lam) = (a + lam b) / sqrt(A + 2 B lam + C lam^2)`` (radians).
+
+    With ``s(lam) = t0 + lam w + R o1 - o2`` the pair's essential matrix is
+    ``[s]x R``: ``F d1 = s x R d1`` and ``|P(d1) F^T d2| = |P(R d1) (d2 x s)|``
+    are affine in ``lam``, so the squared Sampson denominator is quadratic.
+    """
+    d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
+    d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
+    rd1 = d1 @ R.T
+    s0 = t0 + rays.origins1 @ R.T - rays.origins2
+
+    def tangent(v, d):                      # P(d) v, rows
+        return v - np.einsum("ij,ij->i", v, d)[:, None] * d
+
+    g0, g1 = np.cross(s0, rd1), np.cross(w, rd1)
+    a = np.einsum("ij,ij->i", d2, g0)
+    b = np.einsum("ij,ij->i", d2, g1)
+    pg0, pg1 = tangent(g0, d2), tangent(g1, d2)
+    pk0, pk1 = tangent(np.cross(d2, s0), rd1), tangent(np.cross(d2, w), rd1)
+    A = np.einsum("ij,ij->i", pg0, pg0) + np.einsum("ij,ij->i", pk0, pk0)
+    B = np.einsum("ij,ij->i", pg0, pg1) + np.einsum("ij,ij->i", pk0, pk1)
+    C = np.einsum("ij,ij->i", pg1, pg1) + np.einsum("ij,ij->i", pk1, pk1)
+    return a, b, A, B, C
+
+
+def scale_one_point_ransac(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.ndarray,
+                           threshold: float, rng: np.random.Generator,
+                           samples: int = 64, prob: float = 0.999) -> Optional[float]:
+    """The scale ``lam`` of ``t = t0 + lam w`` by 1-point RANSAC (thesis ch. 7.4).
+
+    Each of up to ``samples`` correspondences proposes ``lam = -a / b`` (eq. 7.4);
+    all proposals are scored at once by MSAC on the Sampson angular residuals
+    (``threshold`` radians) of every correspondence; the best is re-estimated by
+    weighted least squares on its inliers. None if no correspondence constrains
+    the scale.
+    """
+    a, b, A, B, C = _sampson_in_scale(rays, R, t0, w)
+    ok = np.flatnonzero(np.abs(b) > 1e-9 * (1.0 + np.abs(a)))
+    if ok.size == 0:
+        return None
+    order = rng.permutation(ok)[:samples]
+    lam, best, inl, used = 0.0, np.inf, None, 0
+    while used < order.size:      # batches of 16 proposals, adaptive stop (1-point)
+        pick = order[used:used + 16]
+        used += pick.size
+        lams = -a[pick] / b[pick]
+        num = a[None, :] + lams[:, None] * b[None, :]
+        den2 = A[None, :] + 2.0 * lams[:, None] * B[None, :] + (lams ** 2)[:, None] * C[None, :]
+        r2 = num ** 2 / np.maximum(den2, 1e-300)
+        score = np.minimum(r2, threshold ** 2).sum(axis=1)
+        k = int(np.argmin(score))
+        if score[k] < best:
+            lam, best, inl = float(lams[k]), float(score[k]), r2[k] < threshold ** 2
+        ratio = float(np.mean(inl))
+        needed = np.log1p(-prob) / np.log1p(-ratio) if 0.0 < ratio < 1.0 else (
+            1.0 if ratio >= 1.0 else np.inf)
+        if used >= needed:
+            break
+    for _ in range(2):
+        # weighted LS of eq. 7.4 on the inliers, kept only if the MSAC score
+        # improves: near the critical motion the linear equation is biased
+        # towards lam = 0 (noise in b), where the robust score is not
+        wts = 1.0 / np.maximum(A + 2.0 * B * lam + C * lam ** 2, 1e-300)
+        bb = float(np.sum(wts[inl] * b[inl] ** 2))
+        if not bb > 0.0:
+            break
+        cand = -float(np.sum(wts[inl] * a[inl] * b[inl])) / bb
+        r2c = (a + cand * b) ** 2 / np.maximum(A + 2.0 * B * cand + C * cand ** 2, 1e-300)
+        sc = float(np.minimum(r2c, threshold ** 2).sum())
+        if not sc < best:
+            break
+        lam, best, inl = cand, sc, r2c < threshold ** 2
+    return lam
