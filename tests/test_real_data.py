@@ -9,8 +9,10 @@ is a row of its table. Only what must hold is asserted:
   (the returned unit ``t`` is documented as meaningful also when the scale is not);
 * with the stereo (cross-camera) correspondences the KITTI scale is observable and
   within 10 % of the ground truth (the OXTS poses jitter by ~5 %);
-* a critical motion is never a confident wrong scale: an "observable" verdict from
-  intra-camera correspondences only must be within 10 % too;
+* never a confident wrong scale: an "observable" verdict on a moving rig is within 10 %
+  of the ground truth (a critical motion from intra-camera correspondences only must be
+  reported unobservable rather than scaled wrongly; DGP's cross-camera data, with their
+  calibration errors, give 6 %);
 * a static rig (EuRoC clip with the MAV standing still, DGP parked car) keeps its
   rotation and is never reported as a confident metric translation: the verdict is
   "unobservable", or the metric |t| is below a few centimetres.
@@ -130,8 +132,8 @@ def test_stereo_rig_gives_metric_scale(results, key, pair, mode):
     assert r["scale_err"] < MAX_SCALE_ERR, _describe(r)
 
 
-@pytest.mark.parametrize("key, pair, mode", _cases(MOVING, ["intra"], "critical"))
-def test_critical_motion_is_not_a_confident_wrong_scale(results, key, pair, mode):
+@pytest.mark.parametrize("key, pair, mode", _cases(MOVING, ev.MODES, "confident"))
+def test_observable_verdict_has_the_right_scale(results, key, pair, mode):
     r = _row(results, key, pair, mode)
     if r["observable"]:
         assert r["scale_err"] < MAX_SCALE_ERR, _describe(r)
