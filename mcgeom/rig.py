@@ -378,6 +378,8 @@ class Camera:
         n = xy_d.shape[0]
         if n == 0:
             return np.zeros((0, 3))
+        if self.model == "pinhole" and not np.any(self.dist):
+            return np.column_stack([xy_d, np.ones(n)])   # nothing to undistort
         src = np.ascontiguousarray(xy_d).reshape(-1, 1, 2)
         if self.model == "pinhole":
             xy = cv2.undistortPoints(src, _IDENTITY, self.dist,

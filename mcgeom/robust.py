@@ -44,7 +44,7 @@ class RansacOptions:
     min_iters: int = 0
     seed: Optional[int] = 0
     local_optimization: bool = True
-    lo_max_rounds: int = 3
+    lo_max_rounds: int = 2
     refine: bool = True
     loss: str = "none"              # final refinement on the inliers (LO uses cauchy)
     max_scale_rel_std: float = 0.1
@@ -148,6 +148,7 @@ class _Scorer:
         self.best_inliers = np.zeros(len(rays), bool)
         self.n_hyp = 0
         self.n_lo = 0
+        self.lo_rounds = opts.lo_max_rounds
 
     def residuals(self, R: np.ndarray, t: np.ndarray) -> np.ndarray:
         return residuals(self.rays, R, t, self.focal)
@@ -168,7 +169,7 @@ class _Scorer:
 
     def _local_optimise(self) -> None:
         """Re-estimate from the inliers by robust least squares while the score improves."""
-        for _ in range(self.opts.lo_max_rounds):
+        for _ in range(self.lo_rounds):
             inl = self.best_inliers
             if inl.sum() < 6:
                 return
@@ -183,7 +184,10 @@ class _Scorer:
             score = _msac(r, self.thr)
             if not score < self.best_score * (1.0 - 1e-9):
                 return
+            same = np.array_equal(r < self.thr, inl)
             self.best, self.best_score, self.best_inliers = (out["R"], out["t"]), score, r < self.thr
+            if same:   # the same inliers would give the same fit again
+                return
 
     def _w(self, mask: np.ndarray) -> Optional[np.ndarray]:
         return None if self.weights is None else self.weights[mask]
@@ -245,6 +249,10 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         raise ValueError(f"estimator {method!r} has no minimal solver: it cannot drive RANSAC")
     iterations = 0
     if use_proposer:
+        # a proposer's motions come out of a robust search with its own local
+        # optimisation (OpenCV's USAC for 5+1): one round here is enough, the
+        # final stage refits on the inliers again
+        scorer.lo_rounds = min(1, options.lo_max_rounds)
         for prop in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
             iterations += 1
             scorer.offer(prop[0], prop[1])
@@ -292,11 +300,15 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         # far, but R and the direction stay right, whereas holding |t| at a
         # wrong value bends R and the direction to compensate (measured: 0.03
         # -> 0.2 deg on the Ladybug head). The verdict then reports the direction.
-        out = _refine(rays.take(inl), R, t, scorer._loss_scale(), options.loss, scorer._w(inl))
-        R, t = out["R"], out["t"]
+        for _ in range(2):   # refit once more if the inlier set moved
+            used = inl
+            out = _refine(rays.take(used), R, t, scorer._loss_scale(), options.loss,
+                          scorer._w(used))
+            R, t = out["R"], out["t"]
+            inl = scorer.residuals(R, t) < options.threshold
+            if np.array_equal(inl, used):
+                break
         rel_std = float(out["scale_rel_std"])
-        r = scorer.residuals(R, t)
-        inl = r < options.threshold
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
     r = scorer.residuals(R, t)
     info.update(inlier_ratio=float(inl.mean()), time_s=time.perf_counter() - t_start,
@@ -305,9 +317,9 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     profile = float("nan")
     if options.refine and rel_std <= options.max_scale_rel_std:
         k = 1.0 + 3.0 * options.max_scale_rel_std
-        profile = scale_profile(rays.take(inl), R, t, out["final_cost"], out["sigma2"],
+        profile = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
                                 (1.0 / k, k), options.loss, scorer._loss_scale(),
-                                scorer._w(inl))
+                                scorer._w(used))
         info["scale_profile"] = profile
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std, fixed,
                             noise_level=scorer._loss_scale(),

@@ -556,8 +556,10 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
         own = np.flatnonzero(intra & (cam1 == a))
         stats: dict = {}
         try:
+            # 0.99 is enough here: the motion is checked on every camera and the
+            # next camera is tried when it falls short
             cands = essential_motions(rays, own, centres[a], method=cv2.USAC_DEFAULT,
-                                      threshold=threshold, prob=prob, stats=stats)
+                                      threshold=threshold, prob=min(prob, 0.99), stats=stats)
         except (DegenerateError, cv2.error):
             continue
         others = np.flatnonzero(~(intra & (cam1 == a)))
