@@ -58,18 +58,8 @@ _COLLAPSED_T = (
     "forward motion each camera sees; the rig direction is then 131 deg off. The verdict "
     "is 'unobservable' but the returned unit t keeps that direction (at |t| = 1 the "
     "inliers have 2.8 px median residual).")
-_PARKED = (
-    "known weakness: parked car, 3 cameras with overlap. Intra-camera data show no "
-    "parallax (pure rotation fits to 0.2-0.4 px) but the no-parallax test compares with "
-    "the Sampson residual of a free translation (0.03 px, ratio 6-16 > 3) and does not "
-    "fire. With cross-camera correspondences the verdict then trusts ~330 cross-camera "
-    "inliers with 1-10 px model error (no distortion in the DGP calibration): "
-    "'observable', |t| = 0.98 m, relative std 1 %. With intra-camera correspondences "
-    "only the rotation comes out 180 deg off (twisted pair, |t| ~ 5e4 m).")
 KNOWN = {
     ("kitti_raw", (2, 3), "intra", "direction"): _COLLAPSED_T,
-    ("dgp_scene_01", (0, 1), "intra", "static"): _PARKED,
-    ("dgp_scene_01", (0, 1), "intra+cross", "static"): _PARKED,
 }
 
 
