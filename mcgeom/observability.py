@@ -26,7 +26,7 @@ from . import _core
 from .types import RayPairs, ScaleVerdict
 
 __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_only_fit",
-           "count_in_front", "orient_by_cheirality", "scale_profile"]
+           "count_in_front", "scale_profile", "travel_direction"]
 
 
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
@@ -114,11 +114,35 @@ def count_in_front(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     return int(np.sum(ok & (s1 > 0) & (s2 > 0)))
 
 
-def orient_by_cheirality(rays: RayPairs, R: np.ndarray, t: np.ndarray,
-                         mask: np.ndarray | None = None) -> np.ndarray:
-    """``t`` or ``-t``, whichever puts more triangulated points in front of the
-    cameras: the sign of a translation direction whose length is unknown."""
-    return t if count_in_front(rays, R, t, mask) >= count_in_front(rays, R, -t, mask) else -t
+def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
+                     t: np.ndarray) -> np.ndarray:
+    """Unit direction of travel when ``|t|`` is not observable.
+
+    Near the critical motion the data fix R and the direction in which the
+    cameras translate, ``tau = t + R c - c`` (the same for all cameras when the
+    motion is critical), but not its length; a refinement may then slide |t|
+    to a few mm, where ``t`` itself is dominated by the rotation-induced part
+    ``R c - c`` and points anywhere (seen on KITTI: 130 deg off). The
+    translation of the centroid ``c`` of the cameras with inliers is the
+    meaningful direction; it differs from the direction of ``t`` by at most
+    the rotation times the centroid's distance from the rig origin over |t|.
+    The sign is chosen by cheirality at a length where the rotation-induced
+    part is negligible.
+    """
+    sel = np.asarray(mask, bool)
+    c = 0.5 * (rays.origins1[sel].mean(axis=0) + rays.origins2[sel].mean(axis=0)) \
+        if sel.any() else np.zeros(3)
+    shift = R @ c - c
+    tau = t + shift
+    n = np.linalg.norm(tau)
+    if not n > 0:
+        return t / max(np.linalg.norm(t), 1e-300)
+    u = tau / n
+    spread = np.sqrt(np.mean(np.sum((rays.origins1[sel] - c) ** 2, axis=1))) if sel.any() else 1.0
+    L = max(1.0, 100.0 * spread, 100.0 * np.linalg.norm(shift))
+    plus = count_in_front(rays, R, L * u - shift, sel)
+    minus = count_in_front(rays, R, -L * u - shift, sel)
+    return u if plus >= minus else -u
 
 
 def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -28,7 +28,7 @@ import numpy as np
 
 from . import _core, registry
 from .errors import DegenerateError
-from .observability import orient_by_cheirality, scale_profile, scale_verdict
+from .observability import scale_profile, scale_verdict, travel_direction
 from .types import RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
@@ -250,16 +250,16 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     iterations = 0
     if use_proposer:
         # a proposer's motions come out of a robust search with its own local
-        # optimisation (OpenCV's USAC for 5+1): one round here is enough, the
+        # optimisation (OpenCV's USAC for 5+1): two rounds here are enough, the
         # final stage refits on the inliers again
-        scorer.lo_rounds = min(1, options.lo_max_rounds)
+        scorer.lo_rounds = min(2, options.lo_max_rounds)
         for prop in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
             iterations += 1
             scorer.offer(prop[0], prop[1])
             # a proposer may say which inlier ratio to expect (e.g. the one of
             # its own robust search): stop once a motion explains about that
             if len(prop) > 2 and scorer.best is not None and \
-                    scorer.best_inliers.mean() >= 0.9 * prop[2]:
+                    scorer.best_inliers.mean() >= 0.95 * prop[2]:
                 break
     else:
         sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
@@ -331,9 +331,8 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     info["t_metric"] = np.array(t)
     if not verdict.observable:
         nt = np.linalg.norm(t)
-        if nt > 0:
-            t = orient_by_cheirality(rays, R, t / nt, inl)
-            info["t_metric"] = nt * t
+        t = travel_direction(rays, inl, R, t)
+        info["t_metric"] = nt * t
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
                      float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan"),
                      inl, info)

@@ -56,10 +56,9 @@ def solved(sols, R, t) -> bool:
 
 def poselib_6pt(rays: RayPairs):
     import poselib
-    p1 = [o for o in rays.origins1]
-    x1 = [d / np.linalg.norm(d) for d in rays.dirs1]
-    p2 = [o for o in rays.origins2]
-    x2 = [d / np.linalg.norm(d) for d in rays.dirs2]
+    p1, p2 = rays.origins1, rays.origins2
+    x1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
+    x2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
     out = []
     for pose in poselib.gen_relpose_6pt(p1, x1, p2, x2):
         out.append((pose.R, pose.t))
