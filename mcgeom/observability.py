@@ -26,7 +26,7 @@ from . import _core
 from .types import RayPairs, ScaleVerdict
 
 __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_only_fit",
-           "count_in_front", "scale_profile", "travel_direction"]
+           "count_in_front", "scale_profile", "travel_direction", "rotation_only_residuals"]
 
 
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
@@ -166,6 +166,14 @@ def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.
     rd1 = d1 @ R.T
     ang = np.arctan2(np.linalg.norm(np.cross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
     return R, ang
+
+
+def rotation_only_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:
+    """Angles (radians) between ``d2`` and ``R d1`` for every correspondence."""
+    d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
+    d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
+    rd1 = d1 @ R.T
+    return np.arctan2(np.linalg.norm(np.cross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
 
 
 def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndarray,

@@ -28,7 +28,8 @@ import numpy as np
 
 from . import _core, registry
 from .errors import DegenerateError
-from .observability import scale_profile, scale_verdict, travel_direction
+from .observability import (rotation_only_fit, rotation_only_residuals, scale_profile,
+                            scale_verdict, travel_direction)
 from .types import RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
@@ -249,40 +250,103 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         raise ValueError(f"estimator {method!r} has no minimal solver: it cannot drive RANSAC")
     iterations = 0
     if use_proposer:
-        # a proposer's motions come out of a robust search with its own local
-        # optimisation (OpenCV's USAC for 5+1): two rounds here are enough, the
-        # final stage refits on the inliers again
-        scorer.lo_rounds = min(2, options.lo_max_rounds)
-        for prop in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
-            iterations += 1
-            scorer.offer(prop[0], prop[1])
-            # a proposer may say which inlier ratio to expect (e.g. the one of
-            # its own robust search): stop once a motion explains about that
-            if len(prop) > 2 and scorer.best is not None and \
-                    scorer.best_inliers.mean() >= 0.95 * prop[2]:
-                break
-    else:
-        sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
-        k_needed = options.max_iters
-        failures = 0
-        while iterations < max(k_needed, options.min_iters) and iterations < options.max_iters:
-            iterations += 1
-            try:
-                idx = sampler(rays, rng)
-                sols = info_est.minimal_solver(rays.take(idx))
-            except DegenerateError:
-                failures += 1
-                continue
-            for R, t in sols:
-                if scorer.offer(R, t):
-                    ratio = scorer.best_inliers.mean()
-                    k_needed = adaptive_iterations(ratio, info_est.min_sample, options.prob,
-                                                   options.max_iters)
+        iterations = _run_proposer(info_est, rays, scorer, options, rng)
+        # nothing proposed (e.g. no camera with enough correspondences for the
+        # proposer's own search): fall back to minimal samples where possible
+        use_proposer = scorer.best is not None or info_est.minimal_solver is None
+    if not use_proposer:
+        iterations += _run_minimal(info_est, rays, scorer, options, rng)
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
+        still = _no_translation(rays, scorer, options, method, t_start)
+        if still is not None:
+            return still
         raise DegenerateError(f"{method}: no motion found that explains at least "
                               f"{max(6, info_est.min_sample)} correspondences "
-                              f"({scorer.n_hyp} hypotheses from {iterations} samples)")
+                              f"({scorer.n_hyp} hypotheses from {iterations} samples): degenerate "
+                              f"data (e.g. points collinear or coplanar in every camera, or "
+                              f"too few correspondences per camera: {_per_camera(rays)})")
     return _finish(rays, scorer, options, method, iterations, t_start)
+
+
+def _per_camera(rays: RayPairs) -> str:
+    if rays.cam1 is None:
+        return "camera ids unknown"
+    same = rays.cam1 == rays.cam2
+    counts = np.bincount(rays.cam1[same], minlength=int(rays.cam1.max(initial=0)) + 1)
+    return (", ".join(f"camera {k}: {c}" for k, c in enumerate(counts)) +
+            f"; {int((~same).sum())} cross-camera")
+
+
+def _run_proposer(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptions,
+                  rng: np.random.Generator) -> int:
+    """Score the proposer's motions until one explains the expected inlier ratio."""
+    iterations = 0
+    # a proposer's motions come out of a robust search with its own local
+    # optimisation (OpenCV's USAC for 5+1): two rounds here are enough, the
+    # final stage refits on the inliers again
+    lo = scorer.lo_rounds
+    scorer.lo_rounds = min(2, options.lo_max_rounds)
+    for prop in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
+        iterations += 1
+        scorer.offer(prop[0], prop[1])
+        # a proposer may say which inlier ratio to expect (e.g. the one of its
+        # own robust search): stop once a motion explains about that
+        if len(prop) > 2 and scorer.best is not None and \
+                scorer.best_inliers.mean() >= 0.95 * prop[2]:
+            break
+    scorer.lo_rounds = lo
+    return iterations
+
+
+def _run_minimal(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptions,
+                 rng: np.random.Generator) -> int:
+    """Classic LO-RANSAC loop over minimal samples with the adaptive stop."""
+    sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
+    k_needed = options.max_iters
+    iterations = 0
+    while iterations < max(k_needed, options.min_iters) and iterations < options.max_iters:
+        iterations += 1
+        try:
+            idx = sampler(rays, rng)
+            sols = info_est.minimal_solver(rays.take(idx))
+        except DegenerateError:
+            continue
+        for R, t in sols:
+            if scorer.offer(R, t):
+                ratio = scorer.best_inliers.mean()
+                k_needed = adaptive_iterations(ratio, info_est.min_sample, options.prob,
+                                               options.max_iters)
+    return iterations
+
+
+def _no_translation(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str,
+                    t_start: float) -> Optional[RigMotion]:
+    """When no motion was found: is it because the rig did not translate?
+
+    A static rig (or a pure rotation) has no essential matrix: every search
+    fails. If a pure rotation (refitted on its own inliers) explains at least
+    half of the intra-camera correspondences within the threshold, report that
+    rotation with ``t = 0`` and the verdict "no translation detected".
+    """
+    sel = np.ones(len(rays), bool)
+    for _ in range(3):
+        R, ang = rotation_only_fit(rays, sel)
+        if ang.size < 5:
+            return None
+        r_all = rotation_only_residuals(rays, R)
+        f = scorer.focal if scorer.focal is not None else 1.0
+        sel = r_all * f < options.threshold
+    same = (rays.cam1 == rays.cam2) if rays.cam1 is not None else np.ones(len(rays), bool)
+    if sel.sum() < 5 or sel[same].mean() < 0.5:
+        return None
+    verdict = ScaleVerdict(False, "no translation detected: a pure rotation explains "
+                                  f"{int(sel.sum())} of {len(rays)} correspondences and no "
+                                  "motion with a translation was found (static rig or pure "
+                                  "rotation): t = 0, neither its direction nor its scale is "
+                                  "determined", 0.0, float("inf"), 0.0)
+    info = {"translation_detected": False, "t_metric": np.zeros(3), "inlier_ratio":
+            float(sel.mean()), "time_s": time.perf_counter() - t_start}
+    return RigMotion(R, np.zeros(3), verdict, f"ransac[{method}]", float("nan"), sel, info)
 
 
 def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str,

@@ -144,3 +144,45 @@ def test_facade_bad_input(bad, match):
         kw["method"] = "no_such_method"
     with pytest.raises(ValueError, match=match):
         mcgeom.estimateRigMotion(a1, a2, c1, c2, p.rig, **kw)
+
+
+# ------------------------------------------------------- degenerate input, end to end
+
+def test_all_points_in_one_camera_gives_rotation_and_direction_without_scale():
+    p = _vehicle_problem(9, yaw_deg=5.0)
+    one = p.cam1 == 0
+    m = cv_estimate(p.pixels1[one], p.pixels2[one], p.cam1[one], p.cam2[one], p.rig)
+    assert not m.scale.observable and "one camera" in m.scale.reason
+    assert rot_err(m.R, p.R) < np.radians(0.2)
+    assert abs(np.linalg.norm(m.t) - 1.0) < 1e-12
+    assert np.degrees(np.arccos(np.clip(m.t @ p.t / np.linalg.norm(p.t), -1, 1))) < 5.0
+
+
+def test_static_rig_is_no_translation_not_a_crash():
+    p = _vehicle_problem(10)
+    m = cv_estimate(p.pixels1, p.pixels1, p.cam1, p.cam1, p.rig)
+    assert not m.scale.observable and m.scale.reason.startswith("no translation")
+    assert rot_err(m.R, np.eye(3)) < 1e-6
+    assert np.all(m.t == 0) and m.info["translation_detected"] is False
+
+
+def test_too_few_correspondences_per_camera_is_named():
+    p = _vehicle_problem(11)
+    few = np.concatenate([np.flatnonzero(p.cam1 == k)[:4] for k in range(8)])
+    with pytest.raises(ValueError, match="5 intra-camera"):
+        cv_estimate(p.pixels1[few], p.pixels2[few], p.cam1[few], p.cam2[few], p.rig)
+
+
+def test_collinear_points_are_reported_degenerate():
+    p = _vehicle_problem(12)
+    px = p.pixels1.copy()
+    px[:, 1] = 384.0
+    with pytest.raises(mcgeom.DegenerateError, match="degenerate"):
+        cv_estimate(px, p.pixels2, p.cam1, p.cam2, p.rig)
+
+
+def test_duplicated_correspondences_do_not_break_the_estimate():
+    p = _vehicle_problem(13, yaw_deg=5.0)
+    dup = np.concatenate([np.arange(len(p))] + [np.arange(30)] * 3)
+    m = cv_estimate(p.pixels1[dup], p.pixels2[dup], p.cam1[dup], p.cam2[dup], p.rig)
+    assert rot_err(m.R, p.R) < np.radians(0.1)

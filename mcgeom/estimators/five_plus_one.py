@@ -584,7 +584,9 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
         except (DegenerateError, cv2.error):
             continue
         others = np.flatnonzero(~(intra & (cam1 == a)))
-        if others.size == 0:
+        if others.size == 0:   # one camera only: R and the direction, no scale
+            for R, t0, w in cands:
+                yield R, t0 + w, stats.get("inlier_ratio", 1.0)
             continue
         # Cross-camera correspondences fix the scale whatever the motion, while
         # near the critical motion the intra-camera ones of the other cameras

@@ -1,0 +1,48 @@
+"""Issue-3 targets, checked on small runs of the experiment scripts (the full
+runs print the tables: ``python tests/experiment_ch7.py 200``,
+``python tests/experiment_minimal_5p1.py 10000``,
+``python tests/bench_robust_vs_poselib.py 50``). Only what must hold is
+asserted, never a timing."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import experiment_ch7
+import experiment_minimal_5p1
+
+
+@pytest.mark.parametrize("cross", [0.0, 0.1])
+def test_scale_verdict_on_the_vehicle_rig(cross):
+    """Forward motion, yaw under 2 deg, 1 px noise: observable verdicts have a
+    median scale error <= 5 %, and >= 90 % of the estimates off by more than
+    30 % are reported unobservable (intra-camera only: no scale at all)."""
+    rows = experiment_ch7.run(40, seed=1, cross=cross)
+    s = experiment_ch7.summary(rows)
+    print(s)
+    assert s["bad_flagged_fraction"] >= 0.9
+    if cross == 0.0:
+        assert s["observable"] <= 2          # critical motion: (almost) never observable
+    else:
+        assert s["observable"] >= 15         # cross-camera rays fix the scale
+        assert s["median_err_observable"] <= 0.05
+    assert s["median_rot_err_deg"] < 0.1
+
+
+def test_minimal_5p1_recovers_noise_free_motion():
+    """Target 99.9 % over 10,000 configurations (measured: 99.92 %); 300 here."""
+    s = experiment_minimal_5p1.run(300, seed=3, with_poselib=False)
+    assert s["mcgeom_success"] >= 0.99
+
+
+def test_robust_pipeline_matches_poselib_accuracy():
+    pytest.importorskip("poselib")
+    import bench_robust_vs_poselib as b
+    res = b.run(trials=8, seed=2, cases={k: b.CASES[k] for k in list(b.CASES)[:2]})
+    print("\n" + b.table(res))
+    for case, methods in res.items():
+        ours, peer = methods["mcgeom"][0], methods["poselib"][0]
+        assert np.mean((ours[:, 0] > 1.0) | (ours[:, 1] > 10.0)) <= np.mean(
+            (peer[:, 0] > 1.0) | (peer[:, 1] > 10.0))
+        assert np.median(ours[:, 0]) < 1.5 * np.median(peer[:, 0]) + 1e-3
