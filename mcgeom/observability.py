@@ -180,7 +180,6 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
                   rel_std: float, max_rel_std: float = 0.1,
                   direction_only: bool = False,
                   noise_level: float = float("nan"),
-                  residual_median: float = float("nan"),
                   profile: float = float("nan")) -> ScaleVerdict:
     """The scale verdict of a motion estimated from the ``inliers`` of ``rays``.
 
@@ -190,18 +189,18 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     ``1 +- 3 max_rel_std``: the scale is observable only if both are excluded
     at 3 sigma (profile >= 9), i.e. a first-order "3 sigma within 30 %" that
     also holds for the non-linear cost;
-    ``noise_level`` (radians, e.g. the inlier threshold) and ``residual_median``
-    (median Sampson residual of the motion on its inliers, radians) enable the
-    no-parallax test of :func:`rotation_only_fit`: when a pure rotation explains
-    the intra-camera inliers about as well as the full motion (median angle
-    under 3x the median Sampson residual, which is ~1.75x under noise alone for
-    the 2-dof angle against the 1-dof Sampson distance) and within twice the
-    noise level, no translation was detected at all.
+    ``noise_level`` (radians, the inlier threshold) enables the no-parallax
+    test of :func:`rotation_only_fit`: when a pure rotation explains at least
+    90 % of the intra-camera inliers within 1.5 x the threshold (the rotation
+    residual is a 2-dof angle, the threshold one of the 1-dof Sampson
+    distance), the translation moves no point measurably: none was detected.
+    (Comparing with the Sampson residual of a free translation instead fails on
+    real data: a tiny translation with a free direction fits calibration error
+    5-15x better than a rotation, seen on the DGP parked car.)
     """
-    if np.isfinite(noise_level) and np.isfinite(residual_median):
+    if np.isfinite(noise_level):
         _, ang = rotation_only_fit(rays, inliers)
-        med = float(np.median(ang)) if ang.size else float("inf")
-        if ang.size >= 5 and med < 3.0 * residual_median and med < 2.0 * noise_level:
+        if ang.size >= 5 and np.mean(ang < 1.5 * noise_level) >= 0.9:
             return ScaleVerdict(False, "no translation detected: a pure rotation explains the "
                                        f"correspondences (median residual "
                                        f"{np.degrees(np.median(ang)) * 3600:.3g} arcsec); static "

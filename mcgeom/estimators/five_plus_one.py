@@ -38,9 +38,9 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..observability import scale_profile, travel_direction
+from ..observability import scale_profile, scale_verdict, travel_direction
 from ..registry import register
-from ..types import RayPairs, RigMotion, ScaleVerdict
+from ..types import RayPairs, RigMotion
 
 __all__ = [
     "five_plus_one", "camera_ids", "essential_motions", "scale_terms",
@@ -424,23 +424,6 @@ def solve(rays: RayPairs, five_camera: Optional[int] = None,
     return best
 
 
-def _verdict(sol: dict, rel_std: float, max_rel_std: float, fixed: bool) -> ScaleVerdict:
-    ang = sol["critical_angles"]
-    crit = float(np.nanmax(ang)) if np.any(np.isfinite(ang)) else float("nan")
-    if sol["n_scale"] == 0:
-        return ScaleVerdict(False, "only one camera has correspondences: the scale needs a "
-                                   "correspondence of another camera (thesis ch. 7.3)",
-                            0.0, float("inf"), crit)
-    if fixed or not np.isfinite(rel_std) or rel_std > max_rel_std:
-        why = ("critical configuration: the camera displacements are parallel (no rotation, "
-               "thesis ch. 7.3.2, Theorem 3)" if not crit > 1e-3 else
-               "scale too uncertain for the noise level (near-critical motion)")
-        return ScaleVerdict(False, f"{why}; relative std of |t| {rel_std:.3g}, critical angle "
-                                   f"{np.degrees(crit):.3g} deg", float("nan"), rel_std, crit)
-    return ScaleVerdict(True, f"scale fixed: relative std {rel_std:.3g}, critical angle "
-                              f"{np.degrees(crit):.3g} deg", float("nan"), rel_std, crit)
-
-
 def _from_camera(rays: RayPairs, a: int, refine: bool) -> tuple[float, dict, Optional[dict]]:
     """The linear 5+1 solution with camera ``a`` as the 5-point camera, refined
     on all correspondences; returns (final cost, linear solution, refinement)."""
@@ -545,7 +528,8 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
                     rel = float("inf")
     sol["critical_angles"] = critical_angles(R, t, camera_ids(rays)[2], sol["five_camera"])
     info["critical_angles"] = sol["critical_angles"]
-    verdict = _verdict(sol, rel, max_scale_rel_std, fixed)
+    verdict = scale_verdict(rays, np.ones(len(rays), bool), R, t, rel, max_scale_rel_std,
+                            fixed)
     info["t_metric"] = np.array(t)   # metric estimate, whatever the verdict
     if not verdict.observable:
         nt = np.linalg.norm(t)
