@@ -126,6 +126,7 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     translation of the centroid ``c`` of the cameras with inliers is the
     meaningful direction; it differs from the direction of ``t`` by at most
     the rotation times the centroid's distance from the rig origin over |t|.
+    It is used when |t| is under 20x that part; otherwise t's own direction.
     The sign is chosen by cheirality at a length where the rotation-induced
     part is negligible.
     """
@@ -133,7 +134,9 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     c = 0.5 * (rays.origins1[sel].mean(axis=0) + rays.origins2[sel].mean(axis=0)) \
         if sel.any() else np.zeros(3)
     shift = R @ c - c
-    tau = t + shift
+    # where |t| dwarfs the rotation-induced shift, t's own direction is the
+    # better estimate (the centroid's motion differs from it by that shift)
+    tau = t if np.linalg.norm(t) >= 20.0 * np.linalg.norm(shift) else t + shift
     n = np.linalg.norm(tau)
     if not n > 0:
         return t / max(np.linalg.norm(t), 1e-300)
