@@ -441,8 +441,11 @@ def _from_camera(rays: RayPairs, a: int, refine: bool) -> tuple[float, dict, Opt
 
 
 def _refine_all(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool) -> dict:
+    # converged to rounding, not to a relative cost change of 1e-10: the result
+    # must not depend on which camera's start won (order, rig frame)
     return _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
-                               loss="none", fix_scale=fix_scale)
+                               loss="none", fix_scale=fix_scale, max_iterations=100,
+                               cost_tolerance=1e-15, step_tolerance=1e-13)
 
 
 @register(
