@@ -81,11 +81,19 @@ class RayPairs:
     def take(self, index: Any) -> "RayPairs":
         """Subset (or permutation) of the correspondences by an index array or mask."""
         idx = np.asarray(index)
-        return RayPairs(
-            self.origins1[idx], self.dirs1[idx], self.origins2[idx], self.dirs2[idx],
-            None if self.cam1 is None else self.cam1[idx],
-            None if self.cam2 is None else self.cam2[idx],
-        )
+        if idx.size == 0:
+            idx = idx.astype(np.int64)
+        if idx.dtype != bool and idx.dtype.kind not in "iu":
+            raise ValueError(f"index must be integers or a boolean mask, got dtype {idx.dtype}")
+        # fancy indexing of validated arrays keeps them valid (float64, C order,
+        # N x 3): skip the checks of __init__, this is on the robust hot path
+        out = object.__new__(RayPairs)
+        for name in ("origins1", "dirs1", "origins2", "dirs2"):
+            object.__setattr__(out, name, getattr(self, name)[idx].reshape(-1, 3))
+        for name in ("cam1", "cam2"):
+            ids = getattr(self, name)
+            object.__setattr__(out, name, None if ids is None else ids[idx].reshape(-1))
+        return out
 
     def swapped(self) -> "RayPairs":
         """The same correspondences with time 1 and time 2 exchanged."""

@@ -51,6 +51,18 @@ __all__ = [
 _MIN_Z = 0.05
 
 
+def _rcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (N, 3) arrays (or one 3-vector with rows);
+    np.cross spends most of its time on axis handling at these sizes."""
+    a = np.broadcast_to(a, np.broadcast_shapes(np.shape(a), np.shape(b)))
+    b = np.broadcast_to(b, a.shape)
+    out = np.empty(a.shape)
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
 # ------------------------------------------------------------------ cameras
 
 def camera_ids(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -244,11 +256,11 @@ def scale_terms(rays: RayPairs, R: np.ndarray, t0: np.ndarray,
     d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
     d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
     rd1 = d1 @ R.T
-    m1 = np.cross(rays.origins1, d1)
-    m2 = np.cross(rays.origins2, d2)
-    a = (np.einsum("ij,ij->i", d2, np.cross(t0, rd1)) + np.einsum("ij,ij->i", d2, m1 @ R.T)
+    m1 = _rcross(rays.origins1, d1)
+    m2 = _rcross(rays.origins2, d2)
+    a = (np.einsum("ij,ij->i", d2, _rcross(t0, rd1)) + np.einsum("ij,ij->i", d2, m1 @ R.T)
          + np.einsum("ij,ij->i", m2, rd1))
-    b = np.einsum("ij,ij->i", d2, np.cross(w, rd1))
+    b = np.einsum("ij,ij->i", d2, _rcross(w, rd1))
     return a, b
 
 
@@ -604,11 +616,11 @@ def _sampson_in_scale(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.ndarr
     def tangent(v, d):                      # P(d) v, rows
         return v - np.einsum("ij,ij->i", v, d)[:, None] * d
 
-    g0, g1 = np.cross(s0, rd1), np.cross(w, rd1)
+    g0, g1 = _rcross(s0, rd1), _rcross(w, rd1)
     a = np.einsum("ij,ij->i", d2, g0)
     b = np.einsum("ij,ij->i", d2, g1)
     pg0, pg1 = tangent(g0, d2), tangent(g1, d2)
-    pk0, pk1 = tangent(np.cross(d2, s0), rd1), tangent(np.cross(d2, w), rd1)
+    pk0, pk1 = tangent(_rcross(d2, s0), rd1), tangent(_rcross(d2, w), rd1)
     A = np.einsum("ij,ij->i", pg0, pg0) + np.einsum("ij,ij->i", pk0, pk0)
     B = np.einsum("ij,ij->i", pg0, pg1) + np.einsum("ij,ij->i", pk0, pk1)
     C = np.einsum("ij,ij->i", pg1, pg1) + np.einsum("ij,ij->i", pk1, pk1)
