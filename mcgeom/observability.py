@@ -226,4 +226,13 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
         else:
             why = "scale too uncertain for the noise (near-critical motion)"
         return ScaleVerdict(False, f"{why}; {evidence}", float("nan"), float(rel_std), crit)
+    # last guard against a confident wrong answer: a metric motion must put
+    # its inliers in front of the cameras (a flipped or twisted solution that
+    # survived the search puts most of them behind)
+    n_in = int(np.count_nonzero(inliers))
+    front = count_in_front(rays, R, t, inliers) / n_in if n_in else 0.0
+    if front < 0.5:
+        return ScaleVerdict(False, f"cheirality fails: only {100 * front:.0f} % of the inliers "
+                                   f"triangulate in front of the cameras (a wrong solution?); "
+                                   f"{evidence}", float("nan"), float(rel_std), crit)
     return ScaleVerdict(True, f"scale observable: {evidence}", float("nan"), float(rel_std), crit)

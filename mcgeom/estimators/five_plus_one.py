@@ -203,8 +203,8 @@ def _least_squares_essential(x1: np.ndarray, x2: np.ndarray,
 
 def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
                       method: int = LEAST_SQUARES, threshold: float = 1e-3,
-                      prob: float = 0.999, stats: Optional[dict] = None
-                      ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+                      prob: float = 0.999, stats: Optional[dict] = None,
+                      max_iters: int = 1000) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Rig rotations and scale lines from the 5-point solver on one camera's rays.
 
     ``index`` selects intra-camera correspondences of one camera whose centre
@@ -228,7 +228,7 @@ def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
         Es = _least_squares_essential(x1, x2)
     else:
         E, mask = cv2.findEssentialMat(x1, x2, np.eye(3), method=method, prob=prob,
-                                       threshold=threshold)
+                                       threshold=threshold, maxIters=max_iters)
         if E is None or E.shape[0] % 3 or not np.all(np.isfinite(E)):
             return []
         Es = list(E.reshape(-1, 3, 3))
@@ -578,8 +578,11 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
         try:
             # 0.99 is enough here: the motion is checked on every camera and the
             # next camera is tried when it falls short
+            # (and at most 300 samples: enough up to ~55 % outliers in that
+            # camera; beyond, the next camera is tried rather than waiting)
             cands = essential_motions(rays, own, centres[a], method=cv2.USAC_DEFAULT,
-                                      threshold=threshold, prob=min(prob, 0.99), stats=stats)
+                                      threshold=threshold, prob=min(prob, 0.99), stats=stats,
+                                      max_iters=300)
         except (DegenerateError, cv2.error):
             continue
         others = np.flatnonzero(~(intra & (cam1 == a)))
