@@ -143,9 +143,31 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     u = tau / n
     spread = np.sqrt(np.mean(np.sum((rays.origins1[sel] - c) ** 2, axis=1))) if sel.any() else 1.0
     L = max(1.0, 100.0 * spread, 100.0 * np.linalg.norm(shift))
-    plus = count_in_front(rays, R, L * u - shift, sel)
-    minus = count_in_front(rays, R, -L * u - shift, sel)
+    plus, minus = _count_in_front_both(rays, R, L * u, -shift, sel)
     return u if plus >= minus else -u
+
+
+def _count_in_front_both(rays: RayPairs, R: np.ndarray, v: np.ndarray, t0: np.ndarray,
+                         sel: np.ndarray) -> tuple[int, int]:
+    """:func:`count_in_front` for ``t = t0 + v`` and ``t = t0 - v`` in one pass."""
+    p = rays.origins1[sel] @ R.T + t0
+    a = rays.dirs1[sel] @ R.T
+    b = rays.dirs2[sel]
+    w0 = rays.origins2[sel] - p
+    aa, bb, ab = (np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", b, b),
+                  np.einsum("ij,ij->i", a, b))
+    aw0, bw0 = np.einsum("ij,ij->i", a, w0), np.einsum("ij,ij->i", b, w0)
+    av, bv = a @ v, b @ v
+    den = aa * bb - ab * ab
+    ok = den > 1e-14 * aa * bb
+    den = np.where(ok, den, 1.0)
+    counts = []
+    for sgn in (1.0, -1.0):                 # w = o2 - (R o1 + t0 + sgn v)
+        aw, bw = aw0 - sgn * av, bw0 - sgn * bv
+        s1 = (aw * bb - bw * ab) / den
+        s2 = (aw * ab - bw * aa) / den
+        counts.append(int(np.sum(ok & (s1 > 0) & (s2 > 0))))
+    return counts[0], counts[1]
 
 
 def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
