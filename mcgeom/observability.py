@@ -26,7 +26,8 @@ from . import _core
 from .types import RayPairs, ScaleVerdict
 
 __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_only_fit",
-           "count_in_front", "scale_profile", "travel_direction", "rotation_only_residuals"]
+           "count_in_front", "scale_profile", "travel_direction", "rotation_only_residuals",
+           "critical_angle"]
 
 
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
@@ -51,6 +52,15 @@ def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> flo
     cos = np.abs(d @ d.T)
     i, j = np.unravel_index(np.argmin(cos + 2.0 * np.eye(len(d))), cos.shape)
     return float(np.arctan2(np.linalg.norm(np.cross(d[i], d[j])), cos[i, j]))
+
+
+def critical_angle(rays: RayPairs, R: np.ndarray, t: np.ndarray,
+                   mask: np.ndarray | None = None) -> float:
+    """The rig's critical angle (radians) for the motion (R, t) over the cameras
+    that have intra-camera correspondences (all, or those in ``mask``)."""
+    sel = np.ones(len(rays), bool) if mask is None else np.asarray(mask, bool)
+    centres, _ = _centres_with_intra(rays, sel)
+    return rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
 
 
 def _centres_with_intra(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, int]:

@@ -19,11 +19,13 @@ Frames and units: rays in the rig frame (metres), motion rig2_from_rig1
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Optional, Union
 
 import numpy as np
 
 from .. import _core
+from ..observability import critical_angle
 from ..registry import get, register
 from ..types import RayPairs, RigMotion, ScaleVerdict
 
@@ -171,7 +173,8 @@ def refine(rays: RayPairs, *, initial: InitialLike = None, loss: str = "cauchy",
         # |t| -> inf); from a converged direction it does not.
         first = _core.refine_motion(*args, R0, t0, fix_scale=True, **kw)
         r = _core.refine_motion(*args, first["R"], first["t"], **kw)
-    verdict = _verdict(r, fixed, start_observable)
+    verdict = replace(_verdict(r, fixed, start_observable),
+                      critical_angle=critical_angle(rays, r["R"], r["t"]))
     t_metric = r["t"].copy()
     t = r["t"]
     if not verdict.observable:
