@@ -361,6 +361,86 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
                       const double *weights, const mcg_refine_options *opt,
                       double R[9], double t[3], mcg_refine_result *res);
 
+/* --------------------------------------------------------------- cone.c */
+
+/* Bits of mcg_cone_result.flags. */
+enum {
+    MCG_CONE_NONUNIQUE = 1,         /* the optimal X is not unique (n = 1,
+                                       coincident apexes, overlapping
+                                       parallel rays, or AT_INFINITY) */
+    MCG_CONE_AT_INFINITY = 2,       /* X on the search ball's boundary: the
+                                       infimum is approached far away (e.g.
+                                       parallel axes); X is a far point */
+    MCG_CONE_COINCIDENT_APEXES = 4, /* all apexes coincide: any point of the
+                                       ray apex + s (X - apex), s > 0, is
+                                       optimal; X - apex has unit length */
+    MCG_CONE_NOT_CONVERGED = 8      /* bracket wider than the tolerance */
+};
+
+/* Options of mcg_cone_linf (mcg_cone_default_options in brackets). */
+typedef struct {
+    double tolerance;        /* stop when gamma_upper - gamma_lower <=
+                                max(abs_tolerance, tolerance * gamma_upper)
+                                [1e-10], 1e-15..0.1 */
+    double abs_tolerance;    /* radians [1e-12], 1e-15..0.1 */
+    int max_iterations;      /* bisection steps, 1..10000 [200] */
+    int max_newton;          /* Newton steps per feasibility test,
+                                1..100000 [400] */
+    double max_radius;       /* search ball radius about the apex centroid,
+                                in units of the scene size L (RMS distance
+                                of the apexes from their centroid),
+                                1..1e12 [1e6] */
+    double active_tolerance; /* a cone is active when its angle at X is
+                                within max(this, 10 x the gamma tolerance)
+                                of gamma (radians) [1e-8] */
+} mcg_cone_options;
+
+/* Result of mcg_cone_linf. */
+typedef struct {
+    double X[3];        /* the minimax point */
+    double gamma;       /* max_i angle(X - C_i, v_i) at X (radians): the
+                           optimal bound gamma*, an upper bound of it */
+    double gamma_lower; /* certified lower bound of gamma* (the last
+                           infeasible bisection step; 0 if none) */
+    int n_active;       /* cones whose angle at X equals gamma (within the
+                           active tolerance); may exceed 8 */
+    int active[8];      /* the first min(n_active, 8) of them, ascending */
+    int iterations;     /* bisection steps (feasibility tests) */
+    int newton_steps;   /* Newton steps of all feasibility tests */
+    int converged;      /* 1 if gamma - gamma_lower met the tolerance */
+    int flags;          /* MCG_CONE_* bits */
+} mcg_cone_result;
+
+void mcg_cone_default_options(mcg_cone_options *opt);
+
+/* L-infinity cone problem (thesis eq. 9.3): the point X minimising
+ *     max_i angle(X - C_i, v_i),  angle in [0, pi],
+ * for n cones with apexes apex (n x 3) and axes axis (n x 3, any non-zero
+ * length, normalised here), by bisection on the bound gamma with an exact
+ * second-order-cone feasibility test at each step (a log-barrier interior
+ * point method in (X, tau); feasible steps are certified by a strictly
+ * feasible point, infeasible ones by the barrier duality-gap bound), searched
+ * within max_radius * L of the apex centroid. A cone contains its apex (the
+ * angle of X - C_i = 0 is taken as 0, as in the SOC formulation).
+ * Uniqueness: the optimum is unique in general position, not always:
+ *   n = 1: gamma = 0, X = apex + unit axis (any point of the ray would do);
+ *   all apexes equal: the optimum is a ray from the apex (the smallest
+ *     angular cap around the axes), X = apex + unit direction;
+ *   gamma* = 0 with overlapping parallel rays, or the infimum at infinity
+ *     (parallel axes): flagged; other ties (e.g. the active cones sharing
+ *     one apex) are not detected.
+ * n = 2: intersecting rays give gamma = 0 at the intersection; skew rays the
+ * point where both angles are equal and minimal.
+ * opt may be NULL (defaults). Returns MCG_OK; MCG_EINFEASIBLE if no point of
+ * the search ball is within pi/2 of every axis (gamma* >= pi/2: the problem
+ * is not quasi-convex there; res->gamma_lower = pi/2, X the best point
+ * found); MCG_ENUMERIC on a breakdown of the interior-point method;
+ * MCG_EINVAL for n outside [1, 2^20], NULL pointers, NaN/inf or |value| >
+ * 1e150 in the inputs, a zero axis (|v| <= 1e-100) or bad options.
+ * Cost: O(n) per Newton step, tens of Newton steps per bisection step. */
+int mcg_cone_linf(int n, const double *apex, const double *axis,
+                  const mcg_cone_options *opt, mcg_cone_result *res);
+
 /* MCG_CDEF_END */
 
 #ifdef __cplusplus
