@@ -533,3 +533,71 @@ def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
         "scale_rel_std": res.scale_rel_std,
         "info_cond": res.info_cond,
     }
+
+
+# ------------------------------------------------------------------ cone.c
+
+__all__ += ["cone_linf"]
+
+
+def cone_linf(apexes: Any, axes: Any, *, tolerance: float = 1e-10,
+              abs_tolerance: float = 1e-12, max_iterations: int = 200,
+              max_newton: int = 400, max_radius: float = 1e6,
+              active_tolerance: float = 1e-8) -> dict:
+    """L-infinity cone problem (thesis eq. 9.3): the point X minimising
+    ``max_i angle(X - apexes[i], axes[i])`` (radians), by bisection on the
+    bound with an exact second-order-cone feasibility test (``mcg_cone_linf``).
+
+    ``apexes``, ``axes``: (N, 3), N >= 1, axes of any non-zero length. Returns
+    a dict: ``X`` (3,), ``gamma`` (the optimal bound, = the largest angle at X),
+    ``gamma_lower`` (certified lower bound), ``active`` (indices of the cones at
+    the bound, at most the first 8; ``n_active`` counts them all),
+    ``iterations`` (bisection steps), ``newton_steps``, ``converged`` and the
+    flags ``nonunique``, ``at_infinity`` (the infimum lies beyond the search
+    ball of ``max_radius`` scene sizes, e.g. parallel axes) and
+    ``coincident_apexes`` (all apexes equal: any point of the ray from the apex
+    through X is optimal). Raises ``InfeasibleError`` when no point is within
+    pi/2 of every axis, ``ValueError`` for bad input.
+    """
+    apexes = _arr("apexes", apexes, (-1, 3))
+    _nonempty("apexes", apexes)
+    n = apexes.shape[0]
+    axes = _arr("axes", axes, (n, 3))
+    if n > (1 << 20):
+        raise ValueError(f"cone_linf accepts at most 2^20 cones, got {n}")
+    if np.abs(apexes).max() > 1e150 or np.abs(axes).max() > 1e150:
+        raise ValueError("apexes and axes must be below 1e150 in magnitude")
+    bad = np.flatnonzero(np.einsum("ij,ij->i", axes, axes) <= 1e-200)
+    if bad.size:
+        raise ValueError(f"axes[{bad[0]}] is zero (all axes need a direction)")
+    opt = ffi.new("mcg_cone_options *")
+    lib.mcg_cone_default_options(opt)
+    opt.tolerance = float(tolerance)
+    opt.abs_tolerance = float(abs_tolerance)
+    opt.max_iterations = int(max_iterations)
+    opt.max_newton = int(max_newton)
+    opt.max_radius = float(max_radius)
+    opt.active_tolerance = float(active_tolerance)
+    if not (1e-15 <= opt.tolerance <= 0.1 and 1e-15 <= opt.abs_tolerance <= 0.1):
+        raise ValueError("tolerance and abs_tolerance must be in [1e-15, 0.1]")
+    if not (1 <= opt.max_iterations <= 10000 and 1 <= opt.max_newton <= 100000):
+        raise ValueError("max_iterations must be in [1, 10000], max_newton in [1, 100000]")
+    if not (1.0 <= opt.max_radius <= 1e12) or not (0.0 <= opt.active_tolerance <= 1.0):
+        raise ValueError("max_radius must be in [1, 1e12], active_tolerance in [0, 1]")
+    res = ffi.new("mcg_cone_result *")
+    st = lib.mcg_cone_linf(n, _p(apexes), _p(axes), opt, res)
+    _check(st, "cone_linf")
+    flags = res.flags
+    return {
+        "X": np.array([res.X[0], res.X[1], res.X[2]]),
+        "gamma": res.gamma,
+        "gamma_lower": res.gamma_lower,
+        "active": np.array([res.active[i] for i in range(min(res.n_active, 8))], dtype=np.intp),
+        "n_active": res.n_active,
+        "iterations": res.iterations,
+        "newton_steps": res.newton_steps,
+        "converged": bool(res.converged),
+        "nonunique": bool(flags & lib.MCG_CONE_NONUNIQUE),
+        "at_infinity": bool(flags & lib.MCG_CONE_AT_INFINITY),
+        "coincident_apexes": bool(flags & lib.MCG_CONE_COINCIDENT_APEXES),
+    }
