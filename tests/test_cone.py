@@ -80,6 +80,8 @@ class ClarabelReference:
         q = np.array([0.0, 0.0, 0.0, 1.0])
         cones = [clarabel.SecondOrderConeT(3)] * n + [clarabel.SecondOrderConeT(4)]
         sol = clarabel.DefaultSolver(P, q, sparse.csc_matrix(A), b, cones, self.settings).solve()
+        if str(sol.status) not in ("Solved", "AlmostSolved"):
+            return math.nan, np.zeros(3)
         z = np.array(sol.x)
         return z[3], z[:3]
 
@@ -152,7 +154,7 @@ def test_against_clarabel_bisection():
         worst_g = max(worst_g, rel)
         assert rel <= 1e-7, (k, r["gamma"], g_ref)
         # the kernel is never worse than the reference point
-        assert r["gamma"] <= g_ref + 1e-12
+        assert r["gamma"] <= g_ref * (1 + 2e-10) + 1e-12
         if not r["nonunique"] and r["n_active"] >= 4:
             _, L = _frame(C)
             dx = np.linalg.norm(r["X"] - X_ref) / L
@@ -182,7 +184,12 @@ def test_bracket_certified_by_clarabel(kind):
             continue
         g = r["gamma"]
         assert g >= r["gamma_lower"] >= 0.0
-        assert abs(_angles(C, V, r["X"]).max() - g) <= 1e-12 or r["coincident_apexes"] or n == 1
+        # gamma is the largest angle at the returned X (to the rounding of X
+        # relative to its distance from the apexes)
+        dist = np.linalg.norm(r["X"] - C, axis=1).min()
+        cond = 1e-15 * max(np.abs(C).max(), np.abs(r["X"]).max()) / max(dist, 1e-300)
+        assert (abs(_angles(C, V, r["X"]).max() - g) <= 1e-12 + cond
+                or r["coincident_apexes"] or n == 1)
         if n == 1:
             assert g == 0.0 and r["nonunique"]
             continue
@@ -190,8 +197,21 @@ def test_bracket_certified_by_clarabel(kind):
             # the kernel solves the homogeneous (common-apex) problem exactly;
             # the SOC reference would return the apex itself (angle 0)
             continue
-        ref = ClarabelReference(C, V)
+        m, L = _frame(C)
+        # clarabel loses accuracy with a ball of 1e6 scene sizes when the
+        # axes are nearly parallel (tau off by O(10)); where the kernel's
+        # point is within 100 sizes a ball of 1e4 leaves the minimum unchanged
+        near = np.linalg.norm(r["X"] - m) / L < 100
+        ref = ClarabelReference(C, V, radius=1e4 if near else RADIUS)
         band = 1e-7 * g + 1e-10
+        if r["at_infinity"]:
+            # X on the search ball (|x| = 1e6 scene sizes): the sign of tau is
+            # beyond clarabel's accuracy at that scale; its best point asked
+            # for a bound below gamma must not achieve it
+            _, x_lo = ref.tau(max(g - band, 0.0))
+            assert ref.f(x_lo) >= g - band, (k, n, g, ref.f(x_lo))
+            checked += 1
+            continue
         if g - band > 0:
             t_lo, _ = ref.tau(g - band)
             assert t_lo > 0, (k, n, g, t_lo)
