@@ -61,8 +61,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
+    if args.what == "cone":
+        return _bench_cone(args)
     if args.what != "linear17":
-        print(f"unknown benchmark {args.what!r}; available: linear17", file=sys.stderr)
+        print(f"unknown benchmark {args.what!r}; available: linear17, cone", file=sys.stderr)
         return 2
     from .bench.linear17 import bench_linear17
 
@@ -75,6 +77,22 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         print(f"{r.n:7d} {r.mcgeom_us:11.1f} {r.numpy_us:11.1f} {r.ratio:7.1f} "
               f"{r.mcgeom_us / r.n:8.3f} {r.iterations:5d}")
     print("reference (published): OpenGV seventeenpt ~100 us at 100 rays, ~400 us at 200 rays")
+    return 0
+
+
+def _bench_cone(args: argparse.Namespace) -> int:
+    from .bench.cone import bench_cone
+
+    sizes = ((3, 6, 20, 100, 1000) if args.sizes == "17,100,1000,10000"
+             else tuple(int(s) for s in args.sizes.split(",")))
+    rows = bench_cone(sizes, budget_s=args.budget)
+    print("cone: mcgeom L-inf cone bisection (C kernel via the Python API) vs "
+          "bisection with clarabel solving each SOCP feasibility step")
+    print(f"{'N':>6} {'mcgeom[us]':>11} {'clarabel[us]':>13} {'ratio':>7} "
+          f"{'steps':>5} {'ref steps':>9} {'rel dgamma':>10}")
+    for r in rows:
+        print(f"{r.n:6d} {r.mcgeom_us:11.1f} {r.clarabel_us:13.1f} {r.ratio:7.1f} "
+              f"{r.steps_mcgeom:5d} {r.steps_clarabel:9d} {r.gamma_rel_diff:10.1e}")
     return 0
 
 
@@ -91,7 +109,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     m = sub.add_parser("methods", help="list the registered estimators")
     m.set_defaults(func=_cmd_methods)
     b = sub.add_parser("bench", help="benchmarks with ratios against references")
-    b.add_argument("what", help="benchmark name (linear17)")
+    b.add_argument("what", help="benchmark name (linear17, cone)")
     b.add_argument("--sizes", default="17,100,1000,10000")
     b.add_argument("--budget", type=float, default=0.5, help="seconds per timing")
     b.set_defaults(func=_cmd_bench)
