@@ -53,7 +53,7 @@
 #define MAX_CONES ((int)1 << 20)
 #define AXIS2_MIN 1e-200   /* |v|^2 below: a zero axis */
 #define COORD_MAX 1e150    /* |coordinate| above: rejected (overflow) */
-#define MU 8.0             /* barrier parameter growth */
+#define MU 3.0
 #define LAMBDA_CENTRED 0.3 /* Newton decrement of a centred iterate */
 #define MAX_BACKTRACK 60
 
@@ -264,7 +264,7 @@ enum { FEAS_NUMERIC = -2, FEAS_NO = -1, FEAS_UNDECIDED = 0, FEAS_YES = 1 };
  * inside the ball), on FEAS_YES a strictly feasible deep point. *steps is
  * incremented by the Newton steps used (at most max_steps). */
 static int feasibility(const cone_ctx *k, double gamma, double x[3],
-                       double deep, int max_steps, int *steps)
+                       double deep, double hint, int max_steps, int *steps)
 {
     double cg = cos(gamma), sg = sin(gamma);
     double nu = 2.0 * k->n + 2.0, t, z[4], g[4], h[16], d[4], rhs[4];
@@ -277,8 +277,13 @@ static int feasibility(const cone_ctx *k, double gamma, double x[3],
     }
     g0 = max_margin(k, x, cg, sg);
     z[0] = x[0]; z[1] = x[1]; z[2] = x[2];
-    z[3] = g0 + fmax(1.0, 0.1 * fabs(g0));
-    t = 1.0 / (1.0 + fabs(g0));
+    /* start on the scale of the current margin: near the optimum g0 is
+     * small and so is the gap needed for a decision */
+    {
+        double sc = fmax(fabs(g0), hint * (1.0 + sqrt(dot3(x, x))));
+        z[3] = g0 + sc;
+        t = nu / sc;
+    }
     for (it = 0; it < max_steps; ++it) {
         double lam2, lam, alpha, zn[4];
         int bt;
@@ -401,6 +406,7 @@ static void clamp_ball(const cone_ctx *k, double x[3], double frac)
 
 #define MAX_SUB 64 /* largest working subset before the full set is used */
 #define ADD_PER_ROUND 4
+#define POLISH_HINT 1e-6
 
 /* Bisection on gamma for the (sub)problem k, from the bracket [*lo, f_k(x)].
  * x: start on input, the best point of k on output (*fx = f_k(x)).
@@ -419,7 +425,7 @@ static int solve_sub(const cone_ctx *k, const mcg_cone_options *o, double *lo,
         /* is there any point within pi / 2 of every axis? */
         memcpy(y, x, sizeof(y));
         ++*iters;
-        r = feasibility(k, HALF_PI, y, 0.5, o->max_newton, newton);
+        r = feasibility(k, HALF_PI, y, 0.5, 1e-14, o->max_newton, newton);
         if (r == FEAS_YES) {
             double f = max_angle(k, y, NULL);
             ub = fmin(f, HALF_PI);
@@ -439,7 +445,14 @@ static int solve_sub(const cone_ctx *k, const mcg_cone_options *o, double *lo,
         ++*iters;
         memcpy(y, x, sizeof(y));
         clamp_ball(k, y, 0.999);
-        r = feasibility(k, mid, y, 0.5, o->max_newton, newton);
+        r = feasibility(k, mid, y, 0.5, 1e-14, o->max_newton, newton);
+        if (r == FEAS_UNDECIDED || r == FEAS_NUMERIC) {
+            /* the start on the scale of the margin can be too aggressive
+             * (ill-conditioned from the first step): retry from afar */
+            memcpy(y, x, sizeof(y));
+            clamp_ball(k, y, 0.999);
+            r = feasibility(k, mid, y, 0.5, 1.0, o->max_newton, newton);
+        }
         if (r == FEAS_YES) {
             double f = max_angle(k, y, NULL);
             ub = fmin(mid, f);
@@ -453,24 +466,40 @@ static int solve_sub(const cone_ctx *k, const mcg_cone_options *o, double *lo,
             *fx = fbest;
             return MCG_ENUMERIC;
         } else {
-            break; /* at the precision limit: keep the bracket */
+            /* the sign of tau* is below the rounding of the margins: the
+             * bracket is at the floating-point limit, as good as it gets */
+            *conv = 1;
+            break;
         }
     }
-    *conv = ub - *lo <= fmax(o->abs_tolerance, o->tolerance * ub);
-    /* polish: the tau-minimiser at gamma = ub is within O(ub - gamma*) of
-     * the optimum where the sublevel sets shrink slowly (few active cones) */
+    if (ub - *lo <= fmax(o->abs_tolerance, o->tolerance * ub))
+        *conv = 1;
+    *fx = fbest;
+    return MCG_OK;
+}
+
+/* Polish x (f_k(x) = *fx): the tau-minimiser at gamma = f_k(x) is within
+ * O(f_k(x) - gamma*) of the optimum also where the sublevel sets shrink
+ * slowly (few active cones, a flat minimum: there any point of the final
+ * bracket's sublevel set would only be within O(sqrt(tolerance))). The
+ * polished point is kept if the full problem kf is no worse there. */
+static void polish(const cone_ctx *k, const cone_ctx *kf,
+                   const mcg_cone_options *o, double x[3], double *fx,
+                   int *newton)
+{
+    double y[3], fb = *fx;
+    int r;
     memcpy(y, x, sizeof(y));
     clamp_ball(k, y, 0.999);
-    r = feasibility(k, fmin(fbest, HALF_PI), y, 1e-9, o->max_newton, newton);
+    r = feasibility(k, fmin(max_angle(k, x, NULL), HALF_PI), y, 1e-9,
+                    POLISH_HINT, o->max_newton, newton);
     if (r == FEAS_YES || r == FEAS_UNDECIDED) {
-        double f = max_angle(k, y, NULL);
-        if (f <= fbest + fmax(o->abs_tolerance, o->tolerance * fbest)) {
-            fbest = f;
+        double f = max_angle(kf, y, NULL);
+        if (f <= fb + fmax(o->abs_tolerance, o->tolerance * fb)) {
+            *fx = f;
             memcpy(x, y, sizeof(y));
         }
     }
-    *fx = fbest;
-    return MCG_OK;
 }
 
 /* Add to the subset sub (size *ns) up to ADD_PER_ROUND cones of the full
@@ -656,9 +685,9 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
         add_violators(&k, x, fs + tol, sub, &ns);
         ks.n = ns;
     }
-    res->converged = status == MCG_OK && conv &&
-                     fbest - lo <= 2.0 * fmax(o.abs_tolerance,
-                                              o.tolerance * fbest);
+    if (status == MCG_OK && fbest > 0.0)
+        polish(&ks, &k, &o, xbest, &fbest, &res->newton_steps);
+    res->converged = status == MCG_OK && conv;
     if (status == MCG_ENUMERIC)
         return status;
 

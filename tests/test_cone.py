@@ -185,7 +185,7 @@ def test_bracket_certified_by_clarabel(kind):
             assert t > 0, k
             continue
         g = r["gamma"]
-        assert g >= r["gamma_lower"] >= 0.0
+        assert g >= r["gamma_lower"] >= 0.0 and r["converged"], k
         # gamma is the largest angle at the returned X (to the rounding of X
         # relative to its distance from the apexes)
         dist = np.linalg.norm(r["X"] - C, axis=1).min()

@@ -407,7 +407,9 @@ typedef struct {
     int active[8];      /* the first min(n_active, 8) of them, ascending */
     int iterations;     /* bisection steps (feasibility tests) */
     int newton_steps;   /* Newton steps of all feasibility tests */
-    int converged;      /* 1 if gamma - gamma_lower met the tolerance */
+    int converged;      /* 1 if gamma - gamma_lower met the tolerance, or
+                           the bisection reached the floating-point limit
+                           of the feasibility test (tau* below rounding) */
     int flags;          /* MCG_CONE_* bits */
 } mcg_cone_result;
 
