@@ -35,8 +35,9 @@
  * Coordinates are normalised (X' = (X - m) / L, m the centroid of the apexes,
  * L their RMS distance from it); the search ball has radius
  * opt->max_radius * L about m. Without it the infimum can lie at infinity
- * (parallel axes: the angles tend to 0 far along them); a solution on the
- * ball's boundary is flagged MCG_CONE_AT_INFINITY.
+ * (parallel axes: the angles tend to 0 far along them); a solution farther
+ * than half the radius is flagged MCG_CONE_AT_INFINITY (out there the angles
+ * change by ~L/|X|^2 per unit of distance: X is not determined).
  *
  * No allocation, no globals: the per-cone quantities are recomputed from the
  * inputs in every pass (O(n) per Newton step), every loop is bounded by n,
@@ -60,6 +61,7 @@
 typedef struct {
     int n;            /* cones of this (sub)problem */
     const int *idx;   /* NULL: cones 0..n-1; else the indices of a subset */
+    const double *cache; /* NULL, or n x 6: normalised apex, unit axis */
     const double *apex, *axis;
     double m[3];   /* centroid of the apexes */
     double L;      /* scene size (RMS distance of the apexes from m) */
@@ -77,8 +79,15 @@ static void cone_get(const cone_ctx *k, int q, double c[3], double v[3])
 {
     int i = k->idx ? k->idx[q] : q;
     const double *a = k->apex + 3 * i, *d = k->axis + 3 * i;
-    double s = 1.0 / sqrt(dot3(d, d));
+    double s;
     int j;
+    if (k->cache) {
+        const double *e = k->cache + 6 * q;
+        c[0] = e[0]; c[1] = e[1]; c[2] = e[2];
+        v[0] = e[3]; v[1] = e[4]; v[2] = e[5];
+        return;
+    }
+    s = 1.0 / sqrt(dot3(d, d));
     for (j = 0; j < 3; ++j) {
         c[j] = (a[j] - k->m[j]) * k->invL;
         v[j] = d[j] * s;
@@ -135,96 +144,109 @@ static double max_margin(const cone_ctx *k, const double x[3], double cg,
 }
 
 /* Gradient g[4] and Hessian h[16] of the barrier part of F_t at z = (x, tau)
- * (without the t tau term). Returns 0 if z is not strictly inside. */
+ * (without the t tau term). Returns 0 if z is not strictly inside.
+ * Per cone, with a = s v.w + tau, q = a^2 - c^2 |P w|^2 and
+ * hv = (a s v - c^2 P w, a): gradient -(2/q) hv, Hessian
+ * (4/q^2) hv hv^T - (2/q) [[v v^T - c^2 I, s v], [s v^T, 1]]. */
 static int barrier_derivs(const cone_ctx *k, const double z[4], double cg,
                           double sg, double g[4], double h[16])
 {
-    double c[3], v[3], w[3], p[3], hv[4];
-    double c2 = cg * cg, b, r2;
-    int i, a, bb;
-    memset(g, 0, 4 * sizeof(double));
-    memset(h, 0, 16 * sizeof(double));
+    double c2 = cg * cg, b, r2, buf[6];
+    double g0 = 0, g1 = 0, g2 = 0, g3 = 0;
+    double h00 = 0, h10 = 0, h11 = 0, h20 = 0, h21 = 0, h22 = 0;
+    double h30 = 0, h31 = 0, h32 = 0, h33 = 0, dsum = 0;
+    int i;
     for (i = 0; i < k->n; ++i) {
-        double vw, pw2, av, q, iq, iq2;
-        cone_get(k, i, c, v);
-        w[0] = z[0] - c[0]; w[1] = z[1] - c[1]; w[2] = z[2] - c[2];
-        vw = dot3(v, w);
-        p[0] = w[0] - vw * v[0]; p[1] = w[1] - vw * v[1];
-        p[2] = w[2] - vw * v[2];
-        pw2 = dot3(p, p);
+        const double *e;
+        double w0, w1, w2, vw, p0, p1, p2, av, q, iq, iq2, a0, a1, a2, a3;
+        double v0, v1, v2;
+        if (k->cache) {
+            e = k->cache + 6 * i;
+        } else {
+            cone_get(k, i, buf, buf + 3);
+            e = buf;
+        }
+        v0 = e[3]; v1 = e[4]; v2 = e[5];
+        w0 = z[0] - e[0]; w1 = z[1] - e[1]; w2 = z[2] - e[2];
+        vw = v0 * w0 + v1 * w1 + v2 * w2;
+        p0 = w0 - vw * v0; p1 = w1 - vw * v1; p2 = w2 - vw * v2;
         av = sg * vw + z[3];
-        if (!(av > 0.0))
-            return 0;
-        q = av * av - c2 * pw2;
-        if (!(q > 0.0))
+        q = av * av - c2 * (p0 * p0 + p1 * p1 + p2 * p2);
+        if (!(av > 0.0) || !(q > 0.0))
             return 0;
         iq = 2.0 / q;
-        iq2 = iq * iq; /* 4 / q^2 */
-        hv[0] = av * sg * v[0] - c2 * p[0];
-        hv[1] = av * sg * v[1] - c2 * p[1];
-        hv[2] = av * sg * v[2] - c2 * p[2];
-        hv[3] = av;
-        for (a = 0; a < 4; ++a) {
-            g[a] -= iq * hv[a];
-            for (bb = 0; bb <= a; ++bb)
-                h[4 * a + bb] += iq2 * hv[a] * hv[bb];
-        }
-        /* - (2 / q) [[v v^T - c^2 I, s v], [s v^T, 1]] */
-        for (a = 0; a < 3; ++a) {
-            for (bb = 0; bb <= a; ++bb)
-                h[4 * a + bb] -= iq * v[a] * v[bb];
-            h[4 * a + a] += iq * c2;
-            h[12 + a] -= iq * sg * v[a];
-        }
-        h[15] -= iq;
+        iq2 = iq * iq;
+        a0 = av * sg * v0 - c2 * p0;
+        a1 = av * sg * v1 - c2 * p1;
+        a2 = av * sg * v2 - c2 * p2;
+        a3 = av;
+        g0 -= iq * a0; g1 -= iq * a1; g2 -= iq * a2; g3 -= iq * a3;
+        h00 += iq2 * a0 * a0 - iq * v0 * v0;
+        h10 += iq2 * a1 * a0 - iq * v1 * v0;
+        h11 += iq2 * a1 * a1 - iq * v1 * v1;
+        h20 += iq2 * a2 * a0 - iq * v2 * v0;
+        h21 += iq2 * a2 * a1 - iq * v2 * v1;
+        h22 += iq2 * a2 * a2 - iq * v2 * v2;
+        h30 += iq2 * a3 * a0 - iq * sg * v0;
+        h31 += iq2 * a3 * a1 - iq * sg * v1;
+        h32 += iq2 * a3 * a2 - iq * sg * v2;
+        h33 += iq2 * a3 * a3 - iq;
+        dsum += iq * c2;
     }
     r2 = dot3(z, z);
     b = k->R * k->R - r2;
     if (!(b > 0.0))
         return 0;
-    for (a = 0; a < 3; ++a) {
-        g[a] += 2.0 * z[a] / b;
-        for (bb = 0; bb <= a; ++bb)
-            h[4 * a + bb] += 4.0 * z[a] * z[bb] / (b * b);
-        h[4 * a + a] += 2.0 / b;
+    {
+        double ib = 2.0 / b, ib2 = ib * ib;
+        g0 += ib * z[0]; g1 += ib * z[1]; g2 += ib * z[2];
+        h00 += ib2 * z[0] * z[0] + ib + dsum;
+        h10 += ib2 * z[1] * z[0];
+        h11 += ib2 * z[1] * z[1] + ib + dsum;
+        h20 += ib2 * z[2] * z[0];
+        h21 += ib2 * z[2] * z[1];
+        h22 += ib2 * z[2] * z[2] + ib + dsum;
     }
-    for (a = 0; a < 4; ++a)
-        for (bb = a + 1; bb < 4; ++bb)
-            h[4 * a + bb] = h[4 * bb + a];
+    g[0] = g0; g[1] = g1; g[2] = g2; g[3] = g3;
+    h[0] = h00; h[1] = h10; h[2] = h20; h[3] = h30;
+    h[4] = h10; h[5] = h11; h[6] = h21; h[7] = h31;
+    h[8] = h20; h[9] = h21; h[10] = h22; h[11] = h32;
+    h[12] = h30; h[13] = h31; h[14] = h32; h[15] = h33;
     return 1;
 }
 
-/* Cholesky solve h d = rhs (4 x 4, SPD). Returns 0 if not positive definite. */
+/* Solve h d = rhs (4 x 4, SPD) by LDL^T. Returns 0 on a tiny pivot. */
 static int chol4_plain(const double h[16], const double rhs[4], double d[4])
 {
-    double l[16], y[4];
+    /* LDL^T without square roots; pivots must stay above 1e-13 of the
+     * diagonal they come from (else the caller scales and shifts) */
+    double l[16], dg[4], y[4];
     int i, j, kk;
-    memset(l, 0, sizeof(l));
     for (j = 0; j < 4; ++j) {
-        double s = h[4 * j + j];
+        double s = h[5 * j];
         for (kk = 0; kk < j; ++kk)
-            s -= l[4 * j + kk] * l[4 * j + kk];
-        if (!(s > 0.0) || !isfinite(s))
+            s -= l[4 * j + kk] * l[4 * j + kk] * dg[kk];
+        if (!(s > 1e-13 * h[5 * j]) || !isfinite(s))
             return 0;
-        l[4 * j + j] = sqrt(s);
+        dg[j] = s;
         for (i = j + 1; i < 4; ++i) {
             double t = h[4 * i + j];
             for (kk = 0; kk < j; ++kk)
-                t -= l[4 * i + kk] * l[4 * j + kk];
-            l[4 * i + j] = t / l[4 * j + j];
+                t -= l[4 * i + kk] * l[4 * j + kk] * dg[kk];
+            l[4 * i + j] = t / s;
         }
     }
     for (i = 0; i < 4; ++i) {
         double s = rhs[i];
         for (kk = 0; kk < i; ++kk)
             s -= l[4 * i + kk] * y[kk];
-        y[i] = s / l[4 * i + i];
+        y[i] = s;
     }
     for (i = 3; i >= 0; --i) {
-        double s = y[i];
+        double s = y[i] / dg[i];
         for (kk = i + 1; kk < 4; ++kk)
             s -= l[4 * kk + i] * d[kk];
-        d[i] = s / l[4 * i + i];
+        d[i] = s;
     }
     return 1;
 }
@@ -237,6 +259,8 @@ static int chol4_solve(const double h[16], const double rhs[4], double d[4])
 {
     double hs[16], sc[4], rs[4], shift = 0.0;
     int i, j, attempt;
+    if (chol4_plain(h, rhs, d)) /* the usual case */
+        return 1;
     for (i = 0; i < 4; ++i) {
         if (!(h[5 * i] > 0.0) || !isfinite(h[5 * i]))
             return 0;
@@ -408,6 +432,16 @@ static void clamp_ball(const cone_ctx *k, double x[3], double frac)
 #define ADD_PER_ROUND 4
 #define POLISH_HINT 1e-6
 
+/* fill cache (k->n <= MAX_SUB rows) with the normalised cones of k */
+static void fill_cache(cone_ctx *k, double *cache)
+{
+    int q;
+    k->cache = NULL;
+    for (q = 0; q < k->n; ++q)
+        cone_get(k, q, cache + 6 * q, cache + 6 * q + 3);
+    k->cache = cache;
+}
+
 /* Bisection on gamma for the (sub)problem k, from the bracket [*lo, f_k(x)].
  * x: start on input, the best point of k on output (*fx = f_k(x)).
  * Returns MCG_OK, MCG_EINFEASIBLE (*lo = pi/2) or MCG_ENUMERIC; *conv = 1
@@ -544,6 +578,7 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
     double lo, fbest, xbest[3], x[3], L2 = 0.0;
     int i, j, status = MCG_OK, coincident = 0, all_parallel = 1, conv = 0;
     int sub[MAX_SUB], ns = 0, round;
+    double cache[6 * MAX_SUB];
 
     if (!res)
         return MCG_EINVAL;
@@ -567,6 +602,7 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
     /* normalisation */
     k.n = n;
     k.idx = NULL;
+    k.cache = NULL;
     k.apex = apex;
     k.axis = axis;
     k.m[0] = k.m[1] = k.m[2] = 0.0;
@@ -663,6 +699,9 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
         ns = 0, add_violators(&k, xbest, -1.0, sub, &ns), ks.n = ns;
     for (round = 0; round <= MAX_SUB; ++round) {
         double fs, ff, tol;
+        ks.cache = NULL;
+        if (ks.n <= MAX_SUB)
+            fill_cache(&ks, cache);
         memcpy(x, xbest, sizeof(x));
         status = solve_sub(&ks, &o, &lo, x, &fs, &res->iterations,
                            &res->newton_steps, &conv);
@@ -720,7 +759,7 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
     }
     if (coincident)
         res->flags |= MCG_CONE_COINCIDENT_APEXES | MCG_CONE_NONUNIQUE;
-    else if (sqrt(dot3(xbest, xbest)) > 0.99 * k.R)
+    else if (sqrt(dot3(xbest, xbest)) > 0.5 * k.R)
         res->flags |= MCG_CONE_AT_INFINITY | MCG_CONE_NONUNIQUE;
     if (all_parallel && fbest <= 100.0 * fmax(o.abs_tolerance, 1e-12))
         res->flags |= MCG_CONE_NONUNIQUE;

@@ -368,9 +368,11 @@ enum {
     MCG_CONE_NONUNIQUE = 1,         /* the optimal X is not unique (n = 1,
                                        coincident apexes, overlapping
                                        parallel rays, or AT_INFINITY) */
-    MCG_CONE_AT_INFINITY = 2,       /* X on the search ball's boundary: the
-                                       infimum is approached far away (e.g.
-                                       parallel axes); X is a far point */
+    MCG_CONE_AT_INFINITY = 2,       /* X farther than max_radius / 2 scene
+                                       sizes: the infimum is approached far
+                                       away (e.g. parallel axes), where the
+                                       angles barely change; X is a far point
+                                       and only gamma is meaningful */
     MCG_CONE_COINCIDENT_APEXES = 4, /* all apexes coincide: any point of the
                                        ray apex + s (X - apex), s > 0, is
                                        optimal; X - apex has unit length */
