@@ -441,7 +441,12 @@ void mcg_cone_default_options(mcg_cone_options *opt);
  * found); MCG_ENUMERIC on a breakdown of the interior-point method;
  * MCG_EINVAL for n outside [1, 2^20], NULL pointers, NaN/inf or |value| >
  * 1e150 in the inputs, a zero axis (|v| <= 1e-100) or bad options.
- * Cost: O(n) per Newton step, tens of Newton steps per bisection step. */
+ * For n > 8 the bisection runs on a growing subset of the cones (a
+ * relaxation: its lower bounds hold for all) until its solution satisfies
+ * every cone. Cost: O(subset) per Newton step, ~10 Newton steps per
+ * bisection step, ~30 bisection steps, plus O(n) per subset round; about
+ * 60 us for n = 6 and 300 us for n = 1000 (x86-64, -O3). No allocation
+ * (3 KB of stack). */
 int mcg_cone_linf(int n, const double *apex, const double *axis,
                   const mcg_cone_options *opt, mcg_cone_result *res);
 
