@@ -27,7 +27,7 @@ from .types import RayPairs, ScaleVerdict
 
 __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_only_fit",
            "count_in_front", "scale_profile", "travel_direction", "rotation_only_residuals",
-           "critical_angle"]
+           "critical_angle", "refine_centred"]
 
 
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
@@ -78,13 +78,32 @@ def _centres_with_intra(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, i
     return centres, cross
 
 
+def refine_centred(rays: RayPairs, R: np.ndarray, t: np.ndarray, **options) -> dict:
+    """``_core.refine_motion`` run in a frame centred on the cameras' centroid.
+
+    The refined motion is returned in the original rig frame; the scale
+    evidence (``scale_rel_std``, and |t| held by ``fix_scale``) then refers to
+    the translation of the centroid ``tau = t + R c - c``: the distance the
+    cameras travelled, which does not depend on where the user put the rig
+    origin (|t| does: a verdict on |t| would change with the rig frame).
+    """
+    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    R = np.asarray(R, dtype=np.float64)
+    cr = rays.in_frame(np.eye(3), -c)
+    out = _core.refine_motion(cr.origins1, cr.dirs1, cr.origins2, cr.dirs2, R,
+                              np.asarray(t, dtype=np.float64) + R @ c - c, **options)
+    out["t"] = out["t"] - out["R"] @ c + c
+    return out
+
+
 def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sigma2: float,
                   factors: tuple = (1.0 / 1.3, 1.3), loss: str = "none",
                   loss_scale: float = 1e-3, weights: np.ndarray | None = None) -> float:
     """How strongly the data exclude ``|t|`` scaled by each of ``factors``.
 
-    For each factor the motion is re-optimised with ``|t|`` held at ``factor
-    |t|`` (rotation and direction free); the returned value is the smallest cost
+    For each factor the motion is re-optimised with the centroid translation
+    held at ``factor`` times its length (see :func:`refine_centred`; rotation
+    and direction free); the returned value is the smallest cost
     increase over the free optimum ``cost``, in units of the residual variance
     ``sigma2`` (a likelihood-ratio statistic: ~chi^2 with 1 dof). Unlike the
     first-order standard deviation it sees the non-linearity of near-critical
@@ -93,11 +112,12 @@ def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sig
     if not (np.isfinite(sigma2) and sigma2 > 0):
         return 0.0
     worst = np.inf
+    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    shift = np.asarray(R) @ c - c
     for f in factors:
         try:
-            out = _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R,
-                                      np.asarray(t) * f, loss=loss, loss_scale=loss_scale,
-                                      fix_scale=True, weights=weights)
+            out = refine_centred(rays, R, (np.asarray(t) + shift) * f - shift, loss=loss,
+                                 loss_scale=loss_scale, fix_scale=True, weights=weights)
         except (ValueError, ArithmeticError):
             return 0.0
         worst = min(worst, (out["final_cost"] - cost) / sigma2)

@@ -28,8 +28,8 @@ import numpy as np
 
 from . import _core, registry
 from .errors import DegenerateError
-from .observability import (rotation_only_fit, rotation_only_residuals, scale_profile,
-                            scale_verdict, travel_direction)
+from .observability import (refine_centred, rotation_only_fit, rotation_only_residuals,
+                            scale_profile, scale_verdict, travel_direction)
 from .types import RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
@@ -200,8 +200,7 @@ class _Scorer:
 
 def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
             weights: Optional[np.ndarray] = None) -> dict:
-    return _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
-                               loss=loss, loss_scale=loss_scale, weights=weights)
+    return refine_centred(rays, R, t, loss=loss, loss_scale=loss_scale, weights=weights)
 
 
 def ransac(rays: RayPairs, method: str = "five_plus_one", *,

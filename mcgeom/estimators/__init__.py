@@ -3,5 +3,6 @@
 from . import linear17  # noqa: F401  (registers "linear17")
 from . import refine  # noqa: F401  (registers "refine")
 from . import five_plus_one  # noqa: F401  (registers "five_plus_one")
+from . import e_socp  # noqa: F401  (registers "e_socp")
 
-__all__ = ["linear17", "refine", "five_plus_one"]
+__all__ = ["linear17", "refine", "five_plus_one", "e_socp"]

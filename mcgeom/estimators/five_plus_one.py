@@ -38,7 +38,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..observability import scale_profile, scale_verdict, travel_direction
+from ..observability import refine_centred, scale_profile, scale_verdict, travel_direction
 from ..registry import register
 from ..types import RayPairs, RigMotion
 
@@ -455,9 +455,8 @@ def _from_camera(rays: RayPairs, a: int, refine: bool) -> tuple[float, dict, Opt
 def _refine_all(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool) -> dict:
     # converged to rounding, not to a relative cost change of 1e-10: the result
     # must not depend on which camera's start won (order, rig frame)
-    return _core.refine_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
-                               loss="none", fix_scale=fix_scale, max_iterations=100,
-                               cost_tolerance=1e-15, step_tolerance=1e-13)
+    return refine_centred(rays, R, t, loss="none", fix_scale=fix_scale, max_iterations=100,
+                          cost_tolerance=1e-15, step_tolerance=1e-13)
 
 
 @register(

@@ -1,0 +1,164 @@
+"""``e_socp``: per-camera essential matrices, then L-infinity triangulation (thesis ch. 9).
+
+Each camera ``i`` with enough intra-camera correspondences gives, through its
+essential matrix (OpenCV's 5-point solver with RANSAC, the same code as the 5+1
+method), the rig rotation ``R_i`` and a half-line of possible rig translations.
+In our convention (DESIGN.md section 3, ``X2 = R X1 + t``) camera ``i``'s centre
+``c_i`` moves to ``R^T (c_i - t)`` and its own translation direction is ``w_i``:
+
+    t = t0_i + lam_i w_i,   t0_i = c_i - R c_i,   lam_i >= 0,
+
+which is eq. 9.2 written for ``t`` rather than for the first camera's new
+centre (the two differ by a known rigid map). The rotations are averaged
+(chordal L2 mean projected onto SO(3)); ``t`` is then the point that
+minimises the largest angle between ``t - t0_i`` and ``w_i`` (eq. 9.3): the
+L-infinity triangulation, solved exactly by cone bisection in C
+(``csrc/cone.c``).
+
+Near-zero rotation makes every apex ``t0_i`` collapse to the origin: all
+half-lines then share their apex and the scale is free (ch. 9.5). The verdict
+says so, with the SOCP residual and the rotation angle in ``info`` so that a
+caller can reject such frames as ch. 9.5 suggests.
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+from .. import _core
+from ..errors import DegenerateError
+from ..observability import refine_centred, scale_verdict
+from ..registry import register
+from ..types import RayPairs, RigMotion
+from .five_plus_one import LEAST_SQUARES, camera_ids, essential_motions
+
+__all__ = ["e_socp", "average_rotations"]
+
+
+def average_rotations(Rs: np.ndarray, weights: Optional[np.ndarray] = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Chordal L2 mean of rotations (the SO(3) projection of their weighted sum)
+    and the angle (radians) of each rotation from it."""
+    Rs = np.asarray(Rs, dtype=np.float64)
+    w = np.ones(len(Rs)) if weights is None else np.asarray(weights, dtype=np.float64)
+    M = np.einsum("k,kij->ij", w, Rs)
+    u, _, vt = np.linalg.svd(M)
+    R = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+    cos = np.clip((np.einsum("kij,ij->k", Rs, R) - 1.0) / 2.0, -1.0, 1.0)
+    return R, np.arccos(cos)
+
+
+def _per_camera(rays: RayPairs, robust_threshold: Optional[float], prob: float):
+    """(camera, R_i, t0_i, w_i, n_i) for every camera whose essential matrix was found."""
+    import cv2
+    cam1, cam2, centres = camera_ids(rays)
+    intra = cam1 == cam2
+    counts = np.bincount(cam1[intra], minlength=len(centres))
+    out = []
+    for a in np.flatnonzero(counts >= 5):
+        own = np.flatnonzero(intra & (cam1 == a))
+        method = LEAST_SQUARES if robust_threshold is None or len(own) < 8 else cv2.USAC_DEFAULT
+        try:
+            cands = essential_motions(rays, own, centres[a], method=method,
+                                      threshold=robust_threshold or 1e-3, prob=prob)
+        except DegenerateError:
+            continue
+        if not cands:
+            continue
+        R, t0, w = cands[0]
+        if len(own) >= 6:
+            R, w = _refine_camera(rays.take(own), centres[a], R, w, robust_threshold)
+            t0 = centres[a] - R @ centres[a]
+        out.append((int(a), R, t0, w, len(own)))
+    return out, centres
+
+
+def _refine_camera(sub: RayPairs, c: np.ndarray, R: np.ndarray, w: np.ndarray,
+                   robust_threshold: Optional[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares (Sampson) rotation and translation direction of one camera.
+
+    The 5-point solution fits 5 points exactly and the others not at all; the
+    per-camera essential matrix of ch. 9 is the estimate from all of them. In a
+    frame centred on the camera its motion is ``(R, lam w)``; one camera cannot
+    see ``lam``, so the refinement holds ``|t| = 1`` there and returns the
+    unit direction ``w`` (independent of the world's scale and origin).
+    """
+    centred = sub.in_frame(np.eye(3), -c)
+    loss = "none" if robust_threshold is None else "cauchy"
+    out = _core.refine_motion(centred.origins1, centred.dirs1, centred.origins2,
+                              centred.dirs2, R, w, loss=loss,
+                              loss_scale=robust_threshold or 1e-3, fix_scale=True,
+                              max_iterations=100, cost_tolerance=1e-15, step_tolerance=1e-13)
+    return out["R"], out["t"] / np.linalg.norm(out["t"])
+
+
+@register(
+    "e_socp",
+    min_sample=10,
+    camera_kinds=("locally-central", "locally-central-and-axial"),
+    family="globally-optimal",
+    needs_rotation=False,
+    recovers_scale=True,
+    description="E+SOCP: per-camera essential matrices, rotation averaging and L-infinity "
+                "triangulation of the translation by cone bisection (thesis ch. 9)",
+    options={"robust_threshold": "RANSAC threshold of each camera's 5-point search, radians "
+                                 "(None: no outliers, least squares; default None)",
+             "tolerance": "bisection tolerance on the L-infinity angle, radians (1e-12)",
+             "max_scale_rel_std": "relative std of |t| above which the scale is reported "
+                                  "unobservable (0.1)"},
+)
+def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = None, prob: float = 0.999,
+           tolerance: float = 1e-12, max_scale_rel_std: float = 0.1) -> RigMotion:
+    """Rig motion rig2_from_rig1 by E+SOCP (thesis ch. 9) from intra-camera correspondences.
+
+    ``rays`` in the rig frame, origins at the camera centres. Needs at least two
+    cameras with 5 intra-camera correspondences for the metric scale (one camera
+    gives R and the direction only); cross-camera correspondences are not used.
+    ``info``: per-camera rotations' spread from their mean (radians), the SOCP
+    residual (the optimal L-infinity angle, radians), the frame-to-frame
+    rotation angle (radians), the cameras used and the active cones.
+    """
+    if not isinstance(rays, RayPairs):
+        raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    for name in ("origins1", "dirs1", "origins2", "dirs2"):
+        if not np.all(np.isfinite(getattr(rays, name))):
+            raise ValueError(f"rays.{name} contains NaN or inf")
+    per, centres = _per_camera(rays, robust_threshold, prob)
+    if not per:
+        raise ValueError("too few correspondences: e_socp needs 5 intra-camera "
+                         "correspondences in at least one camera")
+    R, spread = average_rotations(np.stack([p[1] for p in per]),
+                                  np.array([p[4] for p in per], dtype=float))
+    apex = np.stack([centres[p[0]] - R @ centres[p[0]] for p in per])   # t0_i with the mean R
+    axis = np.stack([p[3] for p in per])
+    info = {"cameras": [p[0] for p in per], "rotation_spread": spread,
+            "rotation_angle": float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1)))}
+    degenerate_scale = len(per) == 1
+    if len(per) == 1:
+        t = axis[0] + apex[0]
+        info["socp_residual"] = 0.0
+    else:
+        sol = _core.cone_linf(apex, axis, tolerance=tolerance)
+        t = np.asarray(sol["X"], dtype=np.float64)
+        info["socp_residual"] = float(sol["gamma"])
+        info["socp_lower_bound"] = float(sol["gamma_lower"])
+        info["active_cones"] = [info["cameras"][k] for k in sol["active"]]
+        # all apexes equal (no rotation) or parallel half-lines: |t| is free
+        degenerate_scale = bool(sol["coincident_apexes"] or sol["at_infinity"])
+    # evidence on |t|: the information matrix of the Sampson cost at (R, t)
+    rel = float("inf")
+    if not degenerate_scale and len(rays) >= 6:
+        try:
+            ev = refine_centred(rays, R, t, max_iterations=0)
+            rel = float(ev["scale_rel_std"])
+        except (ValueError, DegenerateError):
+            pass
+    verdict = scale_verdict(rays, np.ones(len(rays), bool), R, t, rel, max_scale_rel_std,
+                            degenerate_scale)
+    info["t_metric"] = np.array(t)
+    if not verdict.observable:
+        t = t / max(np.linalg.norm(t), 1e-300)
+    r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
+    return RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
