@@ -552,11 +552,27 @@ class Rig:
         """
         px = _check_pixels("pixels", pixels)
         ids = self._check_ids("cam_ids", cam_ids, px.shape[0])
+        used = np.unique(ids)
+        if all(self.cameras[i].model == "pinhole" and not np.any(self.cameras[i].dist)
+               for i in used):
+            return np.ascontiguousarray(self.centres[ids]), self._pinhole_rays(ids, px)
         dirs = np.empty((px.shape[0], 3))
-        for i in np.unique(ids):  # one OpenCV call per camera
+        for i in used:  # one OpenCV call per camera
             sel = ids == i
             dirs[sel] = self.cameras[i].pixels_to_bearings(px[sel])
         return np.ascontiguousarray(self.centres[ids]), dirs
+
+    def _pinhole_rays(self, ids: np.ndarray, px: np.ndarray) -> np.ndarray:
+        """Bearings of undistorted pinhole pixels, all cameras at once:
+        ``R_i^T normalize(K_i^-1 [u, v, 1])`` row by row (the same arithmetic as
+        :meth:`Camera.pixels_to_bearings`, without a call per camera)."""
+        K = np.stack([c.K for c in self.cameras])[ids]
+        y = (px[:, 1] - K[:, 1, 2]) / K[:, 1, 1]
+        x = (px[:, 0] - K[:, 0, 2] - K[:, 0, 1] * y) / K[:, 0, 0]
+        d = np.column_stack([x, y, np.ones(len(x))])
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        Rs = np.stack([c.R for c in self.cameras])
+        return np.ascontiguousarray(np.einsum("nji,nj->ni", Rs[ids], d))
 
     def ray_pairs(self, pixels1: Any, pixels2: Any, cam1: Any, cam2: Any = None) -> RayPairs:
         """Ray correspondences from pixel correspondences.
