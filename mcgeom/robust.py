@@ -356,7 +356,7 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     info: dict = {"iterations": iterations, "hypotheses": scorer.n_hyp,
                   "local_optimizations": scorer.n_lo}
     rel_std = float("inf")
-    fixed = False
+    r = None
     if options.refine:
         # All six degrees of freedom are refined even when |t| turns out to be
         # unobservable: where the cost is flat in |t| the refinement may move it
@@ -368,12 +368,14 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
             out = _refine(rays.take(used), R, t, scorer._loss_scale(), options.loss,
                           scorer._w(used))
             R, t = out["R"], out["t"]
-            inl = scorer.residuals(R, t) < options.threshold
+            r = scorer.residuals(R, t)
+            inl = r < options.threshold
             if np.array_equal(inl, used):
                 break
         rel_std = float(out["scale_rel_std"])
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
-    r = scorer.residuals(R, t)
+    if r is None:
+        r = scorer.residuals(R, t)
     info.update(inlier_ratio=float(inl.mean()), time_s=time.perf_counter() - t_start,
                 score=scorer.best_score)
     profile = float("nan")
@@ -383,9 +385,8 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
                                 (1.0 / k, k), options.loss, scorer._loss_scale(),
                                 scorer._w(used))
         info["scale_profile"] = profile
-    verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std, fixed,
-                            noise_level=scorer._loss_scale(),
-                            profile=profile)
+    verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std,
+                            noise_level=scorer._loss_scale(), profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
     # the metric estimate whatever the verdict (meaningless when unobservable:
     # the free refinement may have slid |t| far, even through zero)
