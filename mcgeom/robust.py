@@ -388,11 +388,12 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std,
                             noise_level=scorer._loss_scale(), profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
-    # the metric estimate whatever the verdict (meaningless when unobservable:
-    # the free refinement may have slid |t| far, even through zero)
+    # the metric estimate whatever the verdict; when the scale is unobservable
+    # the final free refinement may have slid |t| far along its flat valley,
+    # so the length of the best robust hypothesis is kept (a guess either way)
     info["t_metric"] = np.array(t)
     if not verdict.observable:
-        nt = np.linalg.norm(t)
+        nt = np.linalg.norm(scorer.best[1])
         t = travel_direction(rays, inl, R, t)
         info["t_metric"] = nt * t
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
