@@ -510,18 +510,20 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
                              f"correspondences in one camera, most found: {int(counts.max())}")
     else:
         cams = [five_camera]
-    best, err = None, None
+    found, err = [], None
     for a in cams:
         try:
-            cand = _from_camera(rays, a, refine)
+            found.append((a, _from_camera(rays, a, refine)))
         except DegenerateError as e:
             err = e
-            continue
-        if best is None or cand[0] < best[0]:
-            best = cand
-    if best is None:
+    if not found:
         raise err if err is not None else DegenerateError("five_plus_one: no motion found")
-    _, sol, out = best
+    # Several starts usually reach the same minimum, equal in cost to rounding;
+    # among those take the lowest camera id, so that the end point (equal only
+    # to the refinement's tolerance) does not depend on the order of the rays.
+    low = min(c[0] for _, c in found)
+    _, (_, sol, out) = min((fa for fa in found if fa[1][0] <= low * (1 + 1e-9) + 1e-300),
+                           key=lambda fa: fa[0])
     R, t, rel = sol["R"], sol["t"], sol["scale_rel_std"]
     info = {"five_camera": sol["five_camera"], "critical_angles": sol["critical_angles"],
             "scale_linear": sol["lam"], "scale_rel_std_linear": rel,
