@@ -75,3 +75,17 @@ def test_ch10_5_1_errors_grow_with_noise_and_stay_bounded():
         assert np.nanmax(e[:, 0]) < 1e-6 and np.nanmax(np.abs(e[:, 2] - 1)) < 1e-6, name
     for name, e in res[0.5].items():
         assert np.nanmean(e[:, 0]) < 0.1 and np.nanmean(e[:, 3]) < 0.1, name
+
+
+def test_runs_through_the_opencv_facade():
+    rng = np.random.default_rng(5)
+    rig = experiment_ch9.rig4()
+    R = synth.rotation_about([0.3, 1.0, 0.2], np.radians(15))
+    t = np.array([0.5, 0.2, 0.1])
+    p = synth.make_problem(rig, R, t, 200, rng, pixel_noise=0.3, outlier_fraction=0.1)
+    retval, Re, te, mask = mcgeom.estimateRigMotion(p.pixels1, p.pixels2, p.cam1, p.cam2, rig,
+                                                    method="e_socp")
+    assert rot_err(Re, R) < np.radians(0.1)
+    m = mcgeom.cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, method="e_socp")
+    if m.scale.observable:
+        assert np.linalg.norm(te.ravel() - t) < 0.1 * np.linalg.norm(t)

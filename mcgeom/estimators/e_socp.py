@@ -104,12 +104,12 @@ def _refine_camera(sub: RayPairs, c: np.ndarray, R: np.ndarray, w: np.ndarray,
     description="E+SOCP: per-camera essential matrices, rotation averaging and L-infinity "
                 "triangulation of the translation by cone bisection (thesis ch. 9)",
     options={"robust_threshold": "RANSAC threshold of each camera's 5-point search, radians "
-                                 "(None: no outliers, least squares; default None)",
+                                 "(default 1e-3; None: outlier-free data, least squares)",
              "tolerance": "bisection tolerance on the L-infinity angle, radians (1e-12)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
                                   "unobservable (0.1)"},
 )
-def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = None, prob: float = 0.999,
+def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: float = 0.999,
            tolerance: float = 1e-12, max_scale_rel_std: float = 0.1) -> RigMotion:
     """Rig motion rig2_from_rig1 by E+SOCP (thesis ch. 9) from intra-camera correspondences.
 
