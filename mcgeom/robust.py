@@ -47,7 +47,7 @@ class RansacOptions:
     local_optimization: bool = True
     lo_max_rounds: int = 2
     refine: bool = True
-    loss: str = "none"              # final refinement on the inliers (LO uses cauchy)
+    loss: str = "cauchy"            # final refinement (scale: the threshold)
     max_scale_rel_std: float = 0.1
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
 
@@ -363,15 +363,22 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         # far, but R and the direction stay right, whereas holding |t| at a
         # wrong value bends R and the direction to compensate (measured: 0.03
         # -> 0.2 deg on the Ladybug head). The verdict then reports the direction.
-        for _ in range(2):   # refit once more if the inlier set moved
-            used = inl
+        # The fit uses every correspondence within 2.5 thresholds, with a
+        # robust loss of the threshold's scale: a hard cut at the threshold
+        # drops the tail of the true inliers (|r| > 1 px for ~16 % of them at
+        # 0.5 px noise) and loses accuracy (measured on the Ladybug head).
+        wide = 2.5 * options.threshold
+        sel = scorer.residuals(R, t) < wide
+        for _ in range(2):   # refit once more if the set moved
+            used = sel
             out = _refine(rays.take(used), R, t, scorer._loss_scale(), options.loss,
                           scorer._w(used))
             R, t = out["R"], out["t"]
             r = scorer.residuals(R, t)
-            inl = r < options.threshold
-            if np.array_equal(inl, used):
+            sel = r < wide
+            if np.array_equal(sel, used):
                 break
+        inl = r < options.threshold
         rel_std = float(out["scale_rel_std"])
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
     if r is None:
@@ -388,12 +395,11 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std,
                             noise_level=scorer._loss_scale(), profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
-    # the metric estimate whatever the verdict; when the scale is unobservable
-    # the final free refinement may have slid |t| far along its flat valley,
-    # so the length of the best robust hypothesis is kept (a guess either way)
+    # the metric estimate whatever the verdict (when the scale is unobservable
+    # the refinement may have slid |t| far along its flat valley: a guess)
     info["t_metric"] = np.array(t)
     if not verdict.observable:
-        nt = np.linalg.norm(scorer.best[1])
+        nt = np.linalg.norm(t)
         t = travel_direction(rays, inl, R, t)
         info["t_metric"] = nt * t
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
