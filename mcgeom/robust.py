@@ -177,8 +177,11 @@ class _Scorer:
             R, t = self.best
             self.n_lo += 1
             try:
+                # the length of the centroid's translation is held: LO is
+                # about the inlier set, and near the critical motion a free
+                # fit slides |t| towards infinity (the final stage frees it)
                 out = _refine(self.rays.take(inl), R, t, self._loss_scale(), "cauchy",
-                              self._w(inl))
+                              self._w(inl), fix_scale=True)
             except (ValueError, ArithmeticError):
                 return
             r = self.residuals(out["R"], out["t"])
@@ -199,8 +202,9 @@ class _Scorer:
 
 
 def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
-            weights: Optional[np.ndarray] = None) -> dict:
-    return refine_centred(rays, R, t, loss=loss, loss_scale=loss_scale, weights=weights)
+            weights: Optional[np.ndarray] = None, fix_scale: bool = False) -> dict:
+    return refine_centred(rays, R, t, loss=loss, loss_scale=loss_scale, weights=weights,
+                          fix_scale=fix_scale)
 
 
 def ransac(rays: RayPairs, method: str = "five_plus_one", *,
@@ -400,6 +404,9 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     info["t_metric"] = np.array(t)
     if not verdict.observable:
         nt = np.linalg.norm(t)
+        n0 = np.linalg.norm(scorer.best[1])
+        if not 0.1 <= nt / max(n0, 1e-300) <= 10.0:
+            nt = n0   # slid along the flat valley: keep the robust hypothesis' length
         t = travel_direction(rays, inl, R, t)
         info["t_metric"] = nt * t
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
