@@ -601,3 +601,37 @@ def cone_linf(apexes: Any, axes: Any, *, tolerance: float = 1e-10,
         "at_infinity": bool(flags & lib.MCG_CONE_AT_INFINITY),
         "coincident_apexes": bool(flags & lib.MCG_CONE_COINCIDENT_APEXES),
     }
+
+
+# ------------------------------------------------------------------ wedge.c
+
+__all__ += ["wedge_normals"]
+
+
+def wedge_normals(v: Any, vp: Any, eps: float, epsp: float) -> Optional[tuple[np.ndarray, np.ndarray]]:
+    """Bitangent-plane normals of two error cones (thesis eqs. 10.9-10.12),
+    convention X2 = R X1 + t (``mcg_wedge_normals``).
+
+    ``v``: bearing at time 1 rotated into the time-2 orientation (R @ d1),
+    ``vp``: bearing at time 2, ``eps``/``epsp``: their angular error bounds
+    (radians, in [0, pi/2)). Returns unit ``(n1, n2)`` with ``n1 @ t >= 0`` and
+    ``n2 @ t >= 0`` for every translation direction compatible with the two
+    cones (points in front of both cameras); the thesis's normals are the
+    negatives. Returns ``None`` when no wedge exists (v parallel to vp, the
+    cones overlap or are nested): such a correspondence gives no constraint.
+    Raises ``ValueError`` for bad input.
+    """
+    v = _arr("v", v, (3,))
+    vp = _arr("vp", vp, (3,))
+    eps = float(eps)
+    epsp = float(epsp)
+    if not (np.isfinite(eps) and np.isfinite(epsp) and 0.0 <= eps < np.pi / 2
+            and 0.0 <= epsp < np.pi / 2):
+        raise ValueError(f"eps and epsp must be in [0, pi/2), got {eps}, {epsp}")
+    n1 = np.empty(3)
+    n2 = np.empty(3)
+    st = lib.mcg_wedge_normals(_p(v), _p(vp), eps, epsp, _p(n1), _p(n2))
+    if st == lib.MCG_EDEGENERATE:
+        return None
+    _check(st, "wedge_normals")
+    return n1, n2

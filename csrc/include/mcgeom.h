@@ -450,6 +450,29 @@ void mcg_cone_default_options(mcg_cone_options *opt);
 int mcg_cone_linf(int n, const double *apex, const double *axis,
                   const mcg_cone_options *opt, mcg_cone_result *res);
 
+/* -------------------------------------------------------------- wedge.c */
+
+/* The two bitangent-plane normals of a correspondence with angular error
+ * bounds (thesis eqs. 10.9-10.12), in our convention X2 = R X1 + t.
+ * v: the bearing at time 1 ROTATED into the time-2 orientation (v = R d1),
+ * vp: the bearing at time 2 (both any non-zero length, |value| <= 1e150);
+ * eps, epsp: error bounds (radians, in [0, pi/2)) of v and vp.
+ * On MCG_OK, n1 and n2 are unit vectors such that every translation
+ * direction t = l' u' - l u (l, l' > 0: the point in front of both cameras)
+ * with angle(u, v) <= eps and angle(u', vp) <= epsp satisfies
+ * n1.t >= 0 and n2.t >= 0, and each plane is tangent to both error cones.
+ * n1 - n2 points along v x vp. The thesis's normals (it constrains the centre
+ * motion c' - c = -t) are -n1, -n2.
+ * For camera k of a rig (centre c_k in the rig frame, d1 and d2 the rig-frame
+ * directions of the two rays, v = R d1, vp = d2) the constraint on the rig
+ * translation is n.t >= n.(c_k - R c_k), one row of the LP below.
+ * MCG_EDEGENERATE (n1, n2 untouched, no constraint): v parallel to vp, the
+ * error cones overlapping (angle(v, vp) <= eps + epsp: every direction is
+ * compatible) or nested (v close to -vp). MCG_EINVAL: NULL, NaN/inf, a zero
+ * vector, eps or epsp outside [0, pi/2). */
+int mcg_wedge_normals(const double v[3], const double vp[3], double eps,
+                      double epsp, double n1[3], double n2[3]);
+
 /* MCG_CDEF_END */
 
 #ifdef __cplusplus
