@@ -635,3 +635,50 @@ def wedge_normals(v: Any, vp: Any, eps: float, epsp: float) -> Optional[tuple[np
         return None
     _check(st, "wedge_normals")
     return n1, n2
+
+
+# -------------------------------------------------------------- lp_native.c
+
+__all__ += ["lp_feasible", "LP_BACKENDS"]
+
+
+def _lp_native_backend():
+    be = ffi.new("mcg_lp_backend *")
+    _check(lib.mcg_lp_native_backend(be), "lp_native_backend")
+    return be
+
+
+#: LP feasibility backends built into this library (name -> table factory)
+LP_BACKENDS = {"native": _lp_native_backend}
+
+
+def lp_feasible(A: Any, b: Any, backend: str = "native") -> Optional[np.ndarray]:
+    """Feasibility of ``{x : A @ x >= b}`` in 2 or 3 variables (thesis ch. 10.3).
+
+    ``A``: (m, d), d in {2, 3}; ``b``: (m,). Returns a feasible point (d,) or
+    ``None`` when the set is empty. ``backend`` names an entry of
+    ``LP_BACKENDS``. The native backend searches the box ``|x_i| <= 1e6 S`` and
+    relaxes each row by ``1e-9 S`` (``S = max(1, max |b_k| / |A_k|)``): the
+    point satisfies ``A_k @ x >= b_k - 2e-9 S |A_k|``. Raises ``ValueError``
+    for bad input.
+    """
+    if backend not in LP_BACKENDS:
+        raise ValueError(f"unknown LP backend {backend!r}; available: {sorted(LP_BACKENDS)}")
+    A = _arr("A", A, (-1, -1))
+    m, d = A.shape
+    if d not in (2, 3):
+        raise ValueError(f"A must have 2 or 3 columns, got {d}")
+    b = _arr("b", b, (m,))
+    if m > (1 << 20):
+        raise ValueError(f"lp_feasible accepts at most 2^20 rows, got {m}")
+    if m and (np.abs(A).max() > 1e150 or np.abs(b).max() > 1e150):
+        raise ValueError("A and b must be below 1e150 in magnitude")
+    be = LP_BACKENDS[backend]()
+    work = _work(lib.mcg_lp_work_size(be, d, m))
+    x = np.empty(d)
+    st = lib.mcg_lp_feasible(be, d, m, _p(A) if m else ffi.NULL, _p(b) if m else ffi.NULL,
+                             _p(x), _p(work), work.size)
+    if st == lib.MCG_EINFEASIBLE:
+        return None
+    _check(st, f"lp_feasible[{backend}]")
+    return x

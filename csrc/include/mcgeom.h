@@ -473,6 +473,43 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
 int mcg_wedge_normals(const double v[3], const double vp[3], double eps,
                       double epsp, double n1[3], double n2[3]);
 
+/* ---------------------------------------------------- lp_native.c, lp_*.c */
+
+/* LP feasibility of {x in R^dim : A[k] . x >= b[k], k < m}, dim = 2 or 3
+ * (thesis ch. 10.3: 3 variables for the rig translation, 2 for the
+ * single-camera preemptive test), behind one backend table. A is m x dim,
+ * row-major. feasible() returns MCG_OK with a feasible point in x (dim
+ * values), MCG_EINFEASIBLE if the set is empty, MCG_EINVAL for bad
+ * arguments (dim not 2 or 3, m outside [0, 2^20], NULL, NaN/inf or
+ * |value| > 1e150), MCG_ENOMEM if lwork < work_size(ctx, dim, m).
+ * Tolerances and the search box are backend-specific (documented below).
+ * Backends: native (always built), glpk (when built with GLPK). */
+typedef struct {
+    const char *name;   /* "native", "glpk" */
+    void *ctx;          /* backend state passed back to the functions */
+    size_t (*work_size)(void *ctx, int dim, int m);
+    int (*feasible)(void *ctx, int dim, int m, const double *A,
+                    const double *b, double *x, double *work, size_t lwork);
+} mcg_lp_backend;
+
+size_t mcg_lp_work_size(const mcg_lp_backend *be, int dim, int m);
+int mcg_lp_feasible(const mcg_lp_backend *be, int dim, int m, const double *A,
+                    const double *b, double *x, double *work, size_t lwork);
+
+/* The native backend: Seidel's randomized incremental LP with a fixed-seed
+ * shuffle (deterministic), expected O(m). Rows are normalised; with
+ * S = max(1, max_k |b_k| / |A_k|), points are searched in the box
+ * |x_i| <= 1e6 S and each constraint is relaxed by 1e-9 S: on MCG_OK,
+ * A_k . x >= b_k - 2e-9 S |A_k| (verified), x is a vertex of the relaxed set
+ * or of the box. Sets within ~1e-9 S of the feasibility boundary may get
+ * either answer. A row with |A_k| <= 1e-100 means 0 >= b_k. Work size:
+ * 3 m + 1 (dim 2), 7 (m + 6) (dim 3) doubles; 0 for invalid sizes. */
+size_t mcg_lp_native_work_size(int dim, int m);
+int mcg_lp_native_feasible(int dim, int m, const double *A, const double *b,
+                           double *x, double *work, size_t lwork);
+/* Fill *be with the native backend (ctx = NULL). */
+int mcg_lp_native_backend(mcg_lp_backend *be);
+
 /* MCG_CDEF_END */
 
 #ifdef __cplusplus
