@@ -364,3 +364,35 @@ int mcg_lp_feasible(const mcg_lp_backend *be, int dim, int m, const double *A,
         return MCG_EINVAL;
     return be->feasible(be->ctx, dim, m, A, b, x, work, lwork);
 }
+
+#ifndef MCG_HAVE_GLPK
+/* Built without GLPK: the GLPK backend's entry points exist and say so
+ * (lp_glpk.c, GPL-3.0, replaces them when GLPK is found). */
+int mcg_lp_glpk_available(void) { return 0; }
+
+size_t mcg_lp_glpk_work_size(int dim, int m)
+{
+    (void)dim;
+    (void)m;
+    return 0;
+}
+
+int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
+                         double *x, double *work, size_t lwork)
+{
+    (void)dim;
+    (void)m;
+    (void)A;
+    (void)b;
+    (void)x;
+    (void)work;
+    (void)lwork;
+    return MCG_EINVAL;
+}
+
+int mcg_lp_glpk_backend(mcg_lp_backend *be)
+{
+    (void)be;
+    return MCG_EINVAL;
+}
+#endif

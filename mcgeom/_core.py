@@ -682,3 +682,14 @@ def lp_feasible(A: Any, b: Any, backend: str = "native") -> Optional[np.ndarray]
         return None
     _check(st, f"lp_feasible[{backend}]")
     return x
+
+
+def _lp_glpk_backend():
+    be = ffi.new("mcg_lp_backend *")
+    _check(lib.mcg_lp_glpk_backend(be), "lp_glpk_backend")
+    return be
+
+
+# the GLPK backend (GPL-3.0) exists only in builds configured with GLPK
+if lib.mcg_lp_glpk_available():
+    LP_BACKENDS["glpk"] = _lp_glpk_backend

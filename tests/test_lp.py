@@ -61,3 +61,18 @@ def test_known_and_invalid():
         _core.lp_feasible([[1.0, 0.0]], [1.0, 2.0])
     with pytest.raises(ValueError):
         _core.lp_feasible([[1.0, 0.0]], [1.0], backend="nope")
+
+
+@pytest.mark.skipif("glpk" not in _core.LP_BACKENDS, reason="built without GLPK")
+@pytest.mark.parametrize("d", [2, 3])
+def test_glpk_agrees_with_native(d):
+    rng = np.random.default_rng(10 + d)
+    for _ in range(300):
+        m = int(rng.integers(1, 60))
+        A = rng.normal(size=(m, d))
+        b = A @ rng.normal(size=d) + rng.normal(size=m) * 0.5 - 0.4
+        if abs(_margin_lp(A, b)) < 1e-6:
+            continue
+        xn = _core.lp_feasible(A, b)
+        xg = _core.lp_feasible(A, b, backend="glpk")
+        assert (xn is None) == (xg is None)

@@ -510,6 +510,20 @@ int mcg_lp_native_feasible(int dim, int m, const double *A, const double *b,
 /* Fill *be with the native backend (ctx = NULL). */
 int mcg_lp_native_backend(mcg_lp_backend *be);
 
+/* The GLPK backend (lp_glpk.c, GPL-3.0-or-later: a build that includes it is
+ * GPL-3.0 as a whole), compiled only when meson finds GLPK (-Dglpk=auto,
+ * the default, or enabled; -Dglpk_prefix=DIR for an install under DIR/include
+ * and DIR/lib). Same scaling and box as the native backend; GLPK's primal
+ * simplex maximises the margin d of all rows, feasible iff d >= -1e-8 S
+ * (then A_k . x >= b_k - 2e-8 S |A_k|); GLPK allocates internally. mcg_lp_glpk_available() is 1 when
+ * built in; otherwise the other three return 0 / MCG_EINVAL. Work size:
+ * 3 (1 + m (dim + 1)) doubles. */
+int mcg_lp_glpk_available(void);
+size_t mcg_lp_glpk_work_size(int dim, int m);
+int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
+                         double *x, double *work, size_t lwork);
+int mcg_lp_glpk_backend(mcg_lp_backend *be);
+
 /* MCG_CDEF_END */
 
 #ifdef __cplusplus

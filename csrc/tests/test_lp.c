@@ -372,12 +372,100 @@ static void invalid(void)
                  "NULL backend");
 }
 
+/* GLPK backend (when built in): the same answers as the native backend and
+ * brute force on clear-cut random instances (random, near-duplicate rows,
+ * all rows through one point), and on large instances with a known answer */
+static void cross_glpk(void)
+{
+    static double WG[3 * (1 + 4 * 5000)];
+    double x[3], xg[3], x0[3];
+    int trial, dim, k, i, disagree = 0, clear = 0, bad_x = 0, sg, sn;
+    if (!mcg_lp_glpk_available()) {
+        printf("GLPK backend not built: cross-check skipped\n");
+        check_status(mcg_lp_glpk_backend(NULL), MCG_EINVAL,
+                     "glpk stub says not available");
+        return;
+    }
+    for (trial = 0; trial < 4000; ++trial) {
+        int m, bf_lo, bf_hi;
+        dim = 2 + trial % 2;
+        m = 1 + (int)(urand() * 9);
+        randn(x0, 3);
+        for (k = 0; k < m; ++k) {
+            double s = 0;
+            randn(A + k * dim, dim);
+            if (trial % 5 == 0 && k > 0)
+                for (i = 0; i < dim; ++i)
+                    A[k * dim + i] = A[i] + 1e-6 * nrand();
+            for (i = 0; i < dim; ++i)
+                s += A[k * dim + i] * x0[i];
+            B[k] = s + nrand() * 2.0;
+            if (trial % 7 == 0)
+                B[k] = s;
+        }
+        sn = native(dim, m, A, B, x);
+        sg = mcg_lp_glpk_feasible(dim, m, A, B, xg, WG, sizeof WG / sizeof WG[0]);
+        if (sg == MCG_OK && !satisfies(dim, m, A, B, xg, 2.001e-8))
+            ++bad_x;
+        bf_lo = brute(dim, m, A, B, 1e-6);
+        bf_hi = brute(dim, m, A, B, -1e-6);
+        if (trial % 7 == 0) {
+            if (sg != MCG_OK || sn != MCG_OK) {
+                ++disagree;
+                printf("  degenerate trial %d dim %d m %d: native %d glpk %d\n",
+                       trial, dim, m, sn, sg);
+            }
+            continue;
+        }
+        if (bf_lo != bf_hi)
+            continue;
+        ++clear;
+        if (sg != sn || (sg != MCG_OK && sg != MCG_EINFEASIBLE)) {
+            ++disagree;
+            printf("  trial %d dim %d m %d: native %d glpk %d brute %d\n",
+                   trial, dim, m, sn, sg, bf_lo);
+        }
+    }
+    /* large: feasible (tangent to a ball), infeasible (all around, and by
+     * a margin of 1e-5) */
+    for (dim = 2; dim <= 3; ++dim) {
+        int m = 5000, c;
+        randn(x0, 3);
+        for (c = 0; c < 3; ++c) {
+            for (k = 0; k < m; ++k) {
+                double s = 0, nn = 0;
+                if (c == 0)
+                    randn(A + k * dim, dim);
+                for (i = 0; i < dim; ++i) {
+                    s += A[k * dim + i] * x0[i];
+                    nn += A[k * dim + i] * A[k * dim + i];
+                }
+                B[k] = c == 0 ? s - sqrt(nn) : (c == 1 ? 1.0 : s + 1e-5 * sqrt(nn));
+            }
+            sn = native(dim, m, A, B, x);
+            sg = mcg_lp_glpk_feasible(dim, m, A, B, xg, WG,
+                                      sizeof WG / sizeof WG[0]);
+            ++clear;
+            if (sn != sg || sg != (c == 0 ? MCG_OK : MCG_EINFEASIBLE)) {
+                ++disagree;
+                printf("  large dim %d case %d: native %d glpk %d\n", dim, c,
+                       sn, sg);
+            }
+        }
+    }
+    printf("glpk cross-check: %d clear-cut instances\n", clear);
+    check(disagree == 0, "glpk and native agree (clear-cut instances)",
+          (double)disagree, 0);
+    check(bad_x == 0, "glpk: returned x satisfies all rows", (double)bad_x, 0);
+}
+
 int main(void)
 {
     known();
     random_small();
     random_large();
     invalid();
+    cross_glpk();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed != 0;
 }

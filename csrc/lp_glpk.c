@@ -1,0 +1,198 @@
+/*
+ * lp_glpk.c -- the GLPK backend of the LP feasibility interface of mcgeom.h
+ * (thesis ch. 10.3: the thesis solved its LPs with GLPK).
+ *
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ * This file links against GLPK (GNU GPL v3 or later). It is compiled only
+ * when meson finds GLPK (-Dglpk=auto|enabled); a libmcgeom or Python
+ * extension built with it is covered by the GPL-3.0 as a whole. Without it,
+ * lp_native.c provides stubs (mcg_lp_glpk_available() = 0) and the library
+ * stays MIT.
+ *
+ * Formulation: the same scaling as the native backend, so that the two
+ * answer the same question: rows normalised, the box
+ * |x_i| <= 1e6 S, S = max(1, max_k |b_k| / |A_k|). GLPK maximises the
+ * margin d (A_k . x / |A_k| - d >= b_k / |A_k|, d <= S, primal simplex,
+ * messages off), which is always feasible and so never asks GLPK's
+ * tolerances to decide infeasibility; the set is feasible iff d* >= -1e-8 S
+ * (floating-point simplex margins at highly degenerate vertices were seen
+ * off by 3e-9 S, too close to the native backend's 1e-9 S), and then
+ * A_k . x >= b_k - 2e-8 S |A_k| (verified). Answers therefore agree with the
+ * native backend except for sets within ~1e-8 S of the feasibility
+ * boundary. (glp_exact, the rational simplex, was tried for borderline
+ * cases: GLPK 5.0 aborts on an internal assertion in some of them.) GLPK allocates its problem
+ * object internally (malloc inside GLPK, freed before returning); the
+ * caller's workspace is used for the index and value arrays of the matrix.
+ * glp_term_out() sets GLPK's own per-thread environment flag.
+ */
+#include "mcgeom.h"
+#include "internal.h"
+
+#include <glpk.h>
+#include <math.h>
+
+#define LP_MAX_ROWS ((int)1 << 20)
+#define ZERO_ROW 1e-100
+#define VALUE_MAX 1e150
+
+int mcg_lp_glpk_available(void) { return 1; }
+
+/* ia, ja (ints) and ar (doubles), each 1 + m * dim entries, in doubles */
+size_t mcg_lp_glpk_work_size(int dim, int m)
+{
+    size_t n;
+    if ((dim != 2 && dim != 3) || m < 0 || m > LP_MAX_ROWS)
+        return 0;
+    n = 1 + (size_t)m * (size_t)(dim + 1);
+    /* two int arrays stored in doubles (sizeof(int) <= sizeof(double)) */
+    return 3 * n;
+}
+
+int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
+                         double *x, double *work, size_t lwork)
+{
+    glp_prob *lp;
+    glp_smcp parm;
+    int *ia, *ja, k, i, ne = 0, st, status, ret;
+    double *ar, S = 1.0, big, tol;
+    size_t n;
+
+    if ((dim != 2 && dim != 3) || m < 0 || m > LP_MAX_ROWS || !x)
+        return MCG_EINVAL;
+    if (m > 0 && (!A || !b))
+        return MCG_EINVAL;
+    if (!work || lwork < mcg_lp_glpk_work_size(dim, m))
+        return work ? MCG_ENOMEM : MCG_EINVAL;
+    for (k = 0; k < m * dim; ++k)
+        if (!isfinite(A[k]) || fabs(A[k]) > VALUE_MAX)
+            return MCG_EINVAL;
+    for (k = 0; k < m; ++k)
+        if (!isfinite(b[k]) || fabs(b[k]) > VALUE_MAX)
+            return MCG_EINVAL;
+    for (k = 0; k < m; ++k) {
+        double n2 = 0.0, nn;
+        for (i = 0; i < dim; ++i)
+            n2 += A[k * dim + i] * A[k * dim + i];
+        nn = sqrt(n2);
+        if (!(nn > ZERO_ROW)) {
+            if (b[k] > 0.0)
+                return MCG_EINFEASIBLE;
+            continue;
+        }
+        if (fabs(b[k]) / nn > S)
+            S = fabs(b[k]) / nn;
+    }
+    big = 1e6 * S;
+    tol = 1e-8 * S; /* GLPK's threshold, see the file comment */
+    n = 1 + (size_t)m * (size_t)(dim + 1);
+    ar = work;
+    ia = (int *)(work + n);
+    ja = (int *)(work + 2 * n);
+
+    glp_term_out(GLP_OFF);
+    lp = glp_create_prob();
+    /* maximise the margin d: A_k x / |A_k| - d >= b_k / |A_k|, d <= S */
+    glp_set_obj_dir(lp, GLP_MAX);
+    glp_add_cols(lp, dim + 1);
+    for (i = 0; i < dim; ++i) {
+        glp_set_col_bnds(lp, i + 1, GLP_DB, -big, big);
+        glp_set_obj_coef(lp, i + 1, 0.0);
+    }
+    glp_set_col_bnds(lp, dim + 1, GLP_UP, 0.0, S);
+    glp_set_obj_coef(lp, dim + 1, 1.0);
+    {
+        int nr = 0;
+        for (k = 0; k < m; ++k) {
+            double n2 = 0.0, nn;
+            for (i = 0; i < dim; ++i)
+                n2 += A[k * dim + i] * A[k * dim + i];
+            nn = sqrt(n2);
+            if (!(nn > ZERO_ROW))
+                continue;
+            ++nr;
+        }
+        if (nr > 0)
+            glp_add_rows(lp, nr);
+        nr = 0;
+        for (k = 0; k < m; ++k) {
+            double n2 = 0.0, nn;
+            for (i = 0; i < dim; ++i)
+                n2 += A[k * dim + i] * A[k * dim + i];
+            nn = sqrt(n2);
+            if (!(nn > ZERO_ROW))
+                continue;
+            ++nr;
+            glp_set_row_bnds(lp, nr, GLP_LO, b[k] / nn, 0.0);
+            for (i = 0; i < dim; ++i) {
+                ++ne;
+                ia[ne] = nr;
+                ja[ne] = i + 1;
+                ar[ne] = A[k * dim + i] / nn;
+            }
+            ++ne;
+            ia[ne] = nr;
+            ja[ne] = dim + 1;
+            ar[ne] = -1.0;
+        }
+    }
+    if (ne > 0)
+        glp_load_matrix(lp, ne, ia, ja, ar);
+    glp_init_smcp(&parm);
+    parm.msg_lev = GLP_MSG_OFF;
+    parm.presolve = GLP_OFF;
+    /* primal tolerance below the decision threshold (default 1e-7; 1e-10
+     * made GLPK stall), and a bounded number of simplex iterations */
+    parm.tol_bnd = 1e-9;
+    parm.it_lim = 10000 + 20 * m;
+    st = glp_simplex(lp, &parm);
+    status = glp_get_status(lp);
+    if (st == 0 && status == GLP_OPT) {
+        /* feasible iff the relaxed rows (margin -tol) can be met */
+        if (glp_get_col_prim(lp, dim + 1) >= -tol) {
+            for (i = 0; i < dim; ++i)
+                x[i] = glp_get_col_prim(lp, i + 1);
+            ret = MCG_OK;
+        } else {
+            ret = MCG_EINFEASIBLE;
+        }
+    } else {
+        ret = MCG_ENUMERIC;
+    }
+    glp_delete_prob(lp);
+    if (ret == MCG_OK)
+        for (k = 0; k < m; ++k) {
+            double s = 0.0, n2 = 0.0;
+            for (i = 0; i < dim; ++i) {
+                s += A[k * dim + i] * x[i];
+                n2 += A[k * dim + i] * A[k * dim + i];
+            }
+            if (s < b[k] - 2.0 * tol * sqrt(n2) || !isfinite(s))
+                return MCG_ENUMERIC;
+        }
+    return ret;
+}
+
+static size_t glpk_work_size(void *ctx, int dim, int m)
+{
+    (void)ctx;
+    return mcg_lp_glpk_work_size(dim, m);
+}
+
+static int glpk_feasible(void *ctx, int dim, int m, const double *A,
+                         const double *b, double *x, double *work,
+                         size_t lwork)
+{
+    (void)ctx;
+    return mcg_lp_glpk_feasible(dim, m, A, b, x, work, lwork);
+}
+
+int mcg_lp_glpk_backend(mcg_lp_backend *be)
+{
+    if (!be)
+        return MCG_EINVAL;
+    be->name = "glpk";
+    be->ctx = NULL;
+    be->work_size = glpk_work_size;
+    be->feasible = glpk_feasible;
+    return MCG_OK;
+}
