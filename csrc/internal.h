@@ -49,4 +49,25 @@ static inline int all_finite(const double *x, size_t n)
     return 1;
 }
 
+/* Centroid c of the 2n ray origins o1, o2 (n x 3 each, n >= 1) and the RMS
+ * distance of the origins from it: the position and size of a rig, both
+ * independent of the rig frame's origin and orientation. */
+static inline double origin_spread(int n, const double *o1, const double *o2, double c[3])
+{
+    double ss = 0.0;
+    int k, i;
+    c[0] = c[1] = c[2] = 0.0;
+    for (k = 0; k < n; k++)
+        for (i = 0; i < 3; i++)
+            c[i] += o1[3 * k + i] + o2[3 * k + i];
+    for (i = 0; i < 3; i++)
+        c[i] /= 2.0 * n;
+    for (k = 0; k < n; k++)
+        for (i = 0; i < 3; i++) {
+            double a = o1[3 * k + i] - c[i], b = o2[3 * k + i] - c[i];
+            ss += a * a + b * b;
+        }
+    return sqrt(ss / (2.0 * n));
+}
+
 #endif /* MCGEOM_INTERNAL_H */

@@ -671,6 +671,24 @@ int mcg_pinv(int m, int n, const double *a, double rcond, double *ainv,
 
 /* -------------------------------------------------- symmetric eigen */
 
+/* Overwrite the upper triangle (diagonal included) of the n x n matrix a
+ * with its symmetric part 0.5 (a + a^T) scaled by 2^-e so that max |a_ij| is
+ * in [0.5, 1); returns e. A power of two scales exactly: multiplying by it is
+ * exact whenever the factor is a normal number, ldexp is used otherwise. */
+static int scaled_symmetric_part(size_t n, double *a)
+{
+    int e = scale_exponent(max_abs(a, n * n));
+    double f = 0.5 * ldexp(1.0, -e);
+    int exact = f >= DBL_MIN && f <= 1e300;
+    size_t i, j;
+    for (i = 0; i < n; ++i)
+        for (j = i; j < n; ++j)
+            a[i * n + j] = exact ? f * a[i * n + j] + f * a[j * n + i]
+                                 : 0.5 * ldexp(a[i * n + j], -e) +
+                                       0.5 * ldexp(a[j * n + i], -e);
+    return e;
+}
+
 int mcg_sym_eig(int n, double *a, double *w, double *v)
 {
     size_t nn, np, i, j, p, q, r;
@@ -691,13 +709,7 @@ int mcg_sym_eig(int n, double *a, double *w, double *v)
      * in (a_qq - a_pp) below, exact (power of two) and undone at the end.
      * Only the upper triangle is used from here on: each rotation then
      * updates n - 2 pairs of entries instead of mirroring 2 (n - 2). */
-    e = scale_exponent(max_abs(a, nn * nn));
-    for (i = 0; i < nn; ++i) {
-        a[i * nn + i] = ldexp(a[i * nn + i], -e);
-        for (j = i + 1; j < nn; ++j)
-            a[i * nn + j] = 0.5 * ldexp(a[i * nn + j], -e) +
-                            0.5 * ldexp(a[j * nn + i], -e);
-    }
+    e = scaled_symmetric_part(nn, a);
     /* v holds V^T during the iteration (rows = eigenvectors) so that the
      * rotations touch contiguous memory; transposed at the end. */
     memset(v, 0, nn * nn * sizeof(double));
@@ -980,18 +992,8 @@ int mcg_sym_eig_tridiag(int n, double *a, double *w, double *v)
     nn = (size_t)n;
     if (!all_finite(a, nn * nn))
         return MCG_EINVAL;
-    /* symmetric part scaled by a power of two (exact) so that max |a_ij| is
-     * in [0.5, 1): no overflow or harmful underflow in the rotations */
-    ex = scale_exponent(max_abs(a, nn * nn));
-    {
-        double f = 0.5 * ldexp(1.0, -ex); /* |ex| <= 1074: f is normal or... */
-        int exact = f >= DBL_MIN && f <= 1e300; /* ...then multiplying is exact */
-        for (i = 0; i < nn; ++i)
-            for (j = i; j < nn; ++j)
-                a[i * nn + j] = exact ? f * a[i * nn + j] + f * a[j * nn + i]
-                                      : 0.5 * ldexp(a[i * nn + j], -ex) +
-                                            0.5 * ldexp(a[j * nn + i], -ex);
-    }
+    /* no overflow or harmful underflow in the rotations */
+    ex = scaled_symmetric_part(nn, a);
     tridiagonalize(nn, a, w, e, v);
     if (!tridiagonal_qr(nn, w, e, v))
         return MCG_ENUMERIC;

@@ -159,23 +159,13 @@ static int accumulate(int n, const double *o1, const double *d1,
                       const double *o2, const double *d2,
                       double *m, double origin[3], double *scale)
 {
-    double o[3] = {0.0, 0.0, 0.0}, ss = 0.0, s;
+    double o[3], ss, s;
     int k, i, j;
 
     if (!all_finite(o1, 3 * (size_t)n) || !all_finite(o2, 3 * (size_t)n) ||
         !all_finite(d1, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
         return MCG_EINVAL;
-    for (k = 0; k < n; k++)
-        for (i = 0; i < 3; i++)
-            o[i] += o1[3 * k + i] + o2[3 * k + i];
-    for (i = 0; i < 3; i++)
-        o[i] /= 2.0 * n;
-    for (k = 0; k < n; k++)
-        for (i = 0; i < 3; i++) {
-            double a = o1[3 * k + i] - o[i], b = o2[3 * k + i] - o[i];
-            ss += a * a + b * b;
-        }
-    ss = sqrt(ss / (2.0 * n));
+    ss = origin_spread(n, o1, o2, o);
     /* A central camera (all origins equal) has nothing to scale. */
     s = (ss > 1e-12 * (1.0 + sqrt(dot3(o, o)))) ? 1.0 / ss : 1.0;
     memcpy(origin, o, sizeof o);

@@ -25,15 +25,10 @@
  * caller's workspace is used for the index and value arrays of the matrix.
  * glp_term_out() sets GLPK's own per-thread environment flag.
  */
-#include "mcgeom.h"
-#include "internal.h"
+#include "lp_internal.h"
 
 #include <glpk.h>
 #include <math.h>
-
-#define LP_MAX_ROWS ((int)1 << 20)
-#define ZERO_ROW 1e-100
-#define VALUE_MAX 1e150
 
 int mcg_lp_glpk_available(void) { return 1; }
 
@@ -54,7 +49,7 @@ int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
     glp_prob *lp;
     glp_smcp parm;
     int *ia, *ja, k, i, ne = 0, st, status, ret;
-    double *ar, S = 1.0, big, tol;
+    double *ar, S, big, tol;
     size_t n;
 
     if ((dim != 2 && dim != 3) || m < 0 || m > LP_MAX_ROWS || !x)
@@ -63,25 +58,9 @@ int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
         return MCG_EINVAL;
     if (!work || lwork < mcg_lp_glpk_work_size(dim, m))
         return work ? MCG_ENOMEM : MCG_EINVAL;
-    for (k = 0; k < m * dim; ++k)
-        if (!isfinite(A[k]) || fabs(A[k]) > VALUE_MAX)
-            return MCG_EINVAL;
-    for (k = 0; k < m; ++k)
-        if (!isfinite(b[k]) || fabs(b[k]) > VALUE_MAX)
-            return MCG_EINVAL;
-    for (k = 0; k < m; ++k) {
-        double n2 = 0.0, nn;
-        for (i = 0; i < dim; ++i)
-            n2 += A[k * dim + i] * A[k * dim + i];
-        nn = sqrt(n2);
-        if (!(nn > ZERO_ROW)) {
-            if (b[k] > 0.0)
-                return MCG_EINFEASIBLE;
-            continue;
-        }
-        if (fabs(b[k]) / nn > S)
-            S = fabs(b[k]) / nn;
-    }
+    st = lp_check_rows(dim, m, A, b, &S); /* zero rows are decided here */
+    if (st != MCG_OK)
+        return st;
     big = 1e6 * S;
     tol = 1e-8 * S; /* GLPK's threshold, see the file comment */
     n = 1 + (size_t)m * (size_t)(dim + 1);
@@ -102,23 +81,14 @@ int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
     glp_set_obj_coef(lp, dim + 1, 1.0);
     {
         int nr = 0;
-        for (k = 0; k < m; ++k) {
-            double n2 = 0.0, nn;
-            for (i = 0; i < dim; ++i)
-                n2 += A[k * dim + i] * A[k * dim + i];
-            nn = sqrt(n2);
-            if (!(nn > ZERO_ROW))
-                continue;
-            ++nr;
-        }
+        for (k = 0; k < m; ++k)
+            if (lp_row_norm(dim, A, k) > ZERO_ROW)
+                ++nr;
         if (nr > 0)
             glp_add_rows(lp, nr);
         nr = 0;
         for (k = 0; k < m; ++k) {
-            double n2 = 0.0, nn;
-            for (i = 0; i < dim; ++i)
-                n2 += A[k * dim + i] * A[k * dim + i];
-            nn = sqrt(n2);
+            double nn = lp_row_norm(dim, A, k);
             if (!(nn > ZERO_ROW))
                 continue;
             ++nr;
@@ -160,15 +130,7 @@ int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
     }
     glp_delete_prob(lp);
     if (ret == MCG_OK)
-        for (k = 0; k < m; ++k) {
-            double s = 0.0, n2 = 0.0;
-            for (i = 0; i < dim; ++i) {
-                s += A[k * dim + i] * x[i];
-                n2 += A[k * dim + i] * A[k * dim + i];
-            }
-            if (s < b[k] - 2.0 * tol * sqrt(n2) || !isfinite(s))
-                return MCG_ENUMERIC;
-        }
+        return lp_verify_point(dim, m, A, b, x, tol);
     return ret;
 }
 

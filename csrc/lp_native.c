@@ -33,19 +33,15 @@
  *
  * No allocation: the caller passes mcg_lp_native_work_size(dim, m) doubles.
  */
-#include "mcgeom.h"
-#include "internal.h"
+#include "lp_internal.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
-#define LP_MAX_ROWS ((int)1 << 20)
-#define ZERO_ROW 1e-100
 #define PARALLEL 1e-12   /* projected row norm below: parallel to the plane */
 #define BOX_FACTOR 1e6
 #define TOL_FACTOR 1e-9
-#define VALUE_MAX 1e150
 
 /* generic objective directions (powers of the plastic number's inverse) */
 static const double OBJ3[3] = {1.0, 0.7548776662466927, 0.5698402909980532};
@@ -244,8 +240,8 @@ int mcg_lp_native_feasible(int dim, int m, const double *A, const double *b,
                            double *x, double *work, size_t lwork)
 {
     size_t need;
-    double S = 1.0, big, tol;
-    int k, i, nr = 0, w = dim + 1;
+    double S, big, tol;
+    int k, i, st, nr = 0, w = dim + 1;
 
     if ((dim != 2 && dim != 3) || m < 0 || m > LP_MAX_ROWS || !x)
         return MCG_EINVAL;
@@ -254,36 +250,15 @@ int mcg_lp_native_feasible(int dim, int m, const double *A, const double *b,
     need = mcg_lp_native_work_size(dim, m);
     if (!work || lwork < need)
         return work ? MCG_ENOMEM : MCG_EINVAL;
-    for (k = 0; k < m * dim; ++k)
-        if (!isfinite(A[k]) || fabs(A[k]) > VALUE_MAX)
-            return MCG_EINVAL;
-    for (k = 0; k < m; ++k)
-        if (!isfinite(b[k]) || fabs(b[k]) > VALUE_MAX)
-            return MCG_EINVAL;
-
-    /* normalise; zero rows are decided here */
-    for (k = 0; k < m; ++k) {
-        double n2 = 0.0, n;
-        for (i = 0; i < dim; ++i)
-            n2 += A[k * dim + i] * A[k * dim + i];
-        n = sqrt(n2);
-        if (!(n > ZERO_ROW)) {
-            if (b[k] > 0.0)
-                return MCG_EINFEASIBLE;
-            continue;
-        }
-        if (fabs(b[k]) / n > S)
-            S = fabs(b[k]) / n;
-    }
+    st = lp_check_rows(dim, m, A, b, &S); /* zero rows are decided here */
+    if (st != MCG_OK)
+        return st;
     big = BOX_FACTOR * S;
     tol = TOL_FACTOR * S;
     {
         double *rows = work + (dim == 3 ? 6 * w : 0);
         for (k = 0; k < m; ++k) {
-            double n2 = 0.0, n;
-            for (i = 0; i < dim; ++i)
-                n2 += A[k * dim + i] * A[k * dim + i];
-            n = sqrt(n2);
+            double n = lp_row_norm(dim, A, k);
             if (!(n > ZERO_ROW))
                 continue;
             for (i = 0; i < dim; ++i)
@@ -310,17 +285,7 @@ int mcg_lp_native_feasible(int dim, int m, const double *A, const double *b,
                 return MCG_EINFEASIBLE;
         }
     }
-    /* verify against the original rows */
-    for (k = 0; k < m; ++k) {
-        double s = 0.0, n2 = 0.0;
-        for (i = 0; i < dim; ++i) {
-            s += A[k * dim + i] * x[i];
-            n2 += A[k * dim + i] * A[k * dim + i];
-        }
-        if (s < b[k] - 2.0 * tol * sqrt(n2) || !isfinite(s))
-            return MCG_ENUMERIC;
-    }
-    return MCG_OK;
+    return lp_verify_point(dim, m, A, b, x, tol);
 }
 
 /* ------------------------------------------------------ backend table */

@@ -561,20 +561,9 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
             return MCG_EDEGENERATE; /* no ray constrains the motion here */
     }
     {
-        /* characteristic length L of the rig: RMS distance of the ray
-         * origins from their centroid (independent of the rig frame) */
-        double c[3] = {0.0, 0.0, 0.0}, so2 = 0.0;
-        for (k = 0; k < n; k++)
-            for (i = 0; i < 3; i++)
-                c[i] += o1[3 * k + i] + o2[3 * k + i];
-        for (i = 0; i < 3; i++)
-            c[i] /= 2.0 * n;
-        for (k = 0; k < n; k++)
-            for (i = 0; i < 3; i++) {
-                double a1 = o1[3 * k + i] - c[i], a2 = o2[3 * k + i] - c[i];
-                so2 += a1 * a1 + a2 * a2;
-            }
-        ell = sqrt(so2 / (2.0 * n));
+        /* characteristic length L of the rig (independent of the rig frame) */
+        double c[3];
+        ell = origin_spread(n, o1, o2, c);
     }
     lambda = o.initial_lambda;
 

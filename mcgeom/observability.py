@@ -27,7 +27,7 @@ from .types import RayPairs, ScaleVerdict
 
 __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_only_fit",
            "count_in_front", "scale_profile", "travel_direction", "rotation_only_residuals",
-           "critical_angle", "refine_centred"]
+           "critical_angle", "refine_centred", "same_camera"]
 
 
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
@@ -63,17 +63,23 @@ def critical_angle(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     return rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
 
 
+def same_camera(rays: RayPairs) -> np.ndarray:
+    """Intra-camera correspondences: same camera id at both times, or (without
+    ids) the same origin."""
+    if rays.cam1 is not None and rays.cam2 is not None:
+        return rays.cam1 == rays.cam2
+    return np.all(rays.origins1 == rays.origins2, axis=1)
+
+
 def _centres_with_intra(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, int]:
     """Centres of cameras with intra-camera inliers, and the number of cross-camera inliers."""
+    same = same_camera(rays)
+    intra = mask & same
+    cross = int((mask & ~same).sum())
     if rays.cam1 is not None and rays.cam2 is not None:
-        intra = mask & (rays.cam1 == rays.cam2)
-        cross = int((mask & (rays.cam1 != rays.cam2)).sum())
         ids = np.unique(rays.cam1[intra])
         centres = np.array([rays.origins1[intra & (rays.cam1 == k)][0] for k in ids])
         return centres.reshape(-1, 3), cross
-    same = np.all(rays.origins1 == rays.origins2, axis=1)
-    intra = mask & same
-    cross = int((mask & ~same).sum())
     centres = np.unique(rays.origins1[intra], axis=0) if intra.any() else np.zeros((0, 3))
     return centres, cross
 
@@ -129,19 +135,30 @@ def count_in_front(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     """Correspondences whose two rays meet (mid-point) in front of both origins
     when the time-1 ray is moved by (R, t) into the time-2 rig frame."""
     sel = slice(None) if mask is None else np.asarray(mask, bool)
-    p = rays.origins1[sel] @ R.T + t
+    return _counts_in_front(rays, R, t, (np.zeros(3),), sel)[0]
+
+
+def _counts_in_front(rays: RayPairs, R: np.ndarray, t0: np.ndarray, vs, sel) -> list[int]:
+    """:func:`count_in_front` for each ``t = t0 + v``, ``v`` in ``vs``, in one
+    pass: the translation enters the mid-point equations only through the
+    products a.w and b.w, which are affine in it."""
+    p = rays.origins1[sel] @ R.T + t0
     a = rays.dirs1[sel] @ R.T
     b = rays.dirs2[sel]
-    w = rays.origins2[sel] - p
+    w0 = rays.origins2[sel] - p
     aa, bb, ab = (np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", b, b),
                   np.einsum("ij,ij->i", a, b))
-    aw, bw = np.einsum("ij,ij->i", a, w), np.einsum("ij,ij->i", b, w)
+    aw0, bw0 = np.einsum("ij,ij->i", a, w0), np.einsum("ij,ij->i", b, w0)
     den = aa * bb - ab * ab
     ok = den > 1e-14 * aa * bb
     den = np.where(ok, den, 1.0)
-    s1 = (aw * bb - bw * ab) / den
-    s2 = (aw * ab - bw * aa) / den
-    return int(np.sum(ok & (s1 > 0) & (s2 > 0)))
+    counts = []
+    for v in vs:                           # w = o2 - (R o1 + t0 + v)
+        aw, bw = aw0 - a @ v, bw0 - b @ v
+        s1 = (aw * bb - bw * ab) / den
+        s2 = (aw * ab - bw * aa) / den
+        counts.append(int(np.sum(ok & (s1 > 0) & (s2 > 0))))
+    return counts
 
 
 def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
@@ -173,31 +190,8 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     u = tau / n
     spread = np.sqrt(np.mean(np.sum((rays.origins1[sel] - c) ** 2, axis=1))) if sel.any() else 1.0
     L = max(1.0, 100.0 * spread, 100.0 * np.linalg.norm(shift))
-    plus, minus = _count_in_front_both(rays, R, L * u, -shift, sel)
+    plus, minus = _counts_in_front(rays, R, -shift, (L * u, -L * u), sel)
     return u if plus >= minus else -u
-
-
-def _count_in_front_both(rays: RayPairs, R: np.ndarray, v: np.ndarray, t0: np.ndarray,
-                         sel: np.ndarray) -> tuple[int, int]:
-    """:func:`count_in_front` for ``t = t0 + v`` and ``t = t0 - v`` in one pass."""
-    p = rays.origins1[sel] @ R.T + t0
-    a = rays.dirs1[sel] @ R.T
-    b = rays.dirs2[sel]
-    w0 = rays.origins2[sel] - p
-    aa, bb, ab = (np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", b, b),
-                  np.einsum("ij,ij->i", a, b))
-    aw0, bw0 = np.einsum("ij,ij->i", a, w0), np.einsum("ij,ij->i", b, w0)
-    av, bv = a @ v, b @ v
-    den = aa * bb - ab * ab
-    ok = den > 1e-14 * aa * bb
-    den = np.where(ok, den, 1.0)
-    counts = []
-    for sgn in (1.0, -1.0):                 # w = o2 - (R o1 + t0 + sgn v)
-        aw, bw = aw0 - sgn * av, bw0 - sgn * bv
-        s1 = (aw * bb - bw * ab) / den
-        s2 = (aw * ab - bw * aa) / den
-        counts.append(int(np.sum(ok & (s1 > 0) & (s2 > 0))))
-    return counts[0], counts[1]
 
 
 def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -209,18 +203,15 @@ def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.
     pure rotation, or everything at infinity) and neither the direction nor the
     scale of ``t`` is determined.
     """
-    same = (rays.cam1 == rays.cam2) if rays.cam1 is not None and rays.cam2 is not None \
-        else np.all(rays.origins1 == rays.origins2, axis=1)
-    sel = np.asarray(mask, bool) & same
+    sel = np.asarray(mask, bool) & same_camera(rays)
     if sel.sum() < 2:
         return np.eye(3), np.zeros(0)
-    d1 = rays.dirs1[sel] / np.linalg.norm(rays.dirs1[sel], axis=1, keepdims=True)
-    d2 = rays.dirs2[sel] / np.linalg.norm(rays.dirs2[sel], axis=1, keepdims=True)
+    sub = rays.take(sel)
+    d1 = sub.dirs1 / np.linalg.norm(sub.dirs1, axis=1, keepdims=True)
+    d2 = sub.dirs2 / np.linalg.norm(sub.dirs2, axis=1, keepdims=True)
     u, _, vt = np.linalg.svd(d2.T @ d1)
     R = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
-    rd1 = d1 @ R.T
-    ang = np.arctan2(np.linalg.norm(np.cross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
-    return R, ang
+    return R, rotation_only_residuals(sub, R)
 
 
 def rotation_only_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:

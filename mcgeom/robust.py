@@ -81,11 +81,16 @@ def residuals(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     Radians on the unit sphere, or pixels (radians x ``focal``) when ``focal``
     is given.
     """
+    return _residuals(rays, R, t, _focal_array(focal, len(rays)))
+
+
+def _residuals(rays: RayPairs, R: np.ndarray, t: np.ndarray,
+               focal: Optional[np.ndarray]) -> np.ndarray:
+    """:func:`residuals` with ``focal`` already validated (the scoring hot path)."""
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
                                    np.asarray(R, dtype=np.float64),
                                    np.asarray(t, dtype=np.float64)))
-    f = _focal_array(focal, len(rays))
-    return r if f is None else r * f
+    return r if focal is None else r * focal
 
 
 def adaptive_iterations(inlier_ratio: float, sample_size: int, prob: float,
@@ -152,7 +157,7 @@ class _Scorer:
         self.lo_rounds = opts.lo_max_rounds
 
     def residuals(self, R: np.ndarray, t: np.ndarray) -> np.ndarray:
-        return residuals(self.rays, R, t, self.focal)
+        return _residuals(self.rays, R, t, self.focal)
 
     def offer(self, R: np.ndarray, t: np.ndarray) -> bool:
         """Score a hypothesis; keep (and locally optimise) it if it is the best so far."""
@@ -239,9 +244,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     if n < info_est.min_sample:
         raise ValueError(f"too few correspondences: {method} needs at least "
                          f"{info_est.min_sample}, got {n}")
-    for name in ("origins1", "dirs1", "origins2", "dirs2"):
-        if not np.all(np.isfinite(getattr(rays, name))):
-            raise ValueError(f"rays.{name} contains NaN or inf")
+    rays.check_finite()
     f = _focal_array(focal, n)
     rng = np.random.default_rng(options.seed)
     scorer = _Scorer(rays, options.threshold, f, options)

@@ -78,6 +78,14 @@ class RayPairs:
     def __len__(self) -> int:
         return self.origins1.shape[0]
 
+    def check_finite(self) -> None:
+        """Raise ValueError naming the first array that holds NaN or inf (the C
+        kernels check finiteness themselves; estimators that do numpy work
+        before reaching them call this)."""
+        for name in ("origins1", "dirs1", "origins2", "dirs2"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise ValueError(f"rays.{name} contains NaN or inf")
+
     def take(self, index: Any) -> "RayPairs":
         """Subset (or permutation) of the correspondences by an index array or mask."""
         idx = np.asarray(index)

@@ -11,12 +11,12 @@ bound tolerance (1e-10 relative); the mcgeom time is the full Python API call
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _core
+from .timing import best_of
 
 __all__ = ["ConeTiming", "bench_cone", "clarabel_cone_linf"]
 
@@ -110,16 +110,6 @@ def clarabel_cone_linf(C: np.ndarray, V: np.ndarray, tol: float = 1e-10,
     return hi, m + L * best, steps
 
 
-def _best_of(fn, repeat: int, number: int) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - t0) / number)
-    return best
-
-
 def _instance(rng, n):
     P = rng.normal(size=3)
     U = rng.normal(size=(n, 3))
@@ -137,13 +127,13 @@ def bench_cone(sizes=(3, 6, 20, 100, 1000), seed: int = 0,
     for n in sizes:
         C, V = _instance(rng, n)
         r = _core.cone_linf(C, V)
-        once = _best_of(lambda: _core.cone_linf(C, V), 1, 3)
+        once = best_of(lambda: _core.cone_linf(C, V), 1, 3)
         number = max(1, int(budget_s / 5 / max(once, 1e-7)))
-        c_t = _best_of(lambda: _core.cone_linf(C, V), 5, number)
+        c_t = best_of(lambda: _core.cone_linf(C, V), 5, number)
         g_ref, _, steps = clarabel_cone_linf(C, V)
-        ref_once = _best_of(lambda: clarabel_cone_linf(C, V), 1, 1)
+        ref_once = best_of(lambda: clarabel_cone_linf(C, V), 1, 1)
         number = max(1, int(budget_s / 3 / ref_once))
-        ref_t = _best_of(lambda: clarabel_cone_linf(C, V), 3, number)
+        ref_t = best_of(lambda: clarabel_cone_linf(C, V), 3, number)
         out.append(ConeTiming(n, c_t * 1e6, ref_t * 1e6,
                               abs(r["gamma"] - g_ref) / max(g_ref, 1e-3),
                               r["iterations"], steps))

@@ -7,13 +7,13 @@ N; the mcgeom time is the full Python API call (RayPairs in, RigMotion out).
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import estimate, synth
 from .linear17_numpy import linear17_numpy
+from .timing import best_of
 
 __all__ = ["Linear17Timing", "bench_linear17"]
 
@@ -30,17 +30,6 @@ class Linear17Timing:
         return self.numpy_us / self.mcgeom_us
 
 
-def _best_of(fn, repeat: int, number: int) -> float:
-    """Best mean time per call (seconds) over ``repeat`` batches of ``number``."""
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - t0) / number)
-    return best
-
-
 def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0,
                    budget_s: float = 0.5) -> list[Linear17Timing]:
     """Time linear17 (C, via the Python API) and the numpy reference for each N."""
@@ -53,12 +42,12 @@ def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0,
                                   require_visible=False)
         rays = prob.rays
         m = estimate(rays, "linear17")
-        c_once = _best_of(lambda: estimate(rays, "linear17"), 1, 3)
+        c_once = best_of(lambda: estimate(rays, "linear17"), 1, 3)
         number = max(1, int(budget_s / 5 / max(c_once, 1e-7)))
-        c_t = _best_of(lambda: estimate(rays, "linear17"), 5, number)
+        c_t = best_of(lambda: estimate(rays, "linear17"), 5, number)
         args = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
-        np_once = _best_of(lambda: linear17_numpy(*args), 1, 1)
+        np_once = best_of(lambda: linear17_numpy(*args), 1, 1)
         number = max(1, int(budget_s / 5 / np_once))
-        np_t = _best_of(lambda: linear17_numpy(*args), 5, number)
+        np_t = best_of(lambda: linear17_numpy(*args), 5, number)
         out.append(Linear17Timing(n, c_t * 1e6, np_t * 1e6, m.info["iterations"]))
     return out

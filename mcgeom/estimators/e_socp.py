@@ -32,7 +32,7 @@ from ..errors import DegenerateError
 from ..observability import refine_centred, scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
-from .five_plus_one import LEAST_SQUARES, camera_ids, essential_motions
+from .five_plus_one import LEAST_SQUARES, essential_motions, intra_counts
 
 __all__ = ["e_socp", "average_rotations"]
 
@@ -53,9 +53,7 @@ def average_rotations(Rs: np.ndarray, weights: Optional[np.ndarray] = None
 def _per_camera(rays: RayPairs, robust_threshold: Optional[float], prob: float):
     """(camera, R_i, t0_i, w_i, n_i) for every camera whose essential matrix was found."""
     import cv2
-    cam1, cam2, centres = camera_ids(rays)
-    intra = cam1 == cam2
-    counts = np.bincount(cam1[intra], minlength=len(centres))
+    cam1, cam2, centres, intra, counts = intra_counts(rays)
     out = []
     for a in np.flatnonzero(counts >= 5):
         own = np.flatnonzero(intra & (cam1 == a))
@@ -122,9 +120,7 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
-    for name in ("origins1", "dirs1", "origins2", "dirs2"):
-        if not np.all(np.isfinite(getattr(rays, name))):
-            raise ValueError(f"rays.{name} contains NaN or inf")
+    rays.check_finite()
     per, centres = _per_camera(rays, robust_threshold, prob)
     if not per:
         raise ValueError("too few correspondences: e_socp needs 5 intra-camera "

@@ -38,12 +38,13 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..observability import refine_centred, scale_profile, scale_verdict, travel_direction
+from ..observability import (displacements, refine_centred, scale_profile, scale_verdict,
+                             travel_direction)
 from ..registry import register
 from ..types import RayPairs, RigMotion
 
 __all__ = [
-    "five_plus_one", "camera_ids", "essential_motions", "scale_terms",
+    "five_plus_one", "camera_ids", "intra_counts", "essential_motions", "scale_terms",
     "critical_angles", "minimal_solutions", "sample_five_plus_one",
 ]
 
@@ -91,6 +92,15 @@ def camera_ids(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     inv = inv.ravel()
     n = len(rays)
     return inv[:n].astype(np.int64), inv[n:].astype(np.int64), centres
+
+
+def intra_counts(rays: RayPairs):
+    """:func:`camera_ids` plus the intra-camera mask (same camera at both times)
+    and the number of intra-camera correspondences of every camera:
+    ``(cam1, cam2, centres, intra, counts)``."""
+    cam1, cam2, centres = camera_ids(rays)
+    intra = cam1 == cam2
+    return cam1, cam2, centres, intra, np.bincount(cam1[intra], minlength=len(centres))
 
 
 def _local_frame(dirs: np.ndarray) -> np.ndarray:
@@ -273,19 +283,13 @@ def critical_angles(R: np.ndarray, t: np.ndarray, centres: np.ndarray,
     that camera's intra-camera correspondences (Theorem 3). NaN for cameras
     without a centre and for the 5-point camera itself.
     """
-    disp = (centres - t) @ R - centres          # rows: R^T (c - t) - c
+    disp = displacements(R, t, centres)
     da = disp[five_camera]
-    na = np.linalg.norm(da)
-    out = np.full(len(centres), np.nan)
-    for k in range(len(centres)):
-        if k == five_camera or not np.all(np.isfinite(centres[k])):
-            continue
-        nb = np.linalg.norm(disp[k])
-        if na > 0 and nb > 0:
-            c = np.linalg.norm(np.cross(da, disp[k])) / (na * nb)
-            out[k] = float(np.arctan2(c, np.dot(da, disp[k]) / (na * nb)))
-        else:
-            out[k] = 0.0
+    # atan2(|da x db|, da . db): the angle, accurate near 0; 0 where a
+    # displacement vanishes (both terms are then 0)
+    out = np.arctan2(np.linalg.norm(_rcross(da, disp), axis=1), disp @ da)
+    out[five_camera] = np.nan
+    out[~np.all(np.isfinite(centres), axis=1)] = np.nan
     return out
 
 
@@ -293,9 +297,7 @@ def critical_angles(R: np.ndarray, t: np.ndarray, centres: np.ndarray,
 
 def _split_sample(rays: RayPairs) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
     """Indices of the 5 rays of the 5-point camera and the rest, the camera, centres."""
-    cam1, cam2, centres = camera_ids(rays)
-    intra = cam1 == cam2
-    counts = np.bincount(cam1[intra], minlength=len(centres))
+    cam1, cam2, centres, intra, counts = intra_counts(rays)
     a = int(np.argmax(counts))
     if counts[a] < 5:
         raise ValueError("five_plus_one: need 5 intra-camera correspondences of one camera "
@@ -354,9 +356,8 @@ def sample_five_plus_one(rays: RayPairs, rng: np.random.Generator) -> np.ndarray
     correspondence uniformly among those not of that camera, so that every
     camera takes part in the samples.
     """
-    cam1, cam2, centres = camera_ids(rays)
-    intra = cam1 == cam2
-    counts = np.bincount(cam1[intra], minlength=len(centres)).astype(float)
+    cam1, cam2, centres, intra, counts = intra_counts(rays)
+    counts = counts.astype(float)
     counts[counts < 5] = 0.0
     if counts.sum() == 0:
         raise ValueError("five_plus_one: no camera has 5 intra-camera correspondences")
@@ -372,9 +373,7 @@ def sample_five_plus_one(rays: RayPairs, rng: np.random.Generator) -> np.ndarray
 # -------------------------------------------------------------- estimator
 
 def _choose_camera(rays: RayPairs, five_camera: Optional[int]):
-    cam1, cam2, centres = camera_ids(rays)
-    intra = cam1 == cam2
-    counts = np.bincount(cam1[intra], minlength=len(centres))
+    cam1, cam2, centres, intra, counts = intra_counts(rays)
     if five_camera is None:
         a = int(np.argmax(counts))
     else:
@@ -495,15 +494,12 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
     if len(rays) < 6:
         raise ValueError(f"too few correspondences: five_plus_one needs at least 6, got {len(rays)}")
-    for name in ("origins1", "dirs1", "origins2", "dirs2"):
-        if not np.all(np.isfinite(getattr(rays, name))):
-            raise ValueError(f"rays.{name} contains NaN or inf")
+    rays.check_finite()
     if five_camera is None:
         # every camera that can be the 5-point camera, best final cost wins: the
         # refinement from a single camera's start can stop in a local minimum,
         # and the choice must not depend on the rig frame or the order of rays
-        cam1, cam2, _ = camera_ids(rays)
-        counts = np.bincount(cam1[cam1 == cam2], minlength=int(max(cam1.max(), cam2.max())) + 1)
+        counts = intra_counts(rays)[4]
         cams = [int(k) for k in np.argsort(-counts, kind="stable") if counts[k] >= 5]
         if not cams:
             raise ValueError("too few correspondences: five_plus_one needs 5 intra-camera "
@@ -569,9 +565,7 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
     that fraction everywhere (the usual case: one camera is enough).
     """
     import cv2
-    cam1, cam2, centres = camera_ids(rays)
-    intra = cam1 == cam2
-    counts = np.bincount(cam1[intra], minlength=len(centres))
+    cam1, cam2, centres, intra, counts = intra_counts(rays)
     order = [int(k) for k in np.argsort(-counts, kind="stable") if counts[k] >= 8][:max_cameras]
     for a in order:
         own = np.flatnonzero(intra & (cam1 == a))

@@ -118,9 +118,7 @@ def _minimal(sample: RayPairs) -> list:
 def _raise(status: int, r: dict, rays: RayPairs, n: int) -> None:
     """Turn a kernel failure into an exception that names the problem."""
     if status == _core.STATUS_EINVAL:  # find which argument is at fault
-        for name in ("origins1", "dirs1", "origins2", "dirs2"):
-            if not np.isfinite(getattr(rays, name)).all():
-                raise ValueError(f"rays.{name} contains NaN or inf")
+        rays.check_finite()
         for name in ("dirs1", "dirs2"):
             if (np.linalg.norm(getattr(rays, name), axis=1) == 0).any():
                 raise ValueError(f"rays.{name} contains a zero-length direction")
