@@ -633,11 +633,17 @@ def scale_one_point_ransac(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.
     Each of up to ``samples`` correspondences proposes ``lam = -a / b`` (eq. 7.4);
     all proposals are scored at once by MSAC on the Sampson angular residuals
     (``threshold`` radians) of every correspondence; the best is re-estimated by
-    weighted least squares on its inliers. None if no correspondence constrains
-    the scale.
+    weighted least squares on its inliers. Only ``lam > 0`` is considered: the
+    5-point camera's cheirality check fixed the sense of its own travel ``lam
+    w``, and near the critical motion the Sampson error hardly tells ``lam``
+    from ``-lam`` (each camera's epipolar constraint ignores the sign of its
+    translation), so a negative proposal often wins by noise -- a reversed
+    travel from which the final refinement cannot recover (it slides |t| to
+    infinity instead of crossing it; measured: a quarter of the Ladybug
+    hypotheses). None if no correspondence proposes a positive scale.
     """
     a, b, A, B, C = _sampson_in_scale(rays, R, t0, w)
-    ok = np.flatnonzero(np.abs(b) > 1e-9 * (1.0 + np.abs(a)))
+    ok = np.flatnonzero((np.abs(b) > 1e-9 * (1.0 + np.abs(a))) & (a * b < 0.0))
     if ok.size == 0:
         return None
     order = rng.permutation(ok)[:samples]
@@ -667,6 +673,8 @@ def scale_one_point_ransac(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.
         if not bb > 0.0:
             break
         cand = -float(np.sum(wts[inl] * a[inl] * b[inl])) / bb
+        if not cand > 0.0:
+            break
         r2c = (a + cand * b) ** 2 / np.maximum(A + 2.0 * B * cand + C * cand ** 2, 1e-300)
         sc = float(np.minimum(r2c, threshold ** 2).sum())
         if not sc < best:
