@@ -335,6 +335,12 @@ int mcg_lp_feasible(const mcg_lp_backend *be, int dim, int m, const double *A,
  * (lp_glpk.c, GPL-3.0, replaces them when GLPK is found). */
 int mcg_lp_glpk_available(void) { return 0; }
 
+int mcg_lp_glpk_load(const char *path)
+{
+    (void)path;
+    return MCG_EUNAVAILABLE;
+}
+
 size_t mcg_lp_glpk_work_size(int dim, int m)
 {
     (void)dim;
@@ -352,12 +358,11 @@ int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
     (void)x;
     (void)work;
     (void)lwork;
-    return MCG_EINVAL;
+    return MCG_EUNAVAILABLE;
 }
 
 int mcg_lp_glpk_backend(mcg_lp_backend *be)
 {
-    (void)be;
-    return MCG_EINVAL;
+    return be ? MCG_EUNAVAILABLE : MCG_EINVAL;
 }
 #endif

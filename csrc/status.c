@@ -10,6 +10,7 @@ const char *mcg_status_message(int status)
     case MCG_ENOMEM: return "workspace too small";
     case MCG_EINFEASIBLE: return "problem is infeasible";
     case MCG_EDEGENERATE: return "degenerate data or motion for this method";
+    case MCG_EUNAVAILABLE: return "optional component not available (GLPK backend not built or libglpk not loaded)";
     default: return "unknown status code";
     }
 }

