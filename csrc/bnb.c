@@ -80,10 +80,13 @@
 #define EPS_MAX 1.5         /* a bound beyond this (rad) constrains nothing */
 #define SUBSET 8            /* widest-angle correspondences tested first */
 #define BLOCK_DOUBLES 5     /* centre (3), half-side, lower bound */
+#define WS_CAP 48           /* rows of a working set before a full LP */
+#define WS_ADD 4            /* most violated rows added per round */
 
 typedef struct {
     int n, G;
-    const double *d1, *a1, *d2, *a2;
+    const double *a1, *a2;
+    double *u1, *u2;        /* unit bearings d1, d2 (work) */
     const int *grp;
     const int *order;       /* by group, then alpha descending (work) */
     const int *gstart;      /* G + 1 offsets into order (work) */
@@ -97,7 +100,18 @@ typedef struct {
     size_t lplen;
     const mcg_lp_backend *lp;
     int preemptive;
-    long lp2, lp3;
+    long lp2, lp3, hints;
+    double apex[3];         /* apex of the group being built */
+    double *gapex;          /* 3 G: each group's apex */
+    double t_hint[3];       /* the last feasible translation */
+    int have_hint;
+    /* working sets of the constraint-generation LPs (see lp_working_set) */
+    int *rid;               /* 2n: stable id (2 i + k) of each row of A3 */
+    int *where;             /* 2n: row of an id in the current view */
+    int *ws;                /* (G + 1) x WS_CAP ids: slot 0 the 3-variable
+                               LP, slot 1 + g group g's 2-variable LP */
+    int *nws;               /* G + 1 sizes */
+    double *Asub, *bsub;    /* WS_CAP rows */
 } bnb_ctx;
 
 static double now_seconds(void)
@@ -119,43 +133,181 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Wedge rows of correspondence i at (R, eps) with slack s: writes 0 or 2
- * rows at A (3 each) and b, returns the number; -1 on a kernel error. */
-static int wedge_rows(const bnb_ctx *c, int i, const double R[9], double eps,
-                      double s, double *A, double *b, double z[3])
+/* The sines of the two half-angles at (eps, s), enlarged as in wedge.c so
+ * that rounding never tightens a wedge; 0 if the cones are too wide to
+ * constrain anything (then no rows). */
+static int wedge_sines(double eps, double s, double *sb, double *sa)
 {
-    double v[3], ap[3], n1[3], n2[3], off;
-    int st, k;
-    if (eps + s >= EPS_MAX)
+    double e1 = eps + s;
+    if (e1 >= EPS_MAX)
         return 0; /* such cones leave (almost) every direction open */
-    mat_vec(R, c->d1 + 3 * i, v);
-    st = mcg_wedge_normals(v, c->d2 + 3 * i, eps + s, eps, n1, n2);
-    if (st == MCG_EDEGENERATE)
-        return 0;
-    if (st != MCG_OK)
-        return -1;
+    *sb = sin(e1 * (1.0 + 1e-12) + 1e-15);  /* the rotated bearing R d1 */
+    *sa = sin(eps * (1.0 + 1e-12) + 1e-15); /* the bearing d2 */
+    return 1;
+}
+
+/* Wedge rows of correspondence i at rotation R (sines from wedge_sines,
+ * apex slack s): writes 0 or 2 rows at A (3 each) and b, returns the
+ * number; z = n1 + n2 (along the wedge's centre). */
+static int wedge_rows(bnb_ctx *c, int i, const double R[9], double sb, double sa,
+                      double s, int row, double z[3])
+{
+    double *A = c->A3 + 3 * row, *b = c->b3 + row;
+    double v[3], ap[3], n1[3], n2[3], off;
+    int k;
+    mat_vec(R, c->u1 + 3 * i, v);
+    v[0] = -v[0];
+    v[1] = -v[1];
+    v[2] = -v[2];
+    if (mcg_wedge_unit(c->u2 + 3 * i, v, sa, sb, n1, n2) != MCG_OK)
+        return 0; /* cones overlap or nested: no constraint */
     mat_vec(R, c->a1 + 3 * i, ap);
     for (k = 0; k < 3; ++k)
         ap[k] = c->a2[3 * i + k] - ap[k];
+    memcpy(c->apex, ap, sizeof ap);
     off = s * c->a1n[i];
     memcpy(A, n1, sizeof n1);
     memcpy(A + 3, n2, sizeof n2);
     b[0] = dot3(n1, ap) - off;
     b[1] = dot3(n2, ap) - off;
+    c->rid[row] = 2 * i;
+    c->rid[row + 1] = 2 * i + 1;
     for (k = 0; k < 3; ++k)
         z[k] = n1[k] + n2[k];
     return 2;
 }
 
+/* LP feasibility of {x : A_j . x >= b_j, j < m} (dim 2 or 3) by constraint
+ * generation: solve on the working set of the slot (rows that decided the
+ * previous, nearby tests), check every row at the solution, add the most
+ * violated ones and repeat. An infeasible subset proves infeasibility; a
+ * solution that violates no row is feasible. Consecutive tests differ by a
+ * small rotation or bound, so the working set is usually already right and
+ * a 400-row LP costs an LP on a dozen rows plus one pass over the rows.
+ * ids: the rows' stable ids. 1 feasible (x set), 0 not, < 0 status. */
+static int lp_working_set(bnb_ctx *c, int dim, int m, const double *A, const double *b,
+                          const int *ids, int slot, double *x)
+{
+    int *ws = c->ws + (size_t)slot * WS_CAP, *nws = c->nws + slot;
+    int S[WS_CAP], ns = 0, j, k, st;
+    if (m == 0) {
+        for (k = 0; k < dim; ++k)
+            x[k] = 0.0;
+        return 1;
+    }
+    for (j = 0; j < m; ++j)
+        c->where[ids[j]] = j;
+    for (k = 0; k < *nws; ++k) {
+        j = c->where[ws[k]];
+        if (j >= 0 && j < m && ids[j] == ws[k])
+            S[ns++] = j;
+    }
+    for (;;) {
+        int add[WS_ADD], na = 0;
+        double viol[WS_ADD];
+        if (ns > 0) {
+            for (k = 0; k < ns; ++k) {
+                memcpy(c->Asub + dim * k, A + dim * S[k], (size_t)dim * sizeof(double));
+                c->bsub[k] = b[S[k]];
+            }
+            if (dim == 2)
+                ++c->lp2;
+            else
+                ++c->lp3;
+            st = mcg_lp_feasible(c->lp, dim, ns, c->Asub, c->bsub, x, c->lpw, c->lplen);
+            if (st == MCG_EINFEASIBLE)
+                break; /* a subset is infeasible: so is the whole */
+            if (st != MCG_OK)
+                return -st;
+        } else {
+            for (k = 0; k < dim; ++k)
+                x[k] = c->have_hint && dim == 3 ? c->t_hint[k] : 0.0;
+        }
+        /* the WS_ADD most violated rows outside the set */
+        for (j = 0; j < m; ++j) {
+            const double *a = A + dim * j;
+            double v = b[j] - (dim == 3 ? a[0] * x[0] + a[1] * x[1] + a[2] * x[2]
+                                        : a[0] * x[0] + a[1] * x[1]);
+            if (!(v > 0.0))
+                continue;
+            for (k = 0; k < ns; ++k)
+                if (S[k] == j)
+                    break;
+            if (k < ns)
+                continue; /* in the set: satisfied within the LP tolerance */
+            if (na < WS_ADD) {
+                add[na] = j;
+                viol[na++] = v;
+            } else {
+                int w = 0;
+                for (k = 1; k < WS_ADD; ++k)
+                    if (viol[k] < viol[w])
+                        w = k;
+                if (v > viol[w]) {
+                    add[w] = j;
+                    viol[w] = v;
+                }
+            }
+        }
+        if (na == 0) {
+            st = MCG_OK;
+            break;
+        }
+        if (ns + na > WS_CAP) {
+            /* the set would overflow: decide on all rows */
+            if (dim == 2)
+                ++c->lp2;
+            else
+                ++c->lp3;
+            st = mcg_lp_feasible(c->lp, dim, m, A, b, x, c->lpw, c->lplen);
+            if (st != MCG_OK && st != MCG_EINFEASIBLE)
+                return -st;
+            ns = 0; /* start afresh next time */
+            break;
+        }
+        for (k = 0; k < na; ++k)
+            S[ns++] = add[k];
+    }
+    for (k = 0; k < ns; ++k)
+        ws[k] = ids[S[k]];
+    *nws = ns;
+    return st == MCG_OK;
+}
+
+/* Does the direction b satisfy every row of A (m rows) with w.b > 0? */
+static int direction_ok(int m, const double *A, const double b[3], const double w[3])
+{
+    int j;
+    if (!(dot3(w, b) > 0.0))
+        return 0;
+    for (j = 0; j < m; ++j)
+        if (dot3(A + 3 * j, b) < 0.0)
+            return 0;
+    return 1;
+}
+
 /* 2-variable test of one group's rows (m rows of A, zc = sum of unit wedge
- * centres): 1 feasible, 0 not, < 0 status. */
-static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3])
+ * centres, ap = the group's apex): 1 feasible, 0 not, < 0 status. The last
+ * feasible translation, seen from the apex, is tried first: near the
+ * optimum it usually lies in the cone and saves the LP. */
+static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3],
+                           const double ap[3], const int *ids, int slot)
 {
     double w2 = dot3(zc, zc), P[6], e[3] = {0, 0, 0}, nn;
-    int k, j, st, imin = 0;
+    int k, j, imin = 0;
     double y[2];
     if (m < 4 || !(w2 > 1e-24))
         return 1; /* fewer than two wedges, or degenerate: always non-trivial */
+    if (c->have_hint && ap) {
+        double b[3];
+        b[0] = c->t_hint[0] - ap[0];
+        b[1] = c->t_hint[1] - ap[1];
+        b[2] = c->t_hint[2] - ap[2];
+        if (direction_ok(m, A, b, zc)) {
+            ++c->hints;
+            return 1;
+        }
+    }
     /* P: orthonormal basis of the plane orthogonal to zc */
     for (k = 1; k < 3; ++k)
         if (fabs(zc[k]) < fabs(zc[imin]))
@@ -179,13 +331,7 @@ static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3
         c->A2[2 * j + 1] = dot3(a, P + 3);
         c->b2[j] = -dot3(a, zc) / w2;
     }
-    ++c->lp2;
-    st = mcg_lp_feasible(c->lp, 2, m, c->A2, c->b2, y, c->lpw, c->lplen);
-    if (st == MCG_OK)
-        return 1;
-    if (st == MCG_EINFEASIBLE)
-        return 0;
-    return -st;
+    return lp_working_set(c, 2, m, c->A2, c->b2, ids, slot, y);
 }
 
 static void add_unit(double acc[3], const double z[3])
@@ -202,7 +348,8 @@ static int test_groups(bnb_ctx *c)
 {
     int g, r;
     for (g = 0; g < c->G; ++g) {
-        r = cone_nontrivial(c, c->grows[g], c->A3 + 3 * c->gfirst[g], c->zsum + 3 * g);
+        r = cone_nontrivial(c, c->grows[g], c->A3 + 3 * c->gfirst[g], c->zsum + 3 * g,
+                            c->gapex + 3 * g, c->rid + c->gfirst[g], 1 + g);
         if (r <= 0)
             return r;
     }
@@ -211,14 +358,23 @@ static int test_groups(bnb_ctx *c)
 
 static int test_all3(bnb_ctx *c, int m, double t[3])
 {
-    int st;
-    ++c->lp3;
-    st = mcg_lp_feasible(c->lp, 3, m, c->A3, c->b3, t, c->lpw, c->lplen);
-    if (st == MCG_OK)
-        return 1;
-    if (st == MCG_EINFEASIBLE)
-        return 0;
-    return -st;
+    int k, r;
+    if (c->have_hint) {
+        for (k = 0; k < m; ++k)
+            if (dot3(c->A3 + 3 * k, c->t_hint) < c->b3[k])
+                break;
+        if (k == m) {
+            ++c->hints;
+            memcpy(t, c->t_hint, 3 * sizeof(double));
+            return 1;
+        }
+    }
+    r = lp_working_set(c, 3, m, c->A3, c->b3, c->rid, 0, t);
+    if (r == 1) {
+        memcpy(c->t_hint, t, 3 * sizeof(double));
+        c->have_hint = 1;
+    }
+    return r;
 }
 
 /* feasible(R, eps) relaxed by slack s (see the file comment): 1 with t set
@@ -226,7 +382,13 @@ static int test_all3(bnb_ctx *c, int m, double t[3])
 static int feasible(bnb_ctx *c, const double R[9], double eps, double s, double t[3])
 {
     int g, j, m = 0, r;
-    double z[3];
+    double z[3], sb, sa;
+    if (!wedge_sines(eps, s, &sb, &sa)) {
+        /* no constraint at all: any t will do (the last one) */
+        for (j = 0; j < 3; ++j)
+            t[j] = c->have_hint ? c->t_hint[j] : 0.0;
+        return 1;
+    }
     if (c->preemptive) {
         /* stage 1: the widest-angle correspondences of every group */
         for (g = 0; g < c->G; ++g) {
@@ -236,14 +398,12 @@ static int feasible(bnb_ctx *c, const double R[9], double eps, double s, double 
                 continue; /* stage 2 tests the whole group anyway */
             for (j = 0; j < SUBSET; ++j) {
                 int i = c->order[c->gstart[g] + j];
-                r = wedge_rows(c, i, R, eps, s, c->A3 + 3 * mg, c->b3 + mg, z);
-                if (r < 0)
-                    return -MCG_EINVAL;
+                r = wedge_rows(c, i, R, sb, sa, s, mg, z);
                 if (r)
                     add_unit(zs, z);
                 mg += r;
             }
-            r = cone_nontrivial(c, mg, c->A3, zs);
+            r = cone_nontrivial(c, mg, c->A3, zs, mg ? c->apex : NULL, c->rid, 1 + g);
             if (r <= 0)
                 return r;
         }
@@ -254,16 +414,16 @@ static int feasible(bnb_ctx *c, const double R[9], double eps, double s, double 
         zs[0] = zs[1] = zs[2] = 0.0;
         c->gfirst[g] = m;
         for (j = c->gstart[g]; j < c->gstart[g + 1]; ++j) {
-            r = wedge_rows(c, c->order[j], R, eps, s, c->A3 + 3 * m, c->b3 + m, z);
-            if (r < 0)
-                return -MCG_EINVAL;
+            r = wedge_rows(c, c->order[j], R, sb, sa, s, m, z);
             if (r)
                 add_unit(zs, z);
             m += r;
         }
         c->grows[g] = m - c->gfirst[g];
+        memcpy(c->gapex + 3 * g, c->apex, sizeof c->apex);
         if (c->preemptive) {
-            r = cone_nontrivial(c, c->grows[g], c->A3 + 3 * c->gfirst[g], zs);
+            r = cone_nontrivial(c, c->grows[g], c->A3 + 3 * c->gfirst[g], zs,
+                                c->gapex + 3 * g, c->rid + c->gfirst[g], 1 + g);
             if (r <= 0)
                 return r;
         }
@@ -371,6 +531,8 @@ void mcg_bnb_default_options(mcg_bnb_options *opt)
     opt->max_queue = 200000;
     opt->grid = 5;
     opt->preemptive = 1;
+    opt->bound_steps = 1;
+    opt->leaf_gap = -1.0;
     opt->lp = NULL;
 }
 
@@ -397,9 +559,11 @@ size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt)
     if (lp2 == 0 || lp3 == 0)
         return 0;
     lp = max_sz(lp2, lp3);
-    /* A3 6n, b3 2n, A2 4n, b2 2n, a1n n, zsum 3G, ints (order n, gstart
+    /* A3 6n, b3 2n, A2 4n, b2 2n, a1n n, u1 u2 6n, rid where 4n, zsum
+     * gapex 6G, ws (G+1) WS_CAP, nws G+1, Asub bsub 4 WS_CAP, ints (order n, gstart
      * G+1, grows G, gfirst G) one per double, heap, LP */
-    total = add_sz(mul_sz(16, (size_t)n, &ok), mul_sz(6, (size_t)n_groups + 1, &ok), &ok);
+    total = add_sz(mul_sz(26, (size_t)n, &ok), mul_sz(10 + WS_CAP, (size_t)n_groups + 1, &ok), &ok);
+    total = add_sz(total, 4 * WS_CAP, &ok);
     total = add_sz(total, mul_sz(BLOCK_DOUBLES, (size_t)opt->max_queue, &ok), &ok);
     total = add_sz(total, lp, &ok);
     return ok ? total : 0;
@@ -415,7 +579,9 @@ static int check_options(const mcg_bnb_options *o)
         return 0;
     if (o->max_blocks < 1 || o->max_queue < 1 || o->max_queue > (1 << 26))
         return 0;
-    if (o->grid < 1 || o->grid > 64)
+    if (o->grid < 1 || o->grid > 64 || o->bound_steps < 0 || o->bound_steps > 60)
+        return 0;
+    if (!(isfinite(o->leaf_gap) && o->leaf_gap < 1.0))
         return 0;
     return 1;
 }
@@ -442,9 +608,9 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     mcg_lp_backend native;
     bnb_ctx c;
     double *w = work, *heap, *alpha, eps, lo, t[3], Rb[9], blk[BLOCK_DOUBLES];
-    double leaf_lb = INFINITY, prune_lb = INFINITY, t0;
+    double leaf_lb = INFINITY, prune_lb = INFINITY, t0, leaf_gap;
     int *order, *gstart, i, g, k, st, r, hsize = 0, gi, gj, gk;
-    long blocks = 0;
+    long blocks = 0, leaves = 0;
     size_t need;
 
     t0 = now_seconds();
@@ -479,6 +645,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
             if (fabs(a1[3 * i + k]) > 1e150 || fabs(a2[3 * i + k]) > 1e150)
                 return MCG_EINVAL;
     }
+    leaf_gap = o.leaf_gap < 0.0 ? 0.5 * o.resolution : o.leaf_gap;
     if (!o.lp) {
         mcg_lp_native_backend(&native);
         o.lp = &native;
@@ -490,9 +657,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     /* carve the workspace */
     c.n = n;
     c.G = n_groups;
-    c.d1 = d1;
     c.a1 = a1;
-    c.d2 = d2;
     c.a2 = a2;
     c.grp = group;
     c.A3 = w;
@@ -505,7 +670,25 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     w += 2 * (size_t)n;
     c.a1n = w;
     w += (size_t)n;
+    c.u1 = w;
+    w += 3 * (size_t)n;
+    c.u2 = w;
+    w += 3 * (size_t)n;
+    c.rid = (int *)w;
+    w += 2 * (size_t)n;
+    c.where = (int *)w;
+    w += 2 * (size_t)n;
+    c.ws = (int *)w;
+    w += WS_CAP * ((size_t)n_groups + 1);
+    c.nws = (int *)w;
+    w += (size_t)n_groups + 1;
+    c.Asub = w;
+    w += 3 * WS_CAP;
+    c.bsub = w;
+    w += WS_CAP;
     c.zsum = w;
+    w += 3 * (size_t)n_groups;
+    c.gapex = w;
     w += 3 * (size_t)n_groups;
     order = (int *)w;
     w += (size_t)n;
@@ -521,11 +704,23 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     c.lplen = lwork - (size_t)(w - work);
     c.lp = o.lp;
     c.preemptive = o.preemptive != 0;
-    c.lp2 = c.lp3 = 0;
+    c.lp2 = c.lp3 = c.hints = 0;
+    for (i = 0; i < 2 * n; ++i)
+        c.where[i] = -1;
+    for (g = 0; g <= n_groups; ++g)
+        c.nws[g] = 0;
+    c.have_hint = 0;
     c.order = order;
     c.gstart = gstart;
-    for (i = 0; i < n; ++i)
+    for (i = 0; i < n; ++i) {
+        double n1 = sqrt(dot3(d1 + 3 * i, d1 + 3 * i));
+        double n2 = sqrt(dot3(d2 + 3 * i, d2 + 3 * i));
         c.a1n[i] = sqrt(dot3(a1 + 3 * i, a1 + 3 * i));
+        for (k = 0; k < 3; ++k) {
+            c.u1[3 * i + k] = d1[3 * i + k] / n1;
+            c.u2[3 * i + k] = d2[3 * i + k] / n2;
+        }
+    }
 
     /* order: by group, then by alpha at R_init descending (ch. 10.3); the
      * alphas live in the 2-variable rows' slot until the search starts */
@@ -634,10 +829,38 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
                 target = res->linf - o.gap;
             }
         }
-        /* tighten the block's lower bound: two relaxed bisection steps */
         lb = blk[4];
+        if (s <= o.resolution || hsize + 8 > o.max_queue) {
+            /* a leaf: close it at linf - leaf_gap with one relaxed test if
+             * it fails there, else bisect its bound to the tolerance */
+            double level = res->linf - leaf_gap;
+            ++leaves;
+            if (hsize + 8 > o.max_queue && s > o.resolution)
+                res->stop = MCG_BNB_QUEUE_FULL;
+            if (level > lb) {
+                r = feasible(&c, R0, level, s, tt);
+                if (r < 0)
+                    return -r;
+                if (!r) {
+                    if (level < leaf_lb)
+                        leaf_lb = level;
+                    continue;
+                }
+                hi = level;
+            } else {
+                hi = target;
+            }
+            st = find_min_error(&c, R0, s, lb, &hi, tt, o.tol);
+            if (st != MCG_OK)
+                return st;
+            lb = hi - o.tol;
+            if (lb < leaf_lb)
+                leaf_lb = lb;
+            continue;
+        }
+        /* tighten the block's lower bound (best-first key) */
         hi = target;
-        for (k = 0; k < 2 && hi > lb; ++k) {
+        for (k = 0; k < o.bound_steps && hi > lb; ++k) {
             double mid = 0.5 * (lb + hi);
             r = feasible(&c, R0, mid, s, tt);
             if (r < 0)
@@ -646,24 +869,6 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
                 hi = mid;
             else
                 lb = mid;
-        }
-        if (lb >= target) {
-            if (target < prune_lb)
-                prune_lb = target;
-            continue;
-        }
-        if (s <= o.resolution || hsize + 8 > o.max_queue) {
-            /* a leaf: its bound to the tolerance */
-            hi = target;
-            st = find_min_error(&c, R0, s, lb, &hi, tt, o.tol);
-            if (st != MCG_OK)
-                return st;
-            lb = hi - o.tol;
-            if (lb < leaf_lb)
-                leaf_lb = lb;
-            if (hsize + 8 > o.max_queue && s > o.resolution)
-                res->stop = MCG_BNB_QUEUE_FULL;
-            continue;
         }
         for (gi = 0; gi < 8; ++gi) {
             double ch[BLOCK_DOUBLES], hs = 0.5 * blk[3];
@@ -692,6 +897,8 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     res->queued = hsize;
     res->lps_2var = c.lp2;
     res->lps_3var = c.lp3;
+    res->hints = c.hints;
+    res->leaves = leaves;
     res->seconds = now_seconds() - t0;
     return MCG_OK;
 }

@@ -70,4 +70,9 @@ static inline double origin_spread(int n, const double *o1, const double *o2, do
     return sqrt(ss / (2.0 * n));
 }
 
+/* wedge.c: the bitangent normals from unit axes a = v'/|v'|, b = -v/|v| and
+ * the sines of the enlarged half-angles (no checks; see mcg_wedge_normals). */
+int mcg_wedge_unit(const double a[3], const double b[3], double sa, double sb,
+                   double n1[3], double n2[3]);
+
 #endif /* MCGEOM_INTERNAL_H */

@@ -61,8 +61,7 @@ static void cross3(const double *a, const double *b, double *c)
 int mcg_wedge_normals(const double v[3], const double vp[3], double eps,
                       double epsp, double n1[3], double n2[3])
 {
-    double a[3], b[3], w[3], y[3];
-    double na, nb, nw, c, s2, sa, sb, p, q, y2, r;
+    double a[3], b[3], na, nb;
     int i;
 
     if (!v || !vp || !n1 || !n2)
@@ -89,28 +88,35 @@ int mcg_wedge_normals(const double v[3], const double vp[3], double eps,
     /* conservative enlargement of the half-angles (see the file comment) */
     eps = eps * (1.0 + 1e-12) + 1e-15;
     epsp = epsp * (1.0 + 1e-12) + 1e-15;
-    sa = sin(epsp); /* n.a = sin eps' */
-    sb = sin(eps);  /* n.b = sin eps  */
+    return mcg_wedge_unit(a, b, sin(epsp), sin(eps), n1, n2);
+}
+
+/* The normals from unit axes a = v' / |v'|, b = -v / |v| and the sines of
+ * the (already enlarged) half-angles, sa = sin eps', sb = sin eps: the
+ * arithmetic of mcg_wedge_normals without the checks, for callers that
+ * build many wedges at one bound (bnb.c). */
+int mcg_wedge_unit(const double a[3], const double b[3], double sa, double sb,
+                   double n1[3], double n2[3])
+{
+    double w[3], y[3], nw, c, s2, p, q, y2, r;
+    int i;
 
     cross3(a, b, w); /* = v x v' / (|v| |v'|) */
-    nw = sqrt(dot3(w, w));
-    c = dot3(a, b); /* = -cos alpha */
-    s2 = nw * nw;   /* sin^2 alpha, accurate from the cross product */
-    if (!(nw > 1e-12))
+    s2 = dot3(w, w); /* sin^2 alpha, accurate from the cross product */
+    c = dot3(a, b);  /* = -cos alpha */
+    if (!(s2 > 1e-24))
         return MCG_EDEGENERATE; /* v parallel or anti-parallel to v' */
-    for (i = 0; i < 3; ++i)
-        w[i] /= nw;
+    nw = sqrt(s2);
     /* y = p a + q b with [1 c; c 1] [p; q] = [sa; sb] */
     p = (sa - c * sb) / s2;
     q = (sb - c * sa) / s2;
     /* |y|^2 = [sa sb] [p q]^T, as eq. 10.10 */
     y2 = sa * p + sb * q;
-    for (i = 0; i < 3; ++i)
-        y[i] = p * a[i] + q * b[i];
     if (!(y2 < 1.0 - 1e-12))
         return MCG_EDEGENERATE; /* cones overlap or are nested: no wedge */
-    r = sqrt(1.0 - y2);
+    r = sqrt(1.0 - y2) / nw;
     for (i = 0; i < 3; ++i) {
+        y[i] = p * a[i] + q * b[i];
         n1[i] = y[i] + r * w[i];
         n2[i] = y[i] - r * w[i];
     }

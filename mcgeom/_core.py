@@ -742,7 +742,8 @@ BNB_STOP_NAMES = {
 def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
              resolution: float = 1e-4, gap: float = 0.0, tol: float = 1e-9,
              max_blocks: int = 2_000_000, max_queue: int = 200_000, grid: int = 5,
-             preemptive: bool = True, lp_backend: str = "native") -> dict:
+             preemptive: bool = True, bound_steps: int = 1, leaf_gap: float = -1.0,
+             lp_backend: str = "native") -> dict:
     """Globally optimal L-infinity rig motion by branch and bound over rotations
     (thesis ch. 10, ``mcg_bnb_linf``).
 
@@ -753,7 +754,10 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     ``resolution``: rotation blocks are split until all their rotations are
     within this angle (rad) of the centre; ``gap`` (rad): blocks that cannot
     improve by more than this are discarded; ``tol`` (rad): bisection
-    tolerance; ``lp_backend``: a name of :data:`LP_BACKENDS`.
+    tolerance; ``bound_steps``: relaxed bisection steps per split block (its
+    best-first key); ``leaf_gap`` (rad, < 0: half the resolution): a block at
+    the resolution is closed with the bound ``linf - leaf_gap`` when one
+    relaxed test fails there; ``lp_backend``: a name of :data:`LP_BACKENDS`.
 
     Returns a dict: ``R``, ``t`` (X2 = R X1 + t), ``linf`` (the L-infinity
     error f(R), rad), ``initial_linf``, ``lower_bound`` (certified over all
@@ -796,12 +800,15 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     opt.max_queue = int(max_queue)
     opt.grid = int(grid)
     opt.preemptive = 1 if preemptive else 0
+    opt.bound_steps = int(bound_steps)
+    opt.leaf_gap = float(leaf_gap)
     be = LP_BACKENDS[lp_backend]()
     opt.lp = be
     size = lib.mcg_bnb_work_size(n, n_groups, opt)
     if size == 0:
         raise ValueError("bnb_linf: invalid options (resolution in (0, 1), gap in [0, 1), "
-                         "tol in [1e-15, 1e-2), max_queue in [1, 2^26], grid in [1, 64])")
+                         "tol in [1e-15, 1e-2), max_queue in [1, 2^26], grid in [1, 64], "
+                         "bound_steps in [0, 60], leaf_gap < 1)")
     work = _work(size)
     res = ffi.new("mcg_bnb_result *")
     st = lib.mcg_bnb_linf(n, _p(d1), _p(a1), _p(d2), _p(a2),
@@ -814,6 +821,7 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
         "linf": res.linf, "initial_linf": res.initial_linf,
         "lower_bound": res.lower_bound, "gap": res.gap,
         "blocks": res.blocks, "queued": res.queued,
-        "lps_2var": res.lps_2var, "lps_3var": res.lps_3var,
+        "lps_2var": res.lps_2var, "lps_3var": res.lps_3var, "hints": res.hints,
+        "leaves": res.leaves,
         "seconds": res.seconds, "stop": BNB_STOP_NAMES.get(res.stop, str(res.stop)),
     }

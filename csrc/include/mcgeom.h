@@ -546,6 +546,12 @@ typedef struct {
     int max_queue;     /* capacity of the block heap (default 2e5, <= 2^26) */
     int grid;          /* initial tiling: grid^3 cubes of [-pi, pi]^3 (5) */
     int preemptive;    /* 1: per-camera 2-variable tests first (default) */
+    int bound_steps;   /* relaxed bisection steps that tighten a split
+                          block's lower bound, the best-first key (1) */
+    double leaf_gap;   /* a block at the resolution whose relaxed test fails
+                          at linf - leaf_gap is closed with that bound (one
+                          test); otherwise its bound is bisected to tol.
+                          < 0: 0.5 x resolution (default) */
     const mcg_lp_backend *lp; /* NULL: the native backend */
 } mcg_bnb_options;
 
@@ -568,6 +574,9 @@ typedef struct {
     long queued;         /* blocks left in the queue at the stop */
     long lps_2var;       /* 2-variable LPs solved (per-camera tests) */
     long lps_3var;       /* 3-variable LPs solved */
+    long hints;          /* tests decided by the last feasible translation
+                            without an LP */
+    long leaves;         /* blocks closed at the resolution */
     double seconds;      /* wall time of the call */
     int stop;            /* MCG_BNB_* */
 } mcg_bnb_result;
