@@ -82,10 +82,15 @@
 #define BLOCK_DOUBLES 5     /* centre (3), half-side, lower bound */
 #define WS_CAP 48           /* rows of a working set before a full LP */
 #define WS_ADD 4            /* most violated rows added per round */
+/* A test the LP backend could not decide (MCG_ENUMERIC: its point failed the
+ * verification, seen only at bounds ~1e-10 rad on noise-free data): taken as
+ * feasible where a lower bound is at stake (no block is wrongly discarded)
+ * and as infeasible where an upper bound is (no error is wrongly claimed). */
+#define UNDECIDED 2
 
 typedef struct {
     int n, G;
-    const double *a1, *a2;
+    double *a1, *a2;        /* origins, centred and scaled (work) */
     double *u1, *u2;        /* unit bearings d1, d2 (work) */
     const int *grp;
     const int *order;       /* by group, then alpha descending (work) */
@@ -100,7 +105,7 @@ typedef struct {
     size_t lplen;
     const mcg_lp_backend *lp;
     int preemptive;
-    long lp2, lp3, hints;
+    long lp2, lp3, hints, undecided;
     double apex[3];         /* apex of the group being built */
     double *gapex;          /* 3 G: each group's apex */
     double t_hint[3];       /* the last feasible translation */
@@ -217,6 +222,11 @@ static int lp_working_set(bnb_ctx *c, int dim, int m, const double *A, const dou
             st = mcg_lp_feasible(c->lp, dim, ns, c->Asub, c->bsub, x, c->lpw, c->lplen);
             if (st == MCG_EINFEASIBLE)
                 break; /* a subset is infeasible: so is the whole */
+            if (st == MCG_ENUMERIC) {
+                ns = WS_CAP + 1; /* decide on all rows below */
+                na = 1;
+                goto full;
+            }
             if (st != MCG_OK)
                 return -st;
         } else {
@@ -253,17 +263,22 @@ static int lp_working_set(bnb_ctx *c, int dim, int m, const double *A, const dou
             st = MCG_OK;
             break;
         }
+    full:
         if (ns + na > WS_CAP) {
-            /* the set would overflow: decide on all rows */
+            /* the set would overflow (or its LP failed): decide on all rows */
             if (dim == 2)
                 ++c->lp2;
             else
                 ++c->lp3;
             st = mcg_lp_feasible(c->lp, dim, m, A, b, x, c->lpw, c->lplen);
+            *nws = 0; /* start afresh next time */
+            if (st == MCG_ENUMERIC) {
+                ++c->undecided;
+                return UNDECIDED; /* the backend could not verify its answer */
+            }
             if (st != MCG_OK && st != MCG_EINFEASIBLE)
                 return -st;
-            ns = 0; /* start afresh next time */
-            break;
+            return st == MCG_OK;
         }
         for (k = 0; k < na; ++k)
             S[ns++] = add[k];
@@ -346,14 +361,16 @@ static void add_unit(double acc[3], const double z[3])
 
 static int test_groups(bnb_ctx *c)
 {
-    int g, r;
+    int g, r, verdict = 1;
     for (g = 0; g < c->G; ++g) {
         r = cone_nontrivial(c, c->grows[g], c->A3 + 3 * c->gfirst[g], c->zsum + 3 * g,
                             c->gapex + 3 * g, c->rid + c->gfirst[g], 1 + g);
         if (r <= 0)
             return r;
+        if (r == UNDECIDED)
+            verdict = UNDECIDED;
     }
-    return 1;
+    return verdict;
 }
 
 static int test_all3(bnb_ctx *c, int m, double t[3])
@@ -370,7 +387,7 @@ static int test_all3(bnb_ctx *c, int m, double t[3])
         }
     }
     r = lp_working_set(c, 3, m, c->A3, c->b3, c->rid, 0, t);
-    if (r == 1) {
+    if (r == 1) { /* (an undecided point is no hint) */
         memcpy(c->t_hint, t, 3 * sizeof(double));
         c->have_hint = 1;
     }
@@ -381,7 +398,7 @@ static int test_all3(bnb_ctx *c, int m, double t[3])
  * (when feasible), 0 infeasible, negative status on error. */
 static int feasible(bnb_ctx *c, const double R[9], double eps, double s, double t[3])
 {
-    int g, j, m = 0, r;
+    int g, j, m = 0, r, verdict = 1;
     double z[3], sb, sa;
     if (!wedge_sines(eps, s, &sb, &sa)) {
         /* no constraint at all: any t will do (the last one) */
@@ -406,6 +423,8 @@ static int feasible(bnb_ctx *c, const double R[9], double eps, double s, double 
             r = cone_nontrivial(c, mg, c->A3, zs, mg ? c->apex : NULL, c->rid, 1 + g);
             if (r <= 0)
                 return r;
+            if (r == UNDECIDED)
+                verdict = UNDECIDED;
         }
     }
     /* all rows, group by group (stage 2 after each group when preemptive) */
@@ -426,18 +445,31 @@ static int feasible(bnb_ctx *c, const double R[9], double eps, double s, double 
                                 c->gapex + 3 * g, c->rid + c->gfirst[g], 1 + g);
             if (r <= 0)
                 return r;
+            if (r == UNDECIDED)
+                verdict = UNDECIDED;
         }
     }
     r = test_all3(c, m, t);
-    if (r <= 0 || c->preemptive)
+    if (r <= 0)
         return r;
-    return test_groups(c); /* "pure LP" order: the same answer, later */
+    if (r == UNDECIDED)
+        verdict = UNDECIDED;
+    if (!c->preemptive) {
+        r = test_groups(c); /* "pure LP" order: the same answer, later */
+        if (r <= 0)
+            return r;
+        if (r == UNDECIDED)
+            verdict = UNDECIDED;
+    }
+    return verdict;
 }
 
 /* FindMinError: bisection of f(R) in (lo, hi], hi known feasible (t_hi its
- * point). Returns the status; *out_hi, t_hi updated. */
+ * point). Returns the status; *out_hi, t_hi updated. For a lower bound
+ * (lower = 1) an undecided test counts as feasible, for an upper bound as
+ * infeasible. */
 static int find_min_error(bnb_ctx *c, const double R[9], double s, double lo,
-                          double *hi, double t_hi[3], double tol)
+                          double *hi, double t_hi[3], double tol, int lower)
 {
     double t[3];
     while (*hi - lo > tol) {
@@ -445,6 +477,8 @@ static int find_min_error(bnb_ctx *c, const double R[9], double s, double lo,
         int r = feasible(c, R, mid, s, t);
         if (r < 0)
             return -r;
+        if (r == UNDECIDED)
+            r = lower;
         if (r) {
             *hi = mid;
             memcpy(t_hi, t, sizeof t);
@@ -533,6 +567,8 @@ void mcg_bnb_default_options(mcg_bnb_options *opt)
     opt->preemptive = 1;
     opt->bound_steps = 1;
     opt->leaf_gap = -1.0;
+    opt->centre[0] = opt->centre[1] = opt->centre[2] = 0.0;
+    opt->half_side = 0.0;
     opt->lp = NULL;
 }
 
@@ -559,10 +595,10 @@ size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt)
     if (lp2 == 0 || lp3 == 0)
         return 0;
     lp = max_sz(lp2, lp3);
-    /* A3 6n, b3 2n, A2 4n, b2 2n, a1n n, u1 u2 6n, rid where 4n, zsum
+    /* A3 6n, b3 2n, A2 4n, b2 2n, a1n n, a1 a2 u1 u2 12n, rid where 4n, zsum
      * gapex 6G, ws (G+1) WS_CAP, nws G+1, Asub bsub 4 WS_CAP, ints (order n, gstart
      * G+1, grows G, gfirst G) one per double, heap, LP */
-    total = add_sz(mul_sz(26, (size_t)n, &ok), mul_sz(10 + WS_CAP, (size_t)n_groups + 1, &ok), &ok);
+    total = add_sz(mul_sz(32, (size_t)n, &ok), mul_sz(10 + WS_CAP, (size_t)n_groups + 1, &ok), &ok);
     total = add_sz(total, 4 * WS_CAP, &ok);
     total = add_sz(total, mul_sz(BLOCK_DOUBLES, (size_t)opt->max_queue, &ok), &ok);
     total = add_sz(total, lp, &ok);
@@ -577,11 +613,15 @@ static int check_options(const mcg_bnb_options *o)
         return 0;
     if (!(isfinite(o->tol) && o->tol >= 1e-15 && o->tol < 1e-2))
         return 0;
-    if (o->max_blocks < 1 || o->max_queue < 1 || o->max_queue > (1 << 26))
+    if (o->max_blocks < 0 || o->max_queue < 1 || o->max_queue > (1 << 26))
         return 0;
     if (o->grid < 1 || o->grid > 64 || o->bound_steps < 0 || o->bound_steps > 60)
         return 0;
     if (!(isfinite(o->leaf_gap) && o->leaf_gap < 1.0))
+        return 0;
+    if (!(isfinite(o->half_side) && o->half_side >= 0.0 && o->half_side <= PI) ||
+        !all_finite(o->centre, 3) || fabs(o->centre[0]) > 2 * PI ||
+        fabs(o->centre[1]) > 2 * PI || fabs(o->centre[2]) > 2 * PI)
         return 0;
     return 1;
 }
@@ -608,7 +648,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     mcg_lp_backend native;
     bnb_ctx c;
     double *w = work, *heap, *alpha, eps, lo, t[3], Rb[9], blk[BLOCK_DOUBLES];
-    double leaf_lb = INFINITY, prune_lb = INFINITY, t0, leaf_gap;
+    double leaf_lb = INFINITY, prune_lb = INFINITY, t0, leaf_gap, L, oc[3];
     int *order, *gstart, i, g, k, st, r, hsize = 0, gi, gj, gk;
     long blocks = 0, leaves = 0;
     size_t need;
@@ -657,8 +697,10 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     /* carve the workspace */
     c.n = n;
     c.G = n_groups;
-    c.a1 = a1;
-    c.a2 = a2;
+    c.a1 = w;
+    w += 3 * (size_t)n;
+    c.a2 = w;
+    w += 3 * (size_t)n;
     c.grp = group;
     c.A3 = w;
     w += 6 * (size_t)n;
@@ -704,7 +746,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     c.lplen = lwork - (size_t)(w - work);
     c.lp = o.lp;
     c.preemptive = o.preemptive != 0;
-    c.lp2 = c.lp3 = c.hints = 0;
+    c.lp2 = c.lp3 = c.hints = c.undecided = 0;
     for (i = 0; i < 2 * n; ++i)
         c.where[i] = -1;
     for (g = 0; g <= n_groups; ++g)
@@ -712,10 +754,21 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     c.have_hint = 0;
     c.order = order;
     c.gstart = gstart;
+    /* Work in a frame centred on the ray origins and scaled by their spread
+     * (t' = (t + R oc - oc) / L): the LPs' tolerances are relative to the
+     * scene, so the answers do not depend on the rig frame's origin or unit
+     * (up to rounding). */
+    L = origin_spread(n, a1, a2, oc);
+    if (!(L > 1e-150))
+        L = 1.0;
     for (i = 0; i < n; ++i) {
         double n1 = sqrt(dot3(d1 + 3 * i, d1 + 3 * i));
         double n2 = sqrt(dot3(d2 + 3 * i, d2 + 3 * i));
-        c.a1n[i] = sqrt(dot3(a1 + 3 * i, a1 + 3 * i));
+        for (k = 0; k < 3; ++k) {
+            c.a1[3 * i + k] = (a1[3 * i + k] - oc[k]) / L;
+            c.a2[3 * i + k] = (a2[3 * i + k] - oc[k]) / L;
+        }
+        c.a1n[i] = sqrt(dot3(c.a1 + 3 * i, c.a1 + 3 * i));
         for (k = 0; k < 3; ++k) {
             c.u1[3 * i + k] = d1[3 * i + k] / n1;
             c.u2[3 * i + k] = d2[3 * i + k] / n2;
@@ -754,14 +807,14 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
         r = feasible(&c, Rb, eps, 0.0, t);
         if (r < 0)
             return -r;
-        if (r)
+        if (r == 1)
             break;
         lo = eps;
         eps *= 2.0;
         if (eps >= EPS_MAX)
             return MCG_ENUMERIC; /* every bound up to ~86 deg infeasible */
     }
-    st = find_min_error(&c, Rb, 0.0, lo, &eps, t, o.tol);
+    st = find_min_error(&c, Rb, 0.0, lo, &eps, t, o.tol, 0);
     if (st != MCG_OK)
         return st;
     memcpy(res->R, Rb, sizeof Rb);
@@ -769,15 +822,17 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     res->linf = eps;
     res->initial_linf = eps;
 
-    /* the initial tiling of [-pi, pi]^3 */
+    /* the initial tiling of [-pi, pi]^3, or of the region cube */
     {
-        double sig = PI / o.grid;
+        double half = o.half_side > 0.0 ? o.half_side : PI, sig = half / o.grid;
+        const double zero[3] = {0.0, 0.0, 0.0};
+        const double *ctr = o.half_side > 0.0 ? o.centre : zero;
         for (gi = 0; gi < o.grid; ++gi)
             for (gj = 0; gj < o.grid; ++gj)
                 for (gk = 0; gk < o.grid; ++gk) {
-                    blk[0] = -PI + (2 * gi + 1) * sig;
-                    blk[1] = -PI + (2 * gj + 1) * sig;
-                    blk[2] = -PI + (2 * gk + 1) * sig;
+                    blk[0] = ctr[0] - half + (2 * gi + 1) * sig;
+                    blk[1] = ctr[1] - half + (2 * gj + 1) * sig;
+                    blk[2] = ctr[2] - half + (2 * gk + 1) * sig;
                     blk[3] = sig;
                     blk[4] = 0.0;
                     if (cube_distance(blk, sig) > PI)
@@ -817,9 +872,9 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
         r = feasible(&c, R0, res->linf, 0.0, tt);
         if (r < 0)
             return -r;
-        if (r) {
+        if (r == 1) {
             hi = res->linf;
-            st = find_min_error(&c, R0, 0.0, blk[4], &hi, tt, o.tol);
+            st = find_min_error(&c, R0, 0.0, blk[4], &hi, tt, o.tol, 0);
             if (st != MCG_OK)
                 return st;
             if (hi < res->linf) {
@@ -850,7 +905,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
             } else {
                 hi = target;
             }
-            st = find_min_error(&c, R0, s, lb, &hi, tt, o.tol);
+            st = find_min_error(&c, R0, s, lb, &hi, tt, o.tol, 1);
             if (st != MCG_OK)
                 return st;
             lb = hi - o.tol;
@@ -893,11 +948,19 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
         lo = 0.0;
     res->lower_bound = lo;
     res->gap = res->linf - lo;
+    /* back to the caller's frame: t = L t' - R oc + oc */
+    {
+        double ro[3];
+        mat_vec(res->R, oc, ro);
+        for (k = 0; k < 3; ++k)
+            res->t[k] = L * res->t[k] - ro[k] + oc[k];
+    }
     res->blocks = blocks;
     res->queued = hsize;
     res->lps_2var = c.lp2;
     res->lps_3var = c.lp3;
     res->hints = c.hints;
+    res->undecided = c.undecided;
     res->leaves = leaves;
     res->seconds = now_seconds() - t0;
     return MCG_OK;

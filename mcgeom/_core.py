@@ -743,7 +743,7 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
              resolution: float = 1e-4, gap: float = 0.0, tol: float = 1e-9,
              max_blocks: int = 2_000_000, max_queue: int = 200_000, grid: int = 5,
              preemptive: bool = True, bound_steps: int = 1, leaf_gap: float = -1.0,
-             lp_backend: str = "native") -> dict:
+             region: Optional[tuple] = None, lp_backend: str = "native") -> dict:
     """Globally optimal L-infinity rig motion by branch and bound over rotations
     (thesis ch. 10, ``mcg_bnb_linf``).
 
@@ -757,7 +757,10 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     tolerance; ``bound_steps``: relaxed bisection steps per split block (its
     best-first key); ``leaf_gap`` (rad, < 0: half the resolution): a block at
     the resolution is closed with the bound ``linf - leaf_gap`` when one
-    relaxed test fails there; ``lp_backend``: a name of :data:`LP_BACKENDS`.
+    relaxed test fails there; ``region``: ``(centre, half_side)`` to search only
+    the angle-axis cube centre +- half_side (rad; ``lower_bound`` then holds
+    over that cube only), None for all rotations; ``lp_backend``: a name of
+    :data:`LP_BACKENDS`.
 
     Returns a dict: ``R``, ``t`` (X2 = R X1 + t), ``linf`` (the L-infinity
     error f(R), rad), ``initial_linf``, ``lower_bound`` (certified over all
@@ -802,6 +805,13 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     opt.preemptive = 1 if preemptive else 0
     opt.bound_steps = int(bound_steps)
     opt.leaf_gap = float(leaf_gap)
+    if region is not None:
+        centre, half = region
+        centre = _arr("region centre", centre, (3,))
+        opt.centre[0], opt.centre[1], opt.centre[2] = centre
+        opt.half_side = float(half)
+        if not (0.0 < opt.half_side <= np.pi):
+            raise ValueError(f"region half_side must be in (0, pi], got {half}")
     be = LP_BACKENDS[lp_backend]()
     opt.lp = be
     size = lib.mcg_bnb_work_size(n, n_groups, opt)
@@ -822,6 +832,6 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
         "lower_bound": res.lower_bound, "gap": res.gap,
         "blocks": res.blocks, "queued": res.queued,
         "lps_2var": res.lps_2var, "lps_3var": res.lps_3var, "hints": res.hints,
-        "leaves": res.leaves,
+        "leaves": res.leaves, "undecided": res.undecided,
         "seconds": res.seconds, "stop": BNB_STOP_NAMES.get(res.stop, str(res.stop)),
     }

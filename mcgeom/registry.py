@@ -1,4 +1,4 @@
-"""Plugin registry: estimators (and later backends) swapped at runtime by name.
+"""Plugin registry: estimators and LP backends swapped at runtime by name.
 
 An estimator is a callable ``fn(rays: RayPairs, **options) -> RigMotion``
 registered with metadata that tests, the robust layer and the CLI rely on:
@@ -21,6 +21,8 @@ from typing import Callable, Iterable, Optional
 __all__ = [
     "CAMERA_KINDS", "FAMILIES", "EstimatorInfo", "register", "get", "names",
     "list_estimators", "unregister", "load_plugins", "ENTRY_POINT_GROUP",
+    "lp_backends", "set_default_lp_backend", "default_lp_backend", "resolve_lp_backend",
+    "glpk_status",
 ]
 
 ENTRY_POINT_GROUP = "mcgeom.estimators"
@@ -57,6 +59,12 @@ class EstimatorInfo:
     #: (e.g. the two-stage RANSAC of thesis ch. 7.4); the robust layer scores and
     #: refines them and stops once one explains the expected inlier ratio
     proposer: Optional[Callable] = None
+    #: ``objective(rays, R) -> float``: for a globally optimal estimator whose
+    #: optimum may be a set of rotations (an L-infinity minimum), the value it
+    #: minimises; its results carry ``info["linf"]`` and the certified
+    #: ``info["gap"]``. Equivalent inputs must then give equally good results
+    #: (values within the gaps), not necessarily the same rotation.
+    objective: Optional[Callable] = None
 
     def __call__(self, rays, **options):
         return self.func(rays, **options)
@@ -70,12 +78,14 @@ def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family:
              needs_rotation: bool = False, recovers_scale: bool = True,
              description: str = "", options: Optional[dict] = None,
              minimal_solver: Optional[Callable] = None, sampler: Optional[Callable] = None,
-             proposer: Optional[Callable] = None, replace: bool = False) -> Callable[[Callable], Callable]:
+             proposer: Optional[Callable] = None, objective: Optional[Callable] = None,
+             replace: bool = False) -> Callable[[Callable], Callable]:
     """Decorator registering ``fn(rays, **options) -> RigMotion`` under ``name``.
 
     ``options`` documents the keyword options (name -> short description).
     ``minimal_solver``, ``sampler`` and ``proposer`` (see :class:`EstimatorInfo`) let
-    :mod:`mcgeom.robust` drive the estimator with minimal samples.
+    :mod:`mcgeom.robust` drive the estimator with minimal samples; ``objective``
+    declares the value a set-valued global optimum minimises.
     Registering an existing name raises ValueError unless ``replace=True``.
     """
     kinds = tuple(camera_kinds)
@@ -96,7 +106,7 @@ def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family:
                                         bool(needs_rotation), bool(recovers_scale),
                                         description or (fn.__doc__ or "").strip().split("\n")[0],
                                         dict(options or {}), minimal_solver, sampler,
-                                        proposer)
+                                        proposer, objective)
         return fn
 
     return deco
@@ -138,3 +148,52 @@ def list_estimators() -> list[EstimatorInfo]:
     """All registered estimators with their metadata, sorted by name."""
     load_plugins()
     return [_REGISTRY[k] for k in sorted(_REGISTRY)]
+
+
+# ------------------------------------------------------------- LP backends
+# The LP feasibility backends of the branch and bound (thesis ch. 10.3) live
+# in the C core (``native`` always, ``glpk`` when libglpk could be loaded);
+# the registry names them and holds the process-wide default, so a caller
+# swaps the solver at runtime by name, like an estimator.
+
+_lp_default = "native"
+
+
+def lp_backends() -> dict[str, str]:
+    """Available LP backends: name -> short description (the GLPK entry says
+    why it is missing when it is)."""
+    from . import _core
+    out = {"native": "Seidel's randomized incremental LP (csrc/lp_native.c), MIT"}
+    status = _core.glpk_load_status()
+    if "glpk" in _core.LP_BACKENDS:
+        out["glpk"] = "GLPK primal simplex (csrc/lp_glpk.c, GPL-3.0), " + status
+    return out
+
+
+def glpk_status() -> str:
+    """Why the GLPK backend is or is not available."""
+    from . import _core
+    return _core.glpk_load_status()
+
+
+def set_default_lp_backend(name: str) -> None:
+    """Make ``name`` the LP backend used when an estimator is not told one."""
+    global _lp_default
+    _lp_default = resolve_lp_backend(name)
+
+
+def default_lp_backend() -> str:
+    """The LP backend used when an estimator is not told one."""
+    return _lp_default
+
+
+def resolve_lp_backend(name: Optional[str]) -> str:
+    """``name`` checked against the available backends (None: the default)."""
+    if name is None:
+        return _lp_default
+    avail = lp_backends()
+    if name not in avail:
+        hint = f" (glpk: {glpk_status()})" if name == "glpk" else ""
+        raise ValueError(f"unknown or unavailable LP backend {name!r}; available: "
+                         f"{sorted(avail)}{hint}")
+    return name

@@ -39,6 +39,19 @@ def test_exact_recovery_noise_free(name, kind, seed):
     assert m.scale.observable
 
 
+def _equally_optimal(name, rays_a, a, b, R_b_in_a):
+    """A set-valued global optimum (registry ``objective``): both results are
+    optimal within their certified gaps, evaluated in one frame; the
+    rotations need only agree to the width of the near-optimal set."""
+    f = registry.get(name).objective
+    fa, fb = f(rays_a, a.R), f(rays_a, R_b_in_a)
+    assert abs(fa - a.info["linf"]) < 1e-8 and abs(fb - b.info["linf"]) < 1e-8
+    slack = a.info["gap"] + b.info["gap"] + 1e-8
+    assert fb >= a.info["lower_bound"] - 1e-8 and fa >= b.info["lower_bound"] - 1e-8
+    assert abs(fa - fb) <= slack
+    assert rot_err(a.R, R_b_in_a) < 1e-2
+
+
 @pytest.mark.parametrize("name,kind", CASES)
 @SETTINGS
 @given(seed=seeds)
@@ -51,6 +64,10 @@ def test_invariant_to_rig_frame(name, kind, seed):
     F = np.eye(4)
     F[:3, :3], F[:3, 3] = Rf, tf
     expect = F @ m.T @ np.linalg.inv(F)
+    if registry.get(name).objective is not None:
+        _equally_optimal(name, p.rays, m, mf, Rf.T @ mf.R @ Rf)
+        assert mf.scale.observable == m.scale.observable
+        return
     assert rot_err(mf.R, expect[:3, :3]) < 1e-7
     assert mf.scale.observable == m.scale.observable
     if m.scale.observable:  # a unit direction of unknown scale does not conjugate
@@ -91,6 +108,10 @@ def test_scaling_world_scales_t(name, kind, seed, log_s):
     scaled = mcgeom.RayPairs(s * r.origins1, r.dirs1, s * r.origins2, r.dirs2, r.cam1, r.cam2)
     a = mcgeom.estimate(r, name)
     b = mcgeom.estimate(scaled, name)
+    if registry.get(name).objective is not None:
+        _equally_optimal(name, r, a, b, b.R)
+        assert a.scale.observable == b.scale.observable
+        return
     assert rot_err(a.R, b.R) < 1e-8
     assert a.scale.observable == b.scale.observable
     if a.scale.observable:

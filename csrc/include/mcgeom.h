@@ -542,7 +542,8 @@ typedef struct {
                           more than this (rad); [0, 1), default 0 */
     double tol;        /* bisection tolerance on the error bound (rad);
                           [1e-15, 1e-2), default 1e-9 */
-    long max_blocks;   /* stop after this many blocks (default 2e6) */
+    long max_blocks;   /* stop after this many blocks (default 2e6; 0: only
+                          f(R_init), the error at the given rotation) */
     int max_queue;     /* capacity of the block heap (default 2e5, <= 2^26) */
     int grid;          /* initial tiling: grid^3 cubes of [-pi, pi]^3 (5) */
     int preemptive;    /* 1: per-camera 2-variable tests first (default) */
@@ -552,6 +553,10 @@ typedef struct {
                           at linf - leaf_gap is closed with that bound (one
                           test); otherwise its bound is bisected to tol.
                           < 0: 0.5 x resolution (default) */
+    double centre[3];  /* with half_side > 0: search only the angle-axis cube */
+    double half_side;  /* centre +- half_side (a local search, e.g. a finer
+                          pass around an earlier optimum; lower_bound then
+                          holds over that cube only); 0: all rotations */
     const mcg_lp_backend *lp; /* NULL: the native backend */
 } mcg_bnb_options;
 
@@ -577,6 +582,9 @@ typedef struct {
     long hints;          /* tests decided by the last feasible translation
                             without an LP */
     long leaves;         /* blocks closed at the resolution */
+    long undecided;      /* LPs the backend could not verify (MCG_ENUMERIC),
+                            taken as feasible for lower bounds and as
+                            infeasible for upper bounds */
     double seconds;      /* wall time of the call */
     int stop;            /* MCG_BNB_* */
 } mcg_bnb_result;

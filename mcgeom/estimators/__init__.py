@@ -4,5 +4,6 @@ from . import linear17  # noqa: F401  (registers "linear17")
 from . import refine  # noqa: F401  (registers "refine")
 from . import five_plus_one  # noqa: F401  (registers "five_plus_one")
 from . import e_socp  # noqa: F401  (registers "e_socp")
+from . import bnb_lp  # noqa: F401  (registers "bnb_lp")
 
-__all__ = ["linear17", "refine", "five_plus_one", "e_socp"]
+__all__ = ["linear17", "refine", "five_plus_one", "e_socp", "bnb_lp"]
