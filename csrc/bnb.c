@@ -105,6 +105,7 @@ typedef struct {
     size_t lplen;
     const mcg_lp_backend *lp;
     int preemptive;
+    int working_sets;       /* 0: every LP on all its rows, no hints */
     long lp2, lp3, hints, undecided;
     double apex[3];         /* apex of the group being built */
     double *gapex;          /* 3 G: each group's apex */
@@ -182,6 +183,26 @@ static int wedge_rows(bnb_ctx *c, int i, const double R[9], double sb, double sa
     return 2;
 }
 
+/* The LP on all m rows (the working set of the slot is emptied). */
+static int full_lp(bnb_ctx *c, int dim, int m, const double *A, const double *b,
+                   double *x, int *nws)
+{
+    int st;
+    if (dim == 2)
+        ++c->lp2;
+    else
+        ++c->lp3;
+    st = mcg_lp_feasible(c->lp, dim, m, A, b, x, c->lpw, c->lplen);
+    *nws = 0;
+    if (st == MCG_ENUMERIC) {
+        ++c->undecided;
+        return UNDECIDED; /* the backend could not verify its answer */
+    }
+    if (st != MCG_OK && st != MCG_EINFEASIBLE)
+        return -st;
+    return st == MCG_OK;
+}
+
 /* LP feasibility of {x : A_j . x >= b_j, j < m} (dim 2 or 3) by constraint
  * generation: solve on the working set of the slot (rows that decided the
  * previous, nearby tests), check every row at the solution, add the most
@@ -194,12 +215,14 @@ static int lp_working_set(bnb_ctx *c, int dim, int m, const double *A, const dou
                           const int *ids, int slot, double *x)
 {
     int *ws = c->ws + (size_t)slot * WS_CAP, *nws = c->nws + slot;
-    int S[WS_CAP], ns = 0, j, k, st;
+    int S[WS_CAP], ns = 0, j, k, st, na;
     if (m == 0) {
         for (k = 0; k < dim; ++k)
             x[k] = 0.0;
         return 1;
     }
+    if (!c->working_sets)
+        return full_lp(c, dim, m, A, b, x, nws);
     for (j = 0; j < m; ++j)
         c->where[ids[j]] = j;
     for (k = 0; k < *nws; ++k) {
@@ -208,8 +231,9 @@ static int lp_working_set(bnb_ctx *c, int dim, int m, const double *A, const dou
             S[ns++] = j;
     }
     for (;;) {
-        int add[WS_ADD], na = 0;
+        int add[WS_ADD];
         double viol[WS_ADD];
+        na = 0;
         if (ns > 0) {
             for (k = 0; k < ns; ++k) {
                 memcpy(c->Asub + dim * k, A + dim * S[k], (size_t)dim * sizeof(double));
@@ -222,11 +246,8 @@ static int lp_working_set(bnb_ctx *c, int dim, int m, const double *A, const dou
             st = mcg_lp_feasible(c->lp, dim, ns, c->Asub, c->bsub, x, c->lpw, c->lplen);
             if (st == MCG_EINFEASIBLE)
                 break; /* a subset is infeasible: so is the whole */
-            if (st == MCG_ENUMERIC) {
-                ns = WS_CAP + 1; /* decide on all rows below */
-                na = 1;
-                goto full;
-            }
+            if (st == MCG_ENUMERIC) /* decide on all rows */
+                return full_lp(c, dim, m, A, b, x, nws);
             if (st != MCG_OK)
                 return -st;
         } else {
@@ -263,23 +284,8 @@ static int lp_working_set(bnb_ctx *c, int dim, int m, const double *A, const dou
             st = MCG_OK;
             break;
         }
-    full:
-        if (ns + na > WS_CAP) {
-            /* the set would overflow (or its LP failed): decide on all rows */
-            if (dim == 2)
-                ++c->lp2;
-            else
-                ++c->lp3;
-            st = mcg_lp_feasible(c->lp, dim, m, A, b, x, c->lpw, c->lplen);
-            *nws = 0; /* start afresh next time */
-            if (st == MCG_ENUMERIC) {
-                ++c->undecided;
-                return UNDECIDED; /* the backend could not verify its answer */
-            }
-            if (st != MCG_OK && st != MCG_EINFEASIBLE)
-                return -st;
-            return st == MCG_OK;
-        }
+        if (ns + na > WS_CAP) /* the set would overflow: decide on all rows */
+            return full_lp(c, dim, m, A, b, x, nws);
         for (k = 0; k < na; ++k)
             S[ns++] = add[k];
     }
@@ -313,7 +319,7 @@ static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3
     double y[2];
     if (m < 4 || !(w2 > 1e-24))
         return 1; /* fewer than two wedges, or degenerate: always non-trivial */
-    if (c->have_hint && ap) {
+    if (c->have_hint && ap && c->working_sets) {
         double b[3];
         b[0] = c->t_hint[0] - ap[0];
         b[1] = c->t_hint[1] - ap[1];
@@ -376,7 +382,7 @@ static int test_groups(bnb_ctx *c)
 static int test_all3(bnb_ctx *c, int m, double t[3])
 {
     int k, r;
-    if (c->have_hint) {
+    if (c->have_hint && c->working_sets) {
         for (k = 0; k < m; ++k)
             if (dot3(c->A3 + 3 * k, c->t_hint) < c->b3[k])
                 break;
@@ -489,6 +495,253 @@ static int find_min_error(bnb_ctx *c, const double R[9], double s, double lo,
     return MCG_OK;
 }
 
+/* Local descent of f from the incumbent (the polish): a pattern search in
+ * angle-axis space with step h halving from the resolution down to
+ * polish_tol. At each step the 26 neighbours {-1, 0, 1}^3 \ 0 and
+ * POLISH_DIRS pseudo-random unit directions (fixed seed) are tried; f is a
+ * maximum of smooth functions whose descent directions near the minimum
+ * form thin cones that axis-aligned patterns miss. A direction is taken
+ * when one exact test (slack 0) passes just below the incumbent's error,
+ * then FindMinError gives the new error and the move is repeated with a
+ * doubled step while it keeps improving. The branch and bound locates the
+ * optimum's basin to the resolution; this finds the bottom of the basin.
+ * Never increases f. */
+#define POLISH_DIRS 24
+
+static double lcg_uniform(unsigned long long *state)
+{
+    *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*state >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* the d-th direction of the pattern (d < 26: the grid, else random unit) */
+static void pattern_direction(int d, unsigned long long *state, double dir[3])
+{
+    if (d < 26) {
+        int e = d < 13 ? d : d + 1; /* skip the centre of {-1, 0, 1}^3 */
+        dir[0] = e % 3 - 1;
+        dir[1] = (e / 3) % 3 - 1;
+        dir[2] = e / 9 - 1;
+    } else {
+        double n;
+        do {
+            dir[0] = 2.0 * lcg_uniform(state) - 1.0;
+            dir[1] = 2.0 * lcg_uniform(state) - 1.0;
+            dir[2] = 2.0 * lcg_uniform(state) - 1.0;
+            n = dot3(dir, dir);
+        } while (n > 1.0 || n < 1e-4);
+        n = sqrt(n);
+        dir[0] /= n;
+        dir[1] /= n;
+        dir[2] /= n;
+    }
+}
+
+/* f just below the incumbent at angle-axis w? If so, the incumbent moves
+ * there: 1; not: 0; < 0 status. */
+static int try_move(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
+                    const double w[3], long *tests)
+{
+    double Rn[9], hi, tt[3], below = res->linf - 2.0 * o->tol;
+    int st, r;
+    if (below <= 0.0)
+        return 0;
+    st = mcg_rot_from_angle_axis(w, Rn);
+    if (st != MCG_OK)
+        return -st;
+    ++*tests;
+    r = feasible(c, Rn, below, 0.0, tt);
+    if (r < 0)
+        return r;
+    if (r != 1)
+        return 0;
+    hi = below;
+    st = find_min_error(c, Rn, 0.0, 0.0, &hi, tt, o->tol, 0);
+    if (st != MCG_OK)
+        return -st;
+    memcpy(res->R, Rn, sizeof Rn);
+    memcpy(res->t, tt, sizeof tt);
+    res->linf = hi;
+    return 1;
+}
+
+static int polish_incumbent(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
+                            long *tests)
+{
+    unsigned long long state = 0x9e3779b97f4a7c15ULL;
+    double w[3], h;
+    int st, k;
+    st = mcg_angle_axis_from_rot(res->R, w);
+    if (st != MCG_OK)
+        return st;
+    for (h = o->resolution; h >= o->polish_tol; h *= 0.5) {
+        int d, moved = 1;
+        while (moved) {
+            moved = 0;
+            for (d = 0; d < 26 + POLISH_DIRS && !moved; ++d) {
+                double dir[3], wn[3], step = h;
+                int r;
+                pattern_direction(d, &state, dir);
+                for (;;) { /* repeat a good move with doubled steps */
+                    for (k = 0; k < 3; ++k)
+                        wn[k] = w[k] + step * dir[k];
+                    r = try_move(c, o, res, wn, tests);
+                    if (r < 0)
+                        return -r;
+                    if (!r)
+                        break;
+                    memcpy(w, wn, sizeof wn);
+                    moved = 1;
+                    step *= 2.0;
+                }
+            }
+        }
+    }
+    return MCG_OK;
+}
+
+/* f at angle-axis w if it is below level (then 1, *f and t set), else 0
+ * (f >= level up to the tolerance): one exact test decides, a bisection
+ * on [0, level] follows only when it passes. */
+static int f_below(bnb_ctx *c, const mcg_bnb_options *o, const double w[3], double level,
+                   double *f, double t[3], long *tests)
+{
+    double Rn[9], hi = level - 2.0 * o->tol;
+    int st, r;
+    if (hi <= 0.0)
+        return 0;
+    st = mcg_rot_from_angle_axis(w, Rn);
+    if (st != MCG_OK)
+        return -st;
+    ++*tests;
+    r = feasible(c, Rn, hi, 0.0, t);
+    if (r < 0)
+        return r;
+    if (r != 1)
+        return 0;
+    st = find_min_error(c, Rn, 0.0, 0.0, &hi, t, o->tol, 0);
+    if (st != MCG_OK)
+        return -st;
+    *f = hi;
+    return 1;
+}
+
+/* Nelder-Mead on f in angle-axis space from the pattern search's point,
+ * simplex edge = the resolution, until the simplex is below polish_tol: it
+ * follows the curved, narrow valleys of a maximum of smooth functions where
+ * fixed patterns stall. Values are only compared, so a trial point costs
+ * one test unless it is accepted. Never increases f. */
+static int nelder_mead(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
+                       double h, long *tests)
+{
+    double X[4][3], F[4], T[4][3];
+    int st, k, i, it;
+    st = mcg_angle_axis_from_rot(res->R, X[0]);
+    if (st != MCG_OK)
+        return st;
+    F[0] = res->linf;
+    memcpy(T[0], res->t, sizeof T[0]);
+    for (i = 1; i < 4; ++i) {
+        /* the other vertices: f from scratch (bisection below a loose cap) */
+        memcpy(X[i], X[0], sizeof X[0]);
+        X[i][i - 1] += h;
+        st = f_below(c, o, X[i], EPS_MAX, &F[i], T[i], tests);
+        if (st < 0)
+            return -st;
+        if (!st)
+            F[i] = EPS_MAX;
+    }
+    for (it = 0; it < 400; ++it) {
+        double cen[3], xr[3], xe[3], xc[3], fr, fe, fc, tr[3], te[3], tc[3], size = 0.0;
+        int order[4] = {0, 1, 2, 3}, a, bb, w, sw, r;
+        /* sort: order[0] best ... order[3] worst */
+        for (a = 1; a < 4; ++a)
+            for (bb = a; bb > 0 && F[order[bb]] < F[order[bb - 1]]; --bb) {
+                int tmp = order[bb];
+                order[bb] = order[bb - 1];
+                order[bb - 1] = tmp;
+            }
+        for (i = 1; i < 4; ++i)
+            for (k = 0; k < 3; ++k) {
+                double d = fabs(X[order[i]][k] - X[order[0]][k]);
+                if (d > size)
+                    size = d;
+            }
+        if (size < o->polish_tol)
+            break;
+        w = order[3];
+        sw = order[2];
+        for (k = 0; k < 3; ++k)
+            cen[k] = (X[order[0]][k] + X[order[1]][k] + X[order[2]][k]) / 3.0;
+        for (k = 0; k < 3; ++k)
+            xr[k] = 2.0 * cen[k] - X[w][k];
+        r = f_below(c, o, xr, F[w], &fr, tr, tests);
+        if (r < 0)
+            return -r;
+        if (r && fr < F[order[0]]) {
+            for (k = 0; k < 3; ++k)
+                xe[k] = 3.0 * cen[k] - 2.0 * X[w][k];
+            r = f_below(c, o, xe, fr, &fe, te, tests);
+            if (r < 0)
+                return -r;
+            if (r) {
+                memcpy(X[w], xe, sizeof xe);
+                memcpy(T[w], te, sizeof te);
+                F[w] = fe;
+            } else {
+                memcpy(X[w], xr, sizeof xr);
+                memcpy(T[w], tr, sizeof tr);
+                F[w] = fr;
+            }
+            continue;
+        }
+        if (r && fr < F[sw]) {
+            memcpy(X[w], xr, sizeof xr);
+            memcpy(T[w], tr, sizeof tr);
+            F[w] = fr;
+            continue;
+        }
+        /* contraction: outside if the reflection beat the worst, else inside */
+        if (r) {
+            for (k = 0; k < 3; ++k)
+                xc[k] = cen[k] + 0.5 * (xr[k] - cen[k]);
+            r = f_below(c, o, xc, fr, &fc, tc, tests);
+        } else {
+            for (k = 0; k < 3; ++k)
+                xc[k] = cen[k] + 0.5 * (X[w][k] - cen[k]);
+            r = f_below(c, o, xc, F[w], &fc, tc, tests);
+        }
+        if (r < 0)
+            return -r;
+        if (r) {
+            memcpy(X[w], xc, sizeof xc);
+            memcpy(T[w], tc, sizeof tc);
+            F[w] = fc;
+            continue;
+        }
+        /* shrink towards the best vertex */
+        for (i = 1; i < 4; ++i) {
+            int v = order[i];
+            for (k = 0; k < 3; ++k)
+                X[v][k] = X[order[0]][k] + 0.5 * (X[v][k] - X[order[0]][k]);
+            r = f_below(c, o, X[v], EPS_MAX, &F[v], T[v], tests);
+            if (r < 0)
+                return -r;
+            if (!r)
+                F[v] = EPS_MAX;
+        }
+    }
+    for (i = 0; i < 4; ++i)
+        if (F[i] < res->linf) {
+            st = mcg_rot_from_angle_axis(X[i], res->R);
+            if (st != MCG_OK)
+                return st;
+            memcpy(res->t, T[i], sizeof T[i]);
+            res->linf = F[i];
+        }
+    return MCG_OK;
+}
+
 /* ---------------------------------------------------------------- heap */
 
 static void heap_swap(double *h, int i, int j)
@@ -565,11 +818,36 @@ void mcg_bnb_default_options(mcg_bnb_options *opt)
     opt->max_queue = 200000;
     opt->grid = 5;
     opt->preemptive = 1;
+    opt->working_sets = 1;
+    opt->polish_tol = 1e-9;
     opt->bound_steps = 1;
     opt->leaf_gap = -1.0;
     opt->centre[0] = opt->centre[1] = opt->centre[2] = 0.0;
     opt->half_side = 0.0;
     opt->lp = NULL;
+}
+
+static int check_options(const mcg_bnb_options *o)
+{
+    if (!(isfinite(o->resolution) && o->resolution > 0.0 && o->resolution < 1.0))
+        return 0;
+    if (!(isfinite(o->gap) && o->gap >= 0.0 && o->gap < 1.0))
+        return 0;
+    if (!(isfinite(o->tol) && o->tol >= 1e-15 && o->tol < 1e-2))
+        return 0;
+    if (o->max_blocks < 0 || o->max_queue < 1 || o->max_queue > (1 << 26))
+        return 0;
+    if (o->grid < 1 || o->grid > 64 || o->bound_steps < 0 || o->bound_steps > 60)
+        return 0;
+    if (!(isfinite(o->leaf_gap) && o->leaf_gap < 1.0))
+        return 0;
+    if (!(isfinite(o->polish_tol) && o->polish_tol >= 0.0 && o->polish_tol < 1.0))
+        return 0;
+    if (!(isfinite(o->half_side) && o->half_side >= 0.0 && o->half_side <= PI) ||
+        !all_finite(o->centre, 3) || fabs(o->centre[0]) > 2 * PI ||
+        fabs(o->centre[1]) > 2 * PI || fabs(o->centre[2]) > 2 * PI)
+        return 0;
+    return 1;
 }
 
 size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt)
@@ -583,7 +861,7 @@ size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt)
         mcg_bnb_default_options(&d);
         opt = &d;
     }
-    if (opt->max_queue < 1 || opt->max_queue > (1 << 26))
+    if (!check_options(opt))
         return 0;
     if (opt->lp) {
         lp2 = mcg_lp_work_size(opt->lp, 2, 2 * n);
@@ -603,27 +881,6 @@ size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt)
     total = add_sz(total, mul_sz(BLOCK_DOUBLES, (size_t)opt->max_queue, &ok), &ok);
     total = add_sz(total, lp, &ok);
     return ok ? total : 0;
-}
-
-static int check_options(const mcg_bnb_options *o)
-{
-    if (!(isfinite(o->resolution) && o->resolution > 0.0 && o->resolution < 1.0))
-        return 0;
-    if (!(isfinite(o->gap) && o->gap >= 0.0 && o->gap < 1.0))
-        return 0;
-    if (!(isfinite(o->tol) && o->tol >= 1e-15 && o->tol < 1e-2))
-        return 0;
-    if (o->max_blocks < 0 || o->max_queue < 1 || o->max_queue > (1 << 26))
-        return 0;
-    if (o->grid < 1 || o->grid > 64 || o->bound_steps < 0 || o->bound_steps > 60)
-        return 0;
-    if (!(isfinite(o->leaf_gap) && o->leaf_gap < 1.0))
-        return 0;
-    if (!(isfinite(o->half_side) && o->half_side >= 0.0 && o->half_side <= PI) ||
-        !all_finite(o->centre, 3) || fabs(o->centre[0]) > 2 * PI ||
-        fabs(o->centre[1]) > 2 * PI || fabs(o->centre[2]) > 2 * PI)
-        return 0;
-    return 1;
 }
 
 /* sort order[lo, hi) by key descending (insertion sort: groups are small
@@ -746,6 +1003,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     c.lplen = lwork - (size_t)(w - work);
     c.lp = o.lp;
     c.preemptive = o.preemptive != 0;
+    c.working_sets = o.working_sets != 0;
     c.lp2 = c.lp3 = c.hints = c.undecided = 0;
     for (i = 0; i < 2 * n; ++i)
         c.where[i] = -1;
@@ -935,6 +1193,23 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
             if (cube_distance(ch, hs) <= PI)
                 heap_push(heap, &hsize, ch);
         }
+    }
+    if (o.polish_tol > 0.0 && o.polish_tol < o.resolution) {
+        long tests = 0;
+        st = polish_incumbent(&c, &o, res, &tests);
+        /* Nelder-Mead restarted from its own result with fresh simplices
+         * (edges 10, 1, 0.1 x the resolution) until a restart gains
+         * nothing: a collapsed simplex can stall in a curved valley */
+        for (k = 0; st == MCG_OK && k < 6; ++k) {
+            double before = res->linf;
+            st = nelder_mead(&c, &o, res, o.resolution * (k % 3 == 0 ? 10.0 : k % 3 == 1 ? 1.0 : 0.1),
+                             &tests);
+            if (k >= 2 && res->linf >= before - o.tol)
+                break;
+        }
+        if (st != MCG_OK)
+            return st;
+        res->polish_tests = tests;
     }
     /* the certified lower bound over all rotations */
     lo = res->linf;

@@ -742,7 +742,9 @@ BNB_STOP_NAMES = {
 def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
              resolution: float = 1e-4, gap: float = 0.0, tol: float = 1e-9,
              max_blocks: int = 2_000_000, max_queue: int = 200_000, grid: int = 5,
-             preemptive: bool = True, bound_steps: int = 1, leaf_gap: float = -1.0,
+             preemptive: bool = True, working_sets: bool = True, polish_tol: float = 1e-9,
+             bound_steps: int = 1,
+             leaf_gap: float = -1.0,
              region: Optional[tuple] = None, lp_backend: str = "native") -> dict:
     """Globally optimal L-infinity rig motion by branch and bound over rotations
     (thesis ch. 10, ``mcg_bnb_linf``).
@@ -754,7 +756,11 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     ``resolution``: rotation blocks are split until all their rotations are
     within this angle (rad) of the centre; ``gap`` (rad): blocks that cannot
     improve by more than this are discarded; ``tol`` (rad): bisection
-    tolerance; ``bound_steps``: relaxed bisection steps per split block (its
+    tolerance; ``preemptive``: per-camera 2-variable tests first;
+    ``working_sets``: LPs by constraint generation (False: every LP on all its
+    rows, the thesis's way; same answers); ``polish_tol`` (rad): a local
+    pattern search on f from the best rotation, steps halving from the
+    resolution to this (0: none); ``bound_steps``: relaxed bisection steps per split block (its
     best-first key); ``leaf_gap`` (rad, < 0: half the resolution): a block at
     the resolution is closed with the bound ``linf - leaf_gap`` when one
     relaxed test fails there; ``region``: ``(centre, half_side)`` to search only
@@ -803,6 +809,8 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     opt.max_queue = int(max_queue)
     opt.grid = int(grid)
     opt.preemptive = 1 if preemptive else 0
+    opt.working_sets = 1 if working_sets else 0
+    opt.polish_tol = float(polish_tol)
     opt.bound_steps = int(bound_steps)
     opt.leaf_gap = float(leaf_gap)
     if region is not None:
@@ -832,6 +840,6 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
         "lower_bound": res.lower_bound, "gap": res.gap,
         "blocks": res.blocks, "queued": res.queued,
         "lps_2var": res.lps_2var, "lps_3var": res.lps_3var, "hints": res.hints,
-        "leaves": res.leaves, "undecided": res.undecided,
+        "leaves": res.leaves, "undecided": res.undecided, "polish_tests": res.polish_tests,
         "seconds": res.seconds, "stop": BNB_STOP_NAMES.get(res.stop, str(res.stop)),
     }

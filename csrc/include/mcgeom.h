@@ -547,6 +547,14 @@ typedef struct {
     int max_queue;     /* capacity of the block heap (default 2e5, <= 2^26) */
     int grid;          /* initial tiling: grid^3 cubes of [-pi, pi]^3 (5) */
     int preemptive;    /* 1: per-camera 2-variable tests first (default) */
+    int working_sets;  /* 1: LPs by constraint generation over working sets
+                          kept between tests, the last translation tried
+                          first (default); 0: every LP on all its rows, as
+                          the thesis (same answers, slower) */
+    double polish_tol; /* after the search, a local pattern search on f from
+                          the best rotation with steps halving from the
+                          resolution down to polish_tol (rad); 0: none.
+                          Default 1e-9 */
     int bound_steps;   /* relaxed bisection steps that tighten a split
                           block's lower bound, the best-first key (1) */
     double leaf_gap;   /* a block at the resolution whose relaxed test fails
@@ -582,6 +590,7 @@ typedef struct {
     long hints;          /* tests decided by the last feasible translation
                             without an LP */
     long leaves;         /* blocks closed at the resolution */
+    long polish_tests;   /* neighbours tried by the polish */
     long undecided;      /* LPs the backend could not verify (MCG_ENUMERIC),
                             taken as feasible for lower bounds and as
                             infeasible for upper bounds */

@@ -141,6 +141,8 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
              "gap": "stop when no block can improve by more than this, radians (0)",
              "lp_backend": "LP solver: 'native' or 'glpk' (default: the registry's)",
              "preemptive": "per-camera 2-variable tests first (True)",
+             "working_sets": "LPs by constraint generation over working sets (True); "
+                             "False: every LP on all rows (the thesis's way, same answers)",
              "max_blocks": "block budget of the global search (2e6)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
                                   "unobservable (0.1)"},
@@ -148,7 +150,7 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
 )
 def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
            resolution: float = 1e-4, gap: float = 0.0, lp_backend: Optional[str] = None,
-           preemptive: bool = True, max_blocks: int = 2_000_000,
+           preemptive: bool = True, working_sets: bool = True, max_blocks: int = 2_000_000,
            max_scale_rel_std: float = 0.1) -> RigMotion:
     """Globally optimal L-infinity rig motion rig2_from_rig1 (thesis ch. 10).
 
@@ -181,7 +183,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
     R0, t0, source = _initial(sub, initial)
     args = (sub.dirs1, sub.origins1, sub.dirs2, sub.origins2, groups)
     res = _core.bnb_linf(*args, R0, resolution=resolution, gap=gap, preemptive=preemptive,
-                         max_blocks=max_blocks, lp_backend=backend)
+                         working_sets=working_sets, max_blocks=max_blocks, lp_backend=backend)
     R, t, linf = res["R"], res["t"], res["linf"]
     # the initial estimate, when it is as good within the LP's precision
     f0 = res["initial_linf"]
