@@ -107,6 +107,7 @@ typedef struct {
     int preemptive;
     int working_sets;       /* 0: every LP on all its rows, no hints */
     long lp2, lp3, hints, undecided;
+    double floor;           /* certified lower bound of f (for the polish) */
     double apex[3];         /* apex of the group being built */
     double *gapex;          /* 3 G: each group's apex */
     double t_hint[3];       /* the last feasible translation */
@@ -556,7 +557,7 @@ static int try_move(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
     if (r != 1)
         return 0;
     hi = below;
-    st = find_min_error(c, Rn, 0.0, 0.0, &hi, tt, o->tol, 0);
+    st = find_min_error(c, Rn, 0.0, c->floor, &hi, tt, o->tol, 0);
     if (st != MCG_OK)
         return -st;
     memcpy(res->R, Rn, sizeof Rn);
@@ -574,7 +575,7 @@ static int polish_incumbent(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result
     st = mcg_angle_axis_from_rot(res->R, w);
     if (st != MCG_OK)
         return st;
-    for (h = o->resolution; h >= o->polish_tol; h *= 0.5) {
+    for (h = o->resolution; h >= o->resolution / 16 && h >= o->polish_tol; h *= 0.5) {
         int d, moved = 1;
         while (moved) {
             moved = 0;
@@ -619,7 +620,7 @@ static int f_below(bnb_ctx *c, const mcg_bnb_options *o, const double w[3], doub
         return r;
     if (r != 1)
         return 0;
-    st = find_min_error(c, Rn, 0.0, 0.0, &hi, t, o->tol, 0);
+    st = find_min_error(c, Rn, 0.0, c->floor, &hi, t, o->tol, 0);
     if (st != MCG_OK)
         return -st;
     *f = hi;
@@ -651,7 +652,7 @@ static int nelder_mead(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res
         if (!st)
             F[i] = EPS_MAX;
     }
-    for (it = 0; it < 400; ++it) {
+    for (it = 0; it < 600; ++it) {
         double cen[3], xr[3], xe[3], xc[3], fr, fe, fc, tr[3], te[3], tc[3], size = 0.0;
         int order[4] = {0, 1, 2, 3}, a, bb, w, sw, r;
         /* sort: order[0] best ... order[3] worst */
@@ -1194,23 +1195,6 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
                 heap_push(heap, &hsize, ch);
         }
     }
-    if (o.polish_tol > 0.0 && o.polish_tol < o.resolution) {
-        long tests = 0;
-        st = polish_incumbent(&c, &o, res, &tests);
-        /* Nelder-Mead restarted from its own result with fresh simplices
-         * (edges 10, 1, 0.1 x the resolution) until a restart gains
-         * nothing: a collapsed simplex can stall in a curved valley */
-        for (k = 0; st == MCG_OK && k < 6; ++k) {
-            double before = res->linf;
-            st = nelder_mead(&c, &o, res, o.resolution * (k % 3 == 0 ? 10.0 : k % 3 == 1 ? 1.0 : 0.1),
-                             &tests);
-            if (k >= 2 && res->linf >= before - o.tol)
-                break;
-        }
-        if (st != MCG_OK)
-            return st;
-        res->polish_tests = tests;
-    }
     /* the certified lower bound over all rotations */
     lo = res->linf;
     if (hsize > 0 && heap[4] < lo)
@@ -1222,6 +1206,27 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     if (lo < 0.0)
         lo = 0.0;
     res->lower_bound = lo;
+    c.floor = lo - 2.0 * o.tol;
+    if (o.polish_tol > 0.0 && o.polish_tol < o.resolution) {
+        long tests = 0;
+        int idle;
+        st = polish_incumbent(&c, &o, res, &tests);
+        /* Nelder-Mead restarted from its own result with fresh simplices
+         * (edges cycling through 10, 1, 0.1 x the resolution) until three
+         * restarts in a row gain nothing: a collapsed simplex can stall in
+         * a curved valley */
+        for (k = 0, idle = 0; st == MCG_OK && k < 15 && idle < 3; ++k) {
+            double before = res->linf;
+            st = nelder_mead(&c, &o, res, o.resolution * (k % 3 == 0 ? 10.0 : k % 3 == 1 ? 1.0 : 0.1),
+                             &tests);
+            idle = res->linf < before - o.tol ? 0 : idle + 1;
+        }
+        if (st != MCG_OK)
+            return st;
+        res->polish_tests = tests;
+        if (res->linf < lo) /* only within the LPs' tolerances */
+            lo = res->lower_bound = res->linf;
+    }
     res->gap = res->linf - lo;
     /* back to the caller's frame: t = L t' - R oc + oc */
     {

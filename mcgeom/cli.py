@@ -63,8 +63,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     if args.what == "cone":
         return _bench_cone(args)
+    if args.what == "bnb":
+        return _bench_bnb(args)
     if args.what != "linear17":
-        print(f"unknown benchmark {args.what!r}; available: linear17, cone", file=sys.stderr)
+        print(f"unknown benchmark {args.what!r}; available: linear17, cone, bnb", file=sys.stderr)
         return 2
     from .bench.linear17 import bench_linear17
 
@@ -96,6 +98,28 @@ def _bench_cone(args: argparse.Namespace) -> int:
     return 0
 
 
+def _bench_bnb(args: argparse.Namespace) -> int:
+    from .bench.bnb import bench_bnb, growth
+
+    def row(r) -> str:
+        g = "" if r.glpk_s is None else f" {r.glpk_s:9.3f} {r.glpk_ratio:7.1f}"
+        return (f"{r.cams:4d} {r.pts:4d} {r.search_s:9.3f} {r.total_s:9.3f} {r.blocks:8.0f} "
+                f"{r.lps:8.0f} {r.us_per_lp:7.2f}{g}")
+
+    head = (f"{'cams':>4} {'pts':>4} {'search s':>9} {'+polish s':>9} {'blocks':>8} "
+            f"{'LPs':>8} {'us/LP':>7}")
+    print("bnb: branch and bound over rotations to 1e-4 rad (4 cameras x 50 points, "
+          "0.5 px; medians)")
+    print(head + f" {'glpk s':>9} {'glpk/nat':>7}")
+    print(row(bench_bnb(problems=args.problems)))
+    print("published: thesis ch. 10.5.1 about 3.5 s (C++ with GLPK)")
+    print("\ngrowth with points (4 cameras) and cameras (50 points each)")
+    print(head)
+    for r in growth(problems=max(3, args.problems // 2)):
+        print(row(r))
+    return 0
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """Entry point of the ``mcgeom`` command."""
     p = argparse.ArgumentParser(prog="mcgeom", description=__doc__.split("\n")[0])
@@ -109,7 +133,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     m = sub.add_parser("methods", help="list the registered estimators")
     m.set_defaults(func=_cmd_methods)
     b = sub.add_parser("bench", help="benchmarks with ratios against references")
-    b.add_argument("what", help="benchmark name (linear17, cone)")
+    b.add_argument("what", help="benchmark name (linear17, cone, bnb)")
+    b.add_argument("--problems", type=int, default=10, help="problems per row (bnb)")
     b.add_argument("--sizes", default="17,100,1000,10000")
     b.add_argument("--budget", type=float, default=0.5, help="seconds per timing")
     b.set_defaults(func=_cmd_bench)

@@ -38,21 +38,28 @@ def _metric(m) -> np.ndarray:
                       else m.t)
 
 
-def run(runs: int = 10, seed: int = 0, levels=LEVELS) -> dict:
+def problems(runs: int, sigma: float, seed: int = 0):
+    """The ch. 10.5.1 problems at one noise level: (R, t, problem) per run."""
+    rig = rig4()
+    rng = np.random.default_rng(seed)
+    for _ in range(runs):
+        R = synth.random_rotation(rng, np.radians(20))
+        while synth.rotation_error(R, np.eye(3)) < np.radians(5):
+            R = synth.random_rotation(rng, np.radians(20))
+        t = rng.normal(size=3)
+        t *= rng.uniform(0.5, 1.5) / np.linalg.norm(t)
+        yield R, t, synth.make_problem(rig, R, t, 200, rng, pixel_noise=sigma)
+
+
+def run(runs: int = 10, seed: int = 0, levels=LEVELS, methods=METHODS) -> dict:
+    """Mean errors per noise level and method (see :func:`table`)."""
     rig = rig4()
     c1 = rig.centres[0]
     out = {}
     for sigma in levels:
-        rng = np.random.default_rng(seed)
-        rows = {m: [] for m in METHODS}
-        for _ in range(runs):
-            R = synth.random_rotation(rng, np.radians(20))
-            while synth.rotation_error(R, np.eye(3)) < np.radians(5):
-                R = synth.random_rotation(rng, np.radians(20))
-            t = rng.normal(size=3)
-            t *= rng.uniform(0.5, 1.5) / np.linalg.norm(t)
-            p = synth.make_problem(rig, R, t, 200, rng, pixel_noise=sigma)
-            for name in METHODS:
+        rows = {m: [] for m in methods}
+        for R, t, p in problems(runs, sigma, seed):
+            for name in methods:
                 try:
                     m = mcgeom.estimate(p.rays, name)
                 except (ValueError, mcgeom.DegenerateError):

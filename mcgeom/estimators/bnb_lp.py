@@ -18,7 +18,9 @@ Steps:
 2. an initial motion from a registered estimator (default: ``refine``, i.e.
    ``linear17`` then Levenberg-Marquardt; ``five_plus_one`` where linear17
    cannot run): its ``f`` is the first bound (Algorithm 7, step 1);
-3. the global search to ``resolution`` (rad);
+3. the global search to ``resolution`` (rad), then a local descent of f
+   from its best rotation (``polish``, in the same C call): the bottom of the
+   optimum's basin rather than the centre of a block;
 4. the initial estimate is kept when its ``f`` equals the optimum within the
    LP precision (noise-free data: both are exact, the smooth one is exact to
    rounding);
@@ -143,6 +145,8 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
              "preemptive": "per-camera 2-variable tests first (True)",
              "working_sets": "LPs by constraint generation over working sets (True); "
                              "False: every LP on all rows (the thesis's way, same answers)",
+             "polish": "local descent of the L-infinity error from the best rotation (True): "
+                       "the bottom of the optimum's basin rather than a block centre",
              "max_blocks": "block budget of the global search (2e6)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
                                   "unobservable (0.1)"},
@@ -150,7 +154,8 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
 )
 def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
            resolution: float = 1e-4, gap: float = 0.0, lp_backend: Optional[str] = None,
-           preemptive: bool = True, working_sets: bool = True, max_blocks: int = 2_000_000,
+           preemptive: bool = True, working_sets: bool = True, polish: bool = True,
+           max_blocks: int = 2_000_000,
            max_scale_rel_std: float = 0.1) -> RigMotion:
     """Globally optimal L-infinity rig motion rig2_from_rig1 (thesis ch. 10).
 
@@ -183,7 +188,8 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
     R0, t0, source = _initial(sub, initial)
     args = (sub.dirs1, sub.origins1, sub.dirs2, sub.origins2, groups)
     res = _core.bnb_linf(*args, R0, resolution=resolution, gap=gap, preemptive=preemptive,
-                         working_sets=working_sets, max_blocks=max_blocks, lp_backend=backend)
+                         working_sets=working_sets, max_blocks=max_blocks, lp_backend=backend,
+                         polish_tol=1e-9 if polish else 0.0)
     R, t, linf = res["R"], res["t"], res["linf"]
     # the initial estimate, when it is as good within the LP's precision
     f0 = res["initial_linf"]
@@ -212,6 +218,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
         "blocks": res["blocks"], "leaves": res["leaves"], "queued": res["queued"],
         "lps_2var": res["lps_2var"], "lps_3var": res["lps_3var"], "hints": res["hints"],
         "seconds": res["seconds"], "stop": res["stop"], "lp_backend": backend,
+        "polish_tests": res["polish_tests"],
         "resolution": float(resolution), "n_used": len(sub), "groups": int(groups.max()) + 1,
         "t_metric": t_metric,
     }

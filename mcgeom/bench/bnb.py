@@ -1,0 +1,92 @@
+"""``mcgeom bench bnb``: the branch and bound of thesis ch. 10 (csrc/bnb.c).
+
+The ch. 10.5.1 set-up: cameras on a ring looking outward, ``pts`` points per
+camera, Gaussian pixel noise, a random motion of 5-20 deg; the search to a
+rotation resolution (default 1e-4 rad) from the ``refine`` estimate. Printed:
+median search time (the C call, with and without the final polish), blocks,
+LPs and time per LP; the same search with the GLPK backend (same start, same
+decisions) and the time ratio GLPK / native; and how the time grows with the
+number of points and of cameras. The thesis's figure for 4 cameras x 50
+points: about 3.5 s (C++ and GLPK, Core 2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from .. import estimate, registry, synth
+from ..rig import Rig
+
+__all__ = ["BnbTiming", "ring_rig", "bench_bnb", "growth"]
+
+
+@dataclass(frozen=True)
+class BnbTiming:
+    cams: int
+    pts: int
+    search_s: float          # median C time of the search, polish off
+    total_s: float           # median C time with the polish
+    blocks: float
+    lps: float
+    us_per_lp: float
+    glpk_s: Optional[float]  # median C time of the same search with GLPK
+
+    @property
+    def glpk_ratio(self) -> Optional[float]:
+        return None if self.glpk_s is None else self.glpk_s / self.search_s
+
+
+def ring_rig(cams: int, radius: float = 0.5, f: float = 800.0) -> Rig:
+    """``cams`` cameras on a horizontal ring of the given radius (m), looking
+    outward at equal angles (1024 x 768 px, focal f px)."""
+    out = []
+    for k in range(cams):
+        yaw = 2 * np.pi * k / cams
+        h = np.array([np.cos(yaw), np.sin(yaw), 0.0])
+        out.append(synth.look_at_camera(f"cam{k}", radius * h, h, f=f, width=1024, height=768))
+    return Rig(tuple(out))
+
+
+def _problems(cams: int, pts: int, noise: float, n: int, seed: int):
+    rig = ring_rig(cams)
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        R = synth.random_rotation(rng, np.radians(20))
+        while synth.rotation_error(R, np.eye(3)) < np.radians(5):
+            R = synth.random_rotation(rng, np.radians(20))
+        t = rng.normal(size=3)
+        t *= rng.uniform(0.5, 1.5) / np.linalg.norm(t)
+        yield synth.make_problem(rig, R, t, cams * pts, rng, pixel_noise=noise)
+
+
+def bench_bnb(cams: int = 4, pts: int = 50, noise: float = 0.5, problems: int = 10,
+              resolution: float = 1e-4, glpk: bool = True, seed: int = 0) -> BnbTiming:
+    """Medians over ``problems`` problems (see the module docstring)."""
+    rows = []
+    use_glpk = glpk and "glpk" in registry.lp_backends()
+    for p in _problems(cams, pts, noise, problems, seed):
+        start = estimate(p.rays, "refine")
+        kw = dict(initial=start, resolution=resolution)
+        a = estimate(p.rays, "bnb_lp", polish=False, lp_backend="native", **kw).info
+        b = estimate(p.rays, "bnb_lp", polish=True, lp_backend="native", **kw).info
+        g = (estimate(p.rays, "bnb_lp", polish=False, lp_backend="glpk", **kw).info
+             if use_glpk else None)
+        lps = a["lps_2var"] + a["lps_3var"]
+        rows.append((a["seconds"], b["seconds"], a["blocks"], lps,
+                     1e6 * a["seconds"] / max(lps, 1), g["seconds"] if g else np.nan))
+    r = np.array(rows)
+    med = np.median(r, axis=0)
+    return BnbTiming(cams, pts, med[0], med[1], med[2], med[3], med[4],
+                     None if not use_glpk else float(med[5]))
+
+
+def growth(points=(25, 50, 100, 200), cameras=(2, 4, 6, 8), problems: int = 5,
+           noise: float = 0.5, resolution: float = 1e-4) -> list[BnbTiming]:
+    """Search times for 4 cameras x ``points`` and for ``cameras`` x 50 points."""
+    out = [bench_bnb(4, n, noise, problems, resolution, glpk=False) for n in points]
+    out += [bench_bnb(m, 50, noise, problems, resolution, glpk=False)
+            for m in cameras if m != 4]
+    return out
