@@ -109,8 +109,7 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
         if info.name == "bnb_lp":
             raise ValueError("initial: bnb_lp cannot start itself")
         try:
-            opts = {"robust_threshold": None} if name == "five_plus_one" else {}
-            m = info(rays, **opts)
+            m = info(rays)
             return m.R, m.t, name
         except (ValueError, DegenerateError, NumericalError) as e:
             errors.append(f"{name}: {e}")
