@@ -30,10 +30,10 @@ import experiment_ch9
 METHODS = ("bnb_lp", "e_socp")
 
 
-def preemption(runs: int = 5, sigma: float = 0.5, seed: int = 0) -> list[dict]:
+def preemption(runs: int = 5, sigma: float = 0.5, seed: int = 0, glpk: bool = True) -> list[dict]:
     """Search times with and without the preemptive test, same problems, same start."""
     configs = [("native", True), ("native", False)]
-    if "glpk" in registry.lp_backends():
+    if glpk and "glpk" in registry.lp_backends():
         configs += [("glpk", False)]
     rows = []
     for R, t, p in experiment_ch9.problems(runs, sigma, seed):

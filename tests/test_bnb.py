@@ -261,3 +261,18 @@ def test_bad_input():
         _core.bnb_linf(*args, g, np.eye(3), grid=0)
     with pytest.raises(ValueError, match="R_init"):
         _core.bnb_linf(*args, g, np.eye(2))
+
+
+# ------------------------------------------------- the ch. 10.5.1 experiment
+
+@pytest.mark.slow
+def test_experiment_ch10_runs():
+    import experiment_ch9
+    import experiment_ch10
+    res = experiment_ch9.run(2, levels=(0.0, 0.5), methods=experiment_ch10.METHODS)
+    clean, noisy = res[0.0]["bnb_lp"], res[0.5]["bnb_lp"]
+    assert np.all(clean[:, 0] < 1e-5) and np.all(np.abs(clean[:, 2] - 1) < 1e-6)
+    assert np.all(noisy[:, 0] < 0.2) and np.all(noisy[:, 1] < 2.0)   # deg
+    rows = experiment_ch10.preemption(1, glpk=False)
+    print("\n" + experiment_ch10.preemption_table(rows))
+    assert {r["working_sets"] for r in rows} == {True, False}
