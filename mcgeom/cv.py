@@ -94,11 +94,12 @@ def _effective_focal(rig: Rig, rays) -> np.ndarray:
     pixels across the whole image, and the refinement weights residuals by
     their pixel-noise variance.
     """
-    focal = np.array([0.5 * (c.K[0, 0] + c.K[1, 1]) for c in rig.cameras])
-    Rs = np.stack([c.R for c in rig.cameras])
+    Ks = rig._Ks  # type: ignore[attr-defined]  # stacked once by the Rig
+    focal = 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])
+    axes = rig._Rs[:, 2, :]  # type: ignore[attr-defined]  # optical axes, rig frame
     var = np.zeros(len(rays))
     for ids, d in ((rays.cam1, rays.dirs1), (rays.cam2, rays.dirs2)):
-        cz = np.clip(np.einsum("ij,ij->i", Rs[ids][:, 2, :], d), 1e-3, 1.0)
+        cz = np.clip(np.einsum("ij,ij->i", axes[ids], d), 1e-3, 1.0)
         var += 0.5 * (cz ** 4 + cz ** 2) / focal[ids] ** 2
     return 1.0 / np.sqrt(0.5 * var)
 
@@ -133,13 +134,18 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         use = m != 0
     name, run_robust = _resolve(method, robust)
     rays_all = rig.ray_pairs(p1, p2, ids1, ids2)
-    rays = rays_all.take(np.flatnonzero(use))
+    # without a mask every correspondence is used: no copy of the rays
+    keep = None if use.all() else np.flatnonzero(use)
+    rays = rays_all if keep is None else rays_all.take(keep)
     if run_robust:
         f = _effective_focal(rig, rays)
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                           seed=seed, focal=f, **options)
-        inl = np.zeros(n, bool)
-        inl[np.flatnonzero(use)] = m.inliers
+        if keep is None:
+            inl = np.asarray(m.inliers, bool).copy()
+        else:
+            inl = np.zeros(n, bool)
+            inl[keep] = m.inliers
     else:
         m = registry.get(name)(rays, **options)
         inl = use.copy()

@@ -489,6 +489,12 @@ class Rig:
             raise ValueError(f"camera names must be unique; repeated: {', '.join(map(repr, dupes))}")
         object.__setattr__(self, "cameras", cams)
         object.__setattr__(self, "_centres", _frozen(np.array([c.centre for c in cams])))
+        # Stacked intrinsics/extrinsics for the vectorised bearings of
+        # :meth:`_pinhole_rays` (cameras are immutable: stacked once, not per call)
+        object.__setattr__(self, "_Ks", _frozen(np.stack([c.K for c in cams])))
+        object.__setattr__(self, "_Rs", _frozen(np.stack([c.R for c in cams])))
+        object.__setattr__(self, "_plain", np.array(
+            [c.model == "pinhole" and not np.any(c.dist) for c in cams]))
 
     def __len__(self) -> int:
         return len(self.cameras)
@@ -552,27 +558,31 @@ class Rig:
         """
         px = _check_pixels("pixels", pixels)
         ids = self._check_ids("cam_ids", cam_ids, px.shape[0])
-        used = np.unique(ids)
-        if all(self.cameras[i].model == "pinhole" and not np.any(self.cameras[i].dist)
-               for i in used):
-            return np.ascontiguousarray(self.centres[ids]), self._pinhole_rays(ids, px)
+        return self._rays_checked(ids, px)
+
+    def _rays_checked(self, ids: np.ndarray, px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`rays` for ids and pixels already checked (``ray_pairs`` checks them
+        once: the checks cost more than the arithmetic at a few hundred pixels)."""
+        used = np.flatnonzero(np.bincount(ids, minlength=len(self.cameras)))
+        origins = np.ascontiguousarray(self.centres[ids])
+        if self._plain[used].all():  # type: ignore[attr-defined]
+            return origins, self._pinhole_rays(ids, px)
         dirs = np.empty((px.shape[0], 3))
         for i in used:  # one OpenCV call per camera
             sel = ids == i
             dirs[sel] = self.cameras[i].pixels_to_bearings(px[sel])
-        return np.ascontiguousarray(self.centres[ids]), dirs
+        return origins, dirs
 
     def _pinhole_rays(self, ids: np.ndarray, px: np.ndarray) -> np.ndarray:
         """Bearings of undistorted pinhole pixels, all cameras at once:
         ``R_i^T normalize(K_i^-1 [u, v, 1])`` row by row (the same arithmetic as
         :meth:`Camera.pixels_to_bearings`, without a call per camera)."""
-        K = np.stack([c.K for c in self.cameras])[ids]
+        K = self._Ks[ids]  # type: ignore[attr-defined]
         y = (px[:, 1] - K[:, 1, 2]) / K[:, 1, 1]
         x = (px[:, 0] - K[:, 0, 2] - K[:, 0, 1] * y) / K[:, 0, 0]
         d = np.column_stack([x, y, np.ones(len(x))])
         d /= np.linalg.norm(d, axis=1, keepdims=True)
-        Rs = np.stack([c.R for c in self.cameras])
-        return np.ascontiguousarray(np.einsum("nji,nj->ni", Rs[ids], d))
+        return np.ascontiguousarray(np.einsum("nji,nj->ni", self._Rs[ids], d))  # type: ignore[attr-defined]
 
     def ray_pairs(self, pixels1: Any, pixels2: Any, cam1: Any, cam2: Any = None) -> RayPairs:
         """Ray correspondences from pixel correspondences.
@@ -592,8 +602,8 @@ class Rig:
             raise ValueError(f"pixels2 has {px2.shape[0]} rows but pixels1 has {px1.shape[0]}")
         ids1 = self._check_ids("cam1", cam1, px1.shape[0])
         ids2 = ids1 if cam2 is None else self._check_ids("cam2", cam2, px2.shape[0])
-        o1, d1 = self.rays(ids1, px1)
-        o2, d2 = self.rays(ids2, px2)
+        o1, d1 = self._rays_checked(ids1, px1)
+        o2, d2 = self._rays_checked(ids2, px2)
         return RayPairs(o1, d1, o2, d2, ids1, ids2.copy())
 
     def project(self, cam_id: int, points_rig: Any) -> tuple[np.ndarray, np.ndarray]:
