@@ -30,6 +30,22 @@ __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_onl
            "critical_angle", "refine_centred", "same_camera"]
 
 
+def _rcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (N, 3) arrays (or 3-vectors): the arithmetic of
+    ``np.cross``, whose axis handling costs more than the products at these sizes."""
+    a = np.broadcast_to(a, np.broadcast_shapes(np.shape(a), np.shape(b)))
+    b = np.broadcast_to(b, a.shape)
+    out = np.empty(a.shape)
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+def _unit_rows(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:
     """``R^T (c - t) - c`` for each centre (rows), metres in the time-1 rig frame."""
     return (np.asarray(centres) - t) @ np.asarray(R) - centres
@@ -51,7 +67,7 @@ def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> flo
     # the largest folded angle (arctan2 of |cross| and |dot| keeps it accurate)
     cos = np.abs(d @ d.T)
     i, j = np.unravel_index(np.argmin(cos + 2.0 * np.eye(len(d))), cos.shape)
-    return float(np.arctan2(np.linalg.norm(np.cross(d[i], d[j])), cos[i, j]))
+    return float(np.arctan2(np.linalg.norm(_rcross(d[i], d[j])), cos[i, j]))
 
 
 def critical_angle(rays: RayPairs, R: np.ndarray, t: np.ndarray,
@@ -71,15 +87,21 @@ def same_camera(rays: RayPairs) -> np.ndarray:
     return np.all(rays.origins1 == rays.origins2, axis=1)
 
 
-def _centres_with_intra(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, int]:
-    """Centres of cameras with intra-camera inliers, and the number of cross-camera inliers."""
-    same = same_camera(rays)
+def _centres_with_intra(rays: RayPairs, mask: np.ndarray,
+                        same: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+    """Centres of cameras with intra-camera inliers, and the number of cross-camera inliers.
+
+    ``same`` is :func:`same_camera` of ``rays`` if the caller has it already.
+    """
+    if same is None:
+        same = same_camera(rays)
     intra = mask & same
-    cross = int((mask & ~same).sum())
+    cross = int(np.count_nonzero(mask)) - int(np.count_nonzero(intra))
     if rays.cam1 is not None and rays.cam2 is not None:
-        ids = np.unique(rays.cam1[intra])
-        centres = np.array([rays.origins1[intra & (rays.cam1 == k)][0] for k in ids])
-        return centres.reshape(-1, 3), cross
+        # the origin of each camera's first intra-camera inlier, cameras in id order
+        rows = np.flatnonzero(intra)
+        _, first = np.unique(rays.cam1[rows], return_index=True)
+        return rays.origins1[rows[first]].reshape(-1, 3), cross
     centres = np.unique(rays.origins1[intra], axis=0) if intra.any() else np.zeros((0, 3))
     return centres, cross
 
@@ -95,8 +117,9 @@ def refine_centred(rays: RayPairs, R: np.ndarray, t: np.ndarray, **options) -> d
     """
     c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
     R = np.asarray(R, dtype=np.float64)
-    cr = rays.in_frame(np.eye(3), -c)
-    out = _core.refine_motion(cr.origins1, cr.dirs1, cr.origins2, cr.dirs2, R,
+    # a pure shift of the origins (directions unchanged): the arithmetic of
+    # ``rays.in_frame(I, -c)`` without building and re-validating a RayPairs
+    out = _core.refine_motion(rays.origins1 - c, rays.dirs1, rays.origins2 - c, rays.dirs2, R,
                               np.asarray(t, dtype=np.float64) + R @ c - c, **options)
     out["t"] = out["t"] - out["R"] @ c + c
     return out
@@ -135,17 +158,20 @@ def count_in_front(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     """Correspondences whose two rays meet (mid-point) in front of both origins
     when the time-1 ray is moved by (R, t) into the time-2 rig frame."""
     sel = slice(None) if mask is None else np.asarray(mask, bool)
-    return _counts_in_front(rays, R, t, (np.zeros(3),), sel)[0]
+    return _counts_in_front(rays.origins1[sel], rays.dirs1[sel], rays.origins2[sel],
+                            rays.dirs2[sel], R, t, (np.zeros(3),))[0]
 
 
-def _counts_in_front(rays: RayPairs, R: np.ndarray, t0: np.ndarray, vs, sel) -> list[int]:
-    """:func:`count_in_front` for each ``t = t0 + v``, ``v`` in ``vs``, in one
-    pass: the translation enters the mid-point equations only through the
-    products a.w and b.w, which are affine in it."""
-    p = rays.origins1[sel] @ R.T + t0
-    a = rays.dirs1[sel] @ R.T
-    b = rays.dirs2[sel]
-    w0 = rays.origins2[sel] - p
+def _counts_in_front(o1: np.ndarray, d1: np.ndarray, o2: np.ndarray, d2: np.ndarray,
+                     R: np.ndarray, t0: np.ndarray, vs) -> list[int]:
+    """:func:`count_in_front` of the rays ``(o1, d1) <-> (o2, d2)`` (rows) for each
+    ``t = t0 + v``, ``v`` in ``vs``, in one pass: the translation enters the
+    mid-point equations only through the products a.w and b.w, which are
+    affine in it."""
+    p = o1 @ R.T + t0
+    a = d1 @ R.T
+    b = d2
+    w0 = o2 - p
     aa, bb, ab = (np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", b, b),
                   np.einsum("ij,ij->i", a, b))
     aw0, bw0 = np.einsum("ij,ij->i", a, w0), np.einsum("ij,ij->i", b, w0)
@@ -178,8 +204,11 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     part is negligible.
     """
     sel = np.asarray(mask, bool)
-    c = 0.5 * (rays.origins1[sel].mean(axis=0) + rays.origins2[sel].mean(axis=0)) \
-        if sel.any() else np.zeros(3)
+    # the selected rays are gathered once (centroid, spread and cheirality use them)
+    o1, d1, o2, d2 = (rays.origins1[sel], rays.dirs1[sel], rays.origins2[sel],
+                      rays.dirs2[sel])
+    any_sel = len(o1) > 0
+    c = 0.5 * (o1.mean(axis=0) + o2.mean(axis=0)) if any_sel else np.zeros(3)
     shift = R @ c - c
     # where |t| dwarfs the rotation-induced shift, t's own direction is the
     # better estimate (the centroid's motion differs from it by that shift)
@@ -188,9 +217,9 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     if not n > 0:
         return t / max(np.linalg.norm(t), 1e-300)
     u = tau / n
-    spread = np.sqrt(np.mean(np.sum((rays.origins1[sel] - c) ** 2, axis=1))) if sel.any() else 1.0
+    spread = np.sqrt(np.mean(np.sum((o1 - c) ** 2, axis=1))) if any_sel else 1.0
     L = max(1.0, 100.0 * spread, 100.0 * np.linalg.norm(shift))
-    plus, minus = _counts_in_front(rays, R, -shift, (L * u, -L * u), sel)
+    plus, minus = _counts_in_front(o1, d1, o2, d2, R, -shift, (L * u, -L * u))
     return u if plus >= minus else -u
 
 
@@ -203,23 +232,29 @@ def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.
     pure rotation, or everything at infinity) and neither the direction nor the
     scale of ``t`` is determined.
     """
-    sel = np.asarray(mask, bool) & same_camera(rays)
-    if sel.sum() < 2:
+    return _rotation_fit(rays, np.asarray(mask, bool) & same_camera(rays))
+
+
+def _rotation_fit(rays: RayPairs, sel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`rotation_only_fit` on the correspondences ``sel`` (intra-camera already)."""
+    if np.count_nonzero(sel) < 2:
         return np.eye(3), np.zeros(0)
-    sub = rays.take(sel)
-    d1 = sub.dirs1 / np.linalg.norm(sub.dirs1, axis=1, keepdims=True)
-    d2 = sub.dirs2 / np.linalg.norm(sub.dirs2, axis=1, keepdims=True)
+    # the unit directions are normalised once and serve the fit and the angles
+    d1, d2 = _unit_rows(rays.dirs1[sel]), _unit_rows(rays.dirs2[sel])
     u, _, vt = np.linalg.svd(d2.T @ d1)
     R = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
-    return R, rotation_only_residuals(sub, R)
+    return R, _rotation_angles(d1, d2, R)
 
 
 def rotation_only_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:
     """Angles (radians) between ``d2`` and ``R d1`` for every correspondence."""
-    d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
-    d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
+    return _rotation_angles(_unit_rows(rays.dirs1), _unit_rows(rays.dirs2), R)
+
+
+def _rotation_angles(d1: np.ndarray, d2: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Angles (radians) between unit ``d2`` and ``R d1``, row by row."""
     rd1 = d1 @ R.T
-    return np.arctan2(np.linalg.norm(np.cross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
+    return np.arctan2(np.linalg.norm(_rcross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
 
 
 def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndarray,
@@ -244,8 +279,10 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     real data: a tiny translation with a free direction fits calibration error
     5-15x better than a rotation, seen on the DGP parked car.)
     """
+    inliers = np.asarray(inliers, bool)
+    same = same_camera(rays)   # shared by the no-parallax test and the centres
     if np.isfinite(noise_level):
-        _, ang = rotation_only_fit(rays, inliers)
+        _, ang = _rotation_fit(rays, inliers & same)
         if ang.size >= 5 and np.mean(ang < 1.5 * noise_level) >= 0.9:
             return ScaleVerdict(False, "no translation detected: a pure rotation explains the "
                                        f"correspondences (median residual "
@@ -253,7 +290,7 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
                                        "rig, pure rotation or scene at infinity: neither the "
                                        "direction nor the scale of t is determined",
                                 0.0, float("inf"), 0.0)
-    centres, n_cross = _centres_with_intra(rays, np.asarray(inliers, bool))
+    centres, n_cross = _centres_with_intra(rays, inliers, same)
     crit = rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
     evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {np.degrees(crit):.3g} deg "
                 f"over {len(centres)} cameras, {n_cross} cross-camera inliers")
