@@ -30,15 +30,19 @@ __all__ = ["displacements", "rig_critical_angle", "scale_verdict", "rotation_onl
            "critical_angle", "refine_centred", "same_camera"]
 
 
-def _rcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross products of (N, 3) arrays (or 3-vectors): the arithmetic of
-    ``np.cross``, whose axis handling costs more than the products at these sizes."""
-    a = np.broadcast_to(a, np.broadcast_shapes(np.shape(a), np.shape(b)))
-    b = np.broadcast_to(b, a.shape)
-    out = np.empty(a.shape)
-    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
-    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
-    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+def rcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (N, 3) arrays, or of an (N, 3) array and a 3-vector
+    (or of two 3-vectors): the arithmetic of ``np.cross``, whose axis handling
+    costs more than the products at the sizes of a rig problem. (Shapes other
+    than these pairs are not supported: no general broadcasting.)"""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    out = np.empty(a.shape if a.ndim >= b.ndim else b.shape)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
     return out
 
 
@@ -67,7 +71,7 @@ def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> flo
     # the largest folded angle (arctan2 of |cross| and |dot| keeps it accurate)
     cos = np.abs(d @ d.T)
     i, j = np.unravel_index(np.argmin(cos + 2.0 * np.eye(len(d))), cos.shape)
-    return float(np.arctan2(np.linalg.norm(_rcross(d[i], d[j])), cos[i, j]))
+    return float(np.arctan2(np.linalg.norm(rcross(d[i], d[j])), cos[i, j]))
 
 
 def critical_angle(rays: RayPairs, R: np.ndarray, t: np.ndarray,
@@ -254,7 +258,7 @@ def rotation_only_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:
 def _rotation_angles(d1: np.ndarray, d2: np.ndarray, R: np.ndarray) -> np.ndarray:
     """Angles (radians) between unit ``d2`` and ``R d1``, row by row."""
     rd1 = d1 @ R.T
-    return np.arctan2(np.linalg.norm(_rcross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
+    return np.arctan2(np.linalg.norm(rcross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
 
 
 def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndarray,

@@ -40,6 +40,7 @@ from .. import _core
 from ..errors import DegenerateError
 from ..observability import (displacements, refine_centred, scale_profile, scale_verdict,
                              travel_direction)
+from ..observability import rcross as _rcross   # row-wise np.cross without its overhead
 from ..registry import register
 from ..types import RayPairs, RigMotion
 
@@ -50,18 +51,6 @@ __all__ = [
 
 #: bearings closer than this to the local image plane (|z| small) are not projected
 _MIN_Z = 0.05
-
-
-def _rcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross products of (N, 3) arrays (or one 3-vector with rows);
-    np.cross spends most of its time on axis handling at these sizes."""
-    a = np.broadcast_to(a, np.broadcast_shapes(np.shape(a), np.shape(b)))
-    b = np.broadcast_to(b, a.shape)
-    out = np.empty(a.shape)
-    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
-    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
-    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-    return out
 
 
 # ------------------------------------------------------------------ cameras
@@ -112,9 +101,9 @@ def _local_frame(dirs: np.ndarray) -> np.ndarray:
         raise DegenerateError("five_plus_one: the rays of the 5-point camera point in all "
                               "directions; no common image plane")
     z /= nz
-    x = np.cross([0.0, 1.0, 0.0] if abs(z[1]) < 0.9 else [1.0, 0.0, 0.0], z)
+    x = _rcross([0.0, 1.0, 0.0] if abs(z[1]) < 0.9 else [1.0, 0.0, 0.0], z)
     x /= np.linalg.norm(x)
-    y = np.cross(z, x)
+    y = _rcross(z, x)
     return np.stack([x, y, z])
 
 
@@ -170,13 +159,12 @@ def _decompose(E: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> tuple[int, np.n
     import cv2
     R1, R2, t = cv2.decomposeEssentialMat(E)
     t = t.ravel()
-    h1 = np.c_[x1, np.ones(len(x1))]
-    h2 = np.c_[x2, np.ones(len(x2))]
+    h1, h2 = _homogeneous(x1), _homogeneous(x2)
+    bb = np.einsum("ij,ij->i", h2, h2)                 # the same for both rotations
     best = (0, R1, t)
     for R in (R1, R2):
         a = h1 @ R.T                                   # R x1, in camera 2
         aa = np.einsum("ij,ij->i", a, a)
-        bb = np.einsum("ij,ij->i", h2, h2)
         ab = np.einsum("ij,ij->i", a, h2)
         den = aa * bb - ab * ab
         ok = den > 1e-14 * aa * bb
@@ -186,16 +174,23 @@ def _decompose(E: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> tuple[int, np.n
             aw, bw = -(a @ tt), -(h2 @ tt)
             s1 = (aw * bb - bw * ab) / den
             s2 = (aw * ab - bw * aa) / den
-            cnt = int(np.sum(ok & (s1 > 0) & (s2 > 0)))
+            cnt = int(np.count_nonzero(ok & (s1 > 0) & (s2 > 0)))
             if cnt > best[0]:
                 best = (cnt, R, tt)
     return best
 
 
+def _homogeneous(x: np.ndarray) -> np.ndarray:
+    """(N, 2) image points as (N, 3) rows ``[x, y, 1]`` (``np.c_`` without its
+    index-trick overhead)."""
+    h = np.ones((len(x), 3))
+    h[:, :2] = x
+    return h
+
+
 def _sampson_sq(E: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> np.ndarray:
     """Squared Sampson distances of normalised image points under E."""
-    h1 = np.c_[x1, np.ones(len(x1))]
-    h2 = np.c_[x2, np.ones(len(x2))]
+    h1, h2 = _homogeneous(x1), _homogeneous(x2)
     e1 = h1 @ E.T                       # E x1
     e2 = h2 @ E                         # E^T x2
     num = np.einsum("ij,ij->i", h2, e1) ** 2
@@ -692,7 +687,7 @@ def scale_one_point_ransac(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.
         k = int(np.argmin(score))
         if score[k] < best:
             lam, best, inl = float(lams[k]), float(score[k]), r2[k] < threshold ** 2
-        ratio = float(np.mean(inl))
+        ratio = np.count_nonzero(inl) / inl.size      # np.mean without its overhead
         needed = np.log1p(-prob) / np.log1p(-ratio) if 0.0 < ratio < 1.0 else (
             1.0 if ratio >= 1.0 else np.inf)
         if used >= needed:
