@@ -146,12 +146,14 @@ class _Scorer:
         # Per-correspondence focal lengths (pixels per radian of residual)
         # also weight the least squares: a residual of r radians is r * f_i
         # pixels, so its variance under pixel noise is ~ 1 / f_i^2.
-        self.weights = None if focal is None or np.ptp(focal) == 0 else \
-            (focal / np.median(focal)) ** 2
-        self.loss_scale = thr if focal is None else thr / float(np.median(focal))
+        med = None if focal is None else np.median(focal)   # one median serves both
+        self.weights = None if focal is None or np.ptp(focal) == 0 else (focal / med) ** 2
+        self.loss_scale = thr if focal is None else thr / float(med)
         self.best: Optional[tuple[np.ndarray, np.ndarray]] = None
         self.best_score = np.inf
         self.best_inliers = np.zeros(len(rays), bool)
+        # residuals of ``best`` on all correspondences (the final stage starts from them)
+        self.best_residuals: Optional[np.ndarray] = None
         self.n_hyp = 0
         self.n_lo = 0
         self.lo_rounds = opts.lo_max_rounds
@@ -169,6 +171,7 @@ class _Scorer:
         if score >= self.best_score:
             return False
         self.best, self.best_score, self.best_inliers = (R, t), score, r < self.thr
+        self.best_residuals = r
         if self.opts.local_optimization:
             self._local_optimise()
         return True
@@ -195,6 +198,7 @@ class _Scorer:
                 return
             same = np.array_equal(r < self.thr, inl)
             self.best, self.best_score, self.best_inliers = (out["R"], out["t"]), score, r < self.thr
+            self.best_residuals = r
             if same:   # the same inliers would give the same fit again
                 return
 
@@ -301,10 +305,15 @@ def _run_proposer(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOpti
         # a proposer may say which inlier ratio to expect (e.g. the one of its
         # own robust search): stop once a motion explains about that
         if len(prop) > 2 and scorer.best is not None and \
-                scorer.best_inliers.mean() >= 0.95 * prop[2]:
+                _ratio(scorer.best_inliers) >= 0.95 * prop[2]:
             break
     scorer.lo_rounds = lo
     return iterations
+
+
+def _ratio(mask: np.ndarray) -> float:
+    """Fraction of True in a boolean mask (``mask.mean()`` without its overhead)."""
+    return np.count_nonzero(mask) / mask.size
 
 
 def _run_minimal(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptions,
@@ -381,7 +390,7 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         # each one pulls it (2.5 thresholds: Ladybug scale median 0.195,
         # 0.184, 0.194 over three seeds; 2: 0.186, 0.179, 0.174).
         wide = 2.0 * options.threshold
-        sel = scorer.residuals(R, t) < wide
+        sel = scorer.best_residuals < wide     # the residuals of (R, t), kept by the scorer
         for _ in range(2):   # refit once more if the set moved
             used = sel
             out = _refine(rays.take(used), R, t, scorer._loss_scale(), options.loss,
@@ -395,8 +404,8 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         rel_std = float(out["scale_rel_std"])
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
     if r is None:
-        r = scorer.residuals(R, t)
-    info.update(inlier_ratio=float(inl.mean()), time_s=time.perf_counter() - t_start,
+        r = scorer.best_residuals
+    info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start,
                 score=scorer.best_score)
     profile = float("nan")
     if options.refine and rel_std <= options.max_scale_rel_std:

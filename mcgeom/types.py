@@ -93,6 +93,9 @@ class RayPairs:
             idx = idx.astype(np.int64)
         if idx.dtype != bool and idx.dtype.kind not in "iu":
             raise ValueError(f"index must be integers or a boolean mask, got dtype {idx.dtype}")
+        if idx.dtype == bool and idx.ndim == 1 and idx.shape[0] == len(self):
+            # a mask selects the same rows of six arrays: find them once
+            idx = np.flatnonzero(idx)
         # fancy indexing of validated arrays keeps them valid (float64, C order,
         # N x 3): skip the checks of __init__, this is on the robust hot path
         out = object.__new__(RayPairs)
