@@ -133,7 +133,9 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
             raise ValueError(f"mask has {m.shape[0]} entries, expected {n}")
         use = m != 0
     name, run_robust = _resolve(method, robust)
-    rays_all = rig.ray_pairs(p1, p2, ids1, ids2)
+    # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
+    # the rig's cameras): the rig need not check them again
+    rays_all = rig._ray_pairs_checked(p1, p2, ids1, ids2)
     # without a mask every correspondence is used: no copy of the rays
     keep = None if use.all() else np.flatnonzero(use)
     rays = rays_all if keep is None else rays_all.take(keep)

@@ -602,6 +602,13 @@ class Rig:
             raise ValueError(f"pixels2 has {px2.shape[0]} rows but pixels1 has {px1.shape[0]}")
         ids1 = self._check_ids("cam1", cam1, px1.shape[0])
         ids2 = ids1 if cam2 is None else self._check_ids("cam2", cam2, px2.shape[0])
+        return self._ray_pairs_checked(px1, px2, ids1, ids2)
+
+    def _ray_pairs_checked(self, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
+                           ids2: np.ndarray) -> RayPairs:
+        """:meth:`ray_pairs` of finite float64 (N, 2) pixels and int64 ids of this rig's
+        cameras, already checked by the caller (``mcgeom.cv`` checks its input
+        itself: checking again would cost as much as the bearings)."""
         o1, d1 = self._rays_checked(ids1, px1)
         o2, d2 = self._rays_checked(ids2, px2)
         return RayPairs(o1, d1, o2, d2, ids1, ids2.copy())
