@@ -187,7 +187,7 @@ def _counts_in_front(o1: np.ndarray, d1: np.ndarray, o2: np.ndarray, d2: np.ndar
         aw, bw = aw0 - a @ v, bw0 - b @ v
         s1 = (aw * bb - bw * ab) / den
         s2 = (aw * ab - bw * aa) / den
-        counts.append(int(np.sum(ok & (s1 > 0) & (s2 > 0))))
+        counts.append(int(np.count_nonzero(ok & (s1 > 0) & (s2 > 0))))
     return counts
 
 
@@ -207,7 +207,7 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     The sign is chosen by cheirality at a length where the rotation-induced
     part is negligible.
     """
-    sel = np.asarray(mask, bool)
+    sel = np.flatnonzero(np.asarray(mask, bool))
     # the selected rays are gathered once (centroid, spread and cheirality use them)
     o1, d1, o2, d2 = (rays.origins1[sel], rays.dirs1[sel], rays.origins2[sel],
                       rays.dirs2[sel])
@@ -287,7 +287,7 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     same = same_camera(rays)   # shared by the no-parallax test and the centres
     if np.isfinite(noise_level):
         _, ang = _rotation_fit(rays, inliers & same)
-        if ang.size >= 5 and np.mean(ang < 1.5 * noise_level) >= 0.9:
+        if ang.size >= 5 and np.count_nonzero(ang < 1.5 * noise_level) / ang.size >= 0.9:
             return ScaleVerdict(False, "no translation detected: a pure rotation explains the "
                                        f"correspondences (median residual "
                                        f"{np.degrees(np.median(ang)) * 3600:.3g} arcsec); static "
