@@ -1207,17 +1207,17 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
         lo = 0.0;
     res->lower_bound = lo;
     c.floor = lo - 2.0 * o.tol;
-    if (o.polish_tol > 0.0 && o.polish_tol < o.resolution) {
+    if (o.polish_tol > 0.0 && o.polish_tol < o.resolution && o.max_blocks > 0) {
         long tests = 0;
         int idle;
         st = polish_incumbent(&c, &o, res, &tests);
         /* Nelder-Mead restarted from its own result with fresh simplices
-         * (edges cycling through 10, 1, 0.1 x the resolution) until three
+         * (edges cycling through 100, 10, 1, 0.1 x the resolution) until four
          * restarts in a row gain nothing: a collapsed simplex can stall in
          * a curved valley */
-        for (k = 0, idle = 0; st == MCG_OK && k < 15 && idle < 3; ++k) {
+        for (k = 0, idle = 0; st == MCG_OK && k < 16 && idle < 4; ++k) {
             double before = res->linf;
-            st = nelder_mead(&c, &o, res, o.resolution * (k % 3 == 0 ? 10.0 : k % 3 == 1 ? 1.0 : 0.1),
+            st = nelder_mead(&c, &o, res, o.resolution * (k % 4 == 0 ? 100.0 : k % 4 == 1 ? 10.0 : k % 4 == 2 ? 1.0 : 0.1),
                              &tests);
             idle = res->linf < before - o.tol ? 0 : idle + 1;
         }

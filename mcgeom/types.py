@@ -86,6 +86,13 @@ class RayPairs:
             if not np.all(np.isfinite(getattr(self, name))):
                 raise ValueError(f"rays.{name} contains NaN or inf")
 
+    def canonical_order(self) -> np.ndarray:
+        """A permutation that sorts the correspondences by their data (origins,
+        then directions): estimators that process rays in this order give
+        results that do not depend on the order of the input, bit for bit."""
+        cols = np.concatenate([self.origins1, self.dirs1, self.origins2, self.dirs2], axis=1)
+        return np.lexsort(cols.T[::-1])
+
     def take(self, index: Any) -> "RayPairs":
         """Subset (or permutation) of the correspondences by an index array or mask."""
         idx = np.asarray(index)

@@ -17,7 +17,8 @@ Steps:
    depend on the order of the correspondences;
 2. an initial motion from a registered estimator (default: ``refine``, i.e.
    ``linear17`` then Levenberg-Marquardt; ``five_plus_one`` where linear17
-   cannot run): its ``f`` is the first bound (Algorithm 7, step 1);
+   cannot run; the identity when neither can): its ``f`` is the first bound
+   (Algorithm 7, step 1);
 3. the global search to ``resolution`` (rad), then a local descent of f
    from its best rotation (``polish``, in the same C call): the bottom of the
    optimum's basin rather than the centre of a block;
@@ -64,21 +65,15 @@ def apex_groups(rays: RayPairs) -> np.ndarray:
     return labels.reshape(-1).astype(np.int32)
 
 
-def _canonical(rays: RayPairs) -> np.ndarray:
-    """A permutation that sorts the correspondences by their data."""
-    cols = np.concatenate([rays.origins1, rays.dirs1, rays.origins2, rays.dirs2], axis=1)
-    return np.lexsort(cols.T[::-1])
-
-
 def linf_error(rays: RayPairs, R: Any, *, lp_backend: Optional[str] = None,
                tol: float = 1e-11) -> tuple[float, np.ndarray]:
     """``f(R)`` of bnb.c (radians, to ``tol``) and the translation of its LP (metres).
 
     ``rays`` in the rig frame; ``R`` (3, 3) the rotation rig2_from_rig1.
     """
-    sub = rays.take(_canonical(rays))
+    sub = rays.take(rays.canonical_order())
     res = _core.bnb_linf(sub.dirs1, sub.origins1, sub.dirs2, sub.origins2,
-                         apex_groups(sub), R, max_blocks=0, tol=tol,
+                         apex_groups(sub), R, max_blocks=0, tol=tol, polish_tol=0.0,
                          lp_backend=resolve_lp_backend(lp_backend))
     return float(res["initial_linf"]), res["t"]
 
@@ -113,7 +108,11 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
             return m.R, m.t, name
         except (ValueError, DegenerateError, NumericalError) as e:
             errors.append(f"{name}: {e}")
-    raise DegenerateError("no initial estimate for bnb_lp: " + "; ".join(errors))
+    if isinstance(initial, str):
+        raise DegenerateError(f"no initial estimate for bnb_lp: {errors[0]}")
+    # the search is global: any start will do, a poor one only costs time
+    # (Algorithm 7, step 1: "a random guess if necessary")
+    return np.eye(3), np.zeros(3), "identity"
 
 
 def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
@@ -136,7 +135,7 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
     description="Globally optimal L-infinity motion: branch and bound over rotations with "
                 "LP feasibility tests, certified lower bound (thesis ch. 10)",
     options={"initial": "first bound: an estimator name, RigMotion or (R, t); default refine "
-                        "(linear17 + LM), else five_plus_one",
+                        "(linear17 + LM), else five_plus_one, else the identity",
              "mask": "inliers to use (bool or OpenCV uint8, one per correspondence)",
              "resolution": "rotation resolution of the global search, radians (1e-4)",
              "gap": "stop when no block can improve by more than this, radians (0)",
@@ -168,7 +167,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
     ``lp_backend`` and ``t_metric``.
     ``residual_rms`` is the RMS Sampson angular error (radians) of the inliers.
     Raises ValueError for bad input (shape, NaN, too few correspondences, bad
-    options), DegenerateError when no initial estimate exists.
+    options), DegenerateError when the named initial estimator fails.
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -182,7 +181,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
             raise ValueError(f"{name} must be in [{lo}, {hi}), got {v}")
     backend = resolve_lp_backend(lp_backend)
     sub = rays.take(np.flatnonzero(inl))
-    sub = sub.take(_canonical(sub))
+    sub = sub.take(sub.canonical_order())
     groups = apex_groups(sub)
     R0, t0, source = _initial(sub, initial)
     args = (sub.dirs1, sub.origins1, sub.dirs2, sub.origins2, groups)

@@ -121,6 +121,9 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
     rays.check_finite()
+    # one order for any input order: the per-camera searches and the
+    # bisections then give the same answer bit for bit
+    rays = rays.take(rays.canonical_order())
     per, centres = _per_camera(rays, robust_threshold, prob)
     if not per:
         raise ValueError("too few correspondences: e_socp needs 5 intra-camera "
