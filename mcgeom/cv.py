@@ -18,14 +18,15 @@ name may be passed as a string instead. Estimators that can drive RANSAC
 
 from __future__ import annotations
 
-from typing import Any, Optional, Union
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
 from . import registry
 from . import robust as _robust
+from .observability import rcross
 from .rig import Rig
-from .types import RigMotion
+from .types import RayPairs, RigMotion
 
 __all__ = [
     "RIG_5P1_RANSAC", "RIG_LINEAR17", "RIG_LINEAR17_RANSAC", "RIG_5P1_DIRECT",
@@ -104,6 +105,53 @@ def _effective_focal(rig: Rig, rays) -> np.ndarray:
     return 1.0 / np.sqrt(0.5 * var)
 
 
+def _rowdot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot products of two (N, 3) arrays."""
+    return np.einsum("ij,ij->i", a, b)
+
+
+def _motion_focal(rig: Rig) -> Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]:
+    """Pixels per radian of each correspondence's Sampson residual at a given motion.
+
+    :func:`_effective_focal` averages the pixel-noise variance of a bearing over
+    the directions in the image; the Sampson error (thesis eq. 8.15 and
+    ``csrc/refine.c``) only feels the noise along the gradient of the epipolar
+    constraint, whose direction the motion fixes. With the tangent gradients
+    ``g1 = P(a) (d2 x c)`` (bearing ``a = R d1``) and ``g2 = P(d2) (c x a)``,
+    the angular residual is ``e / sqrt(|g1|^2 + |g2|^2)``, while unit pixel
+    noise moves ``e`` by a variance ``sum_k cz_k^2 / f_k^2 (|g_k|^2 -
+    (g_k . axis_k)^2)`` (a pinhole bearing's covariance: ``cos^4 / f^2``
+    radially, ``cos^2 / f^2`` tangentially); their ratio gives the residual in
+    pixels, i.e. the image-plane Sampson error -- the first-order maximum
+    likelihood residual for isotropic pixel noise. Same lens assumption as
+    :func:`_effective_focal` (undistorted pinhole), whose value is kept where
+    the pixel variance vanishes (no first-order constraint).
+    """
+    Ks = rig._Ks  # type: ignore[attr-defined]
+    focal = 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])
+    axes = rig._Rs[:, 2, :]  # type: ignore[attr-defined]  # optical axes, rig frame
+
+    def motion_focal(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> np.ndarray:
+        a = rays.dirs1 @ R.T                                # time-1 bearings, time-2 frame
+        c = t + rays.origins1 @ R.T - rays.origins2         # baseline of each camera pair
+        d2 = rays.dirs2
+        g2 = rcross(c, a)
+        g2 -= _rowdot(g2, d2)[:, None] * d2                 # tangent gradient at d2
+        g1 = rcross(d2, c)
+        g1 -= _rowdot(g1, a)[:, None] * a                   # tangent gradient at a
+        ax1, ax2 = axes[rays.cam1] @ R.T, axes[rays.cam2]
+        n1, n2 = _rowdot(g1, g1), _rowdot(g2, g2)
+        var = ((_rowdot(a, ax1) / focal[rays.cam1]) ** 2 * (n1 - _rowdot(g1, ax1) ** 2) +
+               (_rowdot(d2, ax2) / focal[rays.cam2]) ** 2 * (n2 - _rowdot(g2, ax2) ** 2))
+        ok = var > 1e-12 * (n1 + n2) / np.square(focal).max()
+        f = np.sqrt((n1 + n2) / np.where(ok, var, 1.0))
+        if not ok.all():
+            f[~ok] = _effective_focal(rig, rays)[~ok]
+        return f
+
+    return motion_focal
+
+
 def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
@@ -142,7 +190,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     if run_robust:
         f = _effective_focal(rig, rays)
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
-                          seed=seed, focal=f, **options)
+                          seed=seed, focal=f, motion_focal=_motion_focal(rig), **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:
