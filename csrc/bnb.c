@@ -605,7 +605,7 @@ static int polish_incumbent(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result
  * (f >= level up to the tolerance): one exact test decides, a bisection
  * on [0, level] follows only when it passes. */
 static int f_below(bnb_ctx *c, const mcg_bnb_options *o, const double w[3], double level,
-                   double *f, double t[3], long *tests)
+                   double tol, double *f, double t[3], long *tests)
 {
     double Rn[9], hi = level - 2.0 * o->tol;
     int st, r;
@@ -620,7 +620,7 @@ static int f_below(bnb_ctx *c, const mcg_bnb_options *o, const double w[3], doub
         return r;
     if (r != 1)
         return 0;
-    st = find_min_error(c, Rn, 0.0, c->floor, &hi, t, o->tol, 0);
+    st = find_min_error(c, Rn, 0.0, c->floor, &hi, t, tol, 0);
     if (st != MCG_OK)
         return -st;
     *f = hi;
@@ -646,14 +646,14 @@ static int nelder_mead(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res
         /* the other vertices: f from scratch (bisection below a loose cap) */
         memcpy(X[i], X[0], sizeof X[0]);
         X[i][i - 1] += h;
-        st = f_below(c, o, X[i], EPS_MAX, &F[i], T[i], tests);
+        st = f_below(c, o, X[i], EPS_MAX, o->tol, &F[i], T[i], tests);
         if (st < 0)
             return -st;
         if (!st)
             F[i] = EPS_MAX;
     }
     for (it = 0; it < 600; ++it) {
-        double cen[3], xr[3], xe[3], xc[3], fr, fe, fc, tr[3], te[3], tc[3], size = 0.0;
+        double cen[3], xr[3], xe[3], xc[3], fr, fe, fc, tr[3], te[3], tc[3], size = 0.0, vtol;
         int order[4] = {0, 1, 2, 3}, a, bb, w, sw, r;
         /* sort: order[0] best ... order[3] worst */
         for (a = 1; a < 4; ++a)
@@ -672,17 +672,23 @@ static int nelder_mead(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res
             break;
         w = order[3];
         sw = order[2];
+        /* vertex values are upper bounds bisected only as finely as the
+         * spread of the simplex's values needs (the acceptance tests are
+         * exact); the best vertex is bisected to tol at the end */
+        vtol = 0.01 * (F[w] - F[order[0]]);
+        if (vtol < o->tol)
+            vtol = o->tol;
         for (k = 0; k < 3; ++k)
             cen[k] = (X[order[0]][k] + X[order[1]][k] + X[order[2]][k]) / 3.0;
         for (k = 0; k < 3; ++k)
             xr[k] = 2.0 * cen[k] - X[w][k];
-        r = f_below(c, o, xr, F[w], &fr, tr, tests);
+        r = f_below(c, o, xr, F[w], vtol, &fr, tr, tests);
         if (r < 0)
             return -r;
         if (r && fr < F[order[0]]) {
             for (k = 0; k < 3; ++k)
                 xe[k] = 3.0 * cen[k] - 2.0 * X[w][k];
-            r = f_below(c, o, xe, fr, &fe, te, tests);
+            r = f_below(c, o, xe, fr, vtol, &fe, te, tests);
             if (r < 0)
                 return -r;
             if (r) {
@@ -706,11 +712,11 @@ static int nelder_mead(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res
         if (r) {
             for (k = 0; k < 3; ++k)
                 xc[k] = cen[k] + 0.5 * (xr[k] - cen[k]);
-            r = f_below(c, o, xc, fr, &fc, tc, tests);
+            r = f_below(c, o, xc, fr, vtol, &fc, tc, tests);
         } else {
             for (k = 0; k < 3; ++k)
                 xc[k] = cen[k] + 0.5 * (X[w][k] - cen[k]);
-            r = f_below(c, o, xc, F[w], &fc, tc, tests);
+            r = f_below(c, o, xc, F[w], vtol, &fc, tc, tests);
         }
         if (r < 0)
             return -r;
@@ -725,21 +731,30 @@ static int nelder_mead(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res
             int v = order[i];
             for (k = 0; k < 3; ++k)
                 X[v][k] = X[order[0]][k] + 0.5 * (X[v][k] - X[order[0]][k]);
-            r = f_below(c, o, X[v], EPS_MAX, &F[v], T[v], tests);
+            r = f_below(c, o, X[v], EPS_MAX, vtol, &F[v], T[v], tests);
             if (r < 0)
                 return -r;
             if (!r)
                 F[v] = EPS_MAX;
         }
     }
-    for (i = 0; i < 4; ++i)
-        if (F[i] < res->linf) {
-            st = mcg_rot_from_angle_axis(X[i], res->R);
-            if (st != MCG_OK)
-                return st;
-            memcpy(res->t, T[i], sizeof T[i]);
-            res->linf = F[i];
+    for (i = 1, k = 0; i < 4; ++i)
+        if (F[i] < F[k])
+            k = i;
+    if (F[k] < res->linf) {
+        double Rb[9], hi = F[k];
+        st = mcg_rot_from_angle_axis(X[k], Rb);
+        if (st != MCG_OK)
+            return st;
+        st = find_min_error(c, Rb, 0.0, c->floor, &hi, T[k], o->tol, 0);
+        if (st != MCG_OK)
+            return st;
+        if (hi < res->linf) {
+            memcpy(res->R, Rb, sizeof Rb);
+            memcpy(res->t, T[k], sizeof T[k]);
+            res->linf = hi;
         }
+    }
     return MCG_OK;
 }
 

@@ -87,11 +87,19 @@ class RayPairs:
                 raise ValueError(f"rays.{name} contains NaN or inf")
 
     def canonical_order(self) -> np.ndarray:
-        """A permutation that sorts the correspondences by their data (origins,
-        then directions): estimators that process rays in this order give
-        results that do not depend on the order of the input, bit for bit."""
-        cols = np.concatenate([self.origins1, self.dirs1, self.origins2, self.dirs2], axis=1)
-        return np.lexsort(cols.T[::-1])
+        """A permutation that sorts the correspondences by quantities that do
+        not depend on their order nor on the rig frame or unit: the camera
+        ids, then the angle between the two bearings. Estimators that process
+        rays in this order give the same answer for any input order (bit for
+        bit) and keep their invariance to the frame (their random samples see
+        the rays in the same order in every frame)."""
+        d1 = self.dirs1 / np.linalg.norm(self.dirs1, axis=1, keepdims=True)
+        d2 = self.dirs2 / np.linalg.norm(self.dirs2, axis=1, keepdims=True)
+        angle = np.arctan2(np.linalg.norm(np.cross(d1, d2), axis=1), np.einsum("ij,ij->i", d1, d2))
+        keys = [angle]
+        if self.cam1 is not None and self.cam2 is not None:
+            keys += [self.cam2, self.cam1]
+        return np.lexsort(keys)
 
     def take(self, index: Any) -> "RayPairs":
         """Subset (or permutation) of the correspondences by an index array or mask."""
