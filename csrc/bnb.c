@@ -92,7 +92,6 @@ typedef struct {
     int n, G;
     double *a1, *a2;        /* origins, centred and scaled (work) */
     double *u1, *u2;        /* unit bearings d1, d2 (work) */
-    const int *grp;
     const int *order;       /* by group, then alpha descending (work) */
     const int *gstart;      /* G + 1 offsets into order (work) */
     double *a1n;            /* |a1_i| */
@@ -538,31 +537,46 @@ static void pattern_direction(int d, unsigned long long *state, double dir[3])
     }
 }
 
-/* f just below the incumbent at angle-axis w? If so, the incumbent moves
- * there: 1; not: 0; < 0 status. */
-static int try_move(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
-                    const double w[3], long *tests)
+/* f at angle-axis w if it is below level (then 1, *f and t set), else 0
+ * (f >= level up to the tolerance): one exact test decides, a bisection
+ * above the certified lower bound, to tol, follows only when it passes. */
+static int f_below(bnb_ctx *c, const mcg_bnb_options *o, const double w[3], double level,
+                   double tol, double *f, double t[3], long *tests)
 {
-    double Rn[9], hi, tt[3], below = res->linf - 2.0 * o->tol;
+    double Rn[9], hi = level - 2.0 * o->tol;
     int st, r;
-    if (below <= 0.0)
+    if (hi <= 0.0)
         return 0;
     st = mcg_rot_from_angle_axis(w, Rn);
     if (st != MCG_OK)
         return -st;
     ++*tests;
-    r = feasible(c, Rn, below, 0.0, tt);
+    r = feasible(c, Rn, hi, 0.0, t);
     if (r < 0)
         return r;
     if (r != 1)
         return 0;
-    hi = below;
-    st = find_min_error(c, Rn, 0.0, c->floor, &hi, tt, o->tol, 0);
+    st = find_min_error(c, Rn, 0.0, c->floor, &hi, t, tol, 0);
     if (st != MCG_OK)
         return -st;
-    memcpy(res->R, Rn, sizeof Rn);
+    *f = hi;
+    return 1;
+}
+
+/* f just below the incumbent at angle-axis w? If so, the incumbent moves
+ * there: 1; not: 0; < 0 status. */
+static int try_move(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
+                    const double w[3], long *tests)
+{
+    double f = 0.0, tt[3];
+    int r = f_below(c, o, w, res->linf, o->tol, &f, tt, tests);
+    if (r != 1)
+        return r;
+    r = mcg_rot_from_angle_axis(w, res->R);
+    if (r != MCG_OK)
+        return -r;
+    res->linf = f;
     memcpy(res->t, tt, sizeof tt);
-    res->linf = hi;
     return 1;
 }
 
@@ -599,32 +613,6 @@ static int polish_incumbent(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result
         }
     }
     return MCG_OK;
-}
-
-/* f at angle-axis w if it is below level (then 1, *f and t set), else 0
- * (f >= level up to the tolerance): one exact test decides, a bisection
- * on [0, level] follows only when it passes. */
-static int f_below(bnb_ctx *c, const mcg_bnb_options *o, const double w[3], double level,
-                   double tol, double *f, double t[3], long *tests)
-{
-    double Rn[9], hi = level - 2.0 * o->tol;
-    int st, r;
-    if (hi <= 0.0)
-        return 0;
-    st = mcg_rot_from_angle_axis(w, Rn);
-    if (st != MCG_OK)
-        return -st;
-    ++*tests;
-    r = feasible(c, Rn, hi, 0.0, t);
-    if (r < 0)
-        return r;
-    if (r != 1)
-        return 0;
-    st = find_min_error(c, Rn, 0.0, c->floor, &hi, t, tol, 0);
-    if (st != MCG_OK)
-        return -st;
-    *f = hi;
-    return 1;
 }
 
 /* Nelder-Mead on f in angle-axis space from the pattern search's point,
@@ -974,7 +962,6 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     w += 3 * (size_t)n;
     c.a2 = w;
     w += 3 * (size_t)n;
-    c.grp = group;
     c.A3 = w;
     w += 6 * (size_t)n;
     c.b3 = w;

@@ -89,6 +89,12 @@ def _work(size: int) -> np.ndarray:
     return np.empty(max(int(size), 1), dtype=np.float64)
 
 
+def _first_zero_row(a: np.ndarray) -> Optional[int]:
+    """Index of the first row of ``a`` with (numerically) zero length, or None."""
+    bad = np.flatnonzero(np.einsum("ij,ij->i", a, a) <= 1e-200)
+    return int(bad[0]) if bad.size else None
+
+
 def _nonempty(name: str, a: np.ndarray) -> None:
     if a.size == 0:
         raise ValueError(f"{name} is empty (shape {a.shape})")
@@ -572,9 +578,9 @@ def cone_linf(apexes: Any, axes: Any, *, tolerance: float = 1e-10,
         raise ValueError(f"cone_linf accepts at most 2^20 cones, got {n}")
     if np.abs(apexes).max() > 1e150 or np.abs(axes).max() > 1e150:
         raise ValueError("apexes and axes must be below 1e150 in magnitude")
-    bad = np.flatnonzero(np.einsum("ij,ij->i", axes, axes) <= 1e-200)
-    if bad.size:
-        raise ValueError(f"axes[{bad[0]}] is zero (all axes need a direction)")
+    bad = _first_zero_row(axes)
+    if bad is not None:
+        raise ValueError(f"axes[{bad}] is zero (all axes need a direction)")
     opt = ffi.new("mcg_cone_options *")
     lib.mcg_cone_default_options(opt)
     opt.tolerance = float(tolerance)
@@ -796,9 +802,9 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     if n_groups > n:
         raise ValueError(f"group labels must be < the number of correspondences ({n})")
     for name, d in (("d1", d1), ("d2", d2)):
-        bad = np.flatnonzero(np.einsum("ij,ij->i", d, d) <= 1e-200)
-        if bad.size:
-            raise ValueError(f"{name}[{bad[0]}] is a zero bearing")
+        bad = _first_zero_row(d)
+        if bad is not None:
+            raise ValueError(f"{name}[{bad}] is a zero bearing")
     gi = np.ascontiguousarray(g, dtype=np.int32)
     opt = ffi.new("mcg_bnb_options *")
     lib.mcg_bnb_default_options(opt)

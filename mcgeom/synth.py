@@ -112,6 +112,21 @@ def random_motion(rng: RngLike = None, max_angle: float = 0.3,
     return R, t_norm * _random_unit(gen)
 
 
+def random_motion_between(rng: RngLike, min_angle: float, max_angle: float,
+                          t_min: float, t_max: float) -> tuple[np.ndarray, np.ndarray]:
+    """A random motion ``(R, t)`` with a rotation angle in [min_angle, max_angle]
+    radians (drawn up to max_angle, redrawn below min_angle, so that the scale
+    is observable) and ``|t|`` uniform in [t_min, t_max] metres (the set-up of
+    thesis ch. 10.5.1)."""
+    gen = as_rng(rng)
+    R = random_rotation(gen, max_angle)
+    while rotation_error(R, np.eye(3)) < min_angle:
+        R = random_rotation(gen, max_angle)
+    t = gen.normal(size=3)
+    t *= gen.uniform(t_min, t_max) / np.linalg.norm(t)
+    return R, t
+
+
 # --------------------------------------------------------------------------- rigs
 
 def look_at_camera(name: str, centre: Sequence[float], forward: Sequence[float],
@@ -143,6 +158,19 @@ def _heading(yaw_deg: float, pitch_deg: float = 0.0) -> np.ndarray:
     """Unit direction in the rig frame (x fwd, y left, z up) from yaw/pitch in degrees."""
     yaw, pitch = np.deg2rad(yaw_deg), np.deg2rad(pitch_deg)
     return np.array([np.cos(pitch) * np.cos(yaw), np.cos(pitch) * np.sin(yaw), np.sin(pitch)])
+
+
+def ring_rig(n_cameras: int, radius: float = 0.5, f: float = 800.0,
+             name: str = "cam") -> Rig:
+    """``n_cameras`` cameras on a horizontal ring of ``radius`` metres, looking
+    outward at equal yaw steps (1024 x 768 px, focal ``f`` px); named
+    ``name0``, ``name1``..."""
+    cams = []
+    for k in range(n_cameras):
+        yaw = 2 * np.pi * k / n_cameras
+        h = np.array([np.cos(yaw), np.sin(yaw), 0.0])
+        cams.append(look_at_camera(f"{name}{k}", radius * h, h, f=f, width=1024, height=768))
+    return Rig(tuple(cams))
 
 
 def stereo_head(baseline: float = 0.5, f: float = 600.0) -> Rig:

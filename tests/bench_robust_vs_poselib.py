@@ -28,12 +28,7 @@ from mcgeom.rig import Rig
 
 def ring4(radius: float = 0.25, f: float = 500.0) -> Rig:
     """4 cameras on a horizontal ring looking outward every 90 deg (1024 x 768 px)."""
-    cams = []
-    for k in range(4):
-        yaw = np.radians(90.0 * k)
-        h = np.array([np.cos(yaw), np.sin(yaw), 0.0])
-        cams.append(synth.look_at_camera(f"ring{k}", radius * h, h, f=f, width=1024, height=768))
-    return Rig(tuple(cams))
+    return synth.ring_rig(4, radius, f, name="ring")
 
 
 CASES: dict[str, tuple[Callable[[], Rig], int, float, float]] = {

@@ -43,11 +43,7 @@ def problems(runs: int, sigma: float, seed: int = 0):
     rig = rig4()
     rng = np.random.default_rng(seed)
     for _ in range(runs):
-        R = synth.random_rotation(rng, np.radians(20))
-        while synth.rotation_error(R, np.eye(3)) < np.radians(5):
-            R = synth.random_rotation(rng, np.radians(20))
-        t = rng.normal(size=3)
-        t *= rng.uniform(0.5, 1.5) / np.linalg.norm(t)
+        R, t = synth.random_motion_between(rng, np.radians(5), np.radians(20), 0.5, 1.5)
         yield R, t, synth.make_problem(rig, R, t, 200, rng, pixel_noise=sigma)
 
 

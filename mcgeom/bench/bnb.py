@@ -18,9 +18,8 @@ from typing import Optional
 import numpy as np
 
 from .. import estimate, registry, synth
-from ..rig import Rig
 
-__all__ = ["BnbTiming", "ring_rig", "bench_bnb", "growth"]
+__all__ = ["BnbTiming", "bench_bnb", "growth"]
 
 
 @dataclass(frozen=True)
@@ -39,26 +38,11 @@ class BnbTiming:
         return None if self.glpk_s is None else self.glpk_s / self.search_s
 
 
-def ring_rig(cams: int, radius: float = 0.5, f: float = 800.0) -> Rig:
-    """``cams`` cameras on a horizontal ring of the given radius (m), looking
-    outward at equal angles (1024 x 768 px, focal f px)."""
-    out = []
-    for k in range(cams):
-        yaw = 2 * np.pi * k / cams
-        h = np.array([np.cos(yaw), np.sin(yaw), 0.0])
-        out.append(synth.look_at_camera(f"cam{k}", radius * h, h, f=f, width=1024, height=768))
-    return Rig(tuple(out))
-
-
 def _problems(cams: int, pts: int, noise: float, n: int, seed: int):
-    rig = ring_rig(cams)
+    rig = synth.ring_rig(cams)
     rng = np.random.default_rng(seed)
     for _ in range(n):
-        R = synth.random_rotation(rng, np.radians(20))
-        while synth.rotation_error(R, np.eye(3)) < np.radians(5):
-            R = synth.random_rotation(rng, np.radians(20))
-        t = rng.normal(size=3)
-        t *= rng.uniform(0.5, 1.5) / np.linalg.norm(t)
+        R, t = synth.random_motion_between(rng, np.radians(5), np.radians(20), 0.5, 1.5)
         yield synth.make_problem(rig, R, t, cams * pts, rng, pixel_noise=noise)
 
 
