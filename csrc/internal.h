@@ -75,4 +75,16 @@ static inline double origin_spread(int n, const double *o1, const double *o2, do
 int mcg_wedge_unit(const double a[3], const double b[3], double sa, double sb,
                    double n1[3], double n2[3]);
 
+/* linf_local.c: local minimisation of the L-infinity error over (R, t)
+ * from (R, t) (in/out; unit bearings u1, u2, origins a1, a2, n x 3) by
+ * trust-region sequential LP, at most max_steps steps, trust radius from
+ * delta0 until it falls below delta_min; work: 9 n doubles. *f_out: the final max of sin(e_i) of the
+ * closed-form per-correspondence errors; *steps_out: steps taken. The
+ * caller verifies the result (the model may be invalid near a wedge's
+ * front). */
+int mcg_linf_local(int n, const double *u1, const double *a1, const double *u2,
+                   const double *a2, double R[9], double t[3], double delta0,
+                   double delta_min, int max_steps, double *work, double *f_out,
+                   int *steps_out);
+
 #endif /* MCGEOM_INTERNAL_H */

@@ -764,9 +764,10 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     improve by more than this are discarded; ``tol`` (rad): bisection
     tolerance; ``preemptive``: per-camera 2-variable tests first;
     ``working_sets``: LPs by constraint generation (False: every LP on all its
-    rows, the thesis's way; same answers); ``polish_tol`` (rad): a local
-    pattern search on f from the best rotation, steps halving from the
-    resolution to this (0: none); ``bound_steps``: relaxed bisection steps per split block (its
+    rows, the thesis's way; same answers); ``polish_tol`` (rad): after the search,
+    local minimisations of the L-infinity error over (R, t) by sequential LP from
+    the best rotation and 12 around it, each verified by the exact test, to this
+    trust radius (0: none); ``bound_steps``: relaxed bisection steps per split block (its
     best-first key); ``leaf_gap`` (rad, < 0: half the resolution): a block at
     the resolution is closed with the bound ``linf - leaf_gap`` when one
     relaxed test fails there; ``region``: ``(centre, half_side)`` to search only

@@ -121,13 +121,13 @@ def _dense_then_local(rays, R_center, seed):
 
 @pytest.mark.slow
 def test_global_optimality_200_problems():
-    """Never above f at the true rotation or at any sampled rotation; the
-    certified lower bound below every value of f seen. Against the local
-    refinement (Nelder-Mead from the best sample, which explores a wider
-    simplex than the polish): never above it by more than the certified gap
-    (that is the certificate), and above it by more than the f precision in
-    at most 5 % of the problems (flat valleys whose bottom the polish does
-    not always reach; measured: 4 of 200, at most 6.6e-7 rad)."""
+    """Never above f at the true rotation, at any sampled rotation, nor above
+    the local refinement (Nelder-Mead from the best of the samples around the
+    result, 1e-4 to 1e-2 rad away) by more than the precision of f; the
+    certified lower bound below every value of f seen. Measured before the
+    sequential-LP polish (pattern search + Nelder-Mead): 4 of 200 above the
+    refinement by up to 6.6e-7 rad, a second shallow basin 6e-4 rad away;
+    now none."""
     stats = []
     for seed in range(200):
         p = _problem(seed, n_per_cam=(5, 11))
@@ -138,7 +138,7 @@ def test_global_optimality_200_problems():
         linf, lb = info["linf"], info["lower_bound"]
         assert linf <= f_true + F_TOL, (seed, linf, f_true)
         assert linf <= f_samples + F_TOL, (seed, linf, f_samples)
-        assert linf <= f_local + info["gap"] + F_TOL, (seed, linf, f_local)
+        assert linf <= f_local + F_TOL, (seed, linf, f_local)
         assert lb <= linf + 1e-12
         assert lb <= min(f_true, f_samples, f_local) + 1e-12
         assert abs(linf_error(p.rays, m.R, tol=1e-10)[0] - linf) < F_TOL
@@ -148,7 +148,7 @@ def test_global_optimality_200_problems():
     print(f"\nf(R_true) - linf: median {np.median(s[:, 0]):.3g}; linf - local refinement: "
           f"max {s[:, 1].max():.3g}, {above}/200 above {F_TOL:g}; certified gap: median "
           f"{np.median(s[:, 2]):.3g}")
-    assert above <= 10
+    assert above == 0
 
 
 def test_returned_translation_is_feasible_at_linf():

@@ -551,9 +551,12 @@ typedef struct {
                           kept between tests, the last translation tried
                           first (default); 0: every LP on all its rows, as
                           the thesis (same answers, slower) */
-    double polish_tol; /* after the search, a local pattern search on f from
-                          the best rotation with steps halving from the
-                          resolution down to polish_tol (rad); 0: none.
+    double polish_tol; /* after the search, local minimisations of the
+                          L-infinity error over (R, t) by trust-region
+                          sequential LP from the best rotation and 12
+                          rotations around it (3-100 x the resolution),
+                          each verified by the exact test, until the trust
+                          radius falls below polish_tol (rad); 0: none.
                           Default 1e-9 */
     int bound_steps;   /* relaxed bisection steps that tighten a split
                           block's lower bound, the best-first key (1) */
@@ -590,7 +593,7 @@ typedef struct {
     long hints;          /* tests decided by the last feasible translation
                             without an LP */
     long leaves;         /* blocks closed at the resolution */
-    long polish_tests;   /* neighbours tried by the polish */
+    long polish_tests;   /* sequential-LP steps and exact tests of the polish */
     long undecided;      /* LPs the backend could not verify (MCG_ENUMERIC),
                             taken as feasible for lower bounds and as
                             infeasible for upper bounds */

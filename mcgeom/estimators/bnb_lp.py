@@ -19,9 +19,13 @@ Steps:
    ``linear17`` then Levenberg-Marquardt; ``five_plus_one`` where linear17
    cannot run; the identity when neither can): its ``f`` is the first bound
    (Algorithm 7, step 1);
-3. the global search to ``resolution`` (rad), then a local descent of f
-   from its best rotation (``polish``, in the same C call): the bottom of the
-   optimum's basin rather than the centre of a block;
+3. the global search to ``resolution`` (rad), then local minimisations of
+   the L-infinity error over (R, t) jointly (``polish``, in the same C call,
+   csrc/linf_local.c: trust-region sequential LP on the closed-form
+   per-correspondence errors) from its best rotation and from 12 rotations
+   3-100 resolutions around it, each verified by the exact LP test: the
+   bottom of the optimum's basin rather than the centre of a block, and the
+   lower of nearby basins that the bound cannot tell apart;
 4. the initial estimate is kept when its ``f`` equals the optimum within the
    LP precision (noise-free data: both are exact, the smooth one is exact to
    rounding);
@@ -143,8 +147,9 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
              "preemptive": "per-camera 2-variable tests first (True)",
              "working_sets": "LPs by constraint generation over working sets (True); "
                              "False: every LP on all rows (the thesis's way, same answers)",
-             "polish": "local descent of the L-infinity error from the best rotation (True): "
-                       "the bottom of the optimum's basin rather than a block centre",
+             "polish": "local minimisations of the L-infinity error over (R, t) by "
+                       "sequential LP around the best rotation (True): the bottom of the "
+                       "optimum's basin rather than a block centre",
              "max_blocks": "block budget of the global search (2e6)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
                                   "unobservable (0.1)"},
