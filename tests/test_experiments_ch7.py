@@ -1,7 +1,7 @@
 """Issue-3 targets, checked on small runs of the experiment scripts (the full
 runs print the tables: ``python tests/experiment_ch7.py 200``,
 ``python tests/experiment_minimal_5p1.py 10000``,
-``python tests/bench_robust_vs_poselib.py 50``). Only what must hold is
+``python -P tests/bench_robust_vs_poselib.py``). Only what must hold is
 asserted, never a timing."""
 
 from __future__ import annotations
