@@ -103,11 +103,11 @@ def _bench_bnb(args: argparse.Namespace) -> int:
 
     def row(r) -> str:
         g = "" if r.glpk_s is None else f" {r.glpk_s:9.3f} {r.glpk_ratio:7.1f}"
-        return (f"{r.cams:4d} {r.pts:4d} {r.search_s:9.3f} {r.total_s:9.3f} {r.blocks:8.0f} "
-                f"{r.lps:8.0f} {r.us_per_lp:7.2f}{g}")
+        return (f"{r.cams:4d} {r.pts:4d} {r.search_s:9.3f} {r.total_s:9.3f} "
+                f"{r.estimator_cpu_s:9.3f} {r.blocks:8.0f} {r.lps:8.0f} {r.us_per_lp:7.2f}{g}")
 
-    head = (f"{'cams':>4} {'pts':>4} {'search s':>9} {'+polish s':>9} {'blocks':>8} "
-            f"{'LPs':>8} {'us/LP':>7}")
+    head = (f"{'cams':>4} {'pts':>4} {'search s':>9} {'+polish s':>9} {'est cpu s':>9} "
+            f"{'blocks':>8} {'LPs':>8} {'us/LP':>7}")
     print("bnb: branch and bound over rotations to 1e-4 rad (4 cameras x 50 points, "
           "0.5 px; medians)")
     print(head + f" {'glpk s':>9} {'glpk/nat':>7}")
