@@ -137,7 +137,7 @@ def test_against_clarabel_bisection():
     """Full independent bisection on 1,000 instances: bound and point."""
     rng = np.random.default_rng(1)
     worst_g = worst_x = 0.0
-    count = nx = 0
+    count = nx = contradicted = 0
     for k in range(1000):
         n = int(rng.integers(2, 25))
         C, V = _instance(rng, n, "generic")
@@ -150,19 +150,31 @@ def test_against_clarabel_bisection():
         assert ref is not None
         g_ref, X_ref, lo_ref = ref
         count += 1
-        rel = abs(r["gamma"] - g_ref) / max(g_ref, 1e-3)
-        worst_g = max(worst_g, rel)
-        assert rel <= 1e-7, (k, r["gamma"], g_ref)
+        # the kernel's bound is attained at its point, above its own certificate
+        assert abs(_angles(C, V, r["X"]).max() - r["gamma"]) <= 1e-12 * max(1.0, r["gamma"])
+        assert r["gamma_lower"] <= r["gamma"]
         # the kernel is never worse than the reference point beyond the two
         # bisection tolerances (1e-10 relative each)
         assert r["gamma"] <= g_ref * (1 + 1e-9) + 1e-12
+        if lo_ref > g_ref * (1 + 1e-9):
+            # clarabel contradicted itself: it called a bound infeasible above
+            # the value its own point attains (2 of 1,000 with clarabel
+            # 0.11.1, at gamma ~ 3e-5 rad). The reference is wrong there, so
+            # only the one-sided check above applies.
+            contradicted += 1
+            continue
+        rel = abs(r["gamma"] - g_ref) / max(g_ref, 1e-3)
+        worst_g = max(worst_g, rel)
+        assert rel <= 1e-7, (k, r["gamma"], g_ref)
         if not r["nonunique"]:
             nx += 1
             _, L = _frame(C)
             dx = np.linalg.norm(r["X"] - X_ref) / L
             worst_x = max(worst_x, dx)
             assert dx <= 1e-6, (k, r["X"], X_ref)
-    print(f"clarabel bisection: {count} instances, worst relative gamma "
+    assert contradicted <= 10, contradicted  # the reference is right on >= 99 %
+    print(f"clarabel bisection: {count} instances ({contradicted} where clarabel "
+          f"contradicted itself), worst relative gamma "
           f"difference {worst_g:.2e}, worst X difference {worst_x:.2e} L "
           f"over the {nx} with a unique optimum")
 
