@@ -8,8 +8,10 @@ same 1 px epipolar threshold; PoseLib runs ``estimate_generalized_relative_pose`
 with its default RANSAC and bundle options. Printed per case: median and 90th
 percentile of rotation error (deg), translation-direction error (deg) and scale
 error |(|t_est| / |t_true|) - 1| (the metric estimate, whatever the verdict),
-failure rate (rotation error > 1 deg or direction error > 10 deg), median time
-and the time ratio PoseLib / mcgeom. Then, per case, the difference of the
+failure rate (rotation error > 1 deg or direction error > 10 deg), median wall
+time and the ratio PoseLib / mcgeom, and the same for the process CPU time of
+each call (all threads of the process; not inflated when other jobs share the
+machine's cores, as wall time is). Then, per case, the difference of the
 medians (mcgeom - PoseLib) of the rotation and scale errors with a paired
 bootstrap 95 % interval over the problems: medians of a few hundred problems
 differ by a few per cent from run to run, so a difference whose interval
@@ -86,7 +88,7 @@ def run(trials: int = 50, seed: int = 0, cases=None) -> dict:
     for name, (make_rig, n, outl, noise) in (cases or CASES).items():
         rng = np.random.default_rng(seed)
         rig = make_rig()
-        res = {"mcgeom": ([], []), "poselib": ([], [])}
+        res = {"mcgeom": ([], [], []), "poselib": ([], [], [])}
         for _ in range(trials):
             R = synth.random_rotation(rng, 0.3)
             while synth.rotation_error(R, np.eye(3)) < 0.05:
@@ -95,26 +97,29 @@ def run(trials: int = 50, seed: int = 0, cases=None) -> dict:
             t /= np.linalg.norm(t)
             p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
             for meth, fn in (("mcgeom", _mcgeom), ("poselib", _poselib)):
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 Re, te = fn(rig, p)
+                res[meth][2].append(time.process_time() - c0)
                 res[meth][1].append(time.perf_counter() - t0)
                 res[meth][0].append(_errors(Re, te, R, t))
-        out[name] = {k: (np.array(e), np.array(s)) for k, (e, s) in res.items()}
+        out[name] = {k: tuple(np.array(a) for a in v) for k, v in res.items()}
     return out
 
 
 def table(res: dict) -> str:
     lines = [f"{'case':<28} {'method':<8} {'rot med/p90 deg':>17} {'dir med/p90 deg':>17} "
-             f"{'scale med/p90':>15} {'fail':>6} {'ms med':>8} {'speedup':>8}"]
+             f"{'scale med/p90':>15} {'fail':>6} {'ms med':>8} {'speedup':>8} {'cpu ms':>8} "
+             f"{'cpu spd':>8}"]
     for case, methods in res.items():
         t_pl = np.median(methods["poselib"][1])
-        for meth, (e, secs) in methods.items():
+        c_pl = np.median(methods["poselib"][2])
+        for meth, (e, secs, cpu) in methods.items():
             med, p90 = np.median(e, 0), np.percentile(e, 90, axis=0)
             fail = np.mean((e[:, 0] > 1.0) | (e[:, 1] > 10.0))
             ratio = t_pl / np.median(secs)
             lines.append(f"{case:<28} {meth:<8} {med[0]:7.4f}/{p90[0]:<9.4f} {med[1]:7.3f}/{p90[1]:<9.3f} "
                          f"{med[2]:6.3f}/{p90[2]:<8.3f} {fail:6.3f} {1e3 * np.median(secs):8.2f} "
-                         f"{ratio:7.2f}x")
+                         f"{ratio:7.2f}x {1e3 * np.median(cpu):8.2f} {c_pl / np.median(cpu):7.2f}x")
     return "\n".join(lines)
 
 
