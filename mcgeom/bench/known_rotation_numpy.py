@@ -40,10 +40,9 @@ def dense_rows(x: np.ndarray, views: np.ndarray, m: int) -> tuple[np.ndarray, np
                 Ma = -np.einsum("ks,kt->kst", _cross(xj, np.broadcast_to(e, xj.shape)), v)
                 Mb = np.einsum("ks,kt->kst", u, _cross(xk, np.broadcast_to(e, xk.shape)))
                 Ma, Mb = Ma.reshape(K, 9), Mb.reshape(K, 9)
-                for k in range(K):
-                    Ek[k, :, 3 * views[k, o1] + qd] += Ma[k]
-                    Ek[k, :, 3 * views[k, o2] + qd] += Mb[k]
-                    Ek[k, :, 3 * views[k, ref] + qd] -= Ma[k] + Mb[k]
+                kk, ee = np.arange(K)[:, None], np.arange(9)[None, :]
+                for col, val in ((o1, Ma), (o2, Mb), (ref, -(Ma + Mb))):
+                    np.add.at(Ek, (kk, ee, (3 * views[:, col] + qd)[:, None]), val)
             blocks.append(Ek.reshape(-1, 3 * m))
         E = np.vstack(blocks)
         pairs = [(0, 1), (0, 2), (1, 2)]
