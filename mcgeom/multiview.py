@@ -315,8 +315,14 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
     lam1, lam2 = rel_vals[0], rel_vals[1] if p > 1 else np.inf
     c_hom = eig["vecs"][0]
 
-    verdict, c_unknown, metric = _choose(origins, N, gvec, const, first, ptr, B, c_hom, lam1,
-                                         n_rows, n, solved, pk, max_rel_std)
+    shift = None
+    if w is not None:  # mean world-aligned offset of each solved view's rays
+        cnt = np.maximum(np.bincount(view, minlength=m), 1)[:, None]
+        wbar = np.stack([np.bincount(view, weights=w[:, a], minlength=m) for a in range(3)], 1)
+        wbar = wbar / cnt
+        shift = (wbar[solved[1:]] - wbar[solved[0]]).reshape(-1)
+    verdict, c_unknown, metric = _choose(origins, N, gvec, const, first, ptr, c_hom, lam1,
+                                         n_rows, n, pk, max_rel_std, shift)
     t_solve = time.perf_counter()
 
     centres = np.full((m, 3), np.nan)
@@ -359,9 +365,12 @@ def _sky_matvec(a: np.ndarray, first: np.ndarray, ptr: np.ndarray, x: np.ndarray
     return y
 
 
-def _choose(origins, N, gvec, const, first, ptr, B, c_hom, lam1, n_rows, n, solved, pk,
-            max_rel_std):
-    """The centres (unknowns), whether they are metric, and the scale verdict."""
+def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max_rel_std,
+            shift):
+    """The centres (unknowns), whether they are metric, and the scale verdict.
+    ``shift``: per unknown, the mean offset of the view's rays relative to the
+    gauge view's (the scale evidence is the distance travelled by the cameras'
+    centroids, which does not depend on where the rig frame's origin is)."""
     cond = float(np.sqrt(max(lam1, 0.0)))
     if origins is None:
         return (ScaleVerdict(False, "central views: the scale of the centres is not "
@@ -381,8 +390,8 @@ def _choose(origins, N, gvec, const, first, ptr, B, c_hom, lam1, n_rows, n, solv
     # first-order std of the travelled distance |G c| (frame-independent)
     res2 = max(c @ _sky_matvec(N, first, ptr, c) + 2.0 * gvec @ c + const, 0.0)
     sigma2 = res2 / max(n_rows - n, 1)
-    Lc = _sky_matvec(_laplacian_env(first, ptr, pk), first, ptr, c)
-    s2 = float(c @ Lc)
+    Lc = _sky_matvec(_laplacian_env(first, ptr, pk), first, ptr, c + shift)
+    s2 = float((c + shift) @ Lc)
     if not s2 > 0:
         return (ScaleVerdict(False, "no translation detected: scale not observable",
                              conditioning=cond, rel_std=float("inf")), c_hom, False)
