@@ -905,9 +905,12 @@ def relation_grams(x: Any, w: Any, block: Any, n_blocks: int) -> np.ndarray:
     if q not in (2, 3):
         raise ValueError(f"x must have 2 or 3 bearings per relation, got {q}")
     w = _opt_offsets("w", w, (n, q, 3))
-    b = np.ascontiguousarray(block, dtype=np.int32)
+    b = np.asarray(block)
     if b.shape != (n,):
         raise ValueError(f"block must have shape ({n},), got {b.shape}")
+    if n and (b.dtype.kind not in "iu" or b.min() < 0 or b.max() >= int(n_blocks)):
+        raise ValueError(f"block must hold integer block indices in [0, {n_blocks})")
+    b = np.ascontiguousarray(b, dtype=np.int32)
     n_blocks = int(n_blocks)
     if n_blocks < 1:
         raise ValueError(f"n_blocks must be >= 1, got {n_blocks}")

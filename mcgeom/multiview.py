@@ -129,6 +129,14 @@ def _check_inputs(track, view, bearings, rotations, origins):
     return ids[0], ids[1], b / norms[:, None] if n else b, R, o
 
 
+#: cap on the observation subsets enumerated from the tracks (memory guard)
+MAX_RELATIONS = 20_000_000
+
+
+def _n_choose(n: int, k: int) -> int:
+    return 0 if n < k else (n * (n - 1) // 2 if k == 2 else n * (n - 1) * (n - 2) // 6)
+
+
 def _relations(track, view, q, pairs, window):
     """Index tuples (K, q) of the observations of each relation, sorted by view
     inside each relation: every q-subset of a track's observations in q
@@ -138,6 +146,11 @@ def _relations(track, view, q, pairs, window):
     starts = np.flatnonzero(np.r_[True, t_sorted[1:] != t_sorted[:-1]])
     lengths = np.diff(np.r_[starts, len(order)])
     out = []
+    total = sum(int(np.count_nonzero(lengths == L)) * _n_choose(int(L), q)
+                for L in np.unique(lengths))
+    if total > MAX_RELATIONS:
+        raise ValueError(f"the tracks give {total} {q}-view combinations (more than "
+                         f"{MAX_RELATIONS}): split long tracks")
     for length in np.unique(lengths):
         if length < q:
             continue

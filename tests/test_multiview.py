@@ -230,3 +230,21 @@ def test_bad_input_is_named():
         multiview.translations_from_tracks(track, view, b, r2)
     with pytest.raises(ValueError, match="no bilinear relation"):
         multiview.translations_from_tracks(np.arange(len(view)), view, b, rot)
+
+
+def test_long_tracks_are_refused_not_enumerated(monkeypatch):
+    monkeypatch.setattr(multiview, "MAX_RELATIONS", 1000)
+    m = 30
+    rot = np.array([np.eye(3)] * m)
+    b = np.random.default_rng(0).normal(size=(m, 3))
+    with pytest.raises(ValueError, match="combinations"):
+        multiview.translations_from_tracks(np.zeros(m, int), np.arange(m), b, rot,
+                                           relation="trilinear")
+
+
+def test_relation_grams_rejects_bad_block_indices():
+    x = np.random.default_rng(0).normal(size=(4, 2, 3))
+    with pytest.raises(ValueError, match="block"):
+        _core.relation_grams(x, None, np.array([0, 1, 2, 3.0]), 4)
+    with pytest.raises(ValueError, match="block"):
+        _core.relation_grams(x, None, np.array([0, 1, 2, 4]), 4)

@@ -25,7 +25,11 @@ from ..observability import critical_angle
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
 
-__all__ = ["known_rotation_translation"]
+__all__ = ["known_rotation_translation", "solve"]
+
+#: the multi-view solver behind this estimator (many views, the four variants of
+#: Figs. 6.3-6.6, all pairs or a window, connectivity): see mcgeom.multiview
+solve = multiview.translations_from_tracks
 
 
 def _rotation(rotation: Any) -> np.ndarray:
