@@ -28,23 +28,26 @@ COLOURS = {("bilinear", "svd"): (0, 140, 255), ("bilinear", "constrained"): (0, 
 
 
 def run(trials: int = 10, sigmas=SIGMAS, n_views: int = 101, n_points: int = 1000,
-        seed: int = 0) -> dict:
-    """{(relation, solver, sigma): dict(rms=[...], spiral=[...], seconds=[...])}
-    plus the aligned trajectories of the first trial under key "paths"."""
+        seed: int = 0, visible_range: float = 50.0) -> dict:
+    """{(relation, solver, sigma): dict(rms=[...], spiral=[...], seconds=[...],
+    rigidity=[...])} plus the aligned trajectories of the first trial under
+    key "paths"."""
     out, paths = {}, {}
     for sigma in sigmas:
         for trial in range(trials):
             seq = circle_sequence(n_views=n_views, n_points=n_points, sigma=sigma,
-                                  rng=seed + 1000 * trial)
+                                  rng=seed + 1000 * trial, visible_range=visible_range)
             for rel, sol in VARIANTS:
                 r = multiview.translations_from_tracks(seq.track, seq.view, seq.bearings,
                                                        seq.rotations, relation=rel, solver=sol)
                 ok = r.connected
                 aligned, rms = similarity_align(r.centres[ok], seq.centres[ok])
-                rec = out.setdefault((rel, sol, sigma), {"rms": [], "spiral": [], "seconds": []})
+                rec = out.setdefault((rel, sol, sigma),
+                                     {"rms": [], "spiral": [], "seconds": [], "rigidity": []})
                 rec["rms"].append(rms)
                 rec["spiral"].append(spiral_measure(aligned, seq.centres[ok]))
                 rec["seconds"].append(r.timing["total"])
+                rec["rigidity"].append(r.rigidity)
                 if trial == 0:
                     paths[(rel, sol, sigma)] = aligned
                     paths[("truth", sigma)] = seq.centres[ok]
@@ -77,17 +80,20 @@ def main(argv=None) -> int:
     ap.add_argument("--trials", type=int, default=10)
     ap.add_argument("--out", default="ch6_out")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--range", type=float, default=50.0, help="visible range of a view")
     args = ap.parse_args(argv)
-    res = run(args.trials, seed=args.seed)
-    print(f"thesis ch. 6.5.1: 101 views, circle radius 100, 1000 points, range 50, tracks <= 3 "
-          f"views; medians over {args.trials} trials")
-    print(f"{'sigma':>8} {'variant':>24} {'rms err':>10} {'spiral[deg]':>12} {'ms':>6}")
+    res = run(args.trials, seed=args.seed, visible_range=args.range)
+    print(f"thesis ch. 6.5.1: 101 views, circle radius 100, 1000 points, range {args.range:g}, "
+          f"tracks <= 3 views; medians over {args.trials} trials; rigidity = second smallest "
+          "relative eigenvalue of the solver's pencil (near 0: scales of parts free)")
+    print(f"{'sigma':>8} {'variant':>24} {'rms err':>10} {'spiral[deg]':>12} {'rigidity':>9} "
+          f"{'ms':>6}")
     for sigma in SIGMAS:
         for rel, sol in VARIANTS:
             r = res[(rel, sol, sigma)]
             print(f"{sigma:8.1e} {rel + ' + ' + sol:>24} {np.median(r['rms']):10.4g} "
                   f"{np.degrees(np.median(r['spiral'])):12.4g} "
-                  f"{1000 * np.median(r['seconds']):6.1f}")
+                  f"{np.median(r['rigidity']):9.2e} {1000 * np.median(r['seconds']):6.1f}")
     print("constrained / plain SVD, median RMS error (< 1 = constrained better):")
     for sigma in SIGMAS:
         ratios = [np.median(res[(rel, 'constrained', sigma)]["rms"]) /
