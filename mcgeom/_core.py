@@ -27,6 +27,8 @@ __all__ = [
     "cls_general", "cls_partial", "cls_range",
     "Linear17Options", "linear17", "GC_CASE_NAMES",
     "gec_residuals", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
+    "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
+    "skyline_eig",
 ]
 
 GC_CASE_NAMES = {
@@ -850,3 +852,126 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
         "leaves": res.leaves, "undecided": res.undecided, "polish_tests": res.polish_tests,
         "seconds": res.seconds, "stop": BNB_STOP_NAMES.get(res.stop, str(res.stop)),
     }
+
+
+# ------------------------------------------------------------ translation.c
+
+def _opt_offsets(name: str, w: Any, shape: tuple) -> Optional[np.ndarray]:
+    return None if w is None else _arr(name, w, shape)
+
+
+def bilinear_rows(x1: Any, x2: Any, w1: Any = None, w2: Any = None) -> np.ndarray:
+    """(N, 7) bilinear rows (thesis eq. 6.5) of world-aligned bearings x1 <-> x2
+    with ray origins c_1 + w1, c_2 + w2: ``row . (c_1, c_2, 1) = 0``."""
+    x1 = _arr("x1", x1, (-1, 3))
+    _nonempty("x1", x1)
+    n = x1.shape[0]
+    x2 = _arr("x2", x2, (n, 3))
+    if (w1 is None) != (w2 is None):
+        raise ValueError("bilinear_rows: give both offsets w1, w2 or neither")
+    w1, w2 = _opt_offsets("w1", w1, (n, 3)), _opt_offsets("w2", w2, (n, 3))
+    rows = np.empty((n, 7))
+    _check(lib.mcg_bilinear_rows(n, _p(x1), _p(x2), ffi.NULL if w1 is None else _p(w1),
+                                 ffi.NULL if w2 is None else _p(w2), _p(rows)),
+           "bilinear_rows")
+    return rows
+
+
+def trilinear_rows(x1: Any, x2: Any, x3: Any, w1: Any = None, w2: Any = None,
+                   w3: Any = None) -> np.ndarray:
+    """(N, 9, 7) trilinear rows (thesis eq. 6.11), view 1 the reference: each row
+    holds the coefficients of (a, b) = (c_2 - c_1, c_3 - c_1) and a constant."""
+    x1 = _arr("x1", x1, (-1, 3))
+    _nonempty("x1", x1)
+    n = x1.shape[0]
+    x2, x3 = _arr("x2", x2, (n, 3)), _arr("x3", x3, (n, 3))
+    ws = (w1, w2, w3)
+    if any(w is None for w in ws) != all(w is None for w in ws):
+        raise ValueError("trilinear_rows: give all three offsets w1, w2, w3 or none")
+    ws = [_opt_offsets(f"w{i + 1}", w, (n, 3)) for i, w in enumerate(ws)]
+    rows = np.empty((n, 9, 7))
+    ptrs = [ffi.NULL if w is None else _p(w) for w in ws]
+    _check(lib.mcg_trilinear_rows(n, _p(x1), _p(x2), _p(x3), *ptrs, _p(rows)),
+           "trilinear_rows")
+    return rows
+
+
+def relation_grams(x: Any, w: Any, block: Any, n_blocks: int) -> np.ndarray:
+    """Per-block Gram matrices (n_blocks, 3q+1, 3q+1) of the relation rows of
+    ``x`` (N, q, 3) world-aligned bearings (q = 2 bilinear, 3 trilinear), ray
+    offsets ``w`` (same shape, or None) and block index ``block`` (N,)."""
+    x = _arr("x", x, (-1, -1, 3))
+    n, q = x.shape[0], x.shape[1]
+    if q not in (2, 3):
+        raise ValueError(f"x must have 2 or 3 bearings per relation, got {q}")
+    w = _opt_offsets("w", w, (n, q, 3))
+    b = np.asarray(block)
+    if b.shape != (n,):
+        raise ValueError(f"block must have shape ({n},), got {b.shape}")
+    if n and (b.dtype.kind not in "iu" or b.min() < 0 or b.max() >= int(n_blocks)):
+        raise ValueError(f"block must hold integer block indices in [0, {n_blocks})")
+    b = np.ascontiguousarray(b, dtype=np.int32)
+    n_blocks = int(n_blocks)
+    if n_blocks < 1:
+        raise ValueError(f"n_blocks must be >= 1, got {n_blocks}")
+    d = 3 * q + 1
+    grams = np.empty((n_blocks, d, d))
+    _check(lib.mcg_relation_grams(q, n, _p(x) if n else _p(np.zeros(1)),
+                                  ffi.NULL if w is None else _p(w),
+                                  ffi.from_buffer("int[]", b) if n else ffi.new("int[1]"),
+                                  n_blocks, _p(grams)), "relation_grams")
+    return grams
+
+
+def _profile(first: Any, ptr: Any) -> tuple[np.ndarray, np.ndarray, int]:
+    first = np.ascontiguousarray(first, dtype=np.int32)
+    ptr = np.ascontiguousarray(ptr, dtype=np.int32)
+    n = first.shape[0]
+    if first.ndim != 1 or ptr.shape != (n + 1,) or n < 1:
+        raise ValueError(f"skyline profile: first (n,) and ptr (n + 1,), got {first.shape}, "
+                         f"{ptr.shape}")
+    return first, ptr, n
+
+
+def skyline_cholesky(first: Any, ptr: Any, env: Any) -> np.ndarray:
+    """Cholesky factor (same skyline storage) of a symmetric positive definite
+    matrix; NumericalError if it is not numerically positive definite."""
+    first, ptr, n = _profile(first, ptr)
+    fac = _arr("env", env, (int(ptr[-1]),)).copy()
+    _check(lib.mcg_skyline_cholesky(n, ffi.from_buffer("int[]", first),
+                                    ffi.from_buffer("int[]", ptr), _p(fac)), "skyline_cholesky")
+    return fac
+
+
+def skyline_solve(first: Any, ptr: Any, chol: Any, b: Any) -> np.ndarray:
+    """Solve A x = b with the factor of :func:`skyline_cholesky` (b: (n,))."""
+    first, ptr, n = _profile(first, ptr)
+    chol = _arr("chol", chol, (int(ptr[-1]),))
+    x = _arr("b", b, (n,)).copy()
+    _check(lib.mcg_skyline_solve(n, ffi.from_buffer("int[]", first),
+                                 ffi.from_buffer("int[]", ptr), _p(chol), _p(x)),
+           "skyline_solve")
+    return x
+
+
+def skyline_eig(first: Any, ptr: Any, a: Any, b: Any, *, shift: float = 0.0, p: int = 4,
+                max_iter: int = 500, tol: float = 1e-12) -> dict:
+    """The ``p`` smallest eigenpairs of A v = lambda B v (skyline storage), by
+    subspace inverse iteration (see mcgeom.h). Returns ``vals`` (p,), ``vecs``
+    (p, n), ``resid`` (p,) relative residuals and ``iters``."""
+    first, ptr, n = _profile(first, ptr)
+    env = int(ptr[-1])
+    a = _arr("a", a, (env,))
+    b = _arr("b", b, (env,))
+    p = int(p)
+    size = lib.mcg_skyline_eig_work_size(n, p, env)
+    if size == 0:
+        raise ValueError(f"skyline_eig: p must be in 1..min(8, n = {n}), got {p}")
+    work = _work(size)
+    vals, vecs, resid = np.empty(p), np.empty((p, n)), np.empty(p)
+    iters = ffi.new("int *")
+    _check(lib.mcg_skyline_eig(n, ffi.from_buffer("int[]", first), ffi.from_buffer("int[]", ptr),
+                               _p(a), _p(b), float(shift), p, int(max_iter), float(tol),
+                               _p(vals), _p(vecs), _p(resid), iters, _p(work), work.size),
+           "skyline_eig")
+    return {"vals": vals, "vecs": vecs, "resid": resid, "iters": int(iters[0])}

@@ -65,8 +65,11 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         return _bench_cone(args)
     if args.what == "bnb":
         return _bench_bnb(args)
+    if args.what == "known_rotation":
+        return _bench_known_rotation(args)
     if args.what != "linear17":
-        print(f"unknown benchmark {args.what!r}; available: linear17, cone, bnb", file=sys.stderr)
+        print(f"unknown benchmark {args.what!r}; available: linear17, cone, bnb, known_rotation",
+              file=sys.stderr)
         return 2
     from .bench.linear17 import bench_linear17
 
@@ -95,6 +98,21 @@ def _bench_cone(args: argparse.Namespace) -> int:
     for r in rows:
         print(f"{r.n:6d} {r.mcgeom_us:11.1f} {r.clarabel_us:13.1f} {r.ratio:7.1f} "
               f"{r.steps_mcgeom:5d} {r.steps_clarabel:9d} {r.gamma_rel_diff:10.1e}")
+    return 0
+
+
+def _bench_known_rotation(args: argparse.Namespace) -> int:
+    from .bench.known_rotation import bench_known_rotation
+
+    print("known_rotation: centres of a circle sequence (thesis ch. 6.5.1 scaled up, noise "
+          "1e-4 rad), constrained solver; mcgeom (C rows + skyline) vs dense numpy, seconds")
+    print(f"{'views':>6} {'tracks':>7} {'relation':>10} {'relations':>9} {'mcgeom s':>9} "
+          f"{'numpy s':>9} {'ratio':>7} {'max diff':>9}")
+    for r in bench_known_rotation():
+        dense = ("" if r.numpy_s is None else
+                 f"{r.numpy_s:9.3f} {r.ratio:7.1f} {r.max_diff:9.1e}")
+        print(f"{r.views:6d} {r.tracks:7d} {r.relation:>10} {r.relations:9d} "
+              f"{r.mcgeom_s:9.4f} {dense}")
     return 0
 
 
@@ -133,7 +151,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     m = sub.add_parser("methods", help="list the registered estimators")
     m.set_defaults(func=_cmd_methods)
     b = sub.add_parser("bench", help="benchmarks with ratios against references")
-    b.add_argument("what", help="benchmark name (linear17, cone, bnb)")
+    b.add_argument("what", help="benchmark name (linear17, cone, bnb, known_rotation)")
     b.add_argument("--problems", type=int, default=10, help="problems per row (bnb)")
     b.add_argument("--sizes", default="17,100,1000,10000")
     b.add_argument("--budget", type=float, default=0.5, help="seconds per timing")

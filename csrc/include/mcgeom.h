@@ -625,6 +625,66 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
                  const double R_init[9], const mcg_bnb_options *opt,
                  mcg_bnb_result *res, double *work, size_t lwork);
 
+/* ----------------------------------------------------------- translation.c */
+
+/* Rows of the bilinear relation (thesis eq. 6.5) of n correspondences
+ * x1[k] <-> x2[k] (world-aligned bearings of two views, n x 3, any length)
+ * whose rays start at c_1 + w1[k] and c_2 + w2[k] (w: world-aligned offsets
+ * from the view centres, n x 3; both NULL for central views = offsets 0).
+ * rows: n x 7, row . (c_1, c_2, 1) = (x1 x x2) . (c_2 + w2 - c_1 - w1). */
+int mcg_bilinear_rows(int n, const double *x1, const double *x2, const double *w1,
+                      const double *w2, double *rows);
+
+/* The 9 rows of the trilinear relation (thesis eq. 6.11) of each of n
+ * correspondences x1 <-> x2 <-> x3 (view 1 the reference), offsets as above
+ * (all three NULL or none). rows: 9n x 7, row 9 k + 3 s + t holds the
+ * coefficients of (a, b) = (c_2 - c_1, c_3 - c_1) and the constant term of
+ * M_st = u_s (x3 x B)_t - (x2 x A)_s v_t, u = x1 x x2, v = x1 x x3,
+ * A = a + w2 - w1, B = b + w3 - w1. */
+int mcg_trilinear_rows(int n, const double *x1, const double *x2, const double *x3,
+                       const double *w1, const double *w2, const double *w3,
+                       double *rows);
+
+/* Gram matrices of the relation rows per block (a view pair for q = 2, a
+ * view triple for q = 3; thesis ch. 6.2.3). Relation k has q bearings
+ * x[k] (n x q x 3, in the block's view order), offsets w (same shape, or
+ * NULL) and block index block[k] in [0, n_blocks). grams: n_blocks x
+ * (3q + 1) x (3q + 1), zeroed first, += r r^T for each row r = (coefficients
+ * of the q centres, constant). For q = 3 the 9 rows of each of the three
+ * choices of reference view are added (27 rows), so that a block does not
+ * depend on the order of its views. n may be 0. */
+int mcg_relation_grams(int q, int n, const double *x, const double *w,
+                       const int *block, int n_blocks, double *grams);
+
+/* Skyline (envelope) storage of a symmetric n x n matrix: row r holds the
+ * columns first[r] .. r at env[ptr[r] .. ptr[r + 1] - 1], ptr[0] = 0,
+ * ptr[r + 1] = ptr[r] + r - first[r] + 1 (ptr has n + 1 entries).
+ * In-place Cholesky factor A = L L^T (L in the same storage); MCG_ENUMERIC
+ * if A is not numerically positive definite. */
+int mcg_skyline_cholesky(int n, const int *first, const int *ptr, double *env);
+
+/* Solve A x = b in place (b: n values) with the factor of mcg_skyline_cholesky. */
+int mcg_skyline_solve(int n, const int *first, const int *ptr, const double *chol,
+                      double *b);
+
+/* Doubles of workspace for mcg_skyline_eig (0 for invalid sizes). */
+size_t mcg_skyline_eig_work_size(int n, int p, int env_size);
+
+/* The p (1..8, <= n) smallest eigenpairs of the symmetric-definite pencil
+ * A v = lambda B v, A positive semi-definite and B positive definite, both
+ * in the same skyline profile, by subspace inverse iteration on
+ * (A + shift B)^-1 B (shift >= 0; A + shift B must be positive definite)
+ * with Rayleigh-Ritz (thesis ch. 6.3: min |A G c| s.t. |G c| = 1 is the
+ * smallest pair of N = G^T A^T A G, B = G^T G). vals: p ascending values,
+ * vecs: p x n (B-orthonormal rows), resid[j] = |A v - lambda B v| /
+ * (max_r |A_rr| |v|). Stops when resid[0], resid[1] <= tol or after max_iter
+ * iterations (*iters = iterations done; the caller checks resid).
+ * MCG_ENUMERIC if A + shift B is not positive definite. */
+int mcg_skyline_eig(int n, const int *first, const int *ptr, const double *a,
+                    const double *b, double shift, int p, int max_iter, double tol,
+                    double *vals, double *vecs, double *resid, int *iters,
+                    double *work, size_t lwork);
+
 /* MCG_CDEF_END */
 
 #ifdef __cplusplus

@@ -1,0 +1,90 @@
+"""``known_rotation_translation``: the translation of a rig motion whose
+rotation is known (thesis ch. 6 with the de-rotated rig of ch. 4.2, Fig. 4.2).
+
+With R known, the generalized epipolar constraint (DESIGN.md section 3)
+``d2^T [t]x R d1 + d2^T R m1 + m2^T R d1 = 0`` is linear in t:
+``(R d1 x d2) . t = -(d2^T R m1 + m2^T R d1)``. It is solved as the two-view
+case of :func:`mcgeom.multiview.translations_from_tracks` (view 0 = rig 1 at
+the origin, view 1 = rig 2 with view_from_world rotation R, centre
+c = -R^T t; each correspondence a track of two rays from the camera centres):
+the bilinear relation of eq. 6.5 with the rig's offsets. The metric scale is
+returned where the data fix it; in the critical case (no rotation and only
+intra-camera rays, ch. 7.3.2, the inhomogeneous term vanishes) the verdict is
+"not observable" and ``t`` is the unit direction with the sign that puts the
+points in front. ``residual_rms``: RMS algebraic residual (metres).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from .. import multiview
+from ..observability import critical_angle
+from ..registry import register
+from ..types import RayPairs, RigMotion, ScaleVerdict
+
+__all__ = ["known_rotation_translation", "solve"]
+
+#: the multi-view solver behind this estimator (many views, the four variants of
+#: Figs. 6.3-6.6, all pairs or a window, connectivity): see mcgeom.multiview
+solve = multiview.translations_from_tracks
+
+
+def _rotation(rotation: Any) -> np.ndarray:
+    if rotation is None:
+        raise ValueError("known_rotation_translation needs the rotation: pass rotation=R "
+                         "(3x3, rig2_from_rig1)")
+    R = np.asarray(rotation, dtype=np.float64)
+    if R.shape != (3, 3) or not np.isfinite(R).all():
+        raise ValueError(f"rotation must be a finite 3x3 matrix, got shape {R.shape}")
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
+        raise ValueError("rotation is not a rotation matrix (R^T R != I or det < 0)")
+    return R
+
+
+@register(
+    "known_rotation_translation",
+    min_sample=3,
+    camera_kinds=("most-general", "locally-central", "axial", "locally-central-and-axial"),
+    family="linear",
+    needs_rotation=True,
+    recovers_scale=True,
+    description="translation (metric where observable) for a known rotation: the linear "
+                "generalized epipolar constraint / bilinear relation of thesis ch. 6",
+    options={"rotation": "the known rotation R (rig2_from_rig1), required",
+             "max_rel_std": "relative std of the travelled distance above which the scale "
+                            "is reported unobservable (0.1)"},
+)
+def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
+                               max_rel_std: Optional[float] = None) -> RigMotion:
+    """Translation t (metres, rig2_from_rig1: X2 = R X1 + t) of a rig motion with
+    known rotation ``rotation`` from >= 3 ray correspondences (rig frame).
+
+    Returns a ``RigMotion`` with ``R = rotation``; ``info`` holds the
+    multi-view result (eigenvalues, timing). Raises ValueError on bad input.
+    """
+    if not isinstance(rays, RayPairs):
+        raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    R = _rotation(rotation)
+    n = len(rays)
+    if n < 3:
+        raise ValueError(f"too few correspondences: known_rotation_translation needs 3, got {n}")
+    rays.check_finite()
+    k = np.arange(n)
+    res = multiview.translations_from_tracks(
+        np.r_[k, k], np.r_[np.zeros(n, np.int64), np.ones(n, np.int64)],
+        np.vstack([rays.dirs1, rays.dirs2]), np.stack([np.eye(3), R]),
+        origins=np.vstack([rays.origins1, rays.origins2]), relation="bilinear",
+        solver="constrained", max_rel_std=0.1 if max_rel_std is None else float(max_rel_std))
+    t = -R @ res.centres[1]  # c = -R^T t
+    if not res.scale.observable:
+        t /= np.linalg.norm(t)  # the direction only (already unit up to rounding)
+    v = res.scale
+    verdict = ScaleVerdict(v.observable, v.reason, v.conditioning, v.rel_std,
+                           critical_angle(rays, R, t))
+    info = {"eigenvalues": res.eigenvalues, "converged": res.converged, "timing": res.timing,
+            "metric": res.scale.observable}
+    return RigMotion(R.copy(), t, verdict, "known_rotation_translation", res.residual_rms,
+                     None, info)

@@ -1,0 +1,114 @@
+"""Synthetic sequences of views with known rotations and short tracks (thesis
+ch. 6.5.1, Fig. 6.2), and the similarity alignment used to score them. Seeded.
+
+Conventions of :mod:`mcgeom.multiview`: ``rotations[i]`` is view_from_world,
+bearings are in the view frame, centres in the world frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from .synth import RngLike, as_rng, perturb_directions, random_rotation
+
+__all__ = ["ViewSequence", "circle_sequence", "similarity_align", "spiral_measure"]
+
+
+@dataclass(frozen=True)
+class ViewSequence:
+    """Observations ``track``, ``view``, ``bearings`` (view frame, unit) of
+    ``points`` (world) by views with ``rotations`` (view_from_world) and
+    ``centres`` (world); ``origins`` (view frame) when the views are rigs."""
+
+    centres: np.ndarray
+    rotations: np.ndarray
+    points: np.ndarray
+    track: np.ndarray
+    view: np.ndarray
+    bearings: np.ndarray
+    origins: Optional[np.ndarray] = None
+
+
+def circle_sequence(n_views: int = 101, n_points: int = 1000, radius: float = 100.0,
+                    visible_range: float = 50.0, max_track: int = 3, sigma: float = 0.0,
+                    rng: RngLike = None, cameras: Optional[np.ndarray] = None) -> ViewSequence:
+    """Views on a circle of ``radius`` in the plane z = 0 (one turn), random
+    known rotations, ``n_points`` uniform in [-radius, radius]^3; a view sees
+    the points within ``visible_range``; each point's run of views is cut into
+    tracks of at most ``max_track`` consecutive views (thesis ch. 6.5.1);
+    bearings get angular noise ``sigma`` (radians). With ``cameras`` (K, 3):
+    each view is a rig of K cameras at these rig-frame centres, and a point is
+    seen by the camera of the rig nearest to it (origins filled)."""
+    gen = as_rng(rng)
+    if n_views < 2 or n_points < 1 or max_track < 2 or not visible_range > 0:
+        raise ValueError("circle_sequence: need n_views >= 2, n_points >= 1, max_track >= 2, "
+                         "visible_range > 0")
+    ang = 2.0 * np.pi * np.arange(n_views) / n_views
+    centres = radius * np.c_[np.cos(ang), np.sin(ang), np.zeros(n_views)]
+    rotations = np.array([random_rotation(gen) for _ in range(n_views)])
+    points = gen.uniform(-radius, radius, size=(n_points, 3))
+    sees = np.linalg.norm(points[None, :, :] - centres[:, None, :], axis=2) <= visible_range
+    track, view, pts = [], [], []
+    next_id = 0
+    for p in range(n_points):
+        vs = np.flatnonzero(sees[:, p])
+        if vs.size < 2:
+            continue
+        # runs of consecutive views, cyclic: the circle closes after view m - 1
+        runs = np.split(vs, np.flatnonzero(np.diff(vs) > 1) + 1)
+        if len(runs) > 1 and runs[0][0] == 0 and runs[-1][-1] == n_views - 1:
+            runs = [np.r_[runs[-1], runs[0]]] + runs[1:-1]
+        for run in runs:
+            start = int(gen.integers(0, max_track)) if run.size > max_track else 0
+            pieces = [run[:start]] if start >= 2 else []
+            pieces += [run[s:s + max_track] for s in range(start, run.size, max_track)]
+            for piece in pieces:
+                if piece.size >= 2:
+                    track += [next_id] * piece.size
+                    view += list(piece)
+                    pts += [p] * piece.size
+                    next_id += 1
+    track, view, pts = np.array(track), np.array(view), np.array(pts)
+    origins = None
+    offs = np.zeros((len(view), 3))
+    if cameras is not None:
+        cams = np.asarray(cameras, dtype=np.float64)
+        # rig-frame positions of the points, camera nearest to each
+        Xv = np.einsum("kij,kj->ki", rotations[view], points[pts] - centres[view])
+        k = np.argmin(np.linalg.norm(Xv[:, None, :] - cams[None, :, :], axis=2), axis=1)
+        origins = cams[k]
+        offs = np.einsum("kji,kj->ki", rotations[view], origins)
+    d_world = points[pts] - centres[view] - offs
+    bearings = np.einsum("kij,kj->ki", rotations[view], d_world)
+    bearings /= np.linalg.norm(bearings, axis=1, keepdims=True)
+    if sigma > 0:
+        bearings = perturb_directions(bearings, sigma, gen)
+    return ViewSequence(centres, rotations, points, track, view, bearings, origins)
+
+
+def similarity_align(est: np.ndarray, true: np.ndarray) -> tuple[np.ndarray, float]:
+    """``est`` (m, 3) mapped by the similarity (scale, rotation, translation)
+    that best fits ``true`` in least squares (Umeyama); returns the aligned
+    centres and the RMS distance to ``true`` (units of ``true``)."""
+    mu_e, mu_t = est.mean(0), true.mean(0)
+    E, T = est - mu_e, true - mu_t
+    U, S, Vt = np.linalg.svd(T.T @ E)
+    D = np.eye(3)
+    D[2, 2] = np.sign(np.linalg.det(U @ Vt)) or 1.0
+    Rm = U @ D @ Vt
+    var = np.sum(E ** 2)
+    s = float(np.trace(np.diag(S) @ D) / var) if var > 0 else 0.0
+    aligned = s * E @ Rm.T + mu_t
+    return aligned, float(np.sqrt(np.mean(np.sum((aligned - true) ** 2, axis=1))))
+
+
+def spiral_measure(aligned: np.ndarray, true: np.ndarray) -> float:
+    """Largest angle (radians) between an estimated step c_{i+1} - c_i and the
+    true one: spirals and jumps (thesis Figs. 6.3, 6.5) make it large."""
+    a, t = np.diff(aligned, axis=0), np.diff(true, axis=0)
+    cos = np.einsum("ij,ij->i", a, t)
+    sin = np.linalg.norm(np.cross(a, t), axis=1)
+    return float(np.max(np.arctan2(sin, cos)))
