@@ -47,6 +47,14 @@
 extern "C" {
 #endif
 
+/* Symbol visibility: libmcgeom is compiled with -fvisibility=hidden, and the
+ * declarations of this header (and only they) are marked visible, so the
+ * shared library exports exactly the public mcg_* API. Outside the CDEF
+ * block: cffi parses no pragmas. */
+#if defined(__GNUC__) && __GNUC__ >= 4
+#pragma GCC visibility push(default)
+#endif
+
 /* MCG_CDEF_BEGIN -- the block below is also parsed by cffi (no macros). */
 
 /* Status codes returned by every entry point. */
@@ -569,14 +577,23 @@ typedef struct {
                           pass around an earlier optimum; lower_bound then
                           holds over that cube only); 0: all rotations */
     const mcg_lp_backend *lp; /* NULL: the native backend */
+    double max_seconds; /* wall-time budget of the call (s, CLOCK_MONOTONIC):
+                           the search stops at the first block after it
+                           (checked every 16 blocks) and the polish starts
+                           no new local minimisation; 0: no limit
+                           (default); [0, 1e9]. With max_blocks the two
+                           budgets of the search; res->stop says which one
+                           ended it */
 } mcg_bnb_options;
 
 /* mcg_bnb_result.stop */
 enum {
     MCG_BNB_CONVERGED = 0,  /* every block discarded or at the resolution */
     MCG_BNB_MAX_BLOCKS = 1, /* max_blocks reached (bound still certified) */
-    MCG_BNB_QUEUE_FULL = 2  /* some blocks closed early for lack of queue
+    MCG_BNB_QUEUE_FULL = 2, /* some blocks closed early for lack of queue
                                space (bound still certified, gap wider) */
+    MCG_BNB_TIME_LIMIT = 3  /* max_seconds reached (bound still certified
+                               over the blocks examined and queued) */
 };
 
 typedef struct {
@@ -626,6 +643,10 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
                  mcg_bnb_result *res, double *work, size_t lwork);
 
 /* MCG_CDEF_END */
+
+#if defined(__GNUC__) && __GNUC__ >= 4
+#pragma GCC visibility pop
+#endif
 
 #ifdef __cplusplus
 }
