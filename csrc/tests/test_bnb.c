@@ -95,7 +95,7 @@ static void noise_free(void)
 {
     int trial, fails_r = 0, fails_t = 0, fails_f = 0;
     double worst_r = 0.0, worst_t = 0.0, worst_f = 0.0;
-    for (trial = 0; trial < 6; ++trial) {
+    for (trial = 0; trial < scaled(6); ++trial) {
         double R[9], Rs[9], R0[9], t[3], dt = 0.0;
         int m = 2 + trial % 3, n, i, st;
         mcg_bnb_options o;
@@ -137,7 +137,7 @@ static void noisy(void)
 {
     int trial, above = 0, lb_above = 0;
     double worst = -1.0;
-    for (trial = 0; trial < 8; ++trial) {
+    for (trial = 0; trial < scaled(8); ++trial) {
         double R[9], t[3], I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
         int m = 2 + trial % 3, n, st;
         mcg_bnb_options o;
