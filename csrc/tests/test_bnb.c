@@ -259,6 +259,16 @@ static void time_budget(void)
           0);
     check(res.blocks < o.max_blocks && res.queued > 0, "stopped before the block budget",
           (double)res.blocks, (double)o.max_blocks);
+    /* the block budget: exactly max_blocks blocks, then MAX_BLOCKS */
+    options(&o);
+    o.resolution = 1e-7;
+    o.max_blocks = 50;
+    st = mcg_bnb_linf(n, D1, A1, D2, A2, G, 3, R, &o, &res, W, WORK);
+    check_status(st, MCG_OK, "block-limited search returns");
+    check(res.stop == MCG_BNB_MAX_BLOCKS && res.blocks == 50,
+          "max_blocks = 50: 50 blocks, stop = MCG_BNB_MAX_BLOCKS", (double)res.blocks, 50);
+    check(res.lower_bound <= res.linf, "lower bound <= linf at the block limit",
+          res.linf - res.lower_bound, 0);
 }
 
 int main(void)
