@@ -82,6 +82,9 @@
 #define BLOCK_DOUBLES 5     /* centre (3), half-side, lower bound */
 #define WS_CAP 48           /* rows of a working set before a full LP */
 #define WS_ADD 4            /* most violated rows added per round */
+#define BISECT_MAX 200      /* bisection steps: (0, 1.5] to tol >= 1e-15
+                               takes <= 51; the cap only guards the loop */
+#define CLOCK_EVERY 16      /* blocks between two reads of the clock */
 /* A test the LP backend could not decide (MCG_ENUMERIC: its point failed the
  * verification, seen only at bounds ~1e-10 rad on noise-free data): taken as
  * feasible where a lower bound is at stake (no block is wrongly discarded)
@@ -478,7 +481,8 @@ static int find_min_error(bnb_ctx *c, const double R[9], double s, double lo,
                           double *hi, double t_hi[3], double tol, int lower)
 {
     double t[3];
-    while (*hi - lo > tol) {
+    int it;
+    for (it = 0; it < BISECT_MAX && *hi - lo > tol; ++it) {
         double mid = 0.5 * (lo + *hi);
         int r = feasible(c, R, mid, s, t);
         if (r < 0)
@@ -517,13 +521,24 @@ static double lcg_uniform(unsigned long long *state)
 /* a pseudo-random unit direction */
 static void random_direction(unsigned long long *state, double dir[3])
 {
-    double n;
-    do {
+    double n = 0.0;
+    int tries;
+    /* rejection sampling in the unit ball: a draw is accepted with
+     * probability ~0.52, so 1000 tries never all fail in practice; the last
+     * draw is kept regardless (any non-zero direction would do) */
+    for (tries = 0; tries < 1000; ++tries) {
         dir[0] = 2.0 * lcg_uniform(state) - 1.0;
         dir[1] = 2.0 * lcg_uniform(state) - 1.0;
         dir[2] = 2.0 * lcg_uniform(state) - 1.0;
         n = dot3(dir, dir);
-    } while (n > 1.0 || n < 1e-4);
+        if (n <= 1.0 && n >= 1e-4)
+            break;
+    }
+    if (n < 1e-4) {
+        dir[0] = 1.0;
+        dir[1] = dir[2] = 0.0;
+        n = 1.0;
+    }
     n = sqrt(n);
     dir[0] /= n;
     dir[1] /= n;
@@ -577,7 +592,7 @@ static int try_move(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
  * incumbent moves only where f is lower; never increases f). Its workspace
  * is the 3- and 2-variable rows' space (9 of their 12 n doubles). */
 static int polish_slp(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
-                      long *tests)
+                      long *tests, double deadline)
 {
     unsigned long long state = 0x2545f4914f6cdd1dULL;
     double w0[3];
@@ -588,6 +603,10 @@ static int polish_slp(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
     for (start = 0; start < POLISH_STARTS; ++start) {
         double R[9], t[3], w[3], fs, dir[3];
         int steps;
+        if (start > 0 && now_seconds() > deadline) {
+            res->stop = MCG_BNB_TIME_LIMIT;
+            break; /* the incumbent so far stands: never worse */
+        }
         memcpy(w, w0, sizeof w);
         if (start > 0) {
             static const double scales[4] = {100.0, 3.0, 10.0, 30.0};
@@ -702,6 +721,7 @@ void mcg_bnb_default_options(mcg_bnb_options *opt)
     opt->centre[0] = opt->centre[1] = opt->centre[2] = 0.0;
     opt->half_side = 0.0;
     opt->lp = NULL;
+    opt->max_seconds = 0.0;
 }
 
 static int check_options(const mcg_bnb_options *o)
@@ -723,6 +743,8 @@ static int check_options(const mcg_bnb_options *o)
     if (!(isfinite(o->half_side) && o->half_side >= 0.0 && o->half_side <= PI) ||
         !all_finite(o->centre, 3) || fabs(o->centre[0]) > 2 * PI ||
         fabs(o->centre[1]) > 2 * PI || fabs(o->centre[2]) > 2 * PI)
+        return 0;
+    if (!(isfinite(o->max_seconds) && o->max_seconds >= 0.0 && o->max_seconds <= 1e9))
         return 0;
     return 1;
 }
@@ -782,7 +804,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     mcg_lp_backend native;
     bnb_ctx c;
     double *w = work, *heap, *alpha, eps, lo, t[3], Rb[9], blk[BLOCK_DOUBLES];
-    double leaf_lb = INFINITY, prune_lb = INFINITY, t0, leaf_gap, L, oc[3];
+    double leaf_lb = INFINITY, prune_lb = INFINITY, t0, leaf_gap, L, oc[3], deadline;
     int *order, *gstart, i, g, k, st, r, hsize = 0, gi, gj, gk;
     long blocks = 0, leaves = 0;
     size_t need;
@@ -815,11 +837,15 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
             return MCG_EINVAL;
         if (!(dot3(d1 + 3 * i, d1 + 3 * i) > 1e-200) || !(dot3(d2 + 3 * i, d2 + 3 * i) > 1e-200))
             return MCG_EINVAL;
+        /* |value| <= 1e150: squares and products of bearings and origins
+         * stay finite (a bearing of 1e200 would normalise to 0 or NaN) */
         for (k = 0; k < 3; ++k)
-            if (fabs(a1[3 * i + k]) > 1e150 || fabs(a2[3 * i + k]) > 1e150)
+            if (fabs(a1[3 * i + k]) > 1e150 || fabs(a2[3 * i + k]) > 1e150 ||
+                fabs(d1[3 * i + k]) > 1e150 || fabs(d2[3 * i + k]) > 1e150)
                 return MCG_EINVAL;
     }
     leaf_gap = o.leaf_gap < 0.0 ? 0.5 * o.resolution : o.leaf_gap;
+    deadline = o.max_seconds > 0.0 ? t0 + o.max_seconds : INFINITY;
     if (!o.lp) {
         mcg_lp_native_backend(&native);
         o.lp = &native;
@@ -987,6 +1013,10 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
             res->stop = MCG_BNB_MAX_BLOCKS;
             break;
         }
+        if (o.max_seconds > 0.0 && blocks % CLOCK_EVERY == 0 && now_seconds() > deadline) {
+            res->stop = MCG_BNB_TIME_LIMIT; /* the queue's bounds stay certified */
+            break;
+        }
         heap_pop(heap, &hsize, blk);
         ++blocks;
         s = SQRT3 * blk[3];
@@ -1084,7 +1114,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     c.floor = lo - 2.0 * o.tol;
     if (o.polish_tol > 0.0 && o.polish_tol < o.resolution && o.max_blocks > 0) {
         long tests = 0;
-        st = polish_slp(&c, &o, res, &tests);
+        st = polish_slp(&c, &o, res, &tests, deadline);
         if (st != MCG_OK)
             return st;
         res->polish_tests = tests;

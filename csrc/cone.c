@@ -70,6 +70,11 @@
 #define MU 3.0
 #define LAMBDA_CENTRED 0.3 /* Newton decrement of a centred iterate */
 #define MAX_BACKTRACK 60
+/* Barrier-weight increases per Newton step while the iterate stays centred:
+ * the duality-gap bound shrinks by MU each time, so 700 increases take it
+ * from any finite start below every decision threshold (3^700 > 1e300); the
+ * cap only guarantees termination in floating point. */
+#define MAX_CENTRED_UPDATES 700
 
 typedef struct {
     int n;            /* cones of this (sub)problem */
@@ -306,7 +311,7 @@ static int feasibility(const cone_ctx *k, double gamma, double x[3],
     double cg = cos(gamma), sg = sin(gamma);
     double nu = 2.0 * k->n + 2.0, t, z[4], g[4], h[16], d[4], rhs[4];
     double g0;
-    int it, have = 0, a;
+    int it, have = 0, a, up;
 
     if (gamma >= HALF_PI) {
         cg = 0.0;
@@ -329,7 +334,11 @@ static int feasibility(const cone_ctx *k, double gamma, double x[3],
                 return FEAS_NUMERIC;
             have = 1;
         }
-        for (;;) { /* bounded: t grows by MU until a decision (see below) */
+        for (up = 0;; ++up) { /* t grows by MU until a decision (see below) */
+            if (up == MAX_CENTRED_UPDATES || !isfinite(t)) {
+                x[0] = z[0]; x[1] = z[1]; x[2] = z[2];
+                return z[3] < 0.0 ? FEAS_YES : FEAS_UNDECIDED;
+            }
             for (a = 0; a < 4; ++a)
                 rhs[a] = -g[a];
             rhs[3] -= t;

@@ -744,6 +744,7 @@ BNB_STOP_NAMES = {
     lib.MCG_BNB_CONVERGED: "converged",
     lib.MCG_BNB_MAX_BLOCKS: "max_blocks",
     lib.MCG_BNB_QUEUE_FULL: "queue_full",
+    lib.MCG_BNB_TIME_LIMIT: "time_limit",
 }
 
 
@@ -753,7 +754,8 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
              preemptive: bool = True, working_sets: bool = True, polish_tol: float = 1e-9,
              bound_steps: int = 1,
              leaf_gap: float = -1.0,
-             region: Optional[tuple] = None, lp_backend: str = "native") -> dict:
+             region: Optional[tuple] = None, lp_backend: str = "native",
+             max_seconds: float = 0.0) -> dict:
     """Globally optimal L-infinity rig motion by branch and bound over rotations
     (thesis ch. 10, ``mcg_bnb_linf``).
 
@@ -775,12 +777,15 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     relaxed test fails there; ``region``: ``(centre, half_side)`` to search only
     the angle-axis cube centre +- half_side (rad; ``lower_bound`` then holds
     over that cube only), None for all rotations; ``lp_backend``: a name of
-    :data:`LP_BACKENDS`.
+    :data:`LP_BACKENDS`; ``max_seconds``: wall-time budget of the call
+    (seconds, 0: none), after which the search stops with ``stop ==
+    "time_limit"`` and a still certified (wider) bound.
 
     Returns a dict: ``R``, ``t`` (X2 = R X1 + t), ``linf`` (the L-infinity
     error f(R), rad), ``initial_linf``, ``lower_bound`` (certified over all
     rotations), ``gap``, ``blocks``, ``queued``, ``lps_2var``, ``lps_3var``,
-    ``seconds`` and ``stop`` (``converged`` / ``max_blocks`` / ``queue_full``).
+    ``seconds`` and ``stop`` (``converged`` / ``max_blocks`` / ``queue_full`` /
+    ``time_limit``).
     Raises ``ValueError`` for bad input, ``NumericalError`` if even a bound of
     1.5 rad is infeasible at ``R_init``.
     """
@@ -822,6 +827,7 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     opt.polish_tol = float(polish_tol)
     opt.bound_steps = int(bound_steps)
     opt.leaf_gap = float(leaf_gap)
+    opt.max_seconds = float(max_seconds)
     if region is not None:
         centre, half = region
         centre = _arr("region centre", centre, (3,))
@@ -835,7 +841,7 @@ def bnb_linf(d1: Any, a1: Any, d2: Any, a2: Any, group: Any, R_init: Any, *,
     if size == 0:
         raise ValueError("bnb_linf: invalid options (resolution in (0, 1), gap in [0, 1), "
                          "tol in [1e-15, 1e-2), max_queue in [1, 2^26], grid in [1, 64], "
-                         "bound_steps in [0, 60], leaf_gap < 1)")
+                         "bound_steps in [0, 60], leaf_gap < 1, max_seconds in [0, 1e9])")
     work = _work(size)
     res = ffi.new("mcg_bnb_result *")
     st = lib.mcg_bnb_linf(n, _p(d1), _p(a1), _p(d2), _p(a2),

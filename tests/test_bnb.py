@@ -222,6 +222,17 @@ def test_certificate_and_counts_reported():
     assert m.scale.observable
 
 
+def test_time_budget_stops_the_search_with_a_certified_bound():
+    p = _problem(4)
+    m = mcgeom.estimate(p.rays, "bnb_lp", initial="linear17", resolution=1e-7,
+                        max_seconds=0.02)
+    i = m.info
+    assert i["stop"] == "time_limit"
+    assert i["lower_bound"] <= i["linf"] <= i["initial_linf"]
+    with pytest.raises(ValueError, match="max_seconds"):
+        mcgeom.estimate(p.rays, "bnb_lp", max_seconds=-1.0)
+
+
 def test_mask_selects_inliers():
     p = _problem(6)
     rng = np.random.default_rng(0)

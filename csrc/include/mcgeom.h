@@ -19,12 +19,46 @@
  *         coef(E_ij) = d2_i d1_j,  coef(R_ij) = d2_i m1_j + m2_i d1_j.
  *     (The thesis uses column-major vec(); only the ordering differs.)
  *
- * Every entry point validates its sizes, pointers and the finiteness of its
- * inputs and returns a status code (MCG_OK on success). No function keeps
- * global state or allocates memory; routines whose scratch space depends on the
- * problem size take a caller-provided workspace `work` of `lwork` doubles
- * whose required size is returned by the matching *_work_size() function.
- * All functions are re-entrant and thread-safe on distinct output buffers.
+ * Frames and units: points and ray origins in metres (any consistent unit:
+ * translations come back in it), angles in radians, bearings of any non-zero
+ * length unless a function says "unit". Rig frames at time 1 and time 2 as
+ * above; rotations act on column vectors (R v).
+ *
+ * Status codes. Every entry point that returns int validates its sizes, its
+ * pointers (NULL -> MCG_EINVAL; optional outputs documented "may be NULL"),
+ * the finiteness of every input value (NaN/inf -> MCG_EINVAL) and its
+ * options before it computes anything, and returns MCG_OK on success or one
+ * of the MCG_E* codes below (mcg_status_message gives a text). Unless a
+ * function documents otherwise, outputs are unspecified after an error, and
+ * output arrays must not overlap inputs.
+ *
+ * Memory. No function allocates memory (except inside libglpk when the GLPK
+ * LP backend is used) or keeps state between calls. Routines whose scratch
+ * space depends on the problem size take a caller-provided workspace `work`
+ * of `lwork` doubles (its content on entry does not matter, on return it is
+ * unspecified) whose required size is returned by the matching
+ * *_work_size() function; too small a workspace gives MCG_ENOMEM. The
+ * others use a bounded amount of stack (measured with gcc -O2 on x86-64,
+ * callees included: mcg_spd_solve 33 KB, mcg_linear17 about 16 KB,
+ * mcg_refine_motion 8 KB, every other function under 5 KB).
+ *
+ * Iteration budgets. Every loop is bounded: iterative routines have fixed
+ * internal caps (Jacobi sweeps, QR steps, bisections) or caller-set budgets
+ * (mcg_linear17_options.max_iterations, mcg_refine_options.max_iterations,
+ * mcg_cone_options.max_iterations / max_newton, mcg_bnb_options.max_blocks /
+ * max_seconds), and the result structs report what was used and why the
+ * routine stopped.
+ *
+ * Thread safety. Every function is re-entrant: concurrent calls from several
+ * threads are safe as long as they do not share output buffers or
+ * workspaces. The single exception is the GLPK backend: mcg_lp_glpk_load
+ * sets the one piece of global state of the library (the handle of the
+ * dlopened libglpk and its function pointers); call it once, before the
+ * threads that use the backend start (later calls only read the state), and
+ * note that the thread safety of libglpk itself depends on how it was built
+ * (GLPK keeps its environment in thread-local storage only when compiled
+ * with TLS support): serialise calls into the GLPK backend if unsure. The
+ * native LP backend has no such restriction.
  *
  * Limits and edge cases common to the kernels:
  *   - sizes: rows (and rays) <= 2^20, columns (and sym_eig's n) <= 4096;
@@ -45,6 +79,14 @@
 
 #ifdef __cplusplus
 extern "C" {
+#endif
+
+/* Symbol visibility: libmcgeom is compiled with -fvisibility=hidden, and the
+ * declarations of this header (and only they) are marked visible, so the
+ * shared library exports exactly the public mcg_* API. Outside the CDEF
+ * block: cffi parses no pragmas. */
+#if defined(__GNUC__) && __GNUC__ >= 4
+#pragma GCC visibility push(default)
 #endif
 
 /* MCG_CDEF_BEGIN -- the block below is also parsed by cffi (no macros). */
@@ -72,14 +114,17 @@ enum {
     MCG_GC_DEGENERATE = 5             /* any other null space of A_R */
 };
 
-/* Human-readable message for a status code (static storage). */
+/* Human-readable message for a status code (a string in static storage,
+ * never NULL; "unknown status code" for values outside the enum). */
 const char *mcg_status_message(int status);
 
 /* ---------------------------------------------------------------- linalg.c */
 
 /* Thin Householder QR of an m x n matrix a (m >= n >= 1): a = q r.
  * q: m x n with orthonormal columns (may be NULL), r: n x n upper triangular.
- * Requires lwork >= mcg_qr_work_size(m, n). */
+ * Requires lwork >= mcg_qr_work_size(m, n) (0 for m < n or sizes beyond the
+ * limits). MCG_EINVAL: sizes, NULL a / r / work, NaN/inf in a; MCG_ENOMEM:
+ * lwork too small; MCG_ENUMERIC: entries of r beyond the double range. */
 size_t mcg_qr_work_size(int m, int n);
 int mcg_qr(int m, int n, const double *a, double *q, double *r,
            double *work, size_t lwork);
@@ -94,7 +139,10 @@ int mcg_qr(int m, int n, const double *a, double *q, double *r,
  *   u: m x min(m, n), column k the left singular vector of s[k] (may be NULL;
  *      columns for zero singular values are completed to an orthonormal set).
  * Requires lwork >= mcg_svd_work_size(m, n), which never exceeds
- * p * n + 3 * n * n + 4 * p with p = max(m, n). */
+ * p * n + 3 * n * n + 4 * p with p = max(m, n). MCG_EINVAL: sizes, NULL a /
+ * s / v / work, NaN/inf; MCG_ENOMEM: lwork too small; MCG_ENUMERIC: the
+ * Jacobi sweeps did not converge (capped) or values beyond the double
+ * range. */
 size_t mcg_svd_work_size(int m, int n);
 int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
             double *work, size_t lwork);
@@ -102,7 +150,9 @@ int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
 /* Moore-Penrose pseudo-inverse (n x m) of an m x n matrix; singular values
  * below rcond * s_max are treated as zero (rcond <= 0 selects
  * max(m, n) * DBL_EPSILON). rank (may be NULL) receives the numerical rank.
- * Requires lwork >= mcg_pinv_work_size(m, n). */
+ * Requires lwork >= mcg_pinv_work_size(m, n). MCG_EINVAL: sizes, NULL a /
+ * ainv / work, NaN/inf in a or rcond; MCG_ENOMEM; MCG_ENUMERIC as mcg_svd,
+ * or 1/s overflowing for a tiny rcond. */
 size_t mcg_pinv_work_size(int m, int n);
 int mcg_pinv(int m, int n, const double *a, double rcond, double *ainv,
              int *rank, double *work, size_t lwork);
@@ -110,7 +160,9 @@ int mcg_pinv(int m, int n, const double *a, double rcond, double *ainv,
 /* Eigen-decomposition of a symmetric n x n matrix by cyclic Jacobi rotations.
  * a is overwritten (only its symmetric part is used); w receives the n
  * eigenvalues in ASCENDING order and v (n x n) the eigenvectors as columns
- * (v[i * n + k] is component i of eigenvector k). No workspace needed. */
+ * (v[i * n + k] is component i of eigenvector k). No workspace needed.
+ * n in [1, 4096]. MCG_EINVAL: n, NULL, v aliasing a, NaN/inf in a;
+ * MCG_ENUMERIC: no convergence within the sweep cap. */
 int mcg_sym_eig(int n, double *a, double *w, double *v);
 
 /* The same decomposition (same argument conventions) by Householder
@@ -118,17 +170,22 @@ int mcg_sym_eig(int n, double *a, double *w, double *v);
  * Several times faster than mcg_sym_eig for n >= 6, but eigenvalues are
  * accurate only to ~eps * max|lambda| (absolute), not relatively: use
  * mcg_sym_eig when small eigenvalues of graded matrices matter. Returns
- * MCG_EINVAL for n outside [1, 64], NULL pointers, a == v or NaN/inf. */
+ * MCG_EINVAL for n outside [1, 64], NULL pointers, a == v or NaN/inf;
+ * MCG_ENUMERIC if the QR iteration exceeds its budget (40 n steps). */
 int mcg_sym_eig_tridiag(int n, double *a, double *w, double *v);
 
 /* Solve the symmetric positive definite system a x = b (n x n, n <= 64)
  * by Cholesky; returns MCG_ENUMERIC if a is not numerically positive
- * definite. a and b are not modified. */
+ * definite (a pivot <= eps * max diagonal). a and b are not modified; x may
+ * alias b. MCG_EINVAL: n outside [1, 64], NULL, NaN/inf. */
 int mcg_spd_solve(int n, const double *a, const double *b, double *x);
 
 /* Rotations (3 x 3, row-major). Angle-axis w: |w| = angle in radians,
- * in [0, pi]. Quaternions q = (w, x, y, z), Hamilton convention,
- * R = rotation that maps vectors as R v (active). */
+ * in [0, pi] on output (any length on input). Quaternions q = (w, x, y, z),
+ * Hamilton convention, R = rotation that maps vectors as R v (active).
+ * All return MCG_EINVAL for NULL pointers or NaN/inf; the *_from_rot ones
+ * also when r is not a rotation (see the top of this file); rot_from_quat
+ * when q = 0. */
 int mcg_rot_from_angle_axis(const double w[3], double r[9]);
 int mcg_angle_axis_from_rot(const double r[9], double w[3]);
 int mcg_rot_from_quat(const double q[4], double r[9]); /* q normalised here */
@@ -139,14 +196,19 @@ int mcg_project_so3(const double m[9], double r[9]);
 
 /* --------------------------------------------------------------- plucker.c */
 
-/* Pluecker rays (d, m) from origins o (n x 3) and directions (n x 3, any
- * non-zero length): d = dir / |dir|, m = o x d. rays: n x 6. */
+/* Pluecker rays (d, m) from origins o (n x 3, metres) and directions
+ * (n x 3, any non-zero length), both in the same frame: d = dir / |dir|,
+ * m = o x d. rays: n x 6. n in [1, 2^20]. MCG_EINVAL: n, NULL, NaN/inf, a
+ * zero direction, or an origin so far away that m overflows. */
 int mcg_plucker_from_points(int n, const double *origins, const double *dirs,
                             double *rays);
 
 /* The n x 18 generalized epipolar rows (thesis eq. 8.16, our convention and
  * row-major vec, see the top of this file) of n ray pairs given as Pluecker
- * rays rays1[k] (time 1) and rays2[k] (time 2), each n x 6. */
+ * rays rays1[k] (time 1) and rays2[k] (time 2), each n x 6 (rig frames; d
+ * is expected to be unit, as from mcg_plucker_from_points, but not checked).
+ * rows: n x 18. n in [1, 2^20]. MCG_EINVAL: n, NULL, NaN/inf in the rays or
+ * overflowing products. */
 int mcg_gec_rows(int n, const double *rays1, const double *rays2,
                  double *rows);
 
@@ -154,7 +216,9 @@ int mcg_gec_rows(int n, const double *rays1, const double *rays2,
 
 /* min |A x| subject to |C x| = 1, A m x n, C k x n (thesis Algorithm 3,
  * Hartley & Zisserman A5.4.2). x: n values; resid (may be NULL) = |A x|.
- * MCG_EDEGENERATE if C = 0. */
+ * m, k in [1, 2^20], n in [1, 4096]; lwork >= mcg_cls_general_work_size.
+ * MCG_EINVAL: sizes, NULL a / c / x / work, NaN/inf; MCG_ENOMEM;
+ * MCG_EDEGENERATE if C = 0; MCG_ENUMERIC if an inner SVD fails. */
 size_t mcg_cls_general_work_size(int m, int n, int k);
 int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
                     double *x, double *resid, double *work, size_t lwork);
@@ -163,7 +227,10 @@ int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
  * generalized epipolar system p = 9 and x = (vec E, vec R)). The free part
  * x[p:n] is the minimum-norm minimiser -A_2^+ A_1 x[0:p] (eq. 8.36).
  * rank2 (may be NULL) receives the numerical rank of A_2 = a[:, p:n]
- * (tolerance rcond * s_max(A_2), rcond <= 0 selects 1e-10). */
+ * (tolerance rcond * s_max(A_2), rcond <= 0 selects 1e-10). m in [1, 2^20],
+ * 1 <= p <= n <= 4096; lwork >= mcg_cls_partial_work_size. MCG_EINVAL:
+ * sizes, NULL a / x / work, NaN/inf in a or rcond; MCG_ENOMEM; MCG_ENUMERIC
+ * if an inner SVD fails. */
 size_t mcg_cls_partial_work_size(int m, int n, int p);
 int mcg_cls_partial(int m, int n, int p, const double *a, double rcond,
                     double *x, double *resid, int *rank2,
@@ -171,7 +238,10 @@ int mcg_cls_partial(int m, int n, int p, const double *a, double rcond,
 
 /* min |A x| subject to |x| = 1 and x in the column space of G (n x r)
  * (thesis ch. 6.3, Hartley & Zisserman A5.5). Columns of G below
- * rcond * s_max(G) are dropped (rcond <= 0 selects 1e-12). */
+ * rcond * s_max(G) are dropped (rcond <= 0 selects 1e-12). m in [1, 2^20],
+ * n, r in [1, 4096]; lwork >= mcg_cls_range_work_size. MCG_EINVAL: sizes,
+ * NULL a / g / x / work, NaN/inf; MCG_ENOMEM; MCG_EDEGENERATE if G = 0;
+ * MCG_ENUMERIC if an inner SVD fails. */
 size_t mcg_cls_range_work_size(int m, int n, int r);
 int mcg_cls_range(int m, int n, int r, const double *a, const double *g,
                   double rcond, double *x, double *resid,
@@ -179,7 +249,11 @@ int mcg_cls_range(int m, int n, int r, const double *a, const double *g,
 
 /* ---------------------------------------------------------- linear17.c */
 
-/* Options of the linear 17-point estimator (thesis Algorithm 2). */
+/* Options of the linear 17-point estimator (thesis Algorithm 2); defaults
+ * from mcg_linear17_default_options: refine 1, max_iterations 100,
+ * tolerance 1e-10, rank_rtol 1e-10, min_scale_conditioning 1e-10,
+ * max_scale_rel_std 0.1. Valid: refine 0/1, tolerance >= 0, rank_rtol in
+ * (0, 1), min_scale_conditioning >= 0, max_scale_rel_std > 0. */
 typedef struct {
     int refine;             /* 1: alternation refinement of ch. 8.4.3 */
     int max_iterations;     /* cap on alternation iterations (0..10000) */
@@ -225,6 +299,7 @@ typedef struct {
     double norm_scale;      /*   X' = norm_scale * (X - norm_origin) */
 } mcg_linear17_result;
 
+/* Fill *opt with the defaults (no-op for NULL). */
 void mcg_linear17_default_options(mcg_linear17_options *opt);
 
 /* Linear 17-point relative motion of a generalized camera from n >= 14 ray
@@ -233,7 +308,12 @@ void mcg_linear17_default_options(mcg_linear17_options *opt);
  * points on the rig axis (camera centres), not arbitrary points on the rays.
  * opt may be NULL (defaults). Returns MCG_EDEGENERATE when the data do not
  * determine E (e.g. no translation, or too few independent rays for the
- * detected case); res is then filled with the diagnostics known so far. */
+ * detected case); res is then filled with the diagnostics known so far.
+ * The result is in the caller's rig frame (R, t: rig2_from_rig1, t in the
+ * unit of the origins). n in [14, 2^26]. MCG_EINVAL: NULL, n, bad options,
+ * NaN/inf, a zero direction; MCG_ENUMERIC: an inner decomposition failed.
+ * The alternation runs at most opt->max_iterations steps, the polish at
+ * most a fixed number (res->iterations, res->polish_steps). No workspace. */
 int mcg_linear17(int n, const double *origins1, const double *dirs1,
                  const double *origins2, const double *dirs2,
                  const mcg_linear17_options *opt, mcg_linear17_result *res);
@@ -332,6 +412,7 @@ typedef struct {
                               branch (not capped, not e = D = 0) at the end */
 } mcg_refine_result;
 
+/* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_refine_default_options(mcg_refine_options *opt);
 
 /* Levenberg-Marquardt refinement of the motion rig2_from_rig1 (R, t)
@@ -416,6 +497,7 @@ typedef struct {
     int flags;          /* MCG_CONE_* bits */
 } mcg_cone_result;
 
+/* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_cone_default_options(mcg_cone_options *opt);
 
 /* L-infinity cone problem (thesis eq. 9.3): the point X minimising
@@ -493,6 +575,10 @@ typedef struct {
                     const double *b, double *x, double *work, size_t lwork);
 } mcg_lp_backend;
 
+/* Dispatch through the table: be->work_size / be->feasible (0 /
+ * MCG_EINVAL for a NULL table or NULL function pointers). The table and its
+ * ctx are only read: one table may serve several threads (see the top of
+ * this file for GLPK). */
 size_t mcg_lp_work_size(const mcg_lp_backend *be, int dim, int m);
 int mcg_lp_feasible(const mcg_lp_backend *be, int dim, int m, const double *A,
                     const double *b, double *x, double *work, size_t lwork);
@@ -508,7 +594,7 @@ int mcg_lp_feasible(const mcg_lp_backend *be, int dim, int m, const double *A,
 size_t mcg_lp_native_work_size(int dim, int m);
 int mcg_lp_native_feasible(int dim, int m, const double *A, const double *b,
                            double *x, double *work, size_t lwork);
-/* Fill *be with the native backend (ctx = NULL). */
+/* Fill *be with the native backend (ctx = NULL). MCG_EINVAL for NULL. */
 int mcg_lp_native_backend(mcg_lp_backend *be);
 
 /* The GLPK backend (lp_glpk.c, GPL-3.0-or-later), compiled when glpk.h is
@@ -523,7 +609,11 @@ int mcg_lp_native_backend(mcg_lp_backend *be);
  * d >= -1e-8 S (then A_k . x >= b_k - 2e-8 S |A_k|); GLPK allocates
  * internally. mcg_lp_glpk_available() is 1 once loaded; before that the
  * work size is 0 and the others return MCG_EUNAVAILABLE. Work size:
- * 3 (1 + m (dim + 1)) doubles. */
+ * 3 (1 + m (dim + 1)) doubles. mcg_lp_glpk_backend fills *be (MCG_EINVAL
+ * for NULL, MCG_EUNAVAILABLE before a successful load). mcg_lp_glpk_load
+ * writes the library's only global state: call it before starting threads
+ * (see the top of this file); once loaded, further calls return MCG_OK and
+ * change nothing. */
 int mcg_lp_glpk_load(const char *path);
 int mcg_lp_glpk_available(void);
 size_t mcg_lp_glpk_work_size(int dim, int m);
@@ -569,14 +659,23 @@ typedef struct {
                           pass around an earlier optimum; lower_bound then
                           holds over that cube only); 0: all rotations */
     const mcg_lp_backend *lp; /* NULL: the native backend */
+    double max_seconds; /* wall-time budget of the call (s, CLOCK_MONOTONIC):
+                           the search stops at the first block after it
+                           (checked every 16 blocks) and the polish starts
+                           no new local minimisation; 0: no limit
+                           (default); [0, 1e9]. With max_blocks the two
+                           budgets of the search; res->stop says which one
+                           ended it */
 } mcg_bnb_options;
 
 /* mcg_bnb_result.stop */
 enum {
     MCG_BNB_CONVERGED = 0,  /* every block discarded or at the resolution */
     MCG_BNB_MAX_BLOCKS = 1, /* max_blocks reached (bound still certified) */
-    MCG_BNB_QUEUE_FULL = 2  /* some blocks closed early for lack of queue
+    MCG_BNB_QUEUE_FULL = 2, /* some blocks closed early for lack of queue
                                space (bound still certified, gap wider) */
+    MCG_BNB_TIME_LIMIT = 3  /* max_seconds reached (bound still certified
+                               over the blocks examined and queued) */
 };
 
 typedef struct {
@@ -601,9 +700,12 @@ typedef struct {
     int stop;            /* MCG_BNB_* */
 } mcg_bnb_result;
 
+/* Fill *opt with the defaults given above (no-op for NULL). */
 void mcg_bnb_default_options(mcg_bnb_options *opt);
 
-/* Doubles of workspace for mcg_bnb_linf (0 for invalid sizes/options). */
+/* Doubles of workspace for mcg_bnb_linf (0 for invalid sizes/options):
+ * about 32 n + 58 n_groups + 5 max_queue + the LP backend's work size for
+ * 2 n rows; opt NULL: the defaults (a heap of 2e5 blocks, 8 MB). */
 size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt);
 
 /* Globally optimal L-infinity rig motion (thesis ch. 10, Algorithm 7) by
@@ -619,7 +721,15 @@ size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt);
  * tolerances, 1e-9 relative). MCG_EINVAL: sizes, NULL, NaN/inf, a zero
  * bearing, a group index out of range, bad options; MCG_ENOMEM: lwork too
  * small; MCG_ENUMERIC: f(R_init) >= 1.5 rad; LP backend errors are passed
- * through. R_init (any 3x3, projected onto SO(3)) gives the first bound. */
+ * through. R_init (any 3x3, projected onto SO(3)) gives the first bound.
+ * Sizes: n in [1, 2^20], n_groups in [1, n]; bearings and origins with
+ * |value| <= 1e150. Budgets: the search stops at max_blocks or max_seconds
+ * (res->stop, res->blocks, res->seconds), bisections are capped at 200
+ * steps, the polish at 13 starts of at most 200 sequential-LP steps; the
+ * bound reported stays certified whatever stopped the search. Frames: the
+ * result is in the caller's rig frame (t in the unit of the origins); the
+ * search itself runs in a frame centred on the origins and scaled by their
+ * spread, so results do not depend on the rig frame's origin or unit. */
 int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
                  const double *a2, const int *group, int n_groups,
                  const double R_init[9], const mcg_bnb_options *opt,
@@ -686,6 +796,10 @@ int mcg_skyline_eig(int n, const int *first, const int *ptr, const double *a,
                     double *work, size_t lwork);
 
 /* MCG_CDEF_END */
+
+#if defined(__GNUC__) && __GNUC__ >= 4
+#pragma GCC visibility pop
+#endif
 
 #ifdef __cplusplus
 }

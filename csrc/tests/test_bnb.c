@@ -95,7 +95,7 @@ static void noise_free(void)
 {
     int trial, fails_r = 0, fails_t = 0, fails_f = 0;
     double worst_r = 0.0, worst_t = 0.0, worst_f = 0.0;
-    for (trial = 0; trial < 6; ++trial) {
+    for (trial = 0; trial < scaled(6); ++trial) {
         double R[9], Rs[9], R0[9], t[3], dt = 0.0;
         int m = 2 + trial % 3, n, i, st;
         mcg_bnb_options o;
@@ -137,7 +137,7 @@ static void noisy(void)
 {
     int trial, above = 0, lb_above = 0;
     double worst = -1.0;
-    for (trial = 0; trial < 8; ++trial) {
+    for (trial = 0; trial < scaled(8); ++trial) {
         double R[9], t[3], I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
         int m = 2 + trial % 3, n, st;
         mcg_bnb_options o;
@@ -211,6 +211,21 @@ static void invalid(void)
     D1[3] = D1[4] = D1[5] = 0.0;
     check_status(mcg_bnb_linf(n, D1, A1, D2, A2, G, 2, R, &o, &res, W, WORK), MCG_EINVAL,
                  "zero bearing");
+    D1[3] = 1e200; /* |d| overflows when squared */
+    check_status(mcg_bnb_linf(n, D1, A1, D2, A2, G, 2, R, &o, &res, W, WORK), MCG_EINVAL,
+                 "bearing component 1e200");
+    D1[3] = 1.0;
+    A2[7] = -1e151;
+    check_status(mcg_bnb_linf(n, D1, A1, D2, A2, G, 2, R, &o, &res, W, WORK), MCG_EINVAL,
+                 "origin component -1e151");
+    A2[7] = A1[7];
+    o.max_seconds = -1.0;
+    check_status(mcg_bnb_linf(n, D1, A1, D2, A2, G, 2, R, &o, &res, W, WORK), MCG_EINVAL,
+                 "max_seconds < 0");
+    o.max_seconds = NAN;
+    check_status(mcg_bnb_linf(n, D1, A1, D2, A2, G, 2, R, &o, &res, W, WORK), MCG_EINVAL,
+                 "max_seconds NaN");
+    o.max_seconds = 0.0;
     o.resolution = 0.0;
     check_status(mcg_bnb_linf(n, D1, A1, D2, A2, G, 2, R, &o, &res, W, WORK), MCG_EINVAL,
                  "resolution 0");
@@ -219,6 +234,41 @@ static void invalid(void)
     o.grid = 0;
     check(mcg_bnb_work_size(n, 2, &o) == 0, "work size 0 for grid 0", 0, 0);
     check(mcg_bnb_work_size(0, 1, NULL) == 0, "work size 0 for n = 0", 0, 0);
+}
+
+/* The time budget: a search that would take long (a tiny resolution) stops
+ * at max_seconds with TIME_LIMIT, a certified bound below its error, and
+ * fewer blocks than the block budget. */
+static void time_budget(void)
+{
+    double R[9], t[3] = {0.3, -0.2, 0.1};
+    mcg_bnb_options o;
+    mcg_bnb_result res;
+    int n, st;
+    small_rotation(0.2, R);
+    n = make_problem(3, 20, R, t, 2e-3);
+    options(&o);
+    o.resolution = 1e-7;
+    o.max_seconds = 0.02;
+    st = mcg_bnb_linf(n, D1, A1, D2, A2, G, 3, R, &o, &res, W, WORK);
+    check_status(st, MCG_OK, "time-limited search returns");
+    check(res.stop == MCG_BNB_TIME_LIMIT, "stop = MCG_BNB_TIME_LIMIT", (double)res.stop,
+          MCG_BNB_TIME_LIMIT);
+    check(res.lower_bound <= res.linf && res.linf <= res.initial_linf,
+          "lower bound <= linf <= initial linf at the time limit", res.linf - res.lower_bound,
+          0);
+    check(res.blocks < o.max_blocks && res.queued > 0, "stopped before the block budget",
+          (double)res.blocks, (double)o.max_blocks);
+    /* the block budget: exactly max_blocks blocks, then MAX_BLOCKS */
+    options(&o);
+    o.resolution = 1e-7;
+    o.max_blocks = 50;
+    st = mcg_bnb_linf(n, D1, A1, D2, A2, G, 3, R, &o, &res, W, WORK);
+    check_status(st, MCG_OK, "block-limited search returns");
+    check(res.stop == MCG_BNB_MAX_BLOCKS && res.blocks == 50,
+          "max_blocks = 50: 50 blocks, stop = MCG_BNB_MAX_BLOCKS", (double)res.blocks, 50);
+    check(res.lower_bound <= res.linf, "lower bound <= linf at the block limit",
+          res.linf - res.lower_bound, 0);
 }
 
 int main(void)
@@ -231,6 +281,7 @@ int main(void)
     noisy();
     determinism();
     invalid();
+    time_budget();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed != 0;
 }

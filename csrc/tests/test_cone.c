@@ -206,7 +206,7 @@ static void random_instances(void)
     double worst_bracket = 0.0, worst_perturb = 0.0, worst_eval = 0.0;
     long steps = 0, iters = 0;
     clock_t t0 = clock();
-    for (trial = 0; trial < 300; ++trial) {
+    for (trial = 0; trial < scaled(300); ++trial) {
         int n = 2 + (int)(urand() * (trial % 3 == 0 ? 150 : 10));
         double P[3], noise = (trial % 2 || n > 20) ? 0.05 : 0.5;
         randn(P, 3);
@@ -249,8 +249,8 @@ static void random_instances(void)
           worst_perturb, 1e-10);
     printf("      random: %.1f bisection steps, %.1f Newton steps per call, "
            "%.1f us per call\n",
-           iters / 300.0, steps / 300.0,
-           1e6 * (double)(clock() - t0) / CLOCKS_PER_SEC / 300.0);
+           iters / (double)scaled(300), steps / (double)scaled(300),
+           1e6 * (double)(clock() - t0) / CLOCKS_PER_SEC / (double)scaled(300));
 }
 
 static void bad_arguments(void)

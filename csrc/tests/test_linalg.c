@@ -548,7 +548,7 @@ static void test_sym_eig_with(eig_fn eig, const char *name)
     /* timing (information only): n = 9 and 18 */
     {
         double w[18];
-        int rep, reps = 20000, nn;
+        int rep, reps = scaled(20000), nn;
         for (nn = 9; nn <= 18; nn += 9) {
             clock_t c0;
             double us;

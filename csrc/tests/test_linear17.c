@@ -159,6 +159,49 @@ int main(void)
     opt.max_iterations = -1;
     make_rays(N, 4, general, 0, eye, t, o1, d1, o2, d2);
     CHECK(mcg_linear17(N, o1, d1, o2, d2, &opt, &res) == MCG_EINVAL, "bad options rejected");
+    /* every option is checked */
+    {
+        struct { const char *what; int field; double value; } bad[] = {
+            {"refine = 2", 0, 2}, {"max_iterations = 10001", 1, 10001},
+            {"tolerance NaN", 2, NAN}, {"tolerance < 0", 2, -1e-3},
+            {"rank_rtol = 0", 3, 0.0}, {"rank_rtol = 1", 3, 1.0},
+            {"min_scale_conditioning < 0", 4, -1.0}, {"max_scale_rel_std = 0", 5, 0.0},
+            {"max_scale_rel_std NaN", 5, NAN}};
+        size_t b;
+        for (b = 0; b < sizeof bad / sizeof bad[0]; b++) {
+            mcg_linear17_default_options(&opt);
+            switch (bad[b].field) {
+            case 0: opt.refine = (int)bad[b].value; break;
+            case 1: opt.max_iterations = (int)bad[b].value; break;
+            case 2: opt.tolerance = bad[b].value; break;
+            case 3: opt.rank_rtol = bad[b].value; break;
+            case 4: opt.min_scale_conditioning = bad[b].value; break;
+            default: opt.max_scale_rel_std = bad[b].value; break;
+            }
+            CHECK(mcg_linear17(N, o1, d1, o2, d2, &opt, &res) == MCG_EINVAL,
+                  "option %s rejected", bad[b].what);
+        }
+    }
+    /* the alternation budget: noisy rays, tolerance 0, at most 2 iterations */
+    {
+        double rr[9], w[3] = {0.1, -0.2, 0.05};
+        int k;
+        mcg_rot_from_angle_axis(w, rr);
+        make_rays(N, 4, general, 1, rr, t, o1, d1, o2, d2);
+        for (k = 0; k < 3 * N; k++)
+            d2[k] += 1e-3 * srand1();
+        mcg_linear17_default_options(&opt);
+        opt.tolerance = 0.0;
+        opt.max_iterations = 2;
+        st = mcg_linear17(N, o1, d1, o2, d2, &opt, &res);
+        CHECK(st == MCG_OK && res.iterations <= 2 && !res.converged,
+              "alternation budget 2: status %d, %d iterations, converged %d", st,
+              res.iterations, res.converged);
+        opt.max_iterations = 0;
+        st = mcg_linear17(N, o1, d1, o2, d2, &opt, &res);
+        CHECK(st == MCG_OK && res.iterations == 0,
+              "alternation budget 0: status %d, %d iterations", st, res.iterations);
+    }
     /* zero motion: E = 0, the linear method cannot work -> degenerate, no crash */
     {
         double zero[3] = {0.0, 0.0, 0.0};

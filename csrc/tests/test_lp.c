@@ -233,7 +233,7 @@ static void random_small(void)
     int trial, dim, agree = 0, tested = 0, n_feas = 0, bad_x = 0, sure = 0;
     int degen_fail = 0;
     double x[3];
-    for (trial = 0; trial < 6000; ++trial) {
+    for (trial = 0; trial < scaled(6000); ++trial) {
         int m, k, i, st, bf_lo, bf_hi;
         double x0[3];
         dim = 2 + trial % 2;
@@ -291,7 +291,7 @@ static void random_large(void)
     int dim, st, k, i, ok_f = 1, ok_i = 1, ok_det = 1;
     double x[3], x2[3];
     for (dim = 2; dim <= 3; ++dim) {
-        int m = MMAX;
+        int m = scaled(MMAX) < 1000 ? 1000 : scaled(MMAX);
         double x0[3];
         randn(x0, 3);
         /* feasible: tangent to a unit ball around x0 */
@@ -389,7 +389,7 @@ static void cross_glpk(void)
         return;
     }
     check_status(mcg_lp_glpk_load(NULL), MCG_OK, "glpk load is idempotent");
-    for (trial = 0; trial < 4000; ++trial) {
+    for (trial = 0; trial < scaled(4000); ++trial) {
         int m, bf_lo, bf_hi;
         dim = 2 + trial % 2;
         m = 1 + (int)(urand() * 9);
@@ -432,7 +432,7 @@ static void cross_glpk(void)
     /* large: feasible (tangent to a ball), infeasible (all around, and by
      * a margin of 1e-5) */
     for (dim = 2; dim <= 3; ++dim) {
-        int m = 5000, c;
+        int m = scaled(5000) < 100 ? 100 : scaled(5000), c;
         randn(x0, 3);
         for (c = 0; c < 3; ++c) {
             for (k = 0; k < m; ++k) {

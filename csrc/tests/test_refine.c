@@ -670,6 +670,35 @@ static void test_invalid(void)
 #undef RESET
 }
 
+/* ---- the iteration budget: with zero tolerances the refinement stops at
+ * exactly max_iterations trial steps and says so */
+
+static void test_budget(void)
+{
+    double r[9], t[3] = {0.3, -0.2, 0.25}, rs[9], ts[3], w[3] = {0.05, -0.04, 0.03};
+    double dt[3] = {0.05, 0.04, -0.03};
+    mcg_refine_options opt;
+    mcg_refine_result rr;
+    int n = 60, st;
+    random_rotation(0.3, r);
+    make_rays(n, 1, r, t, o1, d1, o2, d2);
+    perturb(r, t, w, dt, rs, ts);
+    mcg_refine_default_options(&opt);
+    opt.cost_tolerance = opt.step_tolerance = 0.0;
+    opt.max_iterations = 2;
+    st = mcg_refine_motion(n, o1, d1, o2, d2, NULL, &opt, rs, ts, &rr);
+    check_status(st, MCG_OK, "refine budget: status");
+    check(rr.iterations == 2 && rr.reason == MCG_REFINE_STOP_MAX_ITERATIONS && !rr.converged,
+          "refine budget: stops after max_iterations = 2, reason MAX_ITERATIONS",
+          (double)rr.iterations, 2.0);
+    check(rr.final_cost < rr.initial_cost, "refine budget: the 2 steps lowered the cost",
+          rr.final_cost, rr.initial_cost);
+    mcg_refine_default_options(&opt);
+    opt.max_iterations = 10001;
+    check_status(mcg_refine_motion(n, o1, d1, o2, d2, NULL, &opt, rs, ts, &rr), MCG_EINVAL,
+                 "refine: max_iterations 10001 (above the cap)");
+}
+
 /* ---- timings (printed, not asserted; best of 5 rounds of CPU time) */
 
 static void timings(void)
@@ -683,7 +712,7 @@ static void timings(void)
     make_rays(n, 1, r, t, o1, d1, o2, d2);
     for (round = 0; round < 5; round++) {
         double t0 = now();
-        reps = 1000;
+        reps = scaled(1000);
         for (k = 0; k < reps; k++) {
             mcg_gec_residuals(n, o1, d1, o2, d2, r, t, res);
             sink += res[k % n];
@@ -695,7 +724,7 @@ static void timings(void)
     mcg_refine_default_options(&opt);
     for (round = 0; round < 5; round++) {
         double t0 = now();
-        reps = 100;
+        reps = scaled(100);
         iters = 0;
         for (k = 0; k < reps; k++) {
             perturb(r, t, w, dt, rs, ts);
@@ -709,7 +738,7 @@ static void timings(void)
     opt.max_iterations = 10;
     for (round = 0; round < 5; round++) {
         double t0 = now();
-        reps = 100;
+        reps = scaled(100);
         for (k = 0; k < reps; k++) {
             perturb(r, t, w, dt, rs, ts);
             mcg_refine_motion(n, o1, d1, o2, d2, NULL, &opt, rs, ts, &rr);
@@ -733,6 +762,7 @@ int main(void)
     test_robust();
     test_fix_scale();
     test_invalid();
+    test_budget();
     timings();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed ? 1 : 0;

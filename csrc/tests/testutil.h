@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #ifndef TEST_SEED
 #define TEST_SEED 0x9e3779b97f4a7c15ULL
@@ -30,6 +31,18 @@ static inline void check_status(int got, int want, const char *what)
         ++n_failed;
     printf("%s  %-60s  status %d (want %d)\n", got == want ? "ok  " : "FAIL",
            what, got, want);
+}
+
+/* A repetition count n scaled by $MCG_TEST_SCALE, a number in (0, 1]
+ * (default 1): the valgrind run of csrc/tests/run_checks.sh uses fewer random
+ * trials and timing repetitions, with the same checks. Never below 1. */
+static inline int scaled(int n)
+{
+    const char *env = getenv("MCG_TEST_SCALE");
+    double f = env ? strtod(env, NULL) : 1.0;
+    if (!(f > 0.0 && f <= 1.0))
+        f = 1.0;
+    return n * f < 1.0 ? 1 : (int)(n * f);
 }
 
 static uint64_t rng_state = TEST_SEED;

@@ -151,6 +151,8 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
                        "sequential LP around the best rotation (True): the bottom of the "
                        "optimum's basin rather than a block centre",
              "max_blocks": "block budget of the global search (2e6)",
+             "max_seconds": "wall-time budget of the global search and polish, seconds "
+                            "(0: none); info['stop'] is 'time_limit' when it ended them",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
                                   "unobservable (0.1)"},
     objective=_objective,
@@ -158,7 +160,7 @@ def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
 def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
            resolution: float = 1e-4, gap: float = 0.0, lp_backend: Optional[str] = None,
            preemptive: bool = True, working_sets: bool = True, polish: bool = True,
-           max_blocks: int = 2_000_000,
+           max_blocks: int = 2_000_000, max_seconds: float = 0.0,
            max_scale_rel_std: float = 0.1) -> RigMotion:
     """Globally optimal L-infinity rig motion rig2_from_rig1 (thesis ch. 10).
 
@@ -192,7 +194,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
     args = (sub.dirs1, sub.origins1, sub.dirs2, sub.origins2, groups)
     res = _core.bnb_linf(*args, R0, resolution=resolution, gap=gap, preemptive=preemptive,
                          working_sets=working_sets, max_blocks=max_blocks, lp_backend=backend,
-                         polish_tol=1e-9 if polish else 0.0)
+                         polish_tol=1e-9 if polish else 0.0, max_seconds=max_seconds)
     R, t, linf = res["R"], res["t"], res["linf"]
     # the initial estimate, when it is as good within the LP's precision
     f0 = res["initial_linf"]
