@@ -226,6 +226,9 @@ static int valid_profile(int n, const int *first, const int *ptr)
     for (r = 0; r < n; ++r) {
         if (first[r] < 0 || first[r] > r)
             return 0;
+        /* ptr[r] bounded first: the sum below cannot overflow an int */
+        if (ptr[r] < 0 || (size_t)ptr[r] > MAX_SKY_ENV)
+            return 0;
         if (ptr[r + 1] != ptr[r] + (r - first[r]) + 1)
             return 0;
     }
@@ -240,19 +243,23 @@ int mcg_skyline_cholesky(int n, const int *first, const int *ptr, double *env)
     if (!all_finite(env, (size_t)ptr[n]))
         return MCG_EINVAL;
     for (r = 0; r < n; ++r) {
-        double *lr = env + ptr[r] - first[r]; /* lr[c] = L(r, c) */
-        for (c = first[r]; c <= r; ++c) {
-            const double *lc = env + ptr[c] - first[c];
-            int k0 = first[r] > first[c] ? first[r] : first[c];
-            double s = lr[c];
+        /* row pointers at the start of the stored part of the row (pointer
+         * arithmetic stays inside the array): lr[c - fr] = L(r, c) */
+        double *lr = env + ptr[r];
+        const int fr = first[r];
+        for (c = fr; c <= r; ++c) {
+            const double *lc = env + ptr[c];
+            const int fc = first[c];
+            int k0 = fr > fc ? fr : fc;
+            double s = lr[c - fr];
             for (k = k0; k < c; ++k)
-                s -= lr[k] * lc[k];
+                s -= lr[k - fr] * lc[k - fc];
             if (c < r) {
-                lr[c] = s / lc[c];
+                lr[c - fr] = s / lc[c - fc];
             } else {
                 if (!(s > 0.0) || !isfinite(s))
                     return MCG_ENUMERIC; /* not positive definite */
-                lr[r] = sqrt(s);
+                lr[r - fr] = sqrt(s);
             }
         }
     }
@@ -265,18 +272,20 @@ static void sky_solve(int n, const int *first, const int *ptr, const double *l,
 {
     int r, k;
     for (r = 0; r < n; ++r) {
-        const double *lr = l + ptr[r] - first[r];
+        const double *lr = l + ptr[r];
+        const int fr = first[r];
         double s = b[r];
-        for (k = first[r]; k < r; ++k)
-            s -= lr[k] * b[k];
-        b[r] = s / lr[r];
+        for (k = fr; k < r; ++k)
+            s -= lr[k - fr] * b[k];
+        b[r] = s / lr[r - fr];
     }
     for (r = n - 1; r >= 0; --r) {
-        const double *lr = l + ptr[r] - first[r];
-        double xr = b[r] / lr[r];
+        const double *lr = l + ptr[r];
+        const int fr = first[r];
+        double xr = b[r] / lr[r - fr];
         b[r] = xr;
-        for (k = first[r]; k < r; ++k)
-            b[k] -= lr[k] * xr;
+        for (k = fr; k < r; ++k)
+            b[k] -= lr[k - fr] * xr;
     }
 }
 
@@ -298,11 +307,12 @@ static void sky_matvec(int n, const int *first, const int *ptr, const double *a,
     int r, c;
     memset(y, 0, sizeof(double) * (size_t)n);
     for (r = 0; r < n; ++r) {
-        const double *ar = a + ptr[r] - first[r];
-        double s = ar[r] * x[r];
-        for (c = first[r]; c < r; ++c) {
-            s += ar[c] * x[c];
-            y[c] += ar[c] * x[r];
+        const double *ar = a + ptr[r];
+        const int fr = first[r];
+        double s = ar[r - fr] * x[r];
+        for (c = fr; c < r; ++c) {
+            s += ar[c - fr] * x[c];
+            y[c] += ar[c - fr] * x[r];
         }
         y[r] += s;
     }

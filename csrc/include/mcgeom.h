@@ -741,7 +741,10 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
  * x1[k] <-> x2[k] (world-aligned bearings of two views, n x 3, any length)
  * whose rays start at c_1 + w1[k] and c_2 + w2[k] (w: world-aligned offsets
  * from the view centres, n x 3; both NULL for central views = offsets 0).
- * rows: n x 7, row . (c_1, c_2, 1) = (x1 x x2) . (c_2 + w2 - c_1 - w1). */
+ * rows: n x 7, row . (c_1, c_2, 1) = (x1 x x2) . (c_2 + w2 - c_1 - w1)
+ * (units: those of the offsets and centres; bearings need not be unit).
+ * MCG_EINVAL: n outside [1, 2^20], a NULL array (w1, w2 both or
+ * neither), NaN/inf in any input, or rows that overflow. */
 int mcg_bilinear_rows(int n, const double *x1, const double *x2, const double *w1,
                       const double *w2, double *rows);
 
@@ -750,7 +753,7 @@ int mcg_bilinear_rows(int n, const double *x1, const double *x2, const double *w
  * (all three NULL or none). rows: 9n x 7, row 9 k + 3 s + t holds the
  * coefficients of (a, b) = (c_2 - c_1, c_3 - c_1) and the constant term of
  * M_st = u_s (x3 x B)_t - (x2 x A)_s v_t, u = x1 x x2, v = x1 x x3,
- * A = a + w2 - w1, B = b + w3 - w1. */
+ * A = a + w2 - w1, B = b + w3 - w1. MCG_EINVAL as for mcg_bilinear_rows. */
 int mcg_trilinear_rows(int n, const double *x1, const double *x2, const double *x3,
                        const double *w1, const double *w2, const double *w3,
                        double *rows);
@@ -762,7 +765,9 @@ int mcg_trilinear_rows(int n, const double *x1, const double *x2, const double *
  * (3q + 1) x (3q + 1), zeroed first, += r r^T for each row r = (coefficients
  * of the q centres, constant). For q = 3 the 9 rows of each of the three
  * choices of reference view are added (27 rows), so that a block does not
- * depend on the order of its views. n may be 0. */
+ * depend on the order of its views. n may be 0. MCG_EINVAL: q not 2 or 3,
+ * n < 0 or too large, n_blocks outside [1, 2e6], a NULL array (w may be
+ * NULL), NaN/inf, a block index out of range, or Grams that overflow. */
 int mcg_relation_grams(int q, int n, const double *x, const double *w,
                        const int *block, int n_blocks, double *grams);
 
@@ -770,10 +775,14 @@ int mcg_relation_grams(int q, int n, const double *x, const double *w,
  * columns first[r] .. r at env[ptr[r] .. ptr[r + 1] - 1], ptr[0] = 0,
  * ptr[r + 1] = ptr[r] + r - first[r] + 1 (ptr has n + 1 entries).
  * In-place Cholesky factor A = L L^T (L in the same storage); MCG_ENUMERIC
- * if A is not numerically positive definite. */
+ * if A is not numerically positive definite (env then holds a partial
+ * factor). MCG_EINVAL: n outside [1, 200000], a profile that breaks the
+ * rules above or stores more than 2^28 values, NULL, NaN/inf in env. */
 int mcg_skyline_cholesky(int n, const int *first, const int *ptr, double *env);
 
-/* Solve A x = b in place (b: n values) with the factor of mcg_skyline_cholesky. */
+/* Solve A x = b in place (b: n values) with the factor of mcg_skyline_cholesky.
+ * MCG_EINVAL: profile or NULL as above, NaN/inf in b; MCG_ENUMERIC: the
+ * solution overflowed. */
 int mcg_skyline_solve(int n, const int *first, const int *ptr, const double *chol,
                       double *b);
 
@@ -789,7 +798,11 @@ size_t mcg_skyline_eig_work_size(int n, int p, int env_size);
  * vecs: p x n (B-orthonormal rows), resid[j] = |A v - lambda B v| /
  * (max_r |A_rr| |v|). Stops when resid[0], resid[1] <= tol or after max_iter
  * iterations (*iters = iterations done; the caller checks resid).
- * MCG_ENUMERIC if A + shift B is not positive definite. */
+ * MCG_ENUMERIC if A + shift B is not positive definite or an iterate is
+ * not finite; MCG_EINVAL: profile or NULL as above, p outside [1, min(8, n)],
+ * max_iter outside [1, 1e6], tol <= 0, shift < 0 or not finite, NaN/inf in
+ * a or b; MCG_ENOMEM: lwork below mcg_skyline_eig_work_size. The iteration
+ * budget max_iter is the caller's; *iters reports what was used. */
 int mcg_skyline_eig(int n, const int *first, const int *ptr, const double *a,
                     const double *b, double shift, int p, int max_iter, double tol,
                     double *vals, double *vecs, double *resid, int *iters,
