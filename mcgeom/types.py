@@ -126,9 +126,11 @@ class RayPairs:
         return RayPairs(self.origins2, self.dirs2, self.origins1, self.dirs1, self.cam2, self.cam1)
 
     def in_frame(self, R: np.ndarray, t: np.ndarray) -> "RayPairs":
-        """Re-express the rays in a new rig frame ``X_new = R @ X_old + t``."""
-        R = np.asarray(R, dtype=np.float64)
-        t = np.asarray(t, dtype=np.float64)
+        """Re-express the rays in a new rig frame ``X_new = R @ X_old + t``
+        (``R`` a rotation, ``t`` in metres; ValueError otherwise)."""
+        from .rig import _check_rotation, _check_vector3  # rig builds on this module
+        R = _check_rotation("in_frame: R", R)
+        t = _check_vector3("in_frame: t", t)
         return RayPairs(
             self.origins1 @ R.T + t, self.dirs1 @ R.T,
             self.origins2 @ R.T + t, self.dirs2 @ R.T,

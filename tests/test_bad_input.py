@@ -261,7 +261,9 @@ def test_rotation_wrong():
             Camera("x", cam.K, cam.dist, "pinhole", bad, cam.t, 1024, 768)
         with raises(ValueError, f"in_frame: R {what}"):
             ring().in_frame(bad, np.zeros(3))
-        for name in ("refine",):
+        with raises(ValueError, f"in_frame: R {what}"):
+            rays().in_frame(bad, np.zeros(3))
+        for name in ("refine", "bnb_lp"):
             with raises(ValueError, "initial|R0|rotation"):
                 mcgeom.estimate(rays(), name, initial=(bad, np.ones(3)))
 

@@ -97,6 +97,12 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
         t0 = np.asarray(initial[1], dtype=np.float64)
         if R0.shape != (3, 3) or t0.shape != (3,):
             raise ValueError(f"initial: R must be 3x3 and t a 3-vector, got {R0.shape}, {t0.shape}")
+        if not (np.isfinite(R0).all() and np.isfinite(t0).all()):
+            raise ValueError("initial: R and t must be finite")
+        # the search is global, but its first bound and the kept-initial test
+        # use R0 as a rotation: a reflection or a scaled matrix is a mistake
+        if _core._not_rotation(R0):
+            raise ValueError("initial: R is not a rotation (|R R^T - I| > 1e-6 or det R <= 0)")
         return R0, t0, "given"
     names = [initial] if isinstance(initial, str) else ["refine", "five_plus_one"]
     if initial is not None and not isinstance(initial, str):
