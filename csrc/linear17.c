@@ -861,10 +861,14 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
             return MCG_ENUMERIC;
         memcpy(tbest, ts.t, sizeof tbest);
         cost = ts.cost;
-        if (ts.cond < o.min_scale_conditioning) {
-            /* critical motion (ch. 7.3.2): |t| is not determined. Choose the
-             * rotation among equally good candidates and the sign of the
-             * direction by cheirality, in the normalised frame. */
+        if (gc == MCG_GC_CENTRAL || ts.cond < o.min_scale_conditioning) {
+            /* critical motion (ch. 7.3.2) or a central camera: |t| is not
+             * determined. (A central camera has g = 0 and c0 = 0, so the
+             * free solve returns t = 0 for every candidate and cannot tell
+             * them apart; with noise its H is well conditioned, so cond
+             * alone does not flag it.) Choose the rotation among equally
+             * good candidates and the sign of the direction by cheirality,
+             * in the normalised frame. */
             int bestcnt = -1;
             unit_mode = 1;
             for (k = 0; k < ncand; k++) {
