@@ -236,6 +236,10 @@ class _Scorer:
         return f, (f / med) ** 2, self.thr / med
 
 
+#: fewest correspondences the final refinement (``refine_centred``) can fit
+_MIN_REFIT = 6
+
+
 def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
             weights: Optional[np.ndarray] = None, fix_scale: bool = False) -> dict:
     return refine_centred(rays, R, t, loss=loss, loss_scale=loss_scale, weights=weights,
@@ -436,7 +440,9 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
             R, t = out["R"], out["t"]
             r = scorer.residuals(R, t)
             sel = r < wide
-            if np.array_equal(sel, used):
+            # a set too small to refit (the refinement left the consensus,
+            # e.g. sliding along a central rig's free scale): stop here
+            if np.array_equal(sel, used) or np.count_nonzero(sel) < _MIN_REFIT:
                 break
         inl = r < options.threshold
         rel_std = float(out["scale_rel_std"])

@@ -44,7 +44,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError, NumericalError
-from ..observability import refine_centred, scale_verdict, travel_direction
+from ..observability import central_travel, refine_centred, scale_verdict, travel_direction
 from ..registry import get, register, resolve_lp_backend
 from ..types import RayPairs, RigMotion
 
@@ -216,7 +216,10 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
                             not np.linalg.norm(t) > 0)
     t_metric = np.array(t)
     if not verdict.observable:
-        t = travel_direction(sub, np.ones(len(sub), bool), R, t)
+        # central rays (one camera, coincident centres): the L-infinity t is
+        # anywhere on the line t + lam u and says nothing of u; the rays do
+        central = central_travel(sub, R)
+        t = travel_direction(sub, np.ones(len(sub), bool), R, t) if central is None else central
         if not np.linalg.norm(t) > 0:
             t = t0 / max(np.linalg.norm(t0), 1e-300)
     r = _core.gec_residuals(sub.origins1, sub.dirs1, sub.origins2, sub.dirs2, R, t_metric)

@@ -608,8 +608,15 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
                                       max_iters=300)
         except (DegenerateError, cv2.error):
             continue
-        others = np.flatnonzero(~(intra & (cam1 == a)))
-        if others.size == 0:   # one camera only: R and the direction, no scale
+        # A correspondence between cameras centred where camera a is (a central
+        # rig, coincident centres) has e(lam) = lam b (eq. 7.4 with a = 0): its
+        # only root is lam = 0, the trivial motion whose epipolar constraint
+        # vanishes for every such ray (zero residuals, a false consensus).
+        # Only cameras with another centre can fix the scale.
+        here = np.all(np.abs(centres - centres[a]) <= 1e-9 * (1.0 + np.abs(centres[a]).max()),
+                      axis=1)
+        others = np.flatnonzero(~(here[cam1] & here[cam2]))
+        if others.size == 0:   # one camera (or one centre) only: R and the direction, no scale
             for R, t0, w in cands:
                 yield R, t0 + w, stats.get("inlier_ratio", 1.0)
             continue
