@@ -283,6 +283,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         raise ValueError(f"too few correspondences: {method} needs at least "
                          f"{info_est.min_sample}, got {n}")
     rays.check_finite()
+    registry._check_distinct(rays, info_est.min_sample, method)
     f = _focal_array(focal, n)
     rng = np.random.default_rng(options.seed)
     if motion_focal is not None and f is None:

@@ -86,6 +86,21 @@ class RayPairs:
             if not np.all(np.isfinite(getattr(self, name))):
                 raise ValueError(f"rays.{name} contains NaN or inf")
 
+    def n_distinct(self, at_least: Optional[int] = None) -> int:
+        """Number of distinct correspondences (exact repeats of all six arrays'
+        rows counted once). With ``at_least``, returns as soon as the first
+        ``4 * at_least`` rows hold that many: the common case costs a sort of
+        a few rows, not of all of them."""
+        cols = [self.origins1, self.dirs1, self.origins2, self.dirs2]
+        cols += [ids[:, None].astype(np.float64) for ids in (self.cam1, self.cam2)
+                 if ids is not None]
+        rows = np.ascontiguousarray(np.concatenate(cols, axis=1))
+        if at_least is not None and len(rows) > 4 * at_least:
+            k = len(np.unique(rows[:4 * at_least], axis=0))
+            if k >= at_least:
+                return k
+        return len(np.unique(rows, axis=0)) if len(rows) else 0
+
     def canonical_order(self) -> np.ndarray:
         """A permutation that sorts the correspondences by quantities that do
         not depend on their order nor on the rig frame or unit: the camera

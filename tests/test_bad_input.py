@@ -396,6 +396,34 @@ def test_too_few():
     every_estimator(rays().take(np.arange(3)), ValueError, "too few correspondences")
 
 
+@row("duplicated", "every correspondence given twice",
+     "accepted: the motion of the correspondences given once (R right, metric `t` within 5 %, "
+     "scale observable; every estimator)")
+def test_duplicated():
+    p1, p2, c1, c2, rig = pixels()
+    R, t = MOTION
+    twice = lambda a: np.concatenate([a, a])  # noqa: E731
+    m = cv.estimate(twice(p1), twice(p2), twice(c1), twice(c2), rig)
+    r = rays().take(np.r_[np.arange(len(rays())), np.arange(len(rays()))])
+    for name, mm in [("cv", m)] + [(k, mcgeom.estimate(r, k)) for k in names()]:
+        assert rot_err(mm.R, R) < R_TOL, name
+        assert mm.scale.observable, (name, mm.scale.reason)
+        assert np.linalg.norm(mm.t - t) < 0.05 * np.linalg.norm(t), (name, mm.t)
+
+
+@row("one-correspondence-repeated", "one correspondence repeated 40 times",
+     "`DegenerateError`: <method>: only 1 distinct correspondence(s) among 40 (the others repeat "
+     "them); <method> needs at least k (every estimator, robust or not)")
+def test_one_correspondence_repeated():
+    p1, p2, c1, c2, rig = pixels()
+    k = np.zeros(40, int)
+    for m in [cv.RIG_5P1_RANSAC, cv.RIG_5P1_DIRECT, cv.RIG_LINEAR17, cv.RIG_LINEAR17_RANSAC]:
+        with raises(mcgeom.DegenerateError, "only 1 distinct correspondence"):
+            cv.estimate(p1[k], p2[k], c1[k], c2[k], rig, method=m)
+    every_estimator(rays().take(k), mcgeom.DegenerateError,
+                    r"only 1 distinct correspondence\(s\) among 40 \(the others repeat them\)")
+
+
 # ------------------------------------------------------------------ degenerate geometry
 
 def camera_travel(R: np.ndarray, t: np.ndarray, c: np.ndarray) -> np.ndarray:
