@@ -465,7 +465,12 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     # the metric estimate whatever the verdict (when the scale is unobservable
     # the refinement may have slid |t| far along its flat valley: a guess)
     info["t_metric"] = np.array(t)
-    if not verdict.observable:
+    if not info["translation_detected"]:
+        # static rig or pure rotation: the verdict says t = 0 (as the search
+        # that finds no motion at all does, _no_translation), not a unit
+        # vector whose direction the data do not determine
+        t = np.zeros(3)
+    elif not verdict.observable:
         nt = np.linalg.norm(t)
         n0 = np.linalg.norm(scorer.best[1])
         # Slid out along the flat valley (|t| grew more than 10x: the cost

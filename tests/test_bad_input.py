@@ -476,6 +476,32 @@ def test_central_rig():
         check_unobservable(mcgeom.estimate(p.rays, name), p.R, u, name)
 
 
+@row("zero-motion", "a static rig (R = I, t = 0), 0.3 px noise",
+     "pixels: \"no translation detected: a pure rotation explains the correspondences ...\", "
+     "`t = 0`, R = I; rays: R = I, scale unobservable, `t` unit with no meaning (every estimator)")
+def test_zero_motion():
+    p = problem("static")
+    m = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    assert m.scale.reason.startswith("no translation detected"), m.scale.reason
+    assert not m.scale.observable and rot_err(m.R, np.eye(3)) < R_TOL
+    np.testing.assert_array_equal(m.t, np.zeros(3))
+    retval, R, t, mask = mcgeom.estimateRigMotion(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    np.testing.assert_array_equal(t, np.zeros((3, 1)))
+    for name in names():
+        check_unobservable(mcgeom.estimate(p.rays, name), np.eye(3), None, name)
+
+
+@row("pure-translation", "R = I, t = (0.3, 0.1, 0) m, intra-camera correspondences only",
+     "scale unobservable (\"critical motion: camera displacements parallel ...\" / \"scale too "
+     "uncertain\"); R = I; `t` unit along the true direction, sign included (every estimator)")
+def test_pure_translation():
+    p = problem("translation")
+    u = p.t / np.linalg.norm(p.t)
+    check_unobservable(cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig), p.R, u, "cv")
+    for name in names():
+        check_unobservable(mcgeom.estimate(p.rays, name), p.R, u, name)
+
+
 # ------------------------------------------------------------------ the table
 
 BEGIN, END = "<!-- rows of tests/test_bad_input.py: begin -->", "<!-- rows: end -->"
