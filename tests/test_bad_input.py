@@ -502,6 +502,19 @@ def test_pure_translation():
         check_unobservable(mcgeom.estimate(p.rays, name), p.R, u, name)
 
 
+@row("rotation-near-pi", "a rotation of pi - 1e-3 rad (about a tilted vertical axis), "
+     "up-looking cameras",
+     "recovered: R right to 0.5 deg, metric `t`, scale observable (every estimator)")
+def test_rotation_near_pi():
+    p = problem("near-pi")
+    ms = [("cv", cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig))]
+    ms += [(name, mcgeom.estimate(p.rays, name)) for name in names()]
+    for name, m in ms:
+        assert rot_err(m.R, p.R) < R_TOL, (name, np.degrees(rot_err(m.R, p.R)))
+        assert m.scale.observable, (name, m.scale.reason)
+        assert np.linalg.norm(m.t - p.t) < 0.05 * np.linalg.norm(p.t), (name, m.t, p.t)
+
+
 # ------------------------------------------------------------------ the table
 
 BEGIN, END = "<!-- rows of tests/test_bad_input.py: begin -->", "<!-- rows: end -->"
