@@ -14,6 +14,10 @@ import numpy as np
 __all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "as_vectors"]
 
 
+#: largest camera id of a RayPairs (2^20 - 1, the C core's size limit)
+MAX_CAMERA_ID = 2 ** 20 - 1
+
+
 def as_vectors(name: str, a: Any, n: Optional[int] = None) -> np.ndarray:
     """Return ``a`` as a C-contiguous float64 (N, 3) array or raise ValueError.
 
@@ -43,6 +47,11 @@ def _as_ids(name: str, a: Any, n: int) -> Optional[np.ndarray]:
             raise ValueError(f"{name} must hold integer camera ids, got dtype {arr.dtype}")
     if arr.size and arr.min() < 0:
         raise ValueError(f"{name} holds a negative camera id ({int(arr.min())})")
+    # ids index per-camera tables (centres, counts) in the estimators: a huge
+    # label would allocate terabytes. The C core's size limit bounds them.
+    if arr.size and arr.max() > MAX_CAMERA_ID:
+        raise ValueError(f"{name} holds camera id {int(arr.max())}, above the largest "
+                         f"supported {MAX_CAMERA_ID} (ids are 0-based camera indices)")
     return np.ascontiguousarray(arr, dtype=np.int64)
 
 
@@ -79,12 +88,18 @@ class RayPairs:
         return self.origins1.shape[0]
 
     def check_finite(self) -> None:
-        """Raise ValueError naming the first array that holds NaN or inf (the C
-        kernels check finiteness themselves; estimators that do numpy work
-        before reaching them call this)."""
+        """Raise ValueError naming the first array that holds NaN or inf, or a
+        direction of zero length (the C kernels check both themselves;
+        estimators that do numpy work before reaching them call this: a zero
+        direction would otherwise become NaN bearings deep inside them)."""
         for name in ("origins1", "dirs1", "origins2", "dirs2"):
             if not np.all(np.isfinite(getattr(self, name))):
                 raise ValueError(f"rays.{name} contains NaN or inf")
+        for name in ("dirs1", "dirs2"):
+            d = getattr(self, name)
+            zero = np.flatnonzero(np.einsum("ij,ij->i", d, d) <= 1e-200)
+            if zero.size:
+                raise ValueError(f"rays.{name} contains a zero-length direction (row {zero[0]})")
 
     def n_distinct(self, at_least: Optional[int] = None) -> int:
         """Number of distinct correspondences (exact repeats of all six arrays'

@@ -366,6 +366,35 @@ def test_calibration_nan_inf():
         Camera("x", cam.K, cam.dist, "pinhole", cam.R, [0, np.inf, 0], 1024, 768)
 
 
+@row("zero-direction", "a ray direction of length 0",
+     "`ValueError`: ... dirs1 contains a zero-length direction / d1[k] is a zero bearing "
+     "(every estimator, robust too)")
+def test_zero_direction():
+    r = with_rays(dirs1=row_set(rays().dirs1, 2, 0.0))
+    every_estimator(r, ValueError, "zero-length direction|zero bearing")
+    with raises(ValueError, "zero-length direction|zero bearing"):
+        mcgeom.robust.ransac(r, "five_plus_one")
+
+
+@row("pixels-huge", "finite pixels of 1e300",
+     "`ValueError`: camera 'cam0': pixel (...) has no finite bearing (names camera and pixel)")
+def test_pixels_huge():
+    p1, p2, c1, c2, rig = pixels()
+    with raises(ValueError, r"camera 'cam\d': pixel .* has no finite bearing"):
+        cv.estimate(p1 * 1e300, p2, c1, c2, rig)
+    with raises(ValueError, r"camera 'cam\d': pixel .* has no finite bearing"):
+        rig.ray_pairs(p1, p2 * 1e300, c1, c2)
+
+
+@row("rays-huge-camera-id", "`RayPairs` camera ids of 10**11 (ids are labels there)",
+     "`ValueError`: cam1 holds camera id 1000000000.., above the largest supported 1048575")
+def test_rays_huge_camera_id():
+    r = rays()
+    with raises(ValueError, r"cam1 holds camera id 1000000000\d\d, above the largest supported "
+                            "1048575"):
+        RayPairs(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1 + 10 ** 11, r.cam2)
+
+
 # ------------------------------------------------------------------ too little data
 
 @row("empty", "no correspondences: (0, 2) pixels, `[]`, empty `RayPairs`",
