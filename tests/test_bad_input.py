@@ -544,6 +544,139 @@ def test_rotation_near_pi():
         assert np.linalg.norm(m.t - p.t) < 0.05 * np.linalg.norm(p.t), (name, m.t, p.t)
 
 
+# ------------------------------------------------------------------ calibration
+
+def camera_with(**changes) -> Camera:
+    cam = ring().cameras[0]
+    fields = dict(name="x", K=cam.K, dist=cam.dist, model="pinhole", R=cam.R, t=cam.t,
+                  width=1024, height=768)
+    fields.update(changes)
+    return Camera(**fields)
+
+
+def rig_file_with(tmp_path, **camera0) -> Path:
+    """tests/data/calibration/mcgeom/rig4.json with camera 0's entries replaced."""
+    import json
+    d = json.loads((CALIB / "mcgeom" / "rig4.json").read_text())
+    d["cameras"][0].update(camera0)
+    path = tmp_path / "rig.json"
+    path.write_text(json.dumps(d))
+    return path
+
+
+@row("extrinsics-not-rotation", "camera extrinsics that are a reflection (det -1), scaled "
+     "(2 R) or sheared, in a `Camera` or a rig file",
+     "`ValueError`: <file>: cameras[0]: camera '...': extrinsic R is not a rotation "
+     "(det = -1 / not orthonormal: max |R^T R - I| = ...)")
+def test_extrinsics_not_rotation(tmp_path):
+    R = ring().cameras[0].R
+    shear = R.copy()
+    shear[0, 1] += 1e-3
+    for bad, why in ((R @ np.diag([1.0, 1, -1]), r"\(det = -1"), (2 * R, r"\(not orthonormal"),
+                     (shear, r"\(not orthonormal")):
+        with raises(ValueError, f"camera 'x': extrinsic R is not a rotation {why}"):
+            camera_with(R=bad)
+        path = rig_file_with(tmp_path, R_cam_from_rig=bad.tolist())
+        with raises(ValueError, rf"rig.json: cameras\[0\]: camera '.*': extrinsic R is not a "
+                                rf"rotation {why}"):
+            mcgeom.load_rig(path)
+
+
+@row("intrinsics-degenerate", "a singular K (fx = 0), a negative focal length, K not "
+     "upper triangular or K[2, 2] != 1, in a `Camera` or a rig file",
+     "`ValueError`: camera '...': K must have positive focal lengths, got fx=0.0 ... / "
+     "must be upper triangular / K[2,2] must be 1")
+def test_intrinsics_degenerate(tmp_path):
+    K = ring().cameras[0].K
+    for change, why in (((0, 0, 0.0), "K must have positive focal lengths, got fx=0.0"),
+                        ((1, 1, -800.0), "K must have positive focal lengths, got fx=800.0, fy=-800.0"),
+                        ((1, 0, 5.0), "K must be upper triangular"),
+                        ((2, 2, 0.0), r"K\[2,2\] must be 1, got 0.0")):
+        bad = K.copy()
+        bad[change[:2]] = change[2]
+        with raises(ValueError, f"camera 'x': {why}"):
+            camera_with(K=bad)
+        with raises(ValueError, rf"rig.json: cameras\[0\]: camera '.*': {why}"):
+            mcgeom.load_rig(rig_file_with(tmp_path, K=bad.tolist()))
+
+
+#: one calibration file of each format (COLMAP's needs cameras.txt and images.txt beside it)
+FILES = {"mcgeom-json": CALIB / "mcgeom" / "rig4.json",
+         "opencv-yaml": CALIB / "opencv" / "rig4.yml",
+         "kalibr": CALIB / "kalibr" / "camchain-imucam-radtan.yaml",
+         "colmap": CALIB / "colmap" / "rig_config.json"}
+
+
+def damaged_copy(tmp_path, fmt: str, text: str) -> Path:
+    import shutil
+    src = FILES[fmt]
+    for extra in ("cameras.txt", "images.txt"):
+        if (src.parent / extra).exists():
+            shutil.copy(src.parent / extra, tmp_path / extra)
+    path = tmp_path / src.name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def file_rows(fmt: str) -> None:
+    """Three rows for a loader: truncated, malformed, another format's file."""
+    slug = fmt.split("-")[0]
+    text = FILES[fmt].read_text(encoding="utf-8")
+    # a syntax error: a key without its ':' (YAML), a list without a ',' (JSON)
+    malformed = (text.replace(":", " ", 3) if fmt in ("opencv-yaml", "kalibr")
+                 else text.replace(",", "", 2))
+    other = FILES["kalibr" if fmt != "kalibr" else "mcgeom-json"]
+
+    @row(f"file-truncated-{slug}", f"a {fmt} calibration file cut in half",
+         "`ValueError`: <file>: not valid JSON (... truncated?) / malformed or truncated "
+         "OpenCV FileStorage file / line n: unterminated flow sequence (truncated file?)")
+    def truncated(tmp_path):
+        path = damaged_copy(tmp_path, fmt, text[: len(text) // 2])
+        for forced in (None, fmt):
+            with raises(ValueError, f"{re.escape(str(path))}: .*(truncated|not valid JSON)"):
+                mcgeom.load_rig(path, format=forced)
+
+    @row(f"file-malformed-{slug}", f"a {fmt} calibration file with a syntax error",
+         "`ValueError`: <file>: not valid JSON (Expecting ',' delimiter at line 3 ...) / "
+         "malformed ... FileStorage / line 2: content that does not fit ... (or, detecting the "
+         "format: cannot tell the calibration format, each format tried and why)")
+    def malformed_(tmp_path):
+        path = damaged_copy(tmp_path, fmt, malformed)
+        for forced in (None, fmt):
+            with raises(ValueError, f"{re.escape(str(path))}: "):
+                mcgeom.load_rig(path, format=forced)
+
+    @row(f"file-wrong-format-{slug}", f"another format's file loaded with format='{fmt}'",
+         "`ValueError`: <file>: not valid JSON / not an OpenCV FileStorage file (it must start "
+         "with '%YAML:1.0' ...) / unsupported YAML feature (flow mappings)")
+    def wrong_format():
+        with raises(ValueError, f"{re.escape(str(other))}: "):
+            mcgeom.load_rig(other, format=fmt)
+
+    for fn, kind in ((truncated, "truncated"), (malformed_, "malformed"),
+                     (wrong_format, "wrong_format")):
+        fn.__name__ = f"test_file_{kind}_{slug}"
+        globals()[fn.__name__] = fn
+
+
+for _fmt in FILES:
+    file_rows(_fmt)
+
+
+@row("file-unknown-format", "a file that is no calibration format (empty, binary, plain text)",
+     "`ValueError`: <file>: cannot tell the calibration format. Tried mcgeom-json: ...; "
+     "opencv-yaml: ...; kalibr: ...; colmap: .... Pass format= one of ...")
+def test_file_unknown_format(tmp_path):
+    for i, text in enumerate(("", "\x00\xff garbage", "focal length 800\n")):
+        path = tmp_path / f"f{i}.txt"
+        path.write_text(text, encoding="utf-8", errors="surrogateescape")
+        with raises(ValueError, "cannot tell the calibration format. Tried mcgeom-json: .*; "
+                                "opencv-yaml: .*; kalibr: .*; colmap: .*Pass format="):
+            mcgeom.load_rig(path)
+    with raises(OSError, ""):
+        mcgeom.load_rig(tmp_path / "missing.json")
+
+
 # ------------------------------------------------------------------ the table
 
 BEGIN, END = "<!-- rows of tests/test_bad_input.py: begin -->", "<!-- rows: end -->"
