@@ -58,10 +58,18 @@ class RansacOptions:
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
 
     def __post_init__(self) -> None:
+        # numbers only: a string or None would otherwise fail inside numpy
+        # with a TypeError that names nothing
+        for name, v in (("threshold", self.threshold), ("prob", self.prob),
+                        ("maxIters", self.max_iters)):
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
+                raise ValueError(f"{name} must be a number, got {v!r}")
         if not (np.isfinite(self.threshold) and self.threshold > 0):
             raise ValueError(f"threshold must be a positive number, got {self.threshold}")
         if not (0.0 < self.prob < 1.0):
             raise ValueError(f"prob must be in (0, 1), got {self.prob}")
+        if not (np.isfinite(self.max_iters) and self.max_iters == int(self.max_iters)):
+            raise ValueError(f"maxIters must be an integer, got {self.max_iters}")
         if int(self.max_iters) < 1:
             raise ValueError(f"maxIters must be >= 1, got {self.max_iters}")
         if self.strategy not in ("auto", "proposer", "minimal"):

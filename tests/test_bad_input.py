@@ -161,6 +161,14 @@ def test_pixels_wrong_dtype():
             cv.estimate(bad, p2, c1, c2, rig)
 
 
+@row("pixels-ragged", "pixels as a ragged nested list",
+     "`ValueError`: points1 must be an (N, 2) array of pixels (...inhomogeneous shape...)")
+def test_pixels_ragged():
+    p1, p2, c1, c2, rig = pixels()
+    with raises(ValueError, r"points1 must be an \(N, 2\) array of pixels \(.*inhomogeneous"):
+        cv.estimate([[1.0, 2.0], [3.0]], p2, c1, c2, rig)
+
+
 @row("pixels-length-mismatch", "`points2` with fewer rows than `points1`",
      "`ValueError`: points2 has N-1 points but points1 has N")
 def test_pixels_length_mismatch():
@@ -291,8 +299,8 @@ def test_rig_not_rig():
         mcgeom.estimateRigMotion(p1, p2, c1, c2, None)
 
 
-@row("ransac-options", "`prob` 2 or NaN, `threshold` 0, -1 or NaN, `maxIters` 0, a mask of "
-     "the wrong length",
+@row("ransac-options", "`prob` 2, NaN or `None`, `threshold` 0, -1, NaN or a string, "
+     "`maxIters` 0 or 1.5, a mask of the wrong length, with NaN or of strings",
      "`ValueError` naming the option and its valid range")
 def test_ransac_options():
     p1, p2, c1, c2, rig = pixels()
@@ -300,7 +308,13 @@ def test_ransac_options():
                     ({"threshold": 0}, "threshold must be a positive number"),
                     ({"threshold": -1}, "threshold must be"), ({"threshold": np.nan}, "threshold"),
                     ({"maxIters": 0}, "maxIters must be >= 1"),
-                    ({"mask": np.ones(5)}, f"mask has 5 entries, expected {len(p1)}")):
+                    ({"maxIters": 1.5}, "maxIters must be an integer, got 1.5"),
+                    ({"threshold": "1"}, "threshold must be a number, got '1'"),
+                    ({"prob": None}, "prob must be a number, got None"),
+                    ({"mask": np.ones(5)}, f"mask has 5 entries, expected {len(p1)}"),
+                    ({"mask": np.full(len(p1), np.nan)}, "mask must hold finite numbers or "
+                                                         "booleans .* with NaN or inf"),
+                    ({"mask": np.array(["1"] * len(p1))}, "mask must hold finite numbers")):
         with raises(ValueError, msg):
             cv.estimate(p1, p2, c1, c2, rig, **kw)
 
@@ -397,7 +411,8 @@ def test_rays_huge_camera_id():
 
 # ------------------------------------------------------------------ too little data
 
-@row("empty", "no correspondences: (0, 2) pixels, `[]`, empty `RayPairs`",
+@row("empty", "no correspondences: (0, 2) pixels, `[]` (what a matcher returns), "
+     "empty `RayPairs`",
      "`ValueError`: too few correspondences: <method> needs at least k, got 0 (every method flag "
      "and estimator)")
 def test_empty():
@@ -409,6 +424,10 @@ def test_empty():
             cv.estimate(z2, z2, zi, zi, rig, method=m)
     with raises(ValueError, "too few correspondences: five_plus_one needs at least 6, got 0"):
         mcgeom.estimateRigMotion(z2, z2, zi, zi, rig)
+    with raises(ValueError, "too few correspondences: five_plus_one needs at least 6, got 0"):
+        cv.estimate([], [], [], [], rig)
+    with raises(ValueError, "too few correspondences: five_plus_one needs at least 6, got 0"):
+        cv.estimate(np.float32([]), np.float32([]), np.int32([]), None, rig)
     z3 = np.zeros((0, 3))
     every_estimator(RayPairs(z3, z3, z3, z3, zi, zi), ValueError, "too few correspondences")
 
@@ -451,6 +470,52 @@ def test_one_correspondence_repeated():
             cv.estimate(p1[k], p2[k], c1[k], c2[k], rig, method=m)
     every_estimator(rays().take(k), mcgeom.DegenerateError,
                     r"only 1 distinct correspondence\(s\) among 40 \(the others repeat them\)")
+
+
+@row("too-few-per-camera", "4 correspondences in each of the 4 cameras, none across cameras",
+     "`ValueError`: too few correspondences: five_plus_one needs 5 intra-camera correspondences "
+     "in one camera, most found: 4 (robust: 'no camera has 5 intra-camera correspondences'); "
+     "`linear17`, `refine`, `bnb_lp`, `e_socp`: a motion, or `DegenerateError` when 16 rays do "
+     "not determine it")
+def test_too_few_per_camera():
+    p1, p2, c1, c2, rig = pixels()
+    sel = np.concatenate([np.flatnonzero((c1 == k) & (c2 == k))[:4] for k in range(4)])
+    for m in (cv.RIG_5P1_RANSAC, cv.RIG_5P1_DIRECT):
+        with raises(ValueError, "5 intra-camera correspondences"):
+            cv.estimate(p1[sel], p2[sel], c1[sel], c2[sel], rig, method=m)
+    with raises(ValueError, "five_plus_one needs 5 intra-camera correspondences in one camera, "
+                            "most found: 4"):
+        mcgeom.estimate(rays().take(sel), "five_plus_one")
+    R, _ = MOTION
+    for name in names():
+        if name == "five_plus_one":
+            continue
+        try:
+            m = mcgeom.estimate(rays().take(sel), name)
+        except ValueError as e:      # DegenerateError included
+            assert "correspondences" in str(e) or "degenerate" in str(e), (name, e)
+        else:                        # noise-free enough to be right, or says it is unsure
+            assert rot_err(m.R, R) < R_TOL or not m.scale.observable, name
+
+
+@row("collinear-points", "every scene point on one 3-D line, seen by one camera",
+     "`DegenerateError`: five_plus_one: the 40 bearings of the 5-point camera at time 1 lie in "
+     "one plane through its centre ... / linear17: E is not determined by the data (central "
+     "camera) ... / bnb_lp: the data do not determine the motion (every estimator)")
+def test_collinear_points():
+    R, t = MOTION
+    rig = ring()
+    s = np.linspace(-1.0, 1.0, 40)
+    pts = np.array([3.0, 0.5, 0.2]) + s[:, None] * np.array([0.2, 1.0, 0.1])
+    o, d1, o2, d2 = [], [], [], []
+    c = rig.centres[0]
+    for X in pts:    # all seen by camera 0 at both times (rig frame)
+        o.append(c); d1.append(X - c)
+        X2 = R @ X + t
+        o2.append(c); d2.append(X2 - c)
+    rp = RayPairs(np.array(o), np.array(d1), np.array(o2), np.array(d2),
+                  np.zeros(40, int), np.zeros(40, int))
+    every_estimator(rp, mcgeom.DegenerateError, "not determined|do not determine")
 
 
 # ------------------------------------------------------------------ degenerate geometry

@@ -108,7 +108,7 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
     if initial is not None and not isinstance(initial, str):
         raise ValueError("initial must be None, an estimator name, a RigMotion or an (R, t) "
                          f"pair, got {type(initial).__name__}")
-    errors = []
+    errors, degenerate = [], []
     for name in names:
         info = get(name)
         if info.name == "bnb_lp":
@@ -118,8 +118,15 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
             return m.R, m.t, name
         except (ValueError, DegenerateError, NumericalError) as e:
             errors.append(f"{name}: {e}")
+            degenerate.append(isinstance(e, DegenerateError))
     if isinstance(initial, str):
         raise DegenerateError(f"no initial estimate for bnb_lp: {errors[0]}")
+    if all(degenerate):
+        # every method that could start found the data degenerate: the
+        # L-infinity optimum is then a set of rotations, and a search from
+        # the identity returns one of them as if it were the motion
+        raise DegenerateError("bnb_lp: the data do not determine the motion (" +
+                              "; ".join(errors) + ")")
     # the search is global: any start will do, a poor one only costs time
     # (Algorithm 7, step 1: "a random guess if necessary")
     return np.eye(3), np.zeros(3), "identity"
