@@ -400,12 +400,13 @@ def test_pixels_huge():
         rig.ray_pairs(p1, p2 * 1e300, c1, c2)
 
 
-@row("rays-huge-camera-id", "`RayPairs` camera ids of 10**11 (ids are labels there)",
-     "`ValueError`: cam1 holds camera id 1000000000.., above the largest supported 1048575")
+@row("rays-huge-camera-id", "`RayPairs` camera ids 10**11 + (0..3)",
+     "`ValueError`: cam1 holds camera id 100000000003, above the largest supported 1048575 (ids "
+     "are 0-based camera indices)")
 def test_rays_huge_camera_id():
     r = rays()
-    with raises(ValueError, r"cam1 holds camera id 1000000000\d\d, above the largest supported "
-                            "1048575"):
+    with raises(ValueError, r"cam1 holds camera id 100000000003, above the largest supported "
+                            r"1048575 \(ids are 0-based camera indices\)"):
         RayPairs(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1 + 10 ** 11, r.cam2)
 
 
@@ -683,6 +684,36 @@ def damaged_copy(tmp_path, fmt: str, text: str) -> Path:
     return path
 
 
+#: per format: (regex, gist) of the message for a truncated file, a syntax error
+#: (format given), and another format's file loaded as this one
+FILE_MESSAGES = {
+    "mcgeom-json": ((r"not valid JSON \(.* at line \d+ column \d+\)",
+                     "not valid JSON (Expecting ... at line n column m)"),
+                    (r"not valid JSON \(Expecting ',' delimiter", "not valid JSON (Expecting ',' "
+                                                                    "delimiter at line 3 ...)"),
+                    (r"not valid JSON \(Expecting value at line 1", "not valid JSON (Expecting "
+                                                                     "value at line 1 column 1)")),
+    "opencv-yaml": ((r"malformed or truncated OpenCV FileStorage file \(Parsing error",
+                     "malformed or truncated OpenCV FileStorage file (Parsing error: ...)"),
+                    (r"malformed or truncated OpenCV FileStorage file \(Parsing error",
+                     "malformed or truncated OpenCV FileStorage file (Parsing error: ...)"),
+                    (r"not an OpenCV FileStorage file \(it must start with a '%YAML:1.0'",
+                     "not an OpenCV FileStorage file (it must start with a '%YAML:1.0' or "
+                     "'%YAML 1.2' header, or '<?xml'; got ...)")),
+    "kalibr": ((r"line \d+: unterminated flow sequence '\[' \(truncated file\?\)",
+                "line n: unterminated flow sequence '[' (truncated file?)"),
+               (r"line 2: content that does not fit the document's top-level structure",
+                "line 2: content that does not fit the document's top-level structure"),
+               (r"line 1: unsupported YAML feature \(flow mappings\)",
+                "line 1: unsupported YAML feature (flow mappings)")),
+    "colmap": ((r"not valid JSON \(.*; truncated\?\)", "not valid JSON (... ; truncated?)"),
+               (r"not valid JSON \(Expecting ',' delimiter", "not valid JSON (Expecting ',' "
+                                                               "delimiter at line n ...)"),
+               (r"not valid JSON \(Expecting value at line 1 column 1",
+                "not valid JSON (Expecting value at line 1 column 1; truncated?)")),
+}
+
+
 def file_rows(fmt: str) -> None:
     """Three rows for a loader: truncated, malformed, another format's file."""
     slug = fmt.split("-")[0]
@@ -691,31 +722,32 @@ def file_rows(fmt: str) -> None:
     malformed = (text.replace(":", " ", 3) if fmt in ("opencv-yaml", "kalibr")
                  else text.replace(",", "", 2))
     other = FILES["kalibr" if fmt != "kalibr" else "mcgeom-json"]
+    (m_trunc, g_trunc), (m_bad, g_bad), (m_other, g_other) = FILE_MESSAGES[fmt]
+    detected = (" (detected from the content: the same, plus which signature chose the format)")
 
-    @row(f"file-truncated-{slug}", f"a {fmt} calibration file cut in half",
-         "`ValueError`: <file>: not valid JSON (... truncated?) / malformed or truncated "
-         "OpenCV FileStorage file / line n: unterminated flow sequence (truncated file?)")
+    @row(f"file-truncated-{slug}", f"a `{fmt}` calibration file cut in half",
+         f"`ValueError`: <file>: {g_trunc}" + detected)
     def truncated(tmp_path):
         path = damaged_copy(tmp_path, fmt, text[: len(text) // 2])
-        for forced in (None, fmt):
-            with raises(ValueError, f"{re.escape(str(path))}: .*(truncated|not valid JSON)"):
-                mcgeom.load_rig(path, format=forced)
+        with raises(ValueError, f"{re.escape(str(path))}: {m_trunc}"):
+            mcgeom.load_rig(path, format=fmt)
+        with raises(ValueError, f"{re.escape(str(path))}: {m_trunc}.*detected from the content"):
+            mcgeom.load_rig(path)
 
-    @row(f"file-malformed-{slug}", f"a {fmt} calibration file with a syntax error",
-         "`ValueError`: <file>: not valid JSON (Expecting ',' delimiter at line 3 ...) / "
-         "malformed ... FileStorage / line 2: content that does not fit ... (or, detecting the "
-         "format: cannot tell the calibration format, each format tried and why)")
+    @row(f"file-malformed-{slug}", f"a `{fmt}` calibration file with a syntax error",
+         f"`ValueError`: <file>: {g_bad} (format= given; detecting the format may instead say "
+         "it cannot tell the format, listing each format tried and why)")
     def malformed_(tmp_path):
         path = damaged_copy(tmp_path, fmt, malformed)
-        for forced in (None, fmt):
-            with raises(ValueError, f"{re.escape(str(path))}: "):
-                mcgeom.load_rig(path, format=forced)
+        with raises(ValueError, f"{re.escape(str(path))}: {m_bad}"):
+            mcgeom.load_rig(path, format=fmt)
+        with raises(ValueError, f"{re.escape(str(path))}: "):
+            mcgeom.load_rig(path)
 
-    @row(f"file-wrong-format-{slug}", f"another format's file loaded with format='{fmt}'",
-         "`ValueError`: <file>: not valid JSON / not an OpenCV FileStorage file (it must start "
-         "with '%YAML:1.0' ...) / unsupported YAML feature (flow mappings)")
+    @row(f"file-wrong-format-{slug}", f"a `{'kalibr' if fmt != 'kalibr' else 'mcgeom-json'}` "
+         f"file loaded with `format='{fmt}'`", f"`ValueError`: <file>: {g_other}")
     def wrong_format():
-        with raises(ValueError, f"{re.escape(str(other))}: "):
+        with raises(ValueError, f"{re.escape(str(other))}: {m_other}"):
             mcgeom.load_rig(other, format=fmt)
 
     for fn, kind in ((truncated, "truncated"), (malformed_, "malformed"),
