@@ -610,6 +610,28 @@ def test_rotation_near_pi():
         assert np.linalg.norm(m.t - p.t) < 0.05 * np.linalg.norm(p.t), (name, m.t, p.t)
 
 
+@row("cross-camera-only-near-pi", "ring rig turned by pi - 1e-3 rad: every correspondence "
+     "between opposite cameras, none within a camera",
+     "`five_plus_one`, `e_socp`, pixels: `ValueError` (... needs 5 intra-camera correspondences "
+     "...); `linear17`, `refine`: `DegenerateError` (degenerate data ...); `bnb_lp`: R right "
+     "(its global search starts from a rotation of the cube when the identity is too far), "
+     "scale unobservable (the rotated rig nearly maps its cameras onto each other)")
+def test_cross_camera_only_near_pi():
+    R = synth.rotation_about([0, 0, 1], np.pi - 1e-3)
+    p = synth.make_problem(ring(), R, MOTION[1], 60, rng=2, depth_range=(1.0, 8.0),
+                           pixel_noise=0.3, cross_fraction=1.0)
+    with raises(ValueError, "5 intra-camera correspondences"):
+        cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    for name in ("five_plus_one", "e_socp"):
+        with raises(ValueError, "needs 5 intra-camera correspondences"):
+            mcgeom.estimate(p.rays, name)
+    for name in ("linear17", "refine"):
+        with raises(mcgeom.DegenerateError, "degenerate data"):
+            mcgeom.estimate(p.rays, name)
+    m = mcgeom.estimate(p.rays, "bnb_lp")
+    assert rot_err(m.R, R) < R_TOL and not m.scale.observable, m.scale.reason
+
+
 # ------------------------------------------------------------------ calibration
 
 def camera_with(**changes) -> Camera:

@@ -132,6 +132,30 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
     return np.eye(3), np.zeros(3), "identity"
 
 
+def _cube_rotations() -> list[np.ndarray]:
+    """The 24 rotations of the cube (signed permutation matrices, det +1)."""
+    out = []
+    for perm in ((0, 1, 2), (1, 2, 0), (2, 0, 1), (1, 0, 2), (0, 2, 1), (2, 1, 0)):
+        for signs in np.ndindex(2, 2, 2):
+            M = np.zeros((3, 3))
+            M[range(3), perm] = [1 - 2 * s for s in signs]
+            if np.linalg.det(M) > 0:
+                out.append(M)
+    return out
+
+
+def _start_from_cube(args: tuple, kw: dict) -> Optional[dict]:
+    """bnb_linf from the first rotation of the cube it can start from (None if none)."""
+    for Rs in _cube_rotations():
+        try:
+            res = _core.bnb_linf(*args, Rs, **kw)
+        except NumericalError:
+            continue
+        res["R_init"] = Rs
+        return res
+    return None
+
+
 def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
     n = len(rays)
     if mask is None:
@@ -203,13 +227,23 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
     groups = apex_groups(sub)
     R0, t0, source = _initial(sub, initial)
     args = (sub.dirs1, sub.origins1, sub.dirs2, sub.origins2, groups)
-    res = _core.bnb_linf(*args, R0, resolution=resolution, gap=gap, preemptive=preemptive,
-                         working_sets=working_sets, max_blocks=max_blocks, lp_backend=backend,
-                         polish_tol=1e-9 if polish else 0.0)
+    kw = dict(resolution=resolution, gap=gap, preemptive=preemptive, working_sets=working_sets,
+              max_blocks=max_blocks, lp_backend=backend, polish_tol=1e-9 if polish else 0.0)
+    try:
+        res = _core.bnb_linf(*args, R0, **kw)
+    except NumericalError:
+        # the kernel needs a start whose error is below ~86 deg for some t (its
+        # first bound); far from the motion (e.g. the identity fallback for a
+        # rotation near pi) there is none: start from the 24 rotations of the
+        # cube instead (every rotation lies within about 63 deg of one of them)
+        res = _start_from_cube(args, kw)
+        if res is None:
+            raise
+        R0, t0, source = res["R_init"], None, source + ", then a rotation of the cube"
     R, t, linf = res["R"], res["t"], res["linf"]
     # the initial estimate, when it is as good within the LP's precision
     f0 = res["initial_linf"]
-    if f0 <= linf + _SAME_F:
+    if t0 is not None and f0 <= linf + _SAME_F:
         R, t, linf, from_initial = np.asarray(R0, float), np.asarray(t0, float), f0, True
     else:
         from_initial = False
@@ -227,7 +261,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
         # anywhere on the line t + lam u and says nothing of u; the rays do
         central = central_travel(sub, R)
         t = travel_direction(sub, np.ones(len(sub), bool), R, t) if central is None else central
-        if not np.linalg.norm(t) > 0:
+        if not np.linalg.norm(t) > 0 and t0 is not None:
             t = t0 / max(np.linalg.norm(t0), 1e-300)
     r = _core.gec_residuals(sub.origins1, sub.dirs1, sub.origins2, sub.dirs2, R, t_metric)
     info = {
