@@ -861,10 +861,14 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
             return MCG_ENUMERIC;
         memcpy(tbest, ts.t, sizeof tbest);
         cost = ts.cost;
-        if (ts.cond < o.min_scale_conditioning) {
-            /* critical motion (ch. 7.3.2): |t| is not determined. Choose the
-             * rotation among equally good candidates and the sign of the
-             * direction by cheirality, in the normalised frame. */
+        if (gc == MCG_GC_CENTRAL || ts.cond < o.min_scale_conditioning) {
+            /* critical motion (ch. 7.3.2) or a central camera: |t| is not
+             * determined. (A central camera has g = 0 and c0 = 0, so the
+             * free solve returns t = 0 for every candidate and cannot tell
+             * them apart; with noise its H is well conditioned, so cond
+             * alone does not flag it.) Choose the rotation among equally
+             * good candidates and the sign of the direction by cheirality,
+             * in the normalised frame. */
             int bestcnt = -1;
             unit_mode = 1;
             for (k = 0; k < ncand; k++) {
@@ -995,6 +999,29 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
                             res->scale_conditioning >= o.min_scale_conditioning &&
                             res->scale_rel_std <= o.max_scale_rel_std;
     res->cost_final = sqrt(cost / n);
+
+    /* An unobservable scale from the free solve (near-critical motion, e.g. a
+     * pure translation seen by intra-camera rays: e = t . (R d1 x d2) is
+     * nearly homogeneous in t) leaves the sign of t to the noise. Only the
+     * direction is reported then: choose its sign by cheirality, as unit
+     * mode does, at a length (100 in the normalised frame, where the origins
+     * spread over ~1) that dwarfs the rotation-induced part o - R o. */
+    if (!unit_mode && !res->scale_observable) {
+        double nt = sqrt(dot3(tbest, tbest));
+        if (nt > 0.0) {
+            double ro[3], tp[3], tm[3];
+            matvec(3, rbest, res->norm_origin, ro);
+            for (i = 0; i < 3; i++) {
+                double step = 100.0 * tbest[i] / nt / res->norm_scale;
+                tp[i] = step + res->norm_origin[i] - ro[i];
+                tm[i] = -step + res->norm_origin[i] - ro[i];
+            }
+            if (count_in_front(n, origins1, dirs1, origins2, dirs2, rbest, tm) >
+                count_in_front(n, origins1, dirs1, origins2, dirs2, rbest, tp))
+                for (i = 0; i < 3; i++)
+                    tbest[i] = -tbest[i];
+        }
+    }
 
     /* back to the rig frame: t = t'/s + o - R o */
     memcpy(res->R, rbest, sizeof rbest);

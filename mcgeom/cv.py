@@ -44,11 +44,16 @@ RIG_5P1_DIRECT = "direct:five_plus_one"
 
 
 def _points(name: str, p: Any) -> np.ndarray:
-    a = np.asarray(p)
+    try:
+        a = np.asarray(p)
+    except ValueError as exc:   # ragged nested lists
+        raise ValueError(f"{name} must be an (N, 2) array of pixels ({exc})") from None
     if a.dtype.kind not in "fiu":
         raise ValueError(f"{name} must be numeric, got dtype {a.dtype}")
     if a.ndim == 3 and a.shape[1:] == (1, 2):      # OpenCV's (N, 1, 2)
         a = a.reshape(-1, 2)
+    if a.size == 0 and a.ndim <= 2:                # [] or np.float32([]): no matches
+        a = a.reshape(0, 2)
     if a.ndim != 2 or a.shape[1] != 2:
         raise ValueError(f"{name} must have shape (N, 2) or (N, 1, 2), got {a.shape}")
     a = np.ascontiguousarray(a, dtype=np.float64)
@@ -61,6 +66,8 @@ def _ids(name: str, ids: Any, n: int, rig: Rig) -> np.ndarray:
     a = np.asarray(ids).reshape(-1) if np.ndim(ids) else np.full(n, ids)
     if a.shape[0] != n:
         raise ValueError(f"{name} has {a.shape[0]} entries, expected {n} (one per point)")
+    if n == 0:                                     # [] is float64 for numpy
+        return np.zeros(0, np.int64)
     if a.dtype.kind not in "iu":
         raise ValueError(f"{name} must hold integer camera ids, got dtype {a.dtype}")
     bad = (a < 0) | (a >= len(rig.cameras))
@@ -179,6 +186,10 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         m = np.asarray(mask).reshape(-1)
         if m.shape[0] != n:
             raise ValueError(f"mask has {m.shape[0]} entries, expected {n}")
+        if m.dtype.kind not in "biuf" or (m.dtype.kind == "f" and not np.isfinite(m).all()):
+            raise ValueError(f"mask must hold finite numbers or booleans (nonzero = use), "
+                             f"got dtype {m.dtype}" + (" with NaN or inf" if m.dtype.kind == "f"
+                                                       else ""))
         use = m != 0
     name, run_robust = _resolve(method, robust)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of

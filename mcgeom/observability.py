@@ -227,6 +227,32 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     return u if plus >= minus else -u
 
 
+def central_travel(rays: RayPairs, R: np.ndarray) -> np.ndarray | None:
+    """Travel direction of the common centre of central rays, or None if not central.
+
+    When every ray starts at one centre ``c`` (one camera, or a rig whose
+    cameras share their centre) the data fix R and the direction ``u`` in
+    which ``c`` moves, ``t = lam u + c - R c``, and nothing else: each
+    correspondence then reads ``lam u . (R d1 x d2) = 0`` (the essential
+    matrix of thesis ch. 2.3 about ``c``), so ``u`` is the least-squares null
+    vector of the rows ``R d1 x d2``; its sign is chosen by cheirality (as in
+    :func:`travel_direction`). Returns the unit ``u``.
+    """
+    o = np.concatenate([rays.origins1, rays.origins2])
+    if len(o) == 0:
+        return None
+    c = o.mean(axis=0)
+    if np.abs(o - c).max() > 1e-9 * (1.0 + np.abs(c).max()):
+        return None
+    a = rcross(_unit_rows(rays.dirs1) @ R.T, _unit_rows(rays.dirs2))
+    u = np.linalg.eigh(a.T @ a)[1][:, 0]
+    shift = R @ c - c
+    L = max(1.0, 100.0 * np.linalg.norm(shift))
+    plus, minus = _counts_in_front(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R,
+                                   -shift, (L * u, -L * u))
+    return u if plus >= minus else -u
+
+
 def rotation_only_fit(rays: RayPairs, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Best pure rotation for the masked intra-camera correspondences, and their angles.
 

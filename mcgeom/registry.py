@@ -67,7 +67,23 @@ class EstimatorInfo:
     objective: Optional[Callable] = None
 
     def __call__(self, rays, **options):
+        _check_distinct(rays, self.min_sample, self.name)
         return self.func(rays, **options)
+
+
+def _check_distinct(rays, need: int, name: str) -> None:
+    """DegenerateError when repeated correspondences leave fewer distinct ones
+    than ``need`` (the minimal sample): copies of one correspondence constrain
+    no more than it does, and estimators would otherwise return a motion the
+    data do not determine (or search for one at length)."""
+    from .errors import DegenerateError
+    from .types import RayPairs
+    if not isinstance(rays, RayPairs) or len(rays) < need:
+        return  # the estimator's own checks name the problem
+    k = rays.n_distinct(at_least=need)
+    if k < need:
+        raise DegenerateError(f"{name}: only {k} distinct correspondence(s) among {len(rays)} "
+                              f"(the others repeat them); {name} needs at least {need}")
 
 
 _REGISTRY: dict[str, EstimatorInfo] = {}

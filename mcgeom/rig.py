@@ -566,11 +566,21 @@ class Rig:
         used = np.flatnonzero(np.bincount(ids, minlength=len(self.cameras)))
         origins = np.ascontiguousarray(self.centres[ids])
         if self._plain[used].all():  # type: ignore[attr-defined]
-            return origins, self._pinhole_rays(ids, px)
-        dirs = np.empty((px.shape[0], 3))
-        for i in used:  # one OpenCV call per camera
-            sel = ids == i
-            dirs[sel] = self.cameras[i].pixels_to_bearings(px[sel])
+            dirs = self._pinhole_rays(ids, px)
+        else:
+            dirs = np.empty((px.shape[0], 3))
+            for i in used:  # one OpenCV call per camera
+                sel = ids == i
+                dirs[sel] = self.cameras[i].pixels_to_bearings(px[sel])
+        # finite pixels far enough out (1e300) overflow |K^-1 [u, v, 1]| and come
+        # out as zero or NaN bearings: name them here rather than let them fail
+        # deep in an estimator (unit bearings have squared length 1)
+        bad = np.flatnonzero(~(np.einsum("ij,ij->i", dirs, dirs) > 0.5))
+        if bad.size:
+            k = int(bad[0])
+            raise ValueError(f"camera {self.cameras[ids[k]].name!r}: pixel ({px[k, 0]:.6g}, "
+                             f"{px[k, 1]:.6g}) has no finite bearing ({bad.size} such pixel(s); "
+                             f"far outside any image)")
         return origins, dirs
 
     def _pinhole_rays(self, ids: np.ndarray, px: np.ndarray) -> np.ndarray:

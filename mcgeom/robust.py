@@ -58,10 +58,18 @@ class RansacOptions:
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
 
     def __post_init__(self) -> None:
+        # numbers only: a string or None would otherwise fail inside numpy
+        # with a TypeError that names nothing
+        for name, v in (("threshold", self.threshold), ("prob", self.prob),
+                        ("maxIters", self.max_iters)):
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
+                raise ValueError(f"{name} must be a number, got {v!r}")
         if not (np.isfinite(self.threshold) and self.threshold > 0):
             raise ValueError(f"threshold must be a positive number, got {self.threshold}")
         if not (0.0 < self.prob < 1.0):
             raise ValueError(f"prob must be in (0, 1), got {self.prob}")
+        if not (np.isfinite(self.max_iters) and self.max_iters == int(self.max_iters)):
+            raise ValueError(f"maxIters must be an integer, got {self.max_iters}")
         if int(self.max_iters) < 1:
             raise ValueError(f"maxIters must be >= 1, got {self.max_iters}")
         if self.strategy not in ("auto", "proposer", "minimal"):
@@ -236,6 +244,10 @@ class _Scorer:
         return f, (f / med) ** 2, self.thr / med
 
 
+#: fewest correspondences the final refinement (``refine_centred``) can fit
+_MIN_REFIT = 6
+
+
 def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
             weights: Optional[np.ndarray] = None, fix_scale: bool = False) -> dict:
     return refine_centred(rays, R, t, loss=loss, loss_scale=loss_scale, weights=weights,
@@ -279,6 +291,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         raise ValueError(f"too few correspondences: {method} needs at least "
                          f"{info_est.min_sample}, got {n}")
     rays.check_finite()
+    registry._check_distinct(rays, info_est.min_sample, method)
     f = _focal_array(focal, n)
     rng = np.random.default_rng(options.seed)
     if motion_focal is not None and f is None:
@@ -436,7 +449,9 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
             R, t = out["R"], out["t"]
             r = scorer.residuals(R, t)
             sel = r < wide
-            if np.array_equal(sel, used):
+            # a set too small to refit (the refinement left the consensus,
+            # e.g. sliding along a central rig's free scale): stop here
+            if np.array_equal(sel, used) or np.count_nonzero(sel) < _MIN_REFIT:
                 break
         inl = r < options.threshold
         rel_std = float(out["scale_rel_std"])
@@ -458,7 +473,12 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     # the metric estimate whatever the verdict (when the scale is unobservable
     # the refinement may have slid |t| far along its flat valley: a guess)
     info["t_metric"] = np.array(t)
-    if not verdict.observable:
+    if not info["translation_detected"]:
+        # static rig or pure rotation: the verdict says t = 0 (as the search
+        # that finds no motion at all does, _no_translation), not a unit
+        # vector whose direction the data do not determine
+        t = np.zeros(3)
+    elif not verdict.observable:
         nt = np.linalg.norm(t)
         n0 = np.linalg.norm(scorer.best[1])
         # Slid out along the flat valley (|t| grew more than 10x: the cost

@@ -14,6 +14,10 @@ import numpy as np
 __all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "as_vectors"]
 
 
+#: largest camera id of a RayPairs (2^20 - 1, the C core's size limit)
+MAX_CAMERA_ID = 2 ** 20 - 1
+
+
 def as_vectors(name: str, a: Any, n: Optional[int] = None) -> np.ndarray:
     """Return ``a`` as a C-contiguous float64 (N, 3) array or raise ValueError.
 
@@ -43,6 +47,11 @@ def _as_ids(name: str, a: Any, n: int) -> Optional[np.ndarray]:
             raise ValueError(f"{name} must hold integer camera ids, got dtype {arr.dtype}")
     if arr.size and arr.min() < 0:
         raise ValueError(f"{name} holds a negative camera id ({int(arr.min())})")
+    # ids index per-camera tables (centres, counts) in the estimators: a huge
+    # label would allocate terabytes. The C core's size limit bounds them.
+    if arr.size and arr.max() > MAX_CAMERA_ID:
+        raise ValueError(f"{name} holds camera id {int(arr.max())}, above the largest "
+                         f"supported {MAX_CAMERA_ID} (ids are 0-based camera indices)")
     return np.ascontiguousarray(arr, dtype=np.int64)
 
 
@@ -79,12 +88,33 @@ class RayPairs:
         return self.origins1.shape[0]
 
     def check_finite(self) -> None:
-        """Raise ValueError naming the first array that holds NaN or inf (the C
-        kernels check finiteness themselves; estimators that do numpy work
-        before reaching them call this)."""
+        """Raise ValueError naming the first array that holds NaN or inf, or a
+        direction of zero length (the C kernels check both themselves;
+        estimators that do numpy work before reaching them call this: a zero
+        direction would otherwise become NaN bearings deep inside them)."""
         for name in ("origins1", "dirs1", "origins2", "dirs2"):
             if not np.all(np.isfinite(getattr(self, name))):
                 raise ValueError(f"rays.{name} contains NaN or inf")
+        for name in ("dirs1", "dirs2"):
+            d = getattr(self, name)
+            zero = np.flatnonzero(np.einsum("ij,ij->i", d, d) <= 1e-200)
+            if zero.size:
+                raise ValueError(f"rays.{name} contains a zero-length direction (row {zero[0]})")
+
+    def n_distinct(self, at_least: Optional[int] = None) -> int:
+        """Number of distinct correspondences (exact repeats of all six arrays'
+        rows counted once). With ``at_least``, returns as soon as the first
+        ``4 * at_least`` rows hold that many: the common case costs a sort of
+        a few rows, not of all of them."""
+        cols = [self.origins1, self.dirs1, self.origins2, self.dirs2]
+        cols += [ids[:, None].astype(np.float64) for ids in (self.cam1, self.cam2)
+                 if ids is not None]
+        rows = np.ascontiguousarray(np.concatenate(cols, axis=1))
+        if at_least is not None and len(rows) > 4 * at_least:
+            k = len(np.unique(rows[:4 * at_least], axis=0))
+            if k >= at_least:
+                return k
+        return len(np.unique(rows, axis=0)) if len(rows) else 0
 
     def canonical_order(self) -> np.ndarray:
         """A permutation that sorts the correspondences by quantities that do
@@ -126,9 +156,11 @@ class RayPairs:
         return RayPairs(self.origins2, self.dirs2, self.origins1, self.dirs1, self.cam2, self.cam1)
 
     def in_frame(self, R: np.ndarray, t: np.ndarray) -> "RayPairs":
-        """Re-express the rays in a new rig frame ``X_new = R @ X_old + t``."""
-        R = np.asarray(R, dtype=np.float64)
-        t = np.asarray(t, dtype=np.float64)
+        """Re-express the rays in a new rig frame ``X_new = R @ X_old + t``
+        (``R`` a rotation, ``t`` in metres; ValueError otherwise)."""
+        from .rig import _check_rotation, _check_vector3  # rig builds on this module
+        R = _check_rotation("in_frame: R", R)
+        t = _check_vector3("in_frame: t", t)
         return RayPairs(
             self.origins1 @ R.T + t, self.dirs1 @ R.T,
             self.origins2 @ R.T + t, self.dirs2 @ R.T,

@@ -44,7 +44,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError, NumericalError
-from ..observability import refine_centred, scale_verdict, travel_direction
+from ..observability import central_travel, refine_centred, scale_verdict, travel_direction
 from ..registry import get, register, resolve_lp_backend
 from ..types import RayPairs, RigMotion
 
@@ -97,12 +97,18 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
         t0 = np.asarray(initial[1], dtype=np.float64)
         if R0.shape != (3, 3) or t0.shape != (3,):
             raise ValueError(f"initial: R must be 3x3 and t a 3-vector, got {R0.shape}, {t0.shape}")
+        if not (np.isfinite(R0).all() and np.isfinite(t0).all()):
+            raise ValueError("initial: R and t must be finite")
+        # the search is global, but its first bound and the kept-initial test
+        # use R0 as a rotation: a reflection or a scaled matrix is a mistake
+        if _core._not_rotation(R0):
+            raise ValueError("initial: R is not a rotation (|R R^T - I| > 1e-6 or det R <= 0)")
         return R0, t0, "given"
     names = [initial] if isinstance(initial, str) else ["refine", "five_plus_one"]
     if initial is not None and not isinstance(initial, str):
         raise ValueError("initial must be None, an estimator name, a RigMotion or an (R, t) "
                          f"pair, got {type(initial).__name__}")
-    errors = []
+    errors, degenerate = [], []
     for name in names:
         info = get(name)
         if info.name == "bnb_lp":
@@ -112,11 +118,42 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
             return m.R, m.t, name
         except (ValueError, DegenerateError, NumericalError) as e:
             errors.append(f"{name}: {e}")
+            degenerate.append(isinstance(e, DegenerateError))
     if isinstance(initial, str):
         raise DegenerateError(f"no initial estimate for bnb_lp: {errors[0]}")
+    if all(degenerate):
+        # every method that could start found the data degenerate: the
+        # L-infinity optimum is then a set of rotations, and a search from
+        # the identity returns one of them as if it were the motion
+        raise DegenerateError("bnb_lp: the data do not determine the motion (" +
+                              "; ".join(errors) + ")")
     # the search is global: any start will do, a poor one only costs time
     # (Algorithm 7, step 1: "a random guess if necessary")
     return np.eye(3), np.zeros(3), "identity"
+
+
+def _cube_rotations() -> list[np.ndarray]:
+    """The 24 rotations of the cube (signed permutation matrices, det +1)."""
+    out = []
+    for perm in ((0, 1, 2), (1, 2, 0), (2, 0, 1), (1, 0, 2), (0, 2, 1), (2, 1, 0)):
+        for signs in np.ndindex(2, 2, 2):
+            M = np.zeros((3, 3))
+            M[range(3), perm] = [1 - 2 * s for s in signs]
+            if np.linalg.det(M) > 0:
+                out.append(M)
+    return out
+
+
+def _start_from_cube(args: tuple, kw: dict) -> Optional[dict]:
+    """bnb_linf from the first rotation of the cube it can start from (None if none)."""
+    for Rs in _cube_rotations():
+        try:
+            res = _core.bnb_linf(*args, Rs, **kw)
+        except NumericalError:
+            continue
+        res["R_init"] = Rs
+        return res
+    return None
 
 
 def _inliers(rays: RayPairs, mask: Any) -> np.ndarray:
@@ -192,13 +229,24 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
     groups = apex_groups(sub)
     R0, t0, source = _initial(sub, initial)
     args = (sub.dirs1, sub.origins1, sub.dirs2, sub.origins2, groups)
-    res = _core.bnb_linf(*args, R0, resolution=resolution, gap=gap, preemptive=preemptive,
-                         working_sets=working_sets, max_blocks=max_blocks, lp_backend=backend,
-                         polish_tol=1e-9 if polish else 0.0, max_seconds=max_seconds)
+    kw = dict(resolution=resolution, gap=gap, preemptive=preemptive, working_sets=working_sets,
+              max_blocks=max_blocks, lp_backend=backend, polish_tol=1e-9 if polish else 0.0,
+              max_seconds=max_seconds)
+    try:
+        res = _core.bnb_linf(*args, R0, **kw)
+    except NumericalError:
+        # the kernel needs a start whose error is below ~86 deg for some t (its
+        # first bound); far from the motion (e.g. the identity fallback for a
+        # rotation near pi) there is none: start from the 24 rotations of the
+        # cube instead (every rotation lies within about 63 deg of one of them)
+        res = _start_from_cube(args, kw)
+        if res is None:
+            raise
+        R0, t0, source = res["R_init"], None, source + ", then a rotation of the cube"
     R, t, linf = res["R"], res["t"], res["linf"]
     # the initial estimate, when it is as good within the LP's precision
     f0 = res["initial_linf"]
-    if f0 <= linf + _SAME_F:
+    if t0 is not None and f0 <= linf + _SAME_F:
         R, t, linf, from_initial = np.asarray(R0, float), np.asarray(t0, float), f0, True
     else:
         from_initial = False
@@ -212,8 +260,11 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
                             not np.linalg.norm(t) > 0)
     t_metric = np.array(t)
     if not verdict.observable:
-        t = travel_direction(sub, np.ones(len(sub), bool), R, t)
-        if not np.linalg.norm(t) > 0:
+        # central rays (one camera, coincident centres): the L-infinity t is
+        # anywhere on the line t + lam u and says nothing of u; the rays do
+        central = central_travel(sub, R)
+        t = travel_direction(sub, np.ones(len(sub), bool), R, t) if central is None else central
+        if not np.linalg.norm(t) > 0 and t0 is not None:
             t = t0 / max(np.linalg.norm(t0), 1e-300)
     r = _core.gec_residuals(sub.origins1, sub.dirs1, sub.origins2, sub.dirs2, R, t_metric)
     info = {

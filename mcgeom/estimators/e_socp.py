@@ -54,22 +54,28 @@ def _per_camera(rays: RayPairs, robust_threshold: Optional[float], prob: float):
     """(camera, R_i, t0_i, w_i, n_i) for every camera whose essential matrix was found."""
     import cv2
     cam1, cam2, centres, intra, counts = intra_counts(rays)
-    out = []
+    out, failures = [], []
     for a in np.flatnonzero(counts >= 5):
         own = np.flatnonzero(intra & (cam1 == a))
         method = LEAST_SQUARES if robust_threshold is None or len(own) < 8 else cv2.USAC_DEFAULT
         try:
             cands = essential_motions(rays, own, centres[a], method=method,
                                       threshold=robust_threshold or 1e-3, prob=prob)
-        except DegenerateError:
+        except DegenerateError as e:
+            failures.append(f"camera {a}: {e}")
             continue
         if not cands:
+            failures.append(f"camera {a}: the 5-point solver found no motion")
             continue
         R, t0, w = cands[0]
         if len(own) >= 6:
             R, w = _refine_camera(rays.take(own), centres[a], R, w, robust_threshold)
             t0 = centres[a] - R @ centres[a]
         out.append((int(a), R, t0, w, len(own)))
+    if not out and failures:
+        # cameras with enough correspondences, none of them usable: say why
+        raise DegenerateError("e_socp: no camera's essential matrix is determined (" +
+                              "; ".join(failures) + ")")
     return out, centres
 
 

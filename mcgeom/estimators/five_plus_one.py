@@ -235,10 +235,34 @@ def _least_squares_essential(x1: np.ndarray, x2: np.ndarray,
                 best, best_cost = Ek, cost
     return [] if best is None else [best]
 
+#: RMS distance (radians) of a camera's bearings from their best-fitting plane
+#: through its centre below which its essential matrix is not determined
+_PLANAR_BEARINGS = 1e-3
+
+
+def _check_not_planar(d1: np.ndarray, d2: np.ndarray) -> None:
+    """DegenerateError if a camera's bearings at either time lie in one plane
+    through its centre (scene points on a line, or on a plane through the
+    centre): every rotation about that plane's normal then fits as well, and
+    the 5-point solver returns one of them (thesis ch. 2.3, critical surfaces).
+    Only for more than 5 outlier-free rays: a minimal sample, and data with
+    outliers, are the robust layer's to judge."""
+    for when, d in (("time 1", d1), ("time 2", d2)):
+        u = d / np.linalg.norm(d, axis=1, keepdims=True)
+        s_min = np.linalg.svd(u, compute_uv=False)[-1]
+        if s_min < _PLANAR_BEARINGS * np.sqrt(len(u)):
+            raise DegenerateError(
+                f"five_plus_one: the {len(u)} bearings of the 5-point camera at {when} lie in "
+                f"one plane through its centre (RMS {s_min / np.sqrt(len(u)):.2g} rad off it: "
+                "points on a line or a plane through the camera): its essential matrix is "
+                "not determined")
+
+
 def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
                       method: int = LEAST_SQUARES, threshold: float = 1e-3,
                       prob: float = 0.999, stats: Optional[dict] = None,
-                      max_iters: int = 1000) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+                      max_iters: int = 1000,
+                      planar_check: bool = True) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Rig rotations and scale lines from the 5-point solver on one camera's rays.
 
     ``index`` selects intra-camera correspondences of one camera whose centre
@@ -249,8 +273,14 @@ def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
     Returns a list of ``(R, t0, w)``: rig rotation and the line ``t(lam) = t0 +
     lam w`` of rig translations (metres per unit ``lam``, ``|w| = 1``).
     ``stats`` (a dict) receives the robust search's ``inlier_ratio``.
+    ``planar_check``: raise DegenerateError when more than 5 rays (the robust
+    search's inliers) lie in one plane through the centre (see
+    :func:`_check_not_planar`); the 5+1 proposer leaves this to the robust
+    layer, which scores its hypotheses on every camera.
     """
     d1, d2 = rays.dirs1[index], rays.dirs2[index]
+    if planar_check and method == LEAST_SQUARES and len(d1) > 5:  # outlier-free: all count
+        _check_not_planar(d1, d2)
     Q = _local_frame(np.concatenate([d1, d2]))
     x1, ok1 = _project(Q, d1)
     x2, ok2 = _project(Q, d2)
@@ -270,6 +300,9 @@ def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
         if E is None or E.shape[0] % 3 or not np.all(np.isfinite(E)):
             return []
         Es = list(E.reshape(-1, 3, 3))
+        if planar_check and mask is not None and np.count_nonzero(mask) > 5:
+            inl = np.flatnonzero(ok)[np.asarray(mask).ravel() != 0]
+            _check_not_planar(d1[inl], d2[inl])
         if stats is not None and mask is not None:
             stats["inlier_ratio"] = float(np.count_nonzero(mask)) / len(x1)
     out = []
@@ -605,11 +638,18 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
             # camera; beyond, the next camera is tried rather than waiting)
             cands = essential_motions(rays, own, centres[a], method=USAC_EXPLICIT,
                                       threshold=threshold, prob=min(prob, 0.99), stats=stats,
-                                      max_iters=300)
+                                      max_iters=300, planar_check=False)
         except (DegenerateError, cv2.error):
             continue
-        others = np.flatnonzero(~(intra & (cam1 == a)))
-        if others.size == 0:   # one camera only: R and the direction, no scale
+        # A correspondence between cameras centred where camera a is (a central
+        # rig, coincident centres) has e(lam) = lam b (eq. 7.4 with a = 0): its
+        # only root is lam = 0, the trivial motion whose epipolar constraint
+        # vanishes for every such ray (zero residuals, a false consensus).
+        # Only cameras with another centre can fix the scale.
+        here = np.all(np.abs(centres - centres[a]) <= 1e-9 * (1.0 + np.abs(centres[a]).max()),
+                      axis=1)
+        others = np.flatnonzero(~(here[cam1] & here[cam2]))
+        if others.size == 0:   # one camera (or one centre) only: R and the direction, no scale
             for R, t0, w in cands:
                 yield R, t0 + w, stats.get("inlier_ratio", 1.0)
             continue

@@ -1,0 +1,832 @@
+"""Bad input, end to end (issue 7): one test per row of the table in docs/bad_input.md.
+
+Every row runs through the public entry points: ``mcgeom.cv.estimate`` /
+``mcgeom.estimateRigMotion`` for pixels, ``mcgeom.estimate(rays, name)`` for
+EVERY registered estimator (``mcgeom.registry.names()``) where the row applies,
+``mcgeom.load_rig`` for files. The rows live here (``@row``); the table in
+docs/bad_input.md is generated from them (``python tests/test_bad_input.py --write``)
+and ``test_table_lists_exactly_the_rows`` checks that the two agree.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+import sys
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pytest
+
+import mcgeom
+from mcgeom import cv, synth
+from mcgeom.rig import Camera, Rig
+from mcgeom.types import RayPairs
+
+ROOT = Path(__file__).resolve().parent.parent
+TABLE = ROOT / "docs" / "bad_input.md"
+CALIB = Path(__file__).resolve().parent / "data" / "calibration"
+
+#: (id, input, what it gets) in table order
+ROWS: list[tuple[str, str, str]] = []
+
+
+def row(rid: str, given: str, gets: str) -> Callable:
+    """Register a table row; the decorated function is its test."""
+    assert re.fullmatch(r"[a-z0-9-]+", rid) and rid not in [r[0] for r in ROWS], rid
+    ROWS.append((rid, given, gets))
+
+    def deco(fn: Callable) -> Callable:
+        fn.row_id = rid
+        return fn
+    return deco
+
+
+# ------------------------------------------------------------------ data
+
+#: 0.3 px of noise on a 4-camera ring (f = 800 px): every estimator gets R
+#: within a few hundredths of a degree; these tolerances leave a wide margin
+R_TOL = np.radians(0.5)
+DIR_TOL = np.radians(10.0)   # 15 rays of one camera at 0.3 px: e_socp is 5 deg off
+MOTION = (synth.rotation_about([0, 0, 1], 0.2), np.array([0.3, 0.1, 0.05]))
+
+
+def names() -> list[str]:
+    return mcgeom.registry.names()
+
+
+@functools.lru_cache(maxsize=None)
+def ring() -> Rig:
+    return synth.ring_rig(4)
+
+
+@functools.lru_cache(maxsize=None)
+def problem(kind: str = "ring", n: int = 60, seed: int = 1):
+    """Seeded synthetic problems shared by the rows (built once per session)."""
+    R, t = MOTION
+    rig = ring()
+    if kind == "static":
+        R, t = np.eye(3), np.zeros(3)
+    elif kind == "translation":
+        R, t = np.eye(3), np.array([0.3, 0.1, 0.0])
+    elif kind == "central":
+        rig = central_rig()
+    elif kind == "single":
+        rig = Rig((ring().cameras[0],))
+        R = synth.rotation_about([0, 0, 1], 0.1)
+    elif kind == "near-pi":
+        rig = upward_rig()
+        R = synth.rotation_about([0.1, -0.2, 1.0], np.pi - 1e-3)
+    return synth.make_problem(rig, R, t, n, rng=seed, depth_range=(1.0, 8.0), pixel_noise=0.3)
+
+
+def central_rig() -> Rig:
+    """Four cameras with one centre, looking 90 degrees apart (a central rig)."""
+    return Rig(tuple(synth.look_at_camera(f"c{k}", (0.1, 0.2, 0.0), synth._heading(90.0 * k),
+                                          f=800, width=1024, height=768) for k in range(4)))
+
+
+def upward_rig() -> Rig:
+    """Four cameras at different heights around a ring, all looking up: a rotation
+    by nearly pi about the vertical keeps every camera's view."""
+    return Rig(tuple(synth.look_at_camera(
+        f"up{k}", (0.5 * np.cos(k * np.pi / 2), 0.5 * np.sin(k * np.pi / 2), 0.1 * k),
+        (0.2 * np.cos(k * np.pi / 2), 0.2 * np.sin(k * np.pi / 2), 1.0), up=(1, 0, 0),
+        f=400, width=1024, height=768) for k in range(4)))
+
+
+def rays() -> RayPairs:
+    return problem().rays
+
+
+def pixels(kind: str = "ring"):
+    p = problem(kind)
+    return p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig
+
+
+def with_rays(**arrays) -> RayPairs:
+    r = rays()
+    d = dict(origins1=r.origins1, dirs1=r.dirs1, origins2=r.origins2, dirs2=r.dirs2,
+             cam1=r.cam1, cam2=r.cam2)
+    d.update(arrays)
+    return RayPairs(**d)
+
+
+def row_set(a: np.ndarray, k: int, value) -> np.ndarray:
+    out = np.array(a, dtype=np.float64)
+    out[k] = value
+    return out
+
+
+def rot_err(R, R_true) -> float:
+    return synth.rotation_error(np.asarray(R), R_true)
+
+
+def dir_err(t, t_true) -> float:
+    """Angle (rad) between two translation directions."""
+    a, b = np.asarray(t, float), np.asarray(t_true, float)
+    return float(np.arccos(np.clip(a @ b / np.linalg.norm(a) / np.linalg.norm(b), -1, 1)))
+
+
+def raises(exc, match: str):
+    return pytest.raises(exc, match=match)
+
+
+def every_estimator(rp: RayPairs, exc, match: str) -> None:
+    for name in names():
+        with raises(exc, match):
+            mcgeom.estimate(rp, name)
+
+
+# ------------------------------------------------------------------ shapes and dtypes
+
+@row("pixels-wrong-shape", "`points1` of shape (N, 3), (2, N) or a scalar",
+     "`ValueError`: points1 must have shape (N, 2) or (N, 1, 2), got ...")
+def test_pixels_wrong_shape():
+    p1, p2, c1, c2, rig = pixels()
+    for bad in (np.c_[p1, p1[:, :1]], p1.T, 3.0):
+        with raises(ValueError, r"points1 must have shape \(N, 2\) or \(N, 1, 2\), got"):
+            cv.estimate(bad, p2, c1, c2, rig)
+        with raises(ValueError, "points1 must have shape"):
+            mcgeom.estimateRigMotion(bad, p2, c1, c2, rig)
+
+
+@row("pixels-wrong-dtype", "pixels as strings, objects, complex, booleans or `None`",
+     "`ValueError`: points1 must be numeric, got dtype ...")
+def test_pixels_wrong_dtype():
+    p1, p2, c1, c2, rig = pixels()
+    for bad in (p1.astype(str), p1.astype(object), p1.astype(complex), p1 > 300, None):
+        with raises(ValueError, "points1 must be numeric, got dtype"):
+            cv.estimate(bad, p2, c1, c2, rig)
+
+
+@row("pixels-ragged", "pixels as a ragged nested list",
+     "`ValueError`: points1 must be an (N, 2) array of pixels (...inhomogeneous shape...)")
+def test_pixels_ragged():
+    p1, p2, c1, c2, rig = pixels()
+    with raises(ValueError, r"points1 must be an \(N, 2\) array of pixels \(.*inhomogeneous"):
+        cv.estimate([[1.0, 2.0], [3.0]], p2, c1, c2, rig)
+
+
+@row("pixels-length-mismatch", "`points2` with fewer rows than `points1`",
+     "`ValueError`: points2 has N-1 points but points1 has N")
+def test_pixels_length_mismatch():
+    p1, p2, c1, c2, rig = pixels()
+    with raises(ValueError, f"points2 has {len(p1) - 1} points but points1 has {len(p1)}"):
+        cv.estimate(p1, p2[:-1], c1, c2, rig)
+
+
+@row("pixels-opencv-layout", "pixels as OpenCV's (N, 1, 2) float32, or nested lists",
+     "accepted: the same motion as (N, 2) float64")
+def test_pixels_opencv_layout():
+    p1, p2, c1, c2, rig = pixels()
+    ref = cv.estimate(p1, p2, c1, c2, rig)
+    m = cv.estimate(p1.reshape(-1, 1, 2), p2.tolist(), c1.tolist(), c2, rig)
+    np.testing.assert_array_equal(m.R, ref.R)
+    m32 = cv.estimate(np.float32(p1).reshape(-1, 1, 2), np.float32(p2), c1, c2, rig)
+    assert rot_err(m32.R, ref.R) < 1e-5
+
+
+@row("ids-wrong-shape", "camera ids of shape (N, 2) or (N-1,)",
+     "`ValueError`: cameraIds1 has 2N entries, expected N (one per point)")
+def test_ids_wrong_shape():
+    p1, p2, c1, c2, rig = pixels()
+    n = len(p1)
+    with raises(ValueError, rf"cameraIds1 has {2 * n} entries, expected {n} \(one per point\)"):
+        cv.estimate(p1, p2, np.c_[c1, c1], c2, rig)
+    with raises(ValueError, rf"cameraIds2 has {n - 1} entries, expected {n}"):
+        cv.estimate(p1, p2, c1, c2[:-1], rig)
+    with raises(ValueError, rf"cam1 has {n - 1} ids but there are {n} pixels"):
+        rig.ray_pairs(p1, p2, c1[:-1], c2)
+
+
+@row("ids-wrong-dtype", "camera ids as floats with a fraction, strings, booleans or `None`",
+     "`ValueError`: cameraIds1 must hold integer camera ids, got dtype ...")
+def test_ids_wrong_dtype():
+    p1, p2, c1, c2, rig = pixels()
+    for bad in (c1 + 0.5, c1.astype(str), c1 > 0, None):
+        with raises(ValueError, "cameraIds1 must hold integer camera ids"):
+            cv.estimate(p1, p2, bad, c2, rig)
+    with raises(ValueError, "cam1 must hold integer camera ids"):
+        with_rays(cam1=rays().cam1 + 0.5)
+
+
+@row("ids-out-of-range", "camera id 7, -1, 2**62 or 2**63 (uint64) on a 4-camera rig",
+     "`ValueError`: cameraIds1 holds camera id 7, but the rig has cameras 0..3")
+def test_ids_out_of_range():
+    p1, p2, c1, c2, rig = pixels()
+    for bad in (7, -1, 2 ** 62):
+        ids = np.where(c1 == 1, bad, c1)
+        with raises(ValueError, f"cameraIds1 holds camera id {bad}, but the rig has cameras 0..3"):
+            cv.estimate(p1, p2, ids, c2, rig)
+        with raises(ValueError, f"cam2: unknown camera id {bad}: rig has cameras 0..3"):
+            rig.ray_pairs(p1, p2, c1, ids)
+    ids = np.where(c1 == 1, 2 ** 63, c1).astype(np.uint64)
+    with raises(ValueError, f"cameraIds1 holds camera id {2 ** 63}"):
+        cv.estimate(p1, p2, ids, c2, rig)
+    with raises(ValueError, r"cam1 holds a negative camera id \(-1\)"):
+        with_rays(cam1=np.where(rays().cam1 == 1, -1, rays().cam1))
+
+
+@row("rays-wrong-shape", "ray arrays of shape (N, 2), or `dirs2` with N-1 rows",
+     "`ValueError`: dirs1 must have shape (N, 3), got (N, 2) / dirs2 has N-1 rows, expected N")
+def test_rays_wrong_shape():
+    r = rays()
+    with raises(ValueError, r"dirs1 must have shape \(N, 3\), got \(60, 2\)"):
+        with_rays(dirs1=r.dirs1[:, :2])
+    with raises(ValueError, "dirs2 has 59 rows, expected 60"):
+        with_rays(dirs2=r.dirs2[:-1])
+    with raises(ValueError, r"origins1 must have shape \(N, 3\)"):
+        with_rays(origins1=r.origins1.ravel())
+
+
+@row("rays-wrong-dtype", "ray arrays as objects, complex, booleans or strings",
+     "`ValueError`: dirs1 must be a numeric array, got dtype ...")
+def test_rays_wrong_dtype():
+    r = rays()
+    for bad in (r.dirs1.astype(object), r.dirs1.astype(complex), r.dirs1 > 0, r.dirs1.astype(str)):
+        with raises(ValueError, "dirs1 must be a numeric array, got dtype"):
+            with_rays(dirs1=bad)
+
+
+@row("rays-not-raypairs", "`mcgeom.estimate` given an array instead of `RayPairs`",
+     "`TypeError`: rays must be a RayPairs, got ndarray (every estimator)")
+def test_rays_not_raypairs():
+    for name in names():
+        with raises(TypeError, "rays must be a RayPairs, got ndarray"):
+            mcgeom.estimate(np.zeros((20, 3)), name)
+
+
+@row("rotation-wrong", "a rotation argument that is 2x2, a reflection or 2 I: camera "
+     "extrinsics, `initial=(R, t)` of `refine` and `bnb_lp`, `Rig.in_frame`, `RayPairs.in_frame`",
+     "`ValueError`: ... must have shape (3, 3) / is not a rotation")
+def test_rotation_wrong():
+    cam = ring().cameras[0]
+    for bad, what in ((np.eye(2), "must have shape"), (np.diag([1.0, 1, -1]), "is not a rotation"),
+                      (2 * np.eye(3), "is not a rotation")):
+        with raises(ValueError, f"camera 'x': extrinsic R {what}"):
+            Camera("x", cam.K, cam.dist, "pinhole", bad, cam.t, 1024, 768)
+        with raises(ValueError, f"in_frame: R {what}"):
+            ring().in_frame(bad, np.zeros(3))
+        with raises(ValueError, f"in_frame: R {what}"):
+            rays().in_frame(bad, np.zeros(3))
+        for name in ("refine", "bnb_lp"):
+            with raises(ValueError, "initial|R0|rotation"):
+                mcgeom.estimate(rays(), name, initial=(bad, np.ones(3)))
+
+
+@row("method-unknown", "`method=` an unknown name or not a string",
+     "`ValueError`: unknown estimator 'foo'; registered: [...]")
+def test_method_unknown():
+    p1, p2, c1, c2, rig = pixels()
+    for m in ("foo", "ransac:foo"):
+        with raises(ValueError, r"unknown estimator 'foo'; registered: \["):
+            cv.estimate(p1, p2, c1, c2, rig, method=m)
+    with raises(ValueError, "method must be a flag of mcgeom.cv or a registered estimator name"):
+        cv.estimate(p1, p2, c1, c2, rig, method=3)
+    with raises(ValueError, "unknown estimator 'foo'"):
+        mcgeom.estimate(rays(), "foo")
+
+
+@row("rig-not-rig", "a path or `None` passed as `rig`",
+     "`TypeError`: rig must be an mcgeom.rig.Rig, got str")
+def test_rig_not_rig():
+    p1, p2, c1, c2, _ = pixels()
+    with raises(TypeError, "rig must be an mcgeom.rig.Rig, got str"):
+        cv.estimate(p1, p2, c1, c2, "rig.json")
+    with raises(TypeError, "rig must be an mcgeom.rig.Rig, got NoneType"):
+        mcgeom.estimateRigMotion(p1, p2, c1, c2, None)
+
+
+@row("ransac-options", "`prob` 2, NaN or `None`, `threshold` 0, -1, NaN or a string, "
+     "`maxIters` 0 or 1.5, a mask of the wrong length, with NaN or of strings",
+     "`ValueError` naming the option and its valid range")
+def test_ransac_options():
+    p1, p2, c1, c2, rig = pixels()
+    for kw, msg in (({"prob": 2}, r"prob must be in \(0, 1\)"), ({"prob": np.nan}, "prob must be"),
+                    ({"threshold": 0}, "threshold must be a positive number"),
+                    ({"threshold": -1}, "threshold must be"), ({"threshold": np.nan}, "threshold"),
+                    ({"maxIters": 0}, "maxIters must be >= 1"),
+                    ({"maxIters": 1.5}, "maxIters must be an integer, got 1.5"),
+                    ({"threshold": "1"}, "threshold must be a number, got '1'"),
+                    ({"prob": None}, "prob must be a number, got None"),
+                    ({"mask": np.ones(5)}, f"mask has 5 entries, expected {len(p1)}"),
+                    ({"mask": np.full(len(p1), np.nan)}, "mask must hold finite numbers or "
+                                                         "booleans .* with NaN or inf"),
+                    ({"mask": np.array(["1"] * len(p1))}, "mask must hold finite numbers")):
+        with raises(ValueError, msg):
+            cv.estimate(p1, p2, c1, c2, rig, **kw)
+
+
+# ------------------------------------------------------------------ layouts
+
+@row("non-contiguous", "Fortran-ordered, strided or reversed-stride pixels, ids and rays",
+     "accepted: exactly the same motion as the C-contiguous copies (every estimator)")
+def test_non_contiguous():
+    p1, p2, c1, c2, rig = pixels()
+    ref = cv.estimate(p1, p2, c1, c2, rig)
+    m = cv.estimate(np.asfortranarray(p1), np.repeat(p2, 2, axis=0)[::2],
+                    np.repeat(c1, 2)[::2], c2[::-1][::-1], rig)
+    np.testing.assert_array_equal(m.R, ref.R)
+    np.testing.assert_array_equal(m.t, ref.t)
+    r = rays()
+    strided = RayPairs(np.asfortranarray(r.origins1), np.repeat(r.dirs1, 2, axis=0)[::2],
+                       r.origins2[::-1][::-1], np.asfortranarray(r.dirs2),
+                       np.repeat(r.cam1, 3)[::3], r.cam2)
+    for name in names():
+        a, b = mcgeom.estimate(r, name), mcgeom.estimate(strided, name)
+        np.testing.assert_array_equal(a.R, b.R, err_msg=name)
+        np.testing.assert_array_equal(a.t, b.t, err_msg=name)
+
+
+# ------------------------------------------------------------------ non-finite values
+
+@row("pixels-nan-inf", "NaN or inf in `points1` / `points2`",
+     "`ValueError`: points1 contains NaN or inf")
+def test_pixels_nan_inf():
+    p1, p2, c1, c2, rig = pixels()
+    with raises(ValueError, "points1 contains NaN or inf"):
+        cv.estimate(row_set(p1, 3, np.nan), p2, c1, c2, rig)
+    with raises(ValueError, "points2 contains NaN or inf"):
+        mcgeom.estimateRigMotion(p1, row_set(p2, 5, np.inf), c1, c2, rig)
+    with raises(ValueError, r"pixels1 has 1 non-finite row\(s\) \(first: row 3\)"):
+        rig.ray_pairs(row_set(p1, 3, -np.inf), p2, c1, c2)
+
+
+@row("rays-nan-inf", "NaN or inf in any ray array",
+     "`ValueError`: rays.dirs1 contains NaN or inf (every estimator)")
+def test_rays_nan_inf():
+    r = rays()
+    every_estimator(with_rays(dirs1=row_set(r.dirs1, 3, np.nan)), ValueError,
+                    "rays.dirs1 contains NaN or inf")
+    every_estimator(with_rays(origins2=row_set(r.origins2, 5, np.inf)), ValueError,
+                    "rays.origins2 contains NaN or inf")
+
+
+@row("calibration-nan-inf", "NaN or inf in K, distortion, R or t of a camera",
+     "`ValueError`: camera 'x': K has non-finite entries (dist, extrinsic R, extrinsic t alike)")
+def test_calibration_nan_inf():
+    cam = ring().cameras[0]
+    K = cam.K.copy()
+    K[0, 2] = np.nan
+    with raises(ValueError, "camera 'x': K has non-finite entries"):
+        Camera("x", K, cam.dist, "pinhole", cam.R, cam.t, 1024, 768)
+    with raises(ValueError, "camera 'x': dist has non-finite entries"):
+        Camera("x", cam.K, [0.1, np.inf, 0, 0], "pinhole", cam.R, cam.t, 1024, 768)
+    with raises(ValueError, r"camera 'x': extrinsic R is not a rotation \(non-finite entries\)"):
+        Camera("x", cam.K, cam.dist, "pinhole", row_set(cam.R, 1, np.nan), cam.t, 1024, 768)
+    with raises(ValueError, "camera 'x': extrinsic t has non-finite entries"):
+        Camera("x", cam.K, cam.dist, "pinhole", cam.R, [0, np.inf, 0], 1024, 768)
+
+
+@row("zero-direction", "a ray direction of length 0",
+     "`ValueError`: ... dirs1 contains a zero-length direction / d1[k] is a zero bearing "
+     "(every estimator, robust too)")
+def test_zero_direction():
+    r = with_rays(dirs1=row_set(rays().dirs1, 2, 0.0))
+    every_estimator(r, ValueError, "zero-length direction|zero bearing")
+    with raises(ValueError, "zero-length direction|zero bearing"):
+        mcgeom.robust.ransac(r, "five_plus_one")
+
+
+@row("pixels-huge", "finite pixels of 1e300",
+     "`ValueError`: camera 'cam0': pixel (...) has no finite bearing (names camera and pixel)")
+def test_pixels_huge():
+    p1, p2, c1, c2, rig = pixels()
+    with raises(ValueError, r"camera 'cam\d': pixel .* has no finite bearing"):
+        cv.estimate(p1 * 1e300, p2, c1, c2, rig)
+    with raises(ValueError, r"camera 'cam\d': pixel .* has no finite bearing"):
+        rig.ray_pairs(p1, p2 * 1e300, c1, c2)
+
+
+@row("rays-huge-camera-id", "`RayPairs` camera ids 10**11 + (0..3)",
+     "`ValueError`: cam1 holds camera id 100000000003, above the largest supported 1048575 (ids "
+     "are 0-based camera indices)")
+def test_rays_huge_camera_id():
+    r = rays()
+    with raises(ValueError, r"cam1 holds camera id 100000000003, above the largest supported "
+                            r"1048575 \(ids are 0-based camera indices\)"):
+        RayPairs(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1 + 10 ** 11, r.cam2)
+
+
+# ------------------------------------------------------------------ too little data
+
+@row("empty", "no correspondences: (0, 2) pixels, `[]` (what a matcher returns), "
+     "empty `RayPairs`",
+     "`ValueError`: too few correspondences: <method> needs at least k, got 0 (every method flag "
+     "and estimator)")
+def test_empty():
+    _, _, _, _, rig = pixels()
+    z2, zi = np.zeros((0, 2)), np.zeros(0, int)
+    for m in [cv.RIG_5P1_RANSAC, cv.RIG_5P1_DIRECT, cv.RIG_LINEAR17, cv.RIG_LINEAR17_RANSAC,
+              *names()]:
+        with raises(ValueError, "too few correspondences"):
+            cv.estimate(z2, z2, zi, zi, rig, method=m)
+    with raises(ValueError, "too few correspondences: five_plus_one needs at least 6, got 0"):
+        mcgeom.estimateRigMotion(z2, z2, zi, zi, rig)
+    with raises(ValueError, "too few correspondences: five_plus_one needs at least 6, got 0"):
+        cv.estimate([], [], [], [], rig)
+    with raises(ValueError, "too few correspondences: five_plus_one needs at least 6, got 0"):
+        cv.estimate(np.float32([]), np.float32([]), np.int32([]), None, rig)
+    z3 = np.zeros((0, 3))
+    every_estimator(RayPairs(z3, z3, z3, z3, zi, zi), ValueError, "too few correspondences")
+
+
+@row("too-few", "3 correspondences, or a mask that keeps none",
+     "`ValueError`: too few correspondences: five_plus_one needs at least 6, got 3 (every method)")
+def test_too_few():
+    p1, p2, c1, c2, rig = pixels()
+    for name in names():
+        with raises(ValueError, "too few correspondences"):
+            cv.estimate(p1[:3], p2[:3], c1[:3], c2[:3], rig, method=name)
+    with raises(ValueError, "too few correspondences: five_plus_one needs at least 6, got 0"):
+        cv.estimate(p1, p2, c1, c2, rig, mask=np.zeros(len(p1), np.uint8))
+    every_estimator(rays().take(np.arange(3)), ValueError, "too few correspondences")
+
+
+@row("duplicated", "every correspondence given twice",
+     "accepted: the motion of the correspondences given once (R right, metric `t` within 5 %, "
+     "scale observable; every estimator)")
+def test_duplicated():
+    p1, p2, c1, c2, rig = pixels()
+    R, t = MOTION
+    twice = lambda a: np.concatenate([a, a])  # noqa: E731
+    m = cv.estimate(twice(p1), twice(p2), twice(c1), twice(c2), rig)
+    r = rays().take(np.r_[np.arange(len(rays())), np.arange(len(rays()))])
+    for name, mm in [("cv", m)] + [(k, mcgeom.estimate(r, k)) for k in names()]:
+        assert rot_err(mm.R, R) < R_TOL, name
+        assert mm.scale.observable, (name, mm.scale.reason)
+        assert np.linalg.norm(mm.t - t) < 0.05 * np.linalg.norm(t), (name, mm.t)
+
+
+@row("one-correspondence-repeated", "one correspondence repeated 40 times",
+     "`DegenerateError`: <method>: only 1 distinct correspondence(s) among 40 (the others repeat "
+     "them); <method> needs at least k (every estimator, robust or not)")
+def test_one_correspondence_repeated():
+    p1, p2, c1, c2, rig = pixels()
+    k = np.zeros(40, int)
+    for m in [cv.RIG_5P1_RANSAC, cv.RIG_5P1_DIRECT, cv.RIG_LINEAR17, cv.RIG_LINEAR17_RANSAC]:
+        with raises(mcgeom.DegenerateError, "only 1 distinct correspondence"):
+            cv.estimate(p1[k], p2[k], c1[k], c2[k], rig, method=m)
+    every_estimator(rays().take(k), mcgeom.DegenerateError,
+                    r"only 1 distinct correspondence\(s\) among 40 \(the others repeat them\)")
+
+
+@row("too-few-per-camera", "4 correspondences in each of the 4 cameras, none across cameras",
+     "`ValueError`: too few correspondences: five_plus_one needs 5 intra-camera correspondences "
+     "in one camera, most found: 4 (robust: 'no camera has 5 intra-camera correspondences'); "
+     "`linear17`, `refine`, `bnb_lp`, `e_socp`: a motion, or `DegenerateError` when 16 rays do "
+     "not determine it")
+def test_too_few_per_camera():
+    p1, p2, c1, c2, rig = pixels()
+    sel = np.concatenate([np.flatnonzero((c1 == k) & (c2 == k))[:4] for k in range(4)])
+    for m in (cv.RIG_5P1_RANSAC, cv.RIG_5P1_DIRECT):
+        with raises(ValueError, "5 intra-camera correspondences"):
+            cv.estimate(p1[sel], p2[sel], c1[sel], c2[sel], rig, method=m)
+    with raises(ValueError, "five_plus_one needs 5 intra-camera correspondences in one camera, "
+                            "most found: 4"):
+        mcgeom.estimate(rays().take(sel), "five_plus_one")
+    R, _ = MOTION
+    for name in names():
+        if name == "five_plus_one":
+            continue
+        try:
+            m = mcgeom.estimate(rays().take(sel), name)
+        except ValueError as e:      # DegenerateError included
+            assert "correspondences" in str(e) or "degenerate" in str(e), (name, e)
+        else:                        # noise-free enough to be right, or says it is unsure
+            assert rot_err(m.R, R) < R_TOL or not m.scale.observable, name
+
+
+@row("collinear-points", "every scene point on one 3-D line, seen by one camera",
+     "`DegenerateError`: five_plus_one: the 40 bearings of the 5-point camera at time 1 lie in "
+     "one plane through its centre ... / linear17: E is not determined by the data (central "
+     "camera) ... / bnb_lp: the data do not determine the motion (every estimator)")
+def test_collinear_points():
+    R, t = MOTION
+    rig = ring()
+    s = np.linspace(-1.0, 1.0, 40)
+    pts = np.array([3.0, 0.5, 0.2]) + s[:, None] * np.array([0.2, 1.0, 0.1])
+    o, d1, o2, d2 = [], [], [], []
+    c = rig.centres[0]
+    for X in pts:    # all seen by camera 0 at both times (rig frame)
+        o.append(c); d1.append(X - c)
+        X2 = R @ X + t
+        o2.append(c); d2.append(X2 - c)
+    rp = RayPairs(np.array(o), np.array(d1), np.array(o2), np.array(d2),
+                  np.zeros(40, int), np.zeros(40, int))
+    every_estimator(rp, mcgeom.DegenerateError, "not determined|do not determine")
+
+
+# ------------------------------------------------------------------ degenerate geometry
+
+def camera_travel(R: np.ndarray, t: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Direction in which a camera with centre ``c`` moves, ``t + R c - c``: all that
+    the correspondences of one camera (or of a central rig) can tell of ``t``."""
+    tau = t + R @ c - c
+    return tau / np.linalg.norm(tau)
+
+
+def check_unobservable(m, R_true, direction=None, who="") -> None:
+    assert rot_err(m.R, R_true) < R_TOL, (who, np.degrees(rot_err(m.R, R_true)))
+    assert not m.scale.observable, (who, m.scale.reason)
+    assert abs(np.linalg.norm(m.t) - 1.0) < 1e-9, (who, m.t)
+    if direction is not None:
+        assert dir_err(m.t, direction) < DIR_TOL, (who, m.t, direction)
+
+
+@row("one-camera", "every correspondence in camera 0 of a 4-camera rig",
+     "R right; scale unobservable (\"one camera only and no cross-camera correspondence\" / "
+     "\"central camera\"); `t` unit, along the camera's travel `t + R c - c` (every estimator)")
+def test_one_camera():
+    p1, p2, c1, c2, rig = pixels()
+    R, t = MOTION
+    sel = (c1 == 0) & (c2 == 0)
+    u = camera_travel(R, t, rig.centres[0])
+    check_unobservable(cv.estimate(p1[sel], p2[sel], c1[sel], c2[sel], rig), R, u, "cv")
+    one = rays().take(np.flatnonzero(sel))
+    for name in names():
+        check_unobservable(mcgeom.estimate(one, name), R, u, name)
+
+
+@row("single-camera-rig", "a rig of one camera",
+     "as `one-camera`: R right, scale unobservable, `t` the camera's unit travel direction")
+def test_single_camera_rig():
+    p = problem("single")
+    u = camera_travel(p.R, p.t, p.rig.centres[0])
+    check_unobservable(cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig), p.R, u, "cv")
+    for name in names():
+        check_unobservable(mcgeom.estimate(p.rays, name), p.R, u, name)
+
+
+@row("central-rig", "a rig whose 4 cameras share one centre (coincident centres)",
+     "R right; scale unobservable (\"central camera\" / \"critical motion\"); `t` unit, along "
+     "the centre's travel")
+def test_central_rig():
+    p = problem("central")
+    u = camera_travel(p.R, p.t, p.rig.centres[0])
+    check_unobservable(cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig), p.R, u, "cv")
+    for name in names():
+        check_unobservable(mcgeom.estimate(p.rays, name), p.R, u, name)
+
+
+@row("zero-motion", "a static rig (R = I, t = 0), 0.3 px noise",
+     "pixels: \"no translation detected: a pure rotation explains the correspondences ...\", "
+     "`t = 0`, R = I; rays: R = I, scale unobservable, `t` unit with no meaning (every estimator)")
+def test_zero_motion():
+    p = problem("static")
+    m = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    assert m.scale.reason.startswith("no translation detected"), m.scale.reason
+    assert not m.scale.observable and rot_err(m.R, np.eye(3)) < R_TOL
+    np.testing.assert_array_equal(m.t, np.zeros(3))
+    retval, R, t, mask = mcgeom.estimateRigMotion(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    np.testing.assert_array_equal(t, np.zeros((3, 1)))
+    for name in names():
+        check_unobservable(mcgeom.estimate(p.rays, name), np.eye(3), None, name)
+
+
+@row("pure-translation", "R = I, t = (0.3, 0.1, 0) m, intra-camera correspondences only",
+     "scale unobservable (\"critical motion: camera displacements parallel ...\" / \"scale too "
+     "uncertain\"); R = I; `t` unit along the true direction, sign included (every estimator)")
+def test_pure_translation():
+    p = problem("translation")
+    u = p.t / np.linalg.norm(p.t)
+    check_unobservable(cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig), p.R, u, "cv")
+    for name in names():
+        check_unobservable(mcgeom.estimate(p.rays, name), p.R, u, name)
+
+
+@row("rotation-near-pi", "a rotation of pi - 1e-3 rad (about a tilted vertical axis), "
+     "up-looking cameras",
+     "recovered: R right to 0.5 deg, metric `t`, scale observable (every estimator)")
+def test_rotation_near_pi():
+    p = problem("near-pi")
+    ms = [("cv", cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig))]
+    ms += [(name, mcgeom.estimate(p.rays, name)) for name in names()]
+    for name, m in ms:
+        assert rot_err(m.R, p.R) < R_TOL, (name, np.degrees(rot_err(m.R, p.R)))
+        assert m.scale.observable, (name, m.scale.reason)
+        assert np.linalg.norm(m.t - p.t) < 0.05 * np.linalg.norm(p.t), (name, m.t, p.t)
+
+
+@row("cross-camera-only-near-pi", "ring rig turned by pi - 1e-3 rad: every correspondence "
+     "between opposite cameras, none within a camera",
+     "`five_plus_one`, `e_socp`, pixels: `ValueError` (... needs 5 intra-camera correspondences "
+     "...); `linear17`, `refine`: `DegenerateError` (degenerate data ...); `bnb_lp`: R right "
+     "(its global search starts from a rotation of the cube when the identity is too far), "
+     "scale unobservable (the rotated rig nearly maps its cameras onto each other)")
+def test_cross_camera_only_near_pi():
+    R = synth.rotation_about([0, 0, 1], np.pi - 1e-3)
+    p = synth.make_problem(ring(), R, MOTION[1], 60, rng=2, depth_range=(1.0, 8.0),
+                           pixel_noise=0.3, cross_fraction=1.0)
+    with raises(ValueError, "5 intra-camera correspondences"):
+        cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    for name in ("five_plus_one", "e_socp"):
+        with raises(ValueError, "needs 5 intra-camera correspondences"):
+            mcgeom.estimate(p.rays, name)
+    for name in ("linear17", "refine"):
+        with raises(mcgeom.DegenerateError, "degenerate data"):
+            mcgeom.estimate(p.rays, name)
+    m = mcgeom.estimate(p.rays, "bnb_lp")
+    assert rot_err(m.R, R) < R_TOL and not m.scale.observable, m.scale.reason
+
+
+# ------------------------------------------------------------------ calibration
+
+def camera_with(**changes) -> Camera:
+    cam = ring().cameras[0]
+    fields = dict(name="x", K=cam.K, dist=cam.dist, model="pinhole", R=cam.R, t=cam.t,
+                  width=1024, height=768)
+    fields.update(changes)
+    return Camera(**fields)
+
+
+def rig_file_with(tmp_path, **camera0) -> Path:
+    """tests/data/calibration/mcgeom/rig4.json with camera 0's entries replaced."""
+    import json
+    d = json.loads((CALIB / "mcgeom" / "rig4.json").read_text())
+    d["cameras"][0].update(camera0)
+    path = tmp_path / "rig.json"
+    path.write_text(json.dumps(d))
+    return path
+
+
+@row("extrinsics-not-rotation", "camera extrinsics that are a reflection (det -1), scaled "
+     "(2 R) or sheared, in a `Camera` or a rig file",
+     "`ValueError`: <file>: cameras[0]: camera '...': extrinsic R is not a rotation "
+     "(det = -1 / not orthonormal: max |R^T R - I| = ...)")
+def test_extrinsics_not_rotation(tmp_path):
+    R = ring().cameras[0].R
+    shear = R.copy()
+    shear[0, 1] += 1e-3
+    for bad, why in ((R @ np.diag([1.0, 1, -1]), r"\(det = -1"), (2 * R, r"\(not orthonormal"),
+                     (shear, r"\(not orthonormal")):
+        with raises(ValueError, f"camera 'x': extrinsic R is not a rotation {why}"):
+            camera_with(R=bad)
+        path = rig_file_with(tmp_path, R_cam_from_rig=bad.tolist())
+        with raises(ValueError, rf"rig.json: cameras\[0\]: camera '.*': extrinsic R is not a "
+                                rf"rotation {why}"):
+            mcgeom.load_rig(path)
+
+
+@row("intrinsics-degenerate", "a singular K (fx = 0), a negative focal length, K not "
+     "upper triangular or K[2, 2] != 1, in a `Camera` or a rig file",
+     "`ValueError`: camera '...': K must have positive focal lengths, got fx=0.0 ... / "
+     "must be upper triangular / K[2,2] must be 1")
+def test_intrinsics_degenerate(tmp_path):
+    K = ring().cameras[0].K
+    for change, why in (((0, 0, 0.0), "K must have positive focal lengths, got fx=0.0"),
+                        ((1, 1, -800.0), "K must have positive focal lengths, got fx=800.0, fy=-800.0"),
+                        ((1, 0, 5.0), "K must be upper triangular"),
+                        ((2, 2, 0.0), r"K\[2,2\] must be 1, got 0.0")):
+        bad = K.copy()
+        bad[change[:2]] = change[2]
+        with raises(ValueError, f"camera 'x': {why}"):
+            camera_with(K=bad)
+        with raises(ValueError, rf"rig.json: cameras\[0\]: camera '.*': {why}"):
+            mcgeom.load_rig(rig_file_with(tmp_path, K=bad.tolist()))
+
+
+#: one calibration file of each format (COLMAP's needs cameras.txt and images.txt beside it)
+FILES = {"mcgeom-json": CALIB / "mcgeom" / "rig4.json",
+         "opencv-yaml": CALIB / "opencv" / "rig4.yml",
+         "kalibr": CALIB / "kalibr" / "camchain-imucam-radtan.yaml",
+         "colmap": CALIB / "colmap" / "rig_config.json"}
+
+
+def damaged_copy(tmp_path, fmt: str, text: str) -> Path:
+    import shutil
+    src = FILES[fmt]
+    for extra in ("cameras.txt", "images.txt"):
+        if (src.parent / extra).exists():
+            shutil.copy(src.parent / extra, tmp_path / extra)
+    path = tmp_path / src.name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+#: per format: (regex, gist) of the message for a truncated file, a syntax error
+#: (format given), and another format's file loaded as this one
+FILE_MESSAGES = {
+    "mcgeom-json": ((r"not valid JSON \(.* at line \d+ column \d+\)",
+                     "not valid JSON (Expecting ... at line n column m)"),
+                    (r"not valid JSON \(Expecting ',' delimiter", "not valid JSON (Expecting ',' "
+                                                                    "delimiter at line 3 ...)"),
+                    (r"not valid JSON \(Expecting value at line 1", "not valid JSON (Expecting "
+                                                                     "value at line 1 column 1)")),
+    "opencv-yaml": ((r"malformed or truncated OpenCV FileStorage file \(Parsing error",
+                     "malformed or truncated OpenCV FileStorage file (Parsing error: ...)"),
+                    (r"malformed or truncated OpenCV FileStorage file \(Parsing error",
+                     "malformed or truncated OpenCV FileStorage file (Parsing error: ...)"),
+                    (r"not an OpenCV FileStorage file \(it must start with a '%YAML:1.0'",
+                     "not an OpenCV FileStorage file (it must start with a '%YAML:1.0' or "
+                     "'%YAML 1.2' header, or '<?xml'; got ...)")),
+    "kalibr": ((r"line \d+: unterminated flow sequence '\[' \(truncated file\?\)",
+                "line n: unterminated flow sequence '[' (truncated file?)"),
+               (r"line 2: content that does not fit the document's top-level structure",
+                "line 2: content that does not fit the document's top-level structure"),
+               (r"line 1: unsupported YAML feature \(flow mappings\)",
+                "line 1: unsupported YAML feature (flow mappings)")),
+    "colmap": ((r"not valid JSON \(.*; truncated\?\)", "not valid JSON (... ; truncated?)"),
+               (r"not valid JSON \(Expecting ',' delimiter", "not valid JSON (Expecting ',' "
+                                                               "delimiter at line n ...)"),
+               (r"not valid JSON \(Expecting value at line 1 column 1",
+                "not valid JSON (Expecting value at line 1 column 1; truncated?)")),
+}
+
+
+def file_rows(fmt: str) -> None:
+    """Three rows for a loader: truncated, malformed, another format's file."""
+    slug = fmt.split("-")[0]
+    text = FILES[fmt].read_text(encoding="utf-8")
+    # a syntax error: a key without its ':' (YAML), a list without a ',' (JSON)
+    malformed = (text.replace(":", " ", 3) if fmt in ("opencv-yaml", "kalibr")
+                 else text.replace(",", "", 2))
+    other = FILES["kalibr" if fmt != "kalibr" else "mcgeom-json"]
+    (m_trunc, g_trunc), (m_bad, g_bad), (m_other, g_other) = FILE_MESSAGES[fmt]
+    detected = (" (detected from the content: the same, plus which signature chose the format)")
+
+    @row(f"file-truncated-{slug}", f"a `{fmt}` calibration file cut in half",
+         f"`ValueError`: <file>: {g_trunc}" + detected)
+    def truncated(tmp_path):
+        path = damaged_copy(tmp_path, fmt, text[: len(text) // 2])
+        with raises(ValueError, f"{re.escape(str(path))}: {m_trunc}"):
+            mcgeom.load_rig(path, format=fmt)
+        with raises(ValueError, f"{re.escape(str(path))}: {m_trunc}.*detected from the content"):
+            mcgeom.load_rig(path)
+
+    @row(f"file-malformed-{slug}", f"a `{fmt}` calibration file with a syntax error",
+         f"`ValueError`: <file>: {g_bad} (format= given; detecting the format may instead say "
+         "it cannot tell the format, listing each format tried and why)")
+    def malformed_(tmp_path):
+        path = damaged_copy(tmp_path, fmt, malformed)
+        with raises(ValueError, f"{re.escape(str(path))}: {m_bad}"):
+            mcgeom.load_rig(path, format=fmt)
+        with raises(ValueError, f"{re.escape(str(path))}: "):
+            mcgeom.load_rig(path)
+
+    @row(f"file-wrong-format-{slug}", f"a `{'kalibr' if fmt != 'kalibr' else 'mcgeom-json'}` "
+         f"file loaded with `format='{fmt}'`", f"`ValueError`: <file>: {g_other}")
+    def wrong_format():
+        with raises(ValueError, f"{re.escape(str(other))}: {m_other}"):
+            mcgeom.load_rig(other, format=fmt)
+
+    for fn, kind in ((truncated, "truncated"), (malformed_, "malformed"),
+                     (wrong_format, "wrong_format")):
+        fn.__name__ = f"test_file_{kind}_{slug}"
+        globals()[fn.__name__] = fn
+
+
+for _fmt in FILES:
+    file_rows(_fmt)
+
+
+@row("file-unknown-format", "a file that is no calibration format (empty, binary, plain text)",
+     "`ValueError`: <file>: cannot tell the calibration format. Tried mcgeom-json: ...; "
+     "opencv-yaml: ...; kalibr: ...; colmap: .... Pass format= one of ...")
+def test_file_unknown_format(tmp_path):
+    for i, text in enumerate(("", "\x00\xff garbage", "focal length 800\n")):
+        path = tmp_path / f"f{i}.txt"
+        path.write_text(text, encoding="utf-8", errors="surrogateescape")
+        with raises(ValueError, "cannot tell the calibration format. Tried mcgeom-json: .*; "
+                                "opencv-yaml: .*; kalibr: .*; colmap: .*Pass format="):
+            mcgeom.load_rig(path)
+    with raises(OSError, ""):
+        mcgeom.load_rig(tmp_path / "missing.json")
+
+
+# ------------------------------------------------------------------ the table
+
+BEGIN, END = "<!-- rows of tests/test_bad_input.py: begin -->", "<!-- rows: end -->"
+
+
+def markdown_table() -> str:
+    """The table of docs/bad_input.md, one line per row (test ``test_<id>``)."""
+    lines = ["| row (test) | input | what it gets |", "| --- | --- | --- |"]
+    lines += [f"| `{rid}` | {given} | {gets} |" for rid, given, gets in ROWS]
+    return "\n".join(lines)
+
+
+def test_table_lists_exactly_the_rows():
+    """docs/bad_input.md lists every row of this module, in order, as written here,
+    and every row has its test function."""
+    text = TABLE.read_text(encoding="utf-8")
+    assert BEGIN in text and END in text, f"{TABLE} lost its row markers"
+    table = text.split(BEGIN, 1)[1].split(END, 1)[0].strip()
+    assert table == markdown_table(), ("docs/bad_input.md is out of date: regenerate it with "
+                                       "python tests/test_bad_input.py --write")
+    tests = {getattr(f, "row_id", None) for f in globals().values() if callable(f)}
+    missing = [rid for rid, _, _ in ROWS if rid not in tests]
+    assert not missing, f"rows without a test: {missing}"
+    for rid, _, _ in ROWS:
+        assert f"test_{rid.replace('-', '_')}" in globals(), rid
+
+
+if __name__ == "__main__":
+    # regenerate the table of docs/bad_input.md from the rows
+    if sys.argv[1:] != ["--write"]:
+        sys.exit("usage: python tests/test_bad_input.py --write")
+    head, rest = TABLE.read_text(encoding="utf-8").split(BEGIN, 1)
+    TABLE.write_text(f"{head}{BEGIN}\n{markdown_table()}\n{END}{rest.split(END, 1)[1]}",
+                     encoding="utf-8")
