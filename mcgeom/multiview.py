@@ -400,8 +400,14 @@ def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max
         return (ScaleVerdict(False, "the metric system is singular: scale not observable",
                              conditioning=cond), c_hom, False)
     c = _core.skyline_solve(first, ptr, fac, -gvec)
-    # first-order std of the travelled distance |G c| (frame-independent)
-    res2 = max(c @ _sky_matvec(N, first, ptr, c) + 2.0 * gvec @ c + const, 0.0)
+    # first-order std of the travelled distance |G c| (frame-independent). The
+    # residual comes from the Gram expansion c^T N c + 2 g^T c + const, whose
+    # terms cancel: it is known only to about 1e-13 of their size. A nearly
+    # singular N (one camera, a central rig: a line of solutions) makes c and
+    # the terms huge and the difference meaningless (even negative); the floor
+    # then keeps the noise estimate, and with it rel_std, from reading zero.
+    cnc, gc = float(c @ _sky_matvec(N, first, ptr, c)), float(2.0 * gvec @ c)
+    res2 = max(cnc + gc + const, 1e-13 * (abs(cnc) + abs(gc) + abs(const)))
     sigma2 = res2 / max(n_rows - n, 1)
     Lc = _sky_matvec(_laplacian_env(first, ptr, pk), first, ptr, c + shift)
     s2 = float((c + shift) @ Lc)

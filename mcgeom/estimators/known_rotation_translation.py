@@ -67,11 +67,11 @@ def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
-    R = _rotation(rotation)
-    n = len(rays)
+    n = len(rays)  # the data are checked before the option, as in every estimator
     if n < 3:
         raise ValueError(f"too few correspondences: known_rotation_translation needs 3, got {n}")
     rays.check_finite()
+    R = _rotation(rotation)
     k = np.arange(n)
     res = multiview.translations_from_tracks(
         np.r_[k, k], np.r_[np.zeros(n, np.int64), np.ones(n, np.int64)],
