@@ -1119,6 +1119,8 @@ int mcg_rot_from_angle_axis(const double w[3], double r[9])
     if (w == NULL || r == NULL || !all_finite(w, 3))
         return MCG_EINVAL;
     theta = norm_small(w, 3);
+    if (!isfinite(theta))
+        return MCG_EINVAL; /* |w| > DBL_MAX: the angle overflows (found by fuzz_linalg) */
     if (theta == 0.0) {
         for (i = 0; i < 9; ++i)
             r[i] = (i % 4 == 0) ? 1.0 : 0.0;

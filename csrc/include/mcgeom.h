@@ -128,7 +128,8 @@ int mcg_spd_solve(int n, const double *a, const double *b, double *x);
 
 /* Rotations (3 x 3, row-major). Angle-axis w: |w| = angle in radians,
  * in [0, pi]. Quaternions q = (w, x, y, z), Hamilton convention,
- * R = rotation that maps vectors as R v (active). */
+ * R = rotation that maps vectors as R v (active). mcg_rot_from_angle_axis
+ * returns MCG_EINVAL for NaN/inf or an angle |w| that overflows (> DBL_MAX). */
 int mcg_rot_from_angle_axis(const double w[3], double r[9]);
 int mcg_angle_axis_from_rot(const double r[9], double w[3]);
 int mcg_rot_from_quat(const double q[4], double r[9]); /* q normalised here */
