@@ -21,9 +21,35 @@ static void test_angle_axis_overflow(void)
           "rot_from_angle_axis: |w| = 1.4e300 finite", 0.0, 0.0);
 }
 
+/* fuzz_linalg: a 9 x 3 matrix with a column of size 1e-8 next to one of
+ * 1e150 (a graded matrix): the reflector of the small column was computed
+ * from squares in the denormal range, Q lost its orthonormality (2.7e-9). */
+static void test_qr_graded_columns(void)
+{
+    double a[27], q[27], r[9], w[64], e = 0.0;
+    int i, j, k;
+    for (i = 0; i < 9; ++i) {
+        a[3 * i] = (i % 2) ? 1e-8 * (i + 1) : 0.0;
+        a[3 * i + 1] = 2.5 * (i + 1) - 0.3 * i * i;
+        a[3 * i + 2] = (i % 2) ? 1e150 * (i + 1) : -1.27e126 * (i + 1);
+    }
+    check_status(mcg_qr(9, 3, a, q, r, w, 64), MCG_OK, "qr of a graded 9 x 3 matrix");
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            double s = 0.0;
+            for (k = 0; k < 9; ++k)
+                s += q[3 * k + i] * q[3 * k + j];
+            s = fabs(s - (i == j ? 1.0 : 0.0));
+            if (s > e)
+                e = s;
+        }
+    check(e <= 1e-14, "qr of a graded matrix: |Q^T Q - I|", e, 1e-14);
+}
+
 int main(void)
 {
     test_angle_axis_overflow();
+    test_qr_graded_columns();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed != 0;
 }
