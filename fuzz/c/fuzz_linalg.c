@@ -60,8 +60,8 @@ static void check_orthonormal_columns(const double *q, int m, int k, double tol,
             double s = 0.0;
             for (r = 0; r < m; ++r)
                 s += q[r * k + i] * q[r * k + j];
-            FZ_CHECK(fabs(s - (i == j ? 1.0 : 0.0)) <= tol, "%s: column %d . %d = %g", what, i,
-                     j, s);
+            FZ_CHECK(fabs(s - (i == j ? 1.0 : 0.0)) <= tol, "%s: column %d . %d = %.17g (m %d, k %d)", what, i,
+                     j, s, m, k);
         }
 }
 
