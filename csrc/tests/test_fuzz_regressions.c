@@ -46,8 +46,43 @@ static void test_qr_graded_columns(void)
     check(e <= 1e-14, "qr of a graded matrix: |Q^T Q - I|", e, 1e-14);
 }
 
+/* fuzz_linear17: a central camera (all rays through one centre, gc_case
+ * CENTRAL) with exact correspondences: the algebraic cost x^T M x rounds to
+ * slightly below 0 and cost_final = sqrt(cost / n) was NaN with MCG_OK. */
+static void test_linear17_central_exact_cost(void)
+{
+    double o1[3 * 55], d1[3 * 55], o2[3 * 55], d2[3 * 55], w[3], R[9], t[3];
+    int trial, i, k, bad = 0, ok = 0;
+    mcg_linear17_result res;
+    for (trial = 0; trial < 200; ++trial) {
+        double c[3] = {2 * urand() - 1, 2 * urand() - 1, 2 * urand() - 1};
+        for (k = 0; k < 3; ++k) {
+            w[k] = 0.3 * (2 * urand() - 1);
+            t[k] = 2 * (2 * urand() - 1);
+        }
+        mcg_rot_from_angle_axis(w, R);
+        for (i = 0; i < 55; ++i) {
+            double X[3] = {10 * urand() - 5, 10 * urand() - 5, 1 + 19 * urand()};
+            for (k = 0; k < 3; ++k) {
+                o1[3 * i + k] = o2[3 * i + k] = c[k];
+                d1[3 * i + k] = X[k] - c[k];
+                d2[3 * i + k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] +
+                                t[k] - c[k];
+            }
+        }
+        if (mcg_linear17(55, o1, d1, o2, d2, NULL, &res) != MCG_OK)
+            continue;
+        ++ok;
+        if (!isfinite(res.cost_final) || !isfinite(res.cost_linear) || isnan(res.scale_rel_std))
+            ++bad;
+    }
+    check(ok > 0 && bad == 0, "linear17: central exact data, costs never NaN (of MCG_OK)",
+          (double)bad, 0.0);
+}
+
 int main(void)
 {
+    test_linear17_central_exact_cost();
     test_angle_axis_overflow();
     test_qr_graded_columns();
     printf("%d checks, %d failed\n", n_checks, n_failed);
