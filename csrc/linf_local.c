@@ -355,13 +355,19 @@ int mcg_linf_local(int n, const double *u1, const double *a1, const double *u2,
                    double delta_min, int max_steps, double *work, double *f_out,
                    int *steps_out)
 {
-    double *g = work, *G = work + n, *gt = work + 8 * (size_t)n, F, delta = delta0;
-    int *idx = (int *)(void *)(work + 7 * (size_t)n);
+    double *g, *G, *gt, F, delta = delta0;
+    int *idx;
     int step, nbad;
     if (n < 1 || !u1 || !a1 || !u2 || !a2 || !R || !t || !work || max_steps < 0 ||
         !(delta0 > 0.0) || !isfinite(delta0) || !(delta_min > 0.0) || !(delta_min <= delta0) ||
         !all_finite(R, 9) || !all_finite(t, 3))
         return MCG_EINVAL;
+    /* the work layout only once n is known valid: with n < 0 the offsets
+     * overflowed the pointer (undefined behaviour, found by fuzz_linf_local) */
+    g = work;
+    G = work + n;
+    gt = work + 8 * (size_t)n;
+    idx = (int *)(void *)(work + 7 * (size_t)n);
     F = evaluate(n, u1, a1, u2, a2, R, t, g, G, &nbad);
     for (step = 0; step < max_steps; ++step) {
         double h[NV], Rn[9], tn[3], Fn, pred, model = 0.0;

@@ -2,6 +2,7 @@
  * of fuzz/c/ (fuzz/README.md lists them), on the input that triggered it
  * (reduced to its meaning), so a fixed bug stays fixed. */
 #include "mcgeom.h"
+#include "../internal.h"
 #include "testutil.h"
 
 #include <float.h>
@@ -80,8 +81,22 @@ static void test_linear17_central_exact_cost(void)
           (double)bad, 0.0);
 }
 
+/* fuzz_linf_local: n < 0 computed the work layout (work + 8 n) before
+ * rejecting n: a pointer overflow (undefined behaviour; UBSan reports it,
+ * the plain build passed by luck). Now MCG_EINVAL before any arithmetic. */
+static void test_linf_local_negative_n(void)
+{
+    double u[3] = {0, 0, 1}, R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {0, 0, 0}, w[9], f;
+    int steps;
+    check_status(mcg_linf_local(-1, u, u, u, u, R, t, 1.0, 0.1, 5, w, &f, &steps), MCG_EINVAL,
+                 "linf_local: n = -1 rejected");
+    check_status(mcg_linf_local(-2147483647 - 1, u, u, u, u, R, t, 1.0, 0.1, 5, w, &f, &steps),
+                 MCG_EINVAL, "linf_local: n = INT_MIN rejected");
+}
+
 int main(void)
 {
+    test_linf_local_negative_n();
     test_linear17_central_exact_cost();
     test_angle_axis_overflow();
     test_qr_graded_columns();
