@@ -12,8 +12,9 @@ strings in the input format the harness decodes.
   decoder's "nice" double format (selector byte < 224, then a 16-bit integer
   / 4096), a few with special values (NaN, inf, denormals, 1e150, DBL_MAX).
 - fuzz_calibration: byte 0 picks the calibration file of tests/data/calibration
-  (and with it the loader), the rest is the file's text; the seeds are the
-  hand-written files themselves, unmodified and truncated.
+  (and with it the loader), byte 1 the file or a sibling it reads, the rest is
+  the text; the seeds are the hand-written files themselves, whole and
+  truncated.
 - fuzz_estimate, fuzz_estimators: byte strings decoded by
   atheris.FuzzedDataProvider (sizes, seeds, flags, floats).
 """
@@ -32,15 +33,18 @@ SEEDS = FUZZ / "build" / "seeds"
 MODES = {"fuzz_linalg": 8, "fuzz_rays": 3, "fuzz_cls": 3, "fuzz_linear17": 2, "fuzz_refine": 2,
          "fuzz_lp": 3, "fuzz_cone": 2, "fuzz_bnb": 2, "fuzz_linf_local": 1}
 
-# the calibration files, in the order fuzz/python/fuzz_calibration.py indexes them
+# the calibration files, in the order fuzz/python/fuzz_calibration.py indexes
+# them, with the sibling files its byte 1 can select instead (byte 1 % 4 >= 2:
+# sibling number byte 1 % len(siblings))
 CALIBRATION_FILES = [
-    "mcgeom/rig4.json",
-    "opencv/rig4.yml",
-    "opencv/stereo_calib.yml",
-    "kalibr/camchain-equidistant.yaml",
-    "kalibr/camchain-imucam-radtan.yaml",
-    "colmap/rig_config.json",
-    "colmap/rig_config_legacy.json",
+    ("mcgeom/rig4.json", []),
+    ("opencv/rig4.yml", []),
+    ("opencv/stereo_calib.yml", ["opencv/stereo_calib/intrinsics.yml",
+                                 "opencv/stereo_calib/extrinsics.yml"]),
+    ("kalibr/camchain-equidistant.yaml", []),
+    ("kalibr/camchain-imucam-radtan.yaml", []),
+    ("colmap/rig_config.json", ["colmap/cameras.txt", "colmap/images.txt"]),
+    ("colmap/rig_config_legacy.json", ["colmap/cameras.txt", "colmap/images.txt"]),
 ]
 
 
@@ -81,11 +85,15 @@ def c_seeds(name: str, rng: random.Random) -> list[bytes]:
 
 
 def calibration_seeds() -> list[bytes]:
+    """Each file (byte 1 = 0: the file itself), whole and truncated, and each
+    sibling (byte 1 = 2 or 3 selects sibling 0 or 1 of two)."""
+    base = ROOT / "tests" / "data" / "calibration"
     out = []
-    for i, rel in enumerate(CALIBRATION_FILES):
-        text = (ROOT / "tests" / "data" / "calibration" / rel).read_bytes()
-        out.append(bytes([i]) + text)
-        out.append(bytes([i]) + text[: len(text) // 2])
+    for i, (rel, siblings) in enumerate(CALIBRATION_FILES):
+        text = (base / rel).read_bytes()
+        out += [bytes([i, 0]) + text, bytes([i, 0]) + text[: len(text) // 2]]
+        for sel in (2, 3)[: len(siblings)]:
+            out.append(bytes([i, sel]) + (base / siblings[sel % len(siblings)]).read_bytes())
     return out
 
 
