@@ -94,8 +94,69 @@ static void test_linf_local_negative_n(void)
                  MCG_EINVAL, "linf_local: n = INT_MIN rejected");
 }
 
+/* fuzz_bnb: one camera, 5 near-exact pairs, tol 5.4e-5, polish on: the
+ * polish bisected f from a floor of (lower bound - 2 tol) < 0, the relaxed
+ * tests passed at negative bounds and linf = lower_bound = -7.7e-5 came
+ * back with MCG_OK (the decoded input, exact hexadecimal values). */
+static void test_bnb_polish_nonnegative(void)
+{
+    static const double d1[15] = {
+        -0x1.ff81ff81ff82p+1, 0x1.6d17ed17ed17fp+2, 0x1.89e289e289e28p+3,
+        -0x1.fb8ffb8ffb9p+1, 0x1.5064506450645p+2, 0x1.2600e600e600ep+3,
+        -0x1.48a148a148a2p-4, -0x1.3421342134216p-2, 0x1.26ee66ee66ee6p+3,
+        -0x1.48a148a148a2p-4, -0x1.3421342134216p-2, 0x1.c3ffc3ffc3ffcp+0,
+        -0x1.bb98bb98bb98cp+1, 0x1.26ca26ca26ca2p+1, 0x1.9eb67eb67eb68p+3,
+    };
+    static const double a1[15] = {
+        0x1.28fp+1, -0x1.8e178e178e179p-1, -0x1.072p+0,
+        0x1.919p+2, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+    };
+    static const double d2[15] = {
+        0x1.d124d2992d6acp-3, -0x1.0e80ce833035ep-2, 0x1.dce9c1542673ap+3,
+        -0x1.ddc38d78f6efp-2, 0x1.a2031d386e84dp-1, 0x1.80bf00774f19ap+3,
+        0x1.17b44b41e90c6p+0, -0x1.368d4c5295adep+2, 0x1.14a8957fffb88p+3,
+        -0x1.f59f1d52d737p-3, -0x1.58b89179f274p+0, 0x1.1aac6d9b506ep+1,
+        -0x1.959689818c49p-2, -0x1.caeb34effdbc4p+1, 0x1.bf48edfe5e6p+3,
+    };
+    static const double a2[15] = {
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+    };
+    static const double R0[9] = {0x1.919p+2, 0x1.919p+2, 0x1.9p-6, 0x1.b74p-1, -0x1.62c8p+1, 0x1.9258p+2, 0x0p+0, 0x0p+0, 0x0p+0};
+    int group[5] = {0, 0, 0, 0, 0};
+    mcg_bnb_options opt;
+    mcg_bnb_result res;
+    static double work[1 << 16];
+    size_t ws;
+    int st;
+    mcg_bnb_default_options(&opt);
+    opt.resolution = 0x1.47ae147ae147bp-7;
+    opt.tol = 0x1.c1ce8a96b25aap-15;
+    opt.max_blocks = 115;
+    opt.max_queue = 1701;
+    opt.grid = 1;
+    opt.preemptive = 1;
+    opt.working_sets = 1;
+    opt.polish_tol = 0x1.ed7373a856892p-15;
+    opt.bound_steps = 0;
+    ws = mcg_bnb_work_size(5, 1, &opt);
+    check(ws > 0 && ws <= sizeof work / sizeof work[0], "bnb polish case: work size", (double)ws,
+          0.0);
+    st = mcg_bnb_linf(5, d1, a1, d2, a2, group, 1, R0, &opt, &res, work, ws);
+    check_status(st, MCG_OK, "bnb polish case: status");
+    check(res.linf >= 0.0 && res.lower_bound >= 0.0 && res.lower_bound <= res.linf,
+          "bnb polish case: 0 <= lower_bound <= linf", res.linf, 0.0);
+}
+
 int main(void)
 {
+    test_bnb_polish_nonnegative();
     test_linf_local_negative_n();
     test_linear17_central_exact_cost();
     test_angle_axis_overflow();
