@@ -48,7 +48,9 @@ FILES = [
      ["colmap/cameras.txt", "colmap/images.txt"]),
 ]
 WORK = Path(tempfile.mkdtemp(prefix="mcgeom-fuzz-calib-"))
-shutil.copytree(DATA, WORK / "pristine")
+CASE = WORK / "case"
+shutil.copytree(DATA, CASE)
+_last: list[str] = []  # the file the previous input replaced (restored first)
 
 
 def check_rig(rig, what: str) -> None:
@@ -69,12 +71,14 @@ def TestOneInput(data: bytes) -> None:
     target = rel
     if siblings and data[1] % 4 >= 2:
         target = siblings[data[1] % len(siblings)]
-    case = WORK / "case"
-    if case.exists():
-        shutil.rmtree(case)
-    shutil.copytree(WORK / "pristine", case)
-    (case / target).write_bytes(data[2:])
-    path = case / rel
+    # one file differs from the originals at a time: restore the previous
+    # input's, write this one's (a copy of the whole tree per input halved
+    # the executions)
+    for prev in _last:
+        shutil.copyfile(DATA / prev, CASE / prev)
+    _last[:] = [target]
+    (CASE / target).write_bytes(data[2:])
+    path = CASE / rel
     for call, what in ((lambda: mcgeom.load_rig(path), f"load_rig({rel})"),
                        (lambda: loader(path), f"{loader.__name__}({rel})")):
         try:
