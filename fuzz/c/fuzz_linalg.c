@@ -218,8 +218,12 @@ static void fuzz_pinv(fz_in *in)
     {
         double sc = scaled_copy(a, as, (size_t)(m * n)), t[MAXD * MAXD], tol;
         double r_eff = rcond > 0.0 ? rcond : (double)(m > n ? m : n) * DBL_EPSILON;
+        /* plus the rounding of the products, which grows with |A+| (the
+         * condition number: A A+ A is not a backward-stable quantity; the
+         * long run found ill-conditioned inputs at 1e-6 without it) */
         tol = (double)(m + n) * (r_eff + 1e-12) * 4.0 * (double)(m > n ? m : n) +
-              (double)(m * n) * denormal_floor(sc);
+              (double)(m * n) * denormal_floor(sc) +
+              64.0 * DBL_EPSILON * (double)((m + n) * (m + n)) * fz_maxabs(ai, (size_t)(m * n)) * sc;
         /* t = A+ A (n x n), then A t */
         for (i = 0; i < n; ++i)
             for (j = 0; j < n; ++j) {
