@@ -55,8 +55,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int n = fz_size(&in, 1, MAXN, &valid);
     static double u1[3 * MAXN], a1[3 * MAXN], u2[3 * MAXN], a2[3 * MAXN];
     double Rt[9], tt[3], R[9], t[3], R0[9], t0[3], *work, f = NAN, f0 = NAN, delta0, delta_min;
-    if (n == (1 << 21))
-        n = -5; /* no upper limit here: the caller's workspace bounds n */
+    if (!valid && n > 0)
+        n = -5; /* no upper limit here: the caller's workspace bounds n (bnb.c
+                   checks n), so only n < 1 must be rejected */
     if (!valid) {
         double w[9];
         st = mcg_linf_local(n, u1, a1, u2, a2, R, t, 1.0, 0.1, 5, w, &f, &steps);
