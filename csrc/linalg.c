@@ -612,6 +612,12 @@ int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
             }
         apply_q(nn, mm, at, tau, v, nn, 0, tmp);
     }
+    /* entries near DBL_MAX can still overflow in the wide-matrix path (found
+     * by fuzz_linalg: a 2 x 5 matrix with 1.8e308 gave a non-finite V with
+     * MCG_OK): never report success with non-finite output */
+    if (!all_finite(s, nn) || !all_finite(v, nn * nn) ||
+        (u != NULL && !all_finite(u, mm * min_sz(mm, nn))))
+        return MCG_ENUMERIC;
     return MCG_OK;
 }
 

@@ -154,8 +154,23 @@ static void test_bnb_polish_nonnegative(void)
           "bnb polish case: 0 <= lower_bound <= linf", res.linf, 0.0);
 }
 
+/* fuzz_linalg (long run): a 2 x 5 matrix with an entry of 1.8e308 gave
+ * MCG_OK with a non-finite V; now MCG_ENUMERIC or finite output. */
+static void test_svd_near_dbl_max(void)
+{
+    double a[10] = {0.0022, 1.04, 1.0, 1.0, 1.7976931348623157e308, 1.0, 0.0, 0.0, 0.0, 0.0};
+    double s[5], v[25], w[512];
+    int st = mcg_svd(2, 5, a, NULL, s, v, w, 512), ok = 1, i;
+    if (st == MCG_OK)
+        for (i = 0; i < 25; ++i)
+            ok = ok && isfinite(v[i]) && (i >= 5 || isfinite(s[i]));
+    check(st == MCG_ENUMERIC || (st == MCG_OK && ok), "svd near DBL_MAX: finite or MCG_ENUMERIC",
+          (double)st, 0.0);
+}
+
 int main(void)
 {
+    test_svd_near_dbl_max();
     test_bnb_polish_nonnegative();
     test_linf_local_negative_n();
     test_linear17_central_exact_cost();
