@@ -1111,7 +1111,11 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     if (lo < 0.0)
         lo = 0.0;
     res->lower_bound = lo;
-    c.floor = lo - 2.0 * o.tol;
+    /* the polish bisects f from this floor: below the certified bound by the
+     * tolerance, but never below 0 (f is an angle; a negative floor let the
+     * relaxed tests pass at negative bounds and linf came out < 0, found by
+     * fuzz_bnb) */
+    c.floor = lo - 2.0 * o.tol > 0.0 ? lo - 2.0 * o.tol : 0.0;
     if (o.polish_tol > 0.0 && o.polish_tol < o.resolution && o.max_blocks > 0) {
         long tests = 0;
         st = polish_slp(&c, &o, res, &tests, deadline);

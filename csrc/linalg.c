@@ -179,7 +179,7 @@ static void house_qr(size_t len, size_t ncol, double *at, double *tau,
     for (k = 0; k < ncol; ++k) {
         double *x = at + k * len + k;
         size_t nk = len - k;
-        double alpha, xn2, beta, sc;
+        double alpha, xn2, beta, sc, f, xmax;
         if (perm != NULL) {
             size_t best = k;
             for (j = k + 1; j < ncol; ++j)
@@ -195,8 +195,24 @@ static void house_qr(size_t len, size_t ncol, double *at, double *tau,
                 vn2[best] = vn2[k];
             }
         }
-        alpha = x[0];
-        xn2 = dot(x + 1, x + 1, nk - 1);
+        /* The matrix is scaled to max |a_ij| < 1, but a column can still be
+         * tiny next to the others (a graded matrix): below 1e-150 its
+         * squares would underflow into the denormals and the reflector lose
+         * its orthogonality (found by fuzz_linalg), so such a column is
+         * computed scaled by the power of two f (exact; the reflector is
+         * scale-invariant, beta scales back). f = 1 otherwise. */
+        f = 1.0;
+        xmax = max_abs(x, nk);
+        if (xmax > 0.0 && xmax < 1e-150)
+            f = ldexp(1.0, -scale_exponent(xmax));
+        alpha = x[0] * f;
+        if (f == 1.0) {
+            xn2 = dot(x + 1, x + 1, nk - 1);
+        } else {
+            xn2 = 0.0;
+            for (i = 1; i < nk; ++i)
+                xn2 += (x[i] * f) * (x[i] * f);
+        }
         if (xn2 == 0.0) {
             tau[k] = 0.0; /* already triangular in this column */
         } else {
@@ -204,10 +220,10 @@ static void house_qr(size_t len, size_t ncol, double *at, double *tau,
              * cancels */
             beta = -copysign(sqrt(alpha * alpha + xn2), alpha);
             tau[k] = (beta - alpha) / beta;
-            sc = 1.0 / (alpha - beta);
+            sc = f / (alpha - beta);
             for (i = 1; i < nk; ++i)
                 x[i] *= sc;
-            x[0] = beta;
+            x[0] = beta / f;
             for (j = k + 1; j < ncol; ++j) {
                 double *y = at + j * len + k;
                 double d = (y[0] + dot(x + 1, y + 1, nk - 1)) * tau[k];
@@ -596,6 +612,12 @@ int mcg_svd(int m, int n, const double *a, double *u, double *s, double *v,
             }
         apply_q(nn, mm, at, tau, v, nn, 0, tmp);
     }
+    /* entries near DBL_MAX can still overflow in the wide-matrix path (found
+     * by fuzz_linalg: a 2 x 5 matrix with 1.8e308 gave a non-finite V with
+     * MCG_OK): never report success with non-finite output */
+    if (!all_finite(s, nn) || !all_finite(v, nn * nn) ||
+        (u != NULL && !all_finite(u, mm * min_sz(mm, nn))))
+        return MCG_ENUMERIC;
     return MCG_OK;
 }
 
@@ -1119,6 +1141,8 @@ int mcg_rot_from_angle_axis(const double w[3], double r[9])
     if (w == NULL || r == NULL || !all_finite(w, 3))
         return MCG_EINVAL;
     theta = norm_small(w, 3);
+    if (!isfinite(theta))
+        return MCG_EINVAL; /* |w| > DBL_MAX: the angle overflows (found by fuzz_linalg) */
     if (theta == 0.0) {
         for (i = 0; i < 9; ++i)
             r[i] = (i % 4 == 0) ? 1.0 : 0.0;

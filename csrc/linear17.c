@@ -899,6 +899,10 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
             }
         }
     }
+    /* the cost is the quadratic form x^T M x of the Gram matrix: on exact
+     * data it rounds to a tiny negative number (found by fuzz_linear17) */
+    if (cost < 0.0)
+        cost = 0.0;
     res->cost_linear = sqrt(cost / n);
     memcpy(rlin, rbest, sizeof rlin);
     memcpy(tlin, tbest, sizeof tlin);
@@ -953,6 +957,8 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
         }
     }
 
+    if (cost < 0.0)
+        cost = 0.0; /* rounding of x^T M x, as above */
     /* scale observability: conditioning of the scale equation and the
      * first-order std of |t| from the residual (normalised frame) */
     if (solve_t(m, rbest, unit_mode, tbest, 1, &ts) != MCG_OK)

@@ -185,7 +185,8 @@ int mcg_spd_solve(int n, const double *a, const double *b, double *x);
  * Hamilton convention, R = rotation that maps vectors as R v (active).
  * All return MCG_EINVAL for NULL pointers or NaN/inf; the *_from_rot ones
  * also when r is not a rotation (see the top of this file); rot_from_quat
- * when q = 0. */
+ * when q = 0; mcg_rot_from_angle_axis also for an angle |w| that overflows
+ * (> DBL_MAX). */
 int mcg_rot_from_angle_axis(const double w[3], double r[9]);
 int mcg_angle_axis_from_rot(const double r[9], double w[3]);
 int mcg_rot_from_quat(const double q[4], double r[9]); /* q normalised here */

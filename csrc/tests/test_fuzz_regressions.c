@@ -1,0 +1,181 @@
+/* test_fuzz_regressions.c -- one check per finding of the libFuzzer harnesses
+ * of fuzz/c/ (fuzz/README.md lists them), on the input that triggered it
+ * (reduced to its meaning), so a fixed bug stays fixed. */
+#include "mcgeom.h"
+#include "../internal.h"
+#include "testutil.h"
+
+#include <float.h>
+
+/* fuzz_linalg: an angle-axis vector with finite components whose norm
+ * overflows (-DBL_MAX, ...) gave a NaN matrix with MCG_OK. */
+static void test_angle_axis_overflow(void)
+{
+    double w[3] = {-DBL_MAX, -1.3e232, DBL_MAX}, r[9];
+    check_status(mcg_rot_from_angle_axis(w, r), MCG_EINVAL,
+                 "rot_from_angle_axis: |w| > DBL_MAX rejected");
+    w[0] = 1e300;
+    w[2] = -1e300;
+    check_status(mcg_rot_from_angle_axis(w, r), MCG_OK,
+                 "rot_from_angle_axis: |w| = 1.4e300 still a rotation");
+    check(isfinite(r[0] + r[1] + r[2] + r[3] + r[4] + r[5] + r[6] + r[7] + r[8]),
+          "rot_from_angle_axis: |w| = 1.4e300 finite", 0.0, 0.0);
+}
+
+/* fuzz_linalg: a 9 x 3 matrix with a column of size 1e-8 next to one of
+ * 1e150 (a graded matrix): the reflector of the small column was computed
+ * from squares in the denormal range, Q lost its orthonormality (2.7e-9). */
+static void test_qr_graded_columns(void)
+{
+    double a[27], q[27], r[9], w[64], e = 0.0;
+    int i, j, k;
+    for (i = 0; i < 9; ++i) {
+        a[3 * i] = (i % 2) ? 1e-8 * (i + 1) : 0.0;
+        a[3 * i + 1] = 2.5 * (i + 1) - 0.3 * i * i;
+        a[3 * i + 2] = (i % 2) ? 1e150 * (i + 1) : -1.27e126 * (i + 1);
+    }
+    check_status(mcg_qr(9, 3, a, q, r, w, 64), MCG_OK, "qr of a graded 9 x 3 matrix");
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            double s = 0.0;
+            for (k = 0; k < 9; ++k)
+                s += q[3 * k + i] * q[3 * k + j];
+            s = fabs(s - (i == j ? 1.0 : 0.0));
+            if (s > e)
+                e = s;
+        }
+    check(e <= 1e-14, "qr of a graded matrix: |Q^T Q - I|", e, 1e-14);
+}
+
+/* fuzz_linear17: a central camera (all rays through one centre, gc_case
+ * CENTRAL) with exact correspondences: the algebraic cost x^T M x rounds to
+ * slightly below 0 and cost_final = sqrt(cost / n) was NaN with MCG_OK. */
+static void test_linear17_central_exact_cost(void)
+{
+    double o1[3 * 55], d1[3 * 55], o2[3 * 55], d2[3 * 55], w[3], R[9], t[3];
+    int trial, i, k, bad = 0, ok = 0;
+    mcg_linear17_result res;
+    for (trial = 0; trial < 200; ++trial) {
+        double c[3] = {2 * urand() - 1, 2 * urand() - 1, 2 * urand() - 1};
+        for (k = 0; k < 3; ++k) {
+            w[k] = 0.3 * (2 * urand() - 1);
+            t[k] = 2 * (2 * urand() - 1);
+        }
+        mcg_rot_from_angle_axis(w, R);
+        for (i = 0; i < 55; ++i) {
+            double X[3] = {10 * urand() - 5, 10 * urand() - 5, 1 + 19 * urand()};
+            for (k = 0; k < 3; ++k) {
+                o1[3 * i + k] = o2[3 * i + k] = c[k];
+                d1[3 * i + k] = X[k] - c[k];
+                d2[3 * i + k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] +
+                                t[k] - c[k];
+            }
+        }
+        if (mcg_linear17(55, o1, d1, o2, d2, NULL, &res) != MCG_OK)
+            continue;
+        ++ok;
+        if (!isfinite(res.cost_final) || !isfinite(res.cost_linear) || isnan(res.scale_rel_std))
+            ++bad;
+    }
+    check(ok > 0 && bad == 0, "linear17: central exact data, costs never NaN (of MCG_OK)",
+          (double)bad, 0.0);
+}
+
+/* fuzz_linf_local: n < 0 computed the work layout (work + 8 n) before
+ * rejecting n: a pointer overflow (undefined behaviour; UBSan reports it,
+ * the plain build passed by luck). Now MCG_EINVAL before any arithmetic. */
+static void test_linf_local_negative_n(void)
+{
+    double u[3] = {0, 0, 1}, R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {0, 0, 0}, w[9], f;
+    int steps;
+    check_status(mcg_linf_local(-1, u, u, u, u, R, t, 1.0, 0.1, 5, w, &f, &steps), MCG_EINVAL,
+                 "linf_local: n = -1 rejected");
+    check_status(mcg_linf_local(-2147483647 - 1, u, u, u, u, R, t, 1.0, 0.1, 5, w, &f, &steps),
+                 MCG_EINVAL, "linf_local: n = INT_MIN rejected");
+}
+
+/* fuzz_bnb: one camera, 5 near-exact pairs, tol 5.4e-5, polish on: the
+ * polish bisected f from a floor of (lower bound - 2 tol) < 0, the relaxed
+ * tests passed at negative bounds and linf = lower_bound = -7.7e-5 came
+ * back with MCG_OK (the decoded input, exact hexadecimal values). */
+static void test_bnb_polish_nonnegative(void)
+{
+    static const double d1[15] = {
+        -0x1.ff81ff81ff82p+1, 0x1.6d17ed17ed17fp+2, 0x1.89e289e289e28p+3,
+        -0x1.fb8ffb8ffb9p+1, 0x1.5064506450645p+2, 0x1.2600e600e600ep+3,
+        -0x1.48a148a148a2p-4, -0x1.3421342134216p-2, 0x1.26ee66ee66ee6p+3,
+        -0x1.48a148a148a2p-4, -0x1.3421342134216p-2, 0x1.c3ffc3ffc3ffcp+0,
+        -0x1.bb98bb98bb98cp+1, 0x1.26ca26ca26ca2p+1, 0x1.9eb67eb67eb68p+3,
+    };
+    static const double a1[15] = {
+        0x1.28fp+1, -0x1.8e178e178e179p-1, -0x1.072p+0,
+        0x1.919p+2, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+    };
+    static const double d2[15] = {
+        0x1.d124d2992d6acp-3, -0x1.0e80ce833035ep-2, 0x1.dce9c1542673ap+3,
+        -0x1.ddc38d78f6efp-2, 0x1.a2031d386e84dp-1, 0x1.80bf00774f19ap+3,
+        0x1.17b44b41e90c6p+0, -0x1.368d4c5295adep+2, 0x1.14a8957fffb88p+3,
+        -0x1.f59f1d52d737p-3, -0x1.58b89179f274p+0, 0x1.1aac6d9b506ep+1,
+        -0x1.959689818c49p-2, -0x1.caeb34effdbc4p+1, 0x1.bf48edfe5e6p+3,
+    };
+    static const double a2[15] = {
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+        -0x1.ff13ff13ff14p-1, -0x1.8e178e178e179p-1, -0x1.87ff87ff87ff8p-1,
+    };
+    static const double R0[9] = {0x1.919p+2, 0x1.919p+2, 0x1.9p-6, 0x1.b74p-1, -0x1.62c8p+1, 0x1.9258p+2, 0x0p+0, 0x0p+0, 0x0p+0};
+    int group[5] = {0, 0, 0, 0, 0};
+    mcg_bnb_options opt;
+    mcg_bnb_result res;
+    static double work[1 << 16];
+    size_t ws;
+    int st;
+    mcg_bnb_default_options(&opt);
+    opt.resolution = 0x1.47ae147ae147bp-7;
+    opt.tol = 0x1.c1ce8a96b25aap-15;
+    opt.max_blocks = 115;
+    opt.max_queue = 1701;
+    opt.grid = 1;
+    opt.preemptive = 1;
+    opt.working_sets = 1;
+    opt.polish_tol = 0x1.ed7373a856892p-15;
+    opt.bound_steps = 0;
+    ws = mcg_bnb_work_size(5, 1, &opt);
+    check(ws > 0 && ws <= sizeof work / sizeof work[0], "bnb polish case: work size", (double)ws,
+          0.0);
+    st = mcg_bnb_linf(5, d1, a1, d2, a2, group, 1, R0, &opt, &res, work, ws);
+    check_status(st, MCG_OK, "bnb polish case: status");
+    check(res.linf >= 0.0 && res.lower_bound >= 0.0 && res.lower_bound <= res.linf,
+          "bnb polish case: 0 <= lower_bound <= linf", res.linf, 0.0);
+}
+
+/* fuzz_linalg (long run): a 2 x 5 matrix with an entry of 1.8e308 gave
+ * MCG_OK with a non-finite V; now MCG_ENUMERIC or finite output. */
+static void test_svd_near_dbl_max(void)
+{
+    double a[10] = {0.0022, 1.04, 1.0, 1.0, 1.7976931348623157e308, 1.0, 0.0, 0.0, 0.0, 0.0};
+    double s[5], v[25], w[512];
+    int st = mcg_svd(2, 5, a, NULL, s, v, w, 512), ok = 1, i;
+    if (st == MCG_OK)
+        for (i = 0; i < 25; ++i)
+            ok = ok && isfinite(v[i]) && (i >= 5 || isfinite(s[i]));
+    check(st == MCG_ENUMERIC || (st == MCG_OK && ok), "svd near DBL_MAX: finite or MCG_ENUMERIC",
+          (double)st, 0.0);
+}
+
+int main(void)
+{
+    test_svd_near_dbl_max();
+    test_bnb_polish_nonnegative();
+    test_linf_local_negative_n();
+    test_linear17_central_exact_cost();
+    test_angle_axis_overflow();
+    test_qr_graded_columns();
+    printf("%d checks, %d failed\n", n_checks, n_failed);
+    return n_failed != 0;
+}

@@ -1,0 +1,132 @@
+/*
+ * fuzz_refine.c -- libFuzzer harness of mcg_refine_motion, Levenberg-
+ * Marquardt on SO(3) x R^3 of the Sampson angular error of the generalized
+ * epipolar constraint (thesis eq. 8.15), robust losses by IRLS, weights,
+ * fix_scale, and decoded options.
+ *
+ * Inputs: mode 0 a synthetic rig scene started near the true motion, mode 1
+ * arbitrary arrays and start. Invariants: bad sizes, options, weights or a
+ * start that is not a rotation give MCG_EINVAL and leave R, t untouched;
+ * NaN/inf inputs never MCG_OK; on MCG_OK R is a rotation, t finite, the
+ * cost did not increase, iterations <= max_iterations, the reason is one of
+ * MCG_REFINE_STOP_*, n_used <= n, the statistics are not NaN, and with
+ * fix_scale |t| is kept.
+ */
+#include "fuzz_input.h"
+#include "mcgeom.h"
+
+#define MAXN 64
+
+static double norm3(const double *v)
+{
+    return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_in in = fz_make(data, size);
+    int mode = fz_u8(&in) % 2, valid, st, i, use_w, use_opt;
+    int n = fz_size(&in, 6, MAXN, &valid);
+    static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], w[MAXN];
+    double Rt[9], tt[3], R[9], t[3], R0[9], t0[3];
+    mcg_refine_options opt;
+    mcg_refine_result res;
+    if (n == (1 << 21))
+        n = (1 << 26) + 1; /* the limit is 2^26 pairs */
+    if (!valid && n >= 6 && n <= (1 << 26))
+        n = 5;
+    mcg_refine_default_options(&opt);
+    use_opt = fz_u8(&in) % 4;
+    if (use_opt == 1) { /* any option values */
+        opt.loss = fz_int(&in, -1, 4);
+        opt.loss_scale = fz_double(&in);
+        opt.max_iterations = fz_int(&in, -1, 200);
+        opt.cost_tolerance = fz_double(&in);
+        opt.step_tolerance = fz_double(&in);
+        opt.initial_lambda = fz_double(&in);
+        opt.fix_scale = fz_int(&in, -1, 2);
+    } else if (use_opt >= 2) { /* valid option values */
+        opt.loss = fz_int(&in, 0, 3);
+        opt.loss_scale = fz_range(&in, 1e-6, 0.5);
+        opt.max_iterations = fz_int(&in, 0, 60);
+        opt.fix_scale = fz_u8(&in) & 1;
+        opt.initial_lambda = fz_range(&in, 0.0, 1e3);
+    }
+    if (!valid) {
+        st = mcg_refine_motion(n, o1, d1, o2, d2, NULL, &opt, R, t, &res);
+        FZ_CHECK(st == MCG_EINVAL, "refine(n = %d) returned %d", n, st);
+        return 0;
+    }
+    if (mode == 0) {
+        double dw[3], Rd[9];
+        int j, k;
+        fz_rotation(&in, Rt);
+        for (i = 0; i < 3; ++i)
+            tt[i] = fz_range(&in, -2.0, 2.0);
+        fz_scene(&in, n, fz_int(&in, 1, 8), fz_u8(&in) & 1, Rt, tt, o1, d1, o2, d2, NULL);
+        /* the start: the truth moved by a decoded small rotation and shift */
+        for (i = 0; i < 3; ++i)
+            dw[i] = fz_range(&in, -0.2, 0.2);
+        if (mcg_rot_from_angle_axis(dw, Rd) != MCG_OK)
+            return 0;
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) {
+                double s = 0.0;
+                for (k = 0; k < 3; ++k)
+                    s += Rd[3 * i + k] * Rt[3 * k + j];
+                R[3 * i + j] = s;
+            }
+        for (i = 0; i < 3; ++i)
+            t[i] = tt[i] + fz_range(&in, -0.3, 0.3);
+    } else {
+        fz_matrix(&in, o1, (size_t)n, 3);
+        fz_matrix(&in, d1, (size_t)n, 3);
+        fz_matrix(&in, o2, (size_t)n, 3);
+        fz_matrix(&in, d2, (size_t)n, 3);
+        if (fz_u8(&in) & 1)
+            fz_doubles(&in, R, 9);
+        else
+            fz_rotation(&in, R);
+        fz_doubles(&in, t, 3);
+    }
+    use_w = fz_u8(&in) % 3;
+    for (i = 0; i < n; ++i)
+        w[i] = use_w == 1 ? fz_range(&in, 0.0, 3.0) : use_w == 2 ? fz_double(&in) : 1.0;
+    memcpy(R0, R, sizeof R);
+    memcpy(t0, t, sizeof t);
+    st = mcg_refine_motion(n, o1, d1, o2, d2, use_w ? w : NULL, use_opt ? &opt : NULL, R, t,
+                           &res);
+    FZ_CHECK(fz_status_known(st), "refine status %d", st);
+    if (st != MCG_OK) {
+        FZ_CHECK(memcmp(R, R0, sizeof R) == 0 && memcmp(t, t0, sizeof t) == 0,
+                 "refine: R, t modified on error %d", st);
+    }
+    if (!fz_all_finite(o1, 3 * (size_t)n) || !fz_all_finite(d1, 3 * (size_t)n) ||
+        !fz_all_finite(o2, 3 * (size_t)n) || !fz_all_finite(d2, 3 * (size_t)n) ||
+        !fz_all_finite(R0, 9) || !fz_all_finite(t0, 3) || (use_w && !fz_all_finite(w, (size_t)n))) {
+        FZ_CHECK(st == MCG_EINVAL, "refine of non-finite input: %d", st);
+        return 0;
+    }
+    if (st != MCG_OK)
+        return 0;
+    FZ_CHECK(fz_is_rotation(R, 1e-9), "refine: R not a rotation (%g)", fz_orth_err3(R));
+    FZ_CHECK(fz_all_finite(t, 3), "refine: non-finite t");
+    FZ_CHECK(isfinite(res.initial_cost) && isfinite(res.final_cost) && isfinite(res.rms) &&
+                 res.final_cost >= 0.0,
+             "refine: costs %g %g rms %g", res.initial_cost, res.final_cost, res.rms);
+    FZ_CHECK(res.final_cost <= res.initial_cost * (1.0 + 1e-12) + 1e-300,
+             "refine: cost increased %.17g -> %.17g", res.initial_cost, res.final_cost);
+    FZ_CHECK(res.iterations >= 0 &&
+                 res.iterations <= (use_opt ? opt.max_iterations : 50),
+             "refine: %d iterations", res.iterations);
+    FZ_CHECK(res.reason >= MCG_REFINE_STOP_COST && res.reason <= MCG_REFINE_STOP_STALLED,
+             "refine: reason %d", res.reason);
+    FZ_CHECK(res.n_used >= 0 && res.n_used <= n, "refine: n_used %d", res.n_used);
+    FZ_CHECK(fz_all_finite(res.info, 36) && !isnan(res.sigma2) && !isnan(res.scale_rel_std) &&
+                 !isnan(res.info_cond),
+             "refine: NaN statistics");
+    if (use_opt && opt.fix_scale)
+        FZ_CHECK(fabs(norm3(t) - norm3(t0)) <= 1e-9 * norm3(t0), "refine: fix_scale |t| %g -> %g",
+                 norm3(t0), norm3(t));
+    return 0;
+}

@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""Write the seed corpora of the fuzzing harnesses into fuzz/build/seeds/<harness>/.
+
+    python fuzz/make_corpus.py [harness ...]
+
+Seeds are generated, never committed: deterministic (fixed RNG seed) byte
+strings in the input format the harness decodes.
+
+- C harnesses (fuzz/c/fuzz_input.h): the first byte selects the routine
+  (``MODES`` gives how many each harness has), the rest is a stream the
+  decoder reads as sizes and doubles; each seed is encoded with the
+  decoder's "nice" double format (selector byte < 224, then a 16-bit integer
+  / 4096), a few with special values (NaN, inf, denormals, 1e150, DBL_MAX).
+- fuzz_calibration: byte 0 picks the calibration file of tests/data/calibration
+  (and with it the loader), byte 1 the file or a sibling it reads, the rest is
+  the text; the seeds are the hand-written files themselves, whole and
+  truncated.
+- fuzz_estimate, fuzz_estimators: byte strings decoded by
+  atheris.FuzzedDataProvider (sizes, seeds, flags, floats).
+"""
+from __future__ import annotations
+
+import random
+import struct
+import sys
+from pathlib import Path
+
+FUZZ = Path(__file__).resolve().parent
+ROOT = FUZZ.parent
+SEEDS = FUZZ / "build" / "seeds"
+
+# routines selected by the first byte of each C harness's input
+MODES = {"fuzz_linalg": 8, "fuzz_rays": 3, "fuzz_cls": 3, "fuzz_linear17": 2, "fuzz_refine": 2,
+         "fuzz_lp": 3, "fuzz_cone": 2, "fuzz_bnb": 2, "fuzz_linf_local": 1,
+         "fuzz_translation": 3}
+
+# the calibration files, in the order fuzz/python/fuzz_calibration.py indexes
+# them, with the sibling files its byte 1 can select instead (byte 1 % 4 >= 2:
+# sibling number byte 1 % len(siblings))
+CALIBRATION_FILES = [
+    ("mcgeom/rig4.json", []),
+    ("opencv/rig4.yml", []),
+    ("opencv/stereo_calib.yml", ["opencv/stereo_calib/intrinsics.yml",
+                                 "opencv/stereo_calib/extrinsics.yml"]),
+    ("kalibr/camchain-equidistant.yaml", []),
+    ("kalibr/camchain-imucam-radtan.yaml", []),
+    ("colmap/rig_config.json", ["colmap/cameras.txt", "colmap/images.txt"]),
+    ("colmap/rig_config_legacy.json", ["colmap/cameras.txt", "colmap/images.txt"]),
+]
+
+
+def nice(x: float) -> bytes:
+    """A double in the decoder's nice format (exact for multiples of 1/4096)."""
+    v = max(-32768, min(32767, round(x * 4096)))
+    return bytes([0]) + struct.pack("<h", v)
+
+
+def special(k: int) -> bytes:
+    """A special value: index into fz_special's table (k = 28 NaN, 29 inf)."""
+    return bytes([230, k])
+
+
+def raw(x: float) -> bytes:
+    return bytes([250]) + struct.pack("<d", x)
+
+
+def c_seeds(name: str, rng: random.Random) -> list[bytes]:
+    out = []
+    for mode in range(MODES[name]):
+        for length in (16, 64, 256, 1024, 3000):
+            body = bytearray()
+            while len(body) < length:
+                r = rng.random()
+                if r < 0.15:
+                    # a size-like 16-bit value (decoders take it modulo the range)
+                    body += bytes([rng.randrange(15)]) + struct.pack("<H", rng.randrange(65536))
+                elif r < 0.9:
+                    body += nice(rng.uniform(-4.0, 4.0))
+                elif r < 0.97:
+                    body += bytes([rng.randrange(256)])
+                else:
+                    body += special(rng.randrange(31)) if rng.random() < 0.7 else \
+                        raw(rng.choice([5e-324, 1e150, -1e-300, 1.7976931348623157e308]))
+            out.append(bytes([mode]) + bytes(body))
+    return out
+
+
+def calibration_seeds() -> list[bytes]:
+    """Each file (byte 1 = 0: the file itself), whole and truncated, and each
+    sibling (byte 1 = 2 or 3 selects sibling 0 or 1 of two)."""
+    base = ROOT / "tests" / "data" / "calibration"
+    out = []
+    for i, (rel, siblings) in enumerate(CALIBRATION_FILES):
+        text = (base / rel).read_bytes()
+        out += [bytes([i, 0]) + text, bytes([i, 0]) + text[: len(text) // 2]]
+        for sel in (2, 3)[: len(siblings)]:
+            out.append(bytes([i, sel]) + (base / siblings[sel % len(siblings)]).read_bytes())
+    return out
+
+
+def random_seeds(rng: random.Random, n: int = 24) -> list[bytes]:
+    return [bytes(rng.randrange(256) for _ in range(rng.choice([32, 128, 512, 2048])))
+            for _ in range(n)]
+
+
+def seeds_for(name: str) -> list[bytes]:
+    rng = random.Random(f"mcgeom-{name}")
+    if name in MODES:
+        return c_seeds(name, rng)
+    if name == "fuzz_calibration":
+        return calibration_seeds()
+    return random_seeds(rng)
+
+
+def main(argv: list[str]) -> int:
+    known = set(MODES) | {p.stem for p in (FUZZ / "python").glob("fuzz_*.py")}
+    for name in argv or sorted(known):
+        if name not in known:
+            print(f"make_corpus: no seeds defined for {name}", file=sys.stderr)
+            return 2
+        d = SEEDS / name
+        d.mkdir(parents=True, exist_ok=True)
+        for old in d.iterdir():
+            old.unlink()
+        for k, s in enumerate(seeds_for(name)):
+            (d / f"seed-{k:03d}").write_bytes(s)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
