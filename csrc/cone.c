@@ -477,6 +477,12 @@ static int solve_sub(const cone_ctx *k, const mcg_cone_options *o, double *lo,
     fbest = max_angle(k, x, NULL);
     ub = fbest;
     *conv = 0;
+    if (!(fbest < HALF_PI) && *iters >= o->max_iterations) {
+        /* the budget is spent (by earlier active-set rounds): this test is
+         * an iteration too; return unconverged with the bound in hand */
+        *fx = fbest;
+        return MCG_OK;
+    }
     if (!(fbest < HALF_PI)) {
         /* is there any point within pi / 2 of every axis? */
         memcpy(y, x, sizeof(y));

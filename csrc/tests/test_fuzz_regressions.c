@@ -168,8 +168,34 @@ static void test_svd_near_dbl_max(void)
           (double)st, 0.0);
 }
 
+/* fuzz_cone (long run): with a small max_iterations, the budget was spent by
+ * the first active-set rounds and a later round still ran its pi/2
+ * feasibility test, so res.iterations came out above max_iterations (12 >
+ * 11). The decoded input of the finding (11 cones, options as decoded). */
+static void test_cone_iteration_budget(void)
+{
+    static const double apex[33] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, -0.92971694514381631, -1, -0.99218738078889146, -1, 0.84313725490196068, 1, 1, 0.33333333333333326};
+    static const double axis[33] = {-0.041147478446631573, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, -4.06103515625, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 0.066666666666666666, 1.8630502784771497, 1.9333333333333333, 2.0088553190407161, 1.9552859795020472, 0.22352941176470598, 0.066666666666666666, -5.33349609375, 0.68888888888888899};
+    mcg_cone_options o;
+    mcg_cone_result res;
+    int st;
+    mcg_cone_default_options(&o);
+    o.tolerance = 0.0066666666670000003;
+    o.abs_tolerance = 9.9999999999999998e-13;
+    o.max_iterations = 11;
+    o.max_newton = 91;
+    o.max_radius = 1000000;
+    o.active_tolerance = 1e-08;
+    st = mcg_cone_linf(11, apex, axis, &o, &res);
+    check(st == MCG_OK || st == MCG_EINFEASIBLE, "cone: the finding's input solved", (double)st,
+          0.0);
+    check(res.iterations <= o.max_iterations, "cone: iterations <= max_iterations (11)",
+          (double)res.iterations, (double)o.max_iterations);
+}
+
 int main(void)
 {
+    test_cone_iteration_budget();
     test_svd_near_dbl_max();
     test_bnb_polish_nonnegative();
     test_linf_local_negative_n();
