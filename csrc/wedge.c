@@ -98,27 +98,36 @@ int mcg_wedge_normals(const double v[3], const double vp[3], double eps,
 int mcg_wedge_unit(const double a[3], const double b[3], double sa, double sb,
                    double n1[3], double n2[3])
 {
-    double w[3], y[3], nw, c, s2, p, q, y2, r;
+    double w[3], d[3], e[3], nw, nd, ne, y1, y2v, y2, r;
     int i;
 
     cross3(a, b, w); /* = v x v' / (|v| |v'|) */
-    s2 = dot3(w, w); /* sin^2 alpha, accurate from the cross product */
-    c = dot3(a, b);  /* = -cos alpha */
-    if (!(s2 > 1e-24))
+    nw = sqrt(dot3(w, w)); /* sin alpha, accurate from the cross product */
+    if (!(nw > 1e-12))
         return MCG_EDEGENERATE; /* v parallel or anti-parallel to v' */
-    nw = sqrt(s2);
-    /* y = p a + q b with [1 c; c 1] [p; q] = [sa; sb] */
-    p = (sa - c * sb) / s2;
-    q = (sb - c * sa) / s2;
-    /* |y|^2 = [sa sb] [p q]^T, as eq. 10.10 */
-    y2 = sa * p + sb * q;
+    /* y (y.a = sa, y.b = sb, y in the plane of a and b) in the orthonormal
+     * basis u1 = (a - b) / |a - b|, u2 = (a + b) / |a + b| of that plane:
+     * a.u1 = -b.u1 = |a - b| / 2, a.u2 = b.u2 = |a + b| / 2, so
+     * y = (sa - sb) / |a - b| u1 + (sa + sb) / |a + b| u2 and |y|^2 is a sum
+     * of two squares. (Solving [1 c; c 1] [p; q] = [sa; sb] in the basis
+     * (a, b) instead cancels when a is nearly parallel to +-b: |n| then
+     * drifted from 1 by 1e-5, found by fuzz_rays.) */
+    for (i = 0; i < 3; ++i) {
+        d[i] = a[i] - b[i];
+        e[i] = a[i] + b[i];
+    }
+    nd = sqrt(dot3(d, d));
+    ne = sqrt(dot3(e, e));
+    y1 = (sa - sb) / nd;  /* coefficient of d / nd */
+    y2v = (sa + sb) / ne; /* coefficient of e / ne */
+    y2 = y1 * y1 + y2v * y2v;
     if (!(y2 < 1.0 - 1e-12))
         return MCG_EDEGENERATE; /* cones overlap or are nested: no wedge */
     r = sqrt(1.0 - y2) / nw;
     for (i = 0; i < 3; ++i) {
-        y[i] = p * a[i] + q * b[i];
-        n1[i] = y[i] + r * w[i];
-        n2[i] = y[i] - r * w[i];
+        const double yi = y1 * d[i] / nd + y2v * e[i] / ne;
+        n1[i] = yi + r * w[i];
+        n2[i] = yi - r * w[i];
     }
     return MCG_OK;
 }

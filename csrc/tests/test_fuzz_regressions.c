@@ -193,8 +193,36 @@ static void test_cone_iteration_budget(void)
           (double)res.iterations, (double)o.max_iterations);
 }
 
+/* fuzz_rays (long run): bearings nearly parallel or anti-parallel (up to
+ * 1.7e-4 rad) and wide error bounds: |y|^2 came from [1 c; c 1] [p; q] =
+ * [sa; sb] in the basis (a, b), which cancels there, and the normals had
+ * |n|^2 = 0.99999 (planes off by 1e-5) with MCG_OK. Three of the finding's
+ * decoded inputs. */
+static void test_wedge_near_parallel(void)
+{
+    static const double in[3][8] = {
+        {0, 0, -0.0625, -0.000244140625, 1.9305930352295117e-197, 1.443115234375,
+         1.443115234375, 1.443115234375},
+        {0, 4.249755859375, 0, -0.000244140625, -6.375, -0.000244140625, 0.313720703125,
+         0.313720703125},
+        {0, 0.690185546875, 0.690185546875, 0.002685546875, -7.309814453125, -7.309814453125,
+         0.690185546875, 0.690185546875}};
+    double n1[3], n2[3], worst = 0.0;
+    int k, ok = 0;
+    for (k = 0; k < 3; ++k) {
+        if (mcg_wedge_normals(in[k], in[k] + 3, in[k][6], in[k][7], n1, n2) != MCG_OK)
+            continue;
+        ++ok;
+        worst = fmax(worst, fabs(n1[0] * n1[0] + n1[1] * n1[1] + n1[2] * n1[2] - 1.0));
+        worst = fmax(worst, fabs(n2[0] * n2[0] + n2[1] * n2[1] + n2[2] * n2[2] - 1.0));
+    }
+    check(ok == 3, "wedge: the finding's inputs give wedges", (double)ok, 3.0);
+    check(worst <= 1e-12, "wedge: unit normals there", worst, 1e-12);
+}
+
 int main(void)
 {
+    test_wedge_near_parallel();
     test_cone_iteration_budget();
     test_svd_near_dbl_max();
     test_bnb_polish_nonnegative();
