@@ -66,3 +66,10 @@ def floats(fdp, n: int, special: bool = True) -> np.ndarray:
         else:
             out[i] = fdp.ConsumeFloatInRange(-1.0, 1.0)
     return out
+
+
+def cross_fraction(fdp, rig) -> float:
+    """Mostly none or few cross-camera matches (many make make_problem fail)."""
+    if len(rig.cameras) < 2 or fdp.ConsumeBool():
+        return 0.0
+    return fdp.ConsumeFloatInRange(0.0, 0.3)

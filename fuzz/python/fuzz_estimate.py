@@ -78,13 +78,6 @@ def mutate_ids(fdp, ids: np.ndarray, ncams: int):
     return ids
 
 
-def cross_fraction(fdp, rig) -> float:
-    """Mostly none or few cross-camera matches (many make make_problem fail)."""
-    if len(rig.cameras) < 2 or fdp.ConsumeBool():
-        return 0.0
-    return fdp.ConsumeFloatInRange(0.0, 0.3)
-
-
 def TestOneInput(data: bytes) -> None:
     fdp = atheris.FuzzedDataProvider(data)
     rig = rig_for(fdp.ConsumeIntInRange(0, len(RIGS) - 1))
@@ -95,7 +88,7 @@ def TestOneInput(data: bytes) -> None:
     try:
         R, t = synth.random_motion(np.random.default_rng(seed), max_angle=angle, t_norm=tn)
         prob = synth.make_problem(rig, R, t, n, rng=seed,
-                                  cross_fraction=cross_fraction(fdp, rig),
+                                  cross_fraction=_common.cross_fraction(fdp, rig),
                                   pixel_noise=fdp.ConsumeFloatInRange(0.0, 3.0),
                                   outlier_fraction=fdp.ConsumeFloatInRange(0.0, 0.6))
     except _common.ALLOWED as exc:

@@ -43,7 +43,7 @@ def synthetic_rays(fdp):
                                max_angle=fdp.ConsumeFloatInRange(0.0, 3.2),
                                t_norm=fdp.ConsumeFloatInRange(0.0, 2.0))
     prob = synth.make_problem(rig, R, t, n, rng=seed,
-                              cross_fraction=cross_fraction(fdp, rig),
+                              cross_fraction=_common.cross_fraction(fdp, rig),
                               pixel_noise=fdp.ConsumeFloatInRange(0.0, 2.0),
                               outlier_fraction=fdp.ConsumeFloatInRange(0.0, 0.5))
     return rig.ray_pairs(prob.pixels1, prob.pixels2, prob.cam1, prob.cam2)
@@ -110,13 +110,6 @@ def options_for(fdp, name: str) -> dict:
     elif name == "linear17" and fdp.ConsumeBool():
         opts = {"refine": fdp.ConsumeBool(), "max_iterations": fdp.ConsumeIntInRange(-1, 200)}
     return opts
-
-
-def cross_fraction(fdp, rig) -> float:
-    """Mostly none or few cross-camera matches (many make make_problem fail)."""
-    if len(rig.cameras) < 2 or fdp.ConsumeBool():
-        return 0.0
-    return fdp.ConsumeFloatInRange(0.0, 0.3)
 
 
 def TestOneInput(data: bytes) -> None:
