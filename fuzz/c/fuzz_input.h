@@ -198,6 +198,33 @@ static inline double *fz_alloc(size_t n)
         }                                                                      \
     } while (0)
 
+/* Small 3-vector / 3x3 helpers shared by the harnesses (the library keeps
+ * its own static). */
+static inline double fz_dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void fz_cross3(const double *a, const double *b, double *c)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* c = a b for row-major 3x3 matrices (c must not alias a or b) */
+static inline void fz_matmul3(const double a[9], const double b[9], double c[9])
+{
+    int i, j, k;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            double s = 0.0;
+            for (k = 0; k < 3; ++k)
+                s += a[3 * i + k] * b[3 * k + j];
+            c[3 * i + j] = s;
+        }
+}
+
 static inline int fz_all_finite(const double *x, size_t n)
 {
     size_t i;

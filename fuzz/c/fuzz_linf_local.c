@@ -77,17 +77,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fz_doubles(&in, t, 3);
     } else { /* the truth moved a little, as the block centre of bnb.c */
         double dw[3], Rd[9];
-        int j, k;
         for (i = 0; i < 3; ++i)
             dw[i] = fz_range(&in, -0.05, 0.05);
         mcg_rot_from_angle_axis(dw, Rd);
-        for (i = 0; i < 3; ++i)
-            for (j = 0; j < 3; ++j) {
-                double s = 0.0;
-                for (k = 0; k < 3; ++k)
-                    s += Rd[3 * i + k] * Rt[3 * k + j];
-                R[3 * i + j] = s;
-            }
+        fz_matmul3(Rd, Rt, R);
         for (i = 0; i < 3; ++i)
             t[i] = tt[i] + fz_range(&in, -0.05, 0.05);
     }

@@ -18,11 +18,6 @@
 #define MAXN 40
 #define HALF_PI 1.5707963267948966
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 static void fuzz_plucker_rows(fz_in *in)
 {
     int valid, st, k, i, j;
@@ -58,9 +53,9 @@ static void fuzz_plucker_rows(fz_in *in)
     for (k = 0; k < n; ++k) {
         const double *r = r1 + 6 * k;
         double om = 2.0 * fz_maxabs(o1 + 3 * k, 3); /* no underflow */
-        FZ_CHECK(fabs(dot3(r, r) - 1.0) <= 1e-14, "plucker: |d| = %g", sqrt(dot3(r, r)));
-        FZ_CHECK(fabs(dot3(r, r + 3)) <= 1e-14 * (om + 1e-300) + 1e-300, "plucker: d . m = %g",
-                 dot3(r, r + 3));
+        FZ_CHECK(fabs(fz_dot3(r, r) - 1.0) <= 1e-14, "plucker: |d| = %g", sqrt(fz_dot3(r, r)));
+        FZ_CHECK(fabs(fz_dot3(r, r + 3)) <= 1e-14 * (om + 1e-300) + 1e-300, "plucker: d . m = %g",
+                 fz_dot3(r, r + 3));
     }
     if (mcg_plucker_from_points(n, o2, d2, r2) != MCG_OK)
         return;
@@ -132,7 +127,7 @@ static void fuzz_residuals(fz_in *in)
         if (exact) {
             /* bearings of at least 1e-3 m: the rounding of the synthetic
              * data is then far below the tolerance */
-            double l1 = sqrt(dot3(d1 + 3 * k, d1 + 3 * k)), l2 = sqrt(dot3(d2 + 3 * k, d2 + 3 * k));
+            double l1 = sqrt(fz_dot3(d1 + 3 * k, d1 + 3 * k)), l2 = sqrt(fz_dot3(d2 + 3 * k, d2 + 3 * k));
             if (l1 > 1e-3 && l2 > 1e-3)
                 FZ_CHECK(fabs(res[k]) <= 1e-8, "gec_residuals: exact pair %d has residual %g", k,
                          res[k]);
@@ -146,8 +141,8 @@ static void tilt(const double c[3], const double p[3], double a, double out[3])
     double q[3], nq;
     int i;
     for (i = 0; i < 3; ++i)
-        q[i] = p[i] - dot3(p, c) * c[i];
-    nq = sqrt(dot3(q, q));
+        q[i] = p[i] - fz_dot3(p, c) * c[i];
+    nq = sqrt(fz_dot3(q, q));
     if (!(nq > 1e-6)) {
         for (i = 0; i < 3; ++i)
             out[i] = c[i];
@@ -182,10 +177,10 @@ static void fuzz_wedge(fz_in *in)
     if (st != MCG_OK)
         return;
     FZ_CHECK(fz_all_finite(n1, 3) && fz_all_finite(n2, 3), "wedge: non-finite normal");
-    FZ_CHECK(fabs(dot3(n1, n1) - 1.0) <= 1e-9 && fabs(dot3(n2, n2) - 1.0) <= 1e-9,
-             "wedge: normals not unit (%g, %g)", dot3(n1, n1), dot3(n2, n2));
+    FZ_CHECK(fabs(fz_dot3(n1, n1) - 1.0) <= 1e-9 && fabs(fz_dot3(n2, n2) - 1.0) <= 1e-9,
+             "wedge: normals not unit (%g, %g)", fz_dot3(n1, n1), fz_dot3(n2, n2));
     {
-        double vh[3], vph[3], nv = sqrt(dot3(v, v)), nvp = sqrt(dot3(vp, vp));
+        double vh[3], vph[3], nv = sqrt(fz_dot3(v, v)), nvp = sqrt(fz_dot3(vp, vp));
         if (!(nv > 0.0) || !(nvp > 0.0) || !isfinite(nv) || !isfinite(nvp))
             return; /* |v|^2 under- or overflows here: the kernel scales */
         for (i = 0; i < 3; ++i) {
@@ -204,9 +199,9 @@ static void fuzz_wedge(fz_in *in)
             lp = fz_range(in, 0.01, 10.0);
             for (i = 0; i < 3; ++i)
                 tt[i] = lp * up[i] - l * u[i];
-            FZ_CHECK(dot3(n1, tt) >= -1e-9 * (l + lp) && dot3(n2, tt) >= -1e-9 * (l + lp),
-                     "wedge: t in the cones violates a plane (n1.t %g, n2.t %g)", dot3(n1, tt),
-                     dot3(n2, tt));
+            FZ_CHECK(fz_dot3(n1, tt) >= -1e-9 * (l + lp) && fz_dot3(n2, tt) >= -1e-9 * (l + lp),
+                     "wedge: t in the cones violates a plane (n1.t %g, n2.t %g)", fz_dot3(n1, tt),
+                     fz_dot3(n2, tt));
         }
     }
 }

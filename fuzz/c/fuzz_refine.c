@@ -59,7 +59,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if (mode == 0) {
         double dw[3], Rd[9];
-        int j, k;
         fz_rotation(&in, Rt);
         for (i = 0; i < 3; ++i)
             tt[i] = fz_range(&in, -2.0, 2.0);
@@ -69,13 +68,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             dw[i] = fz_range(&in, -0.2, 0.2);
         if (mcg_rot_from_angle_axis(dw, Rd) != MCG_OK)
             return 0;
-        for (i = 0; i < 3; ++i)
-            for (j = 0; j < 3; ++j) {
-                double s = 0.0;
-                for (k = 0; k < 3; ++k)
-                    s += Rd[3 * i + k] * Rt[3 * k + j];
-                R[3 * i + j] = s;
-            }
+        fz_matmul3(Rd, Rt, R);
         for (i = 0; i < 3; ++i)
             t[i] = tt[i] + fz_range(&in, -0.3, 0.3);
     } else {

@@ -19,18 +19,6 @@
 #define MAXN 24
 #define MAXSKY 40
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 /* |lhs - rhs| within rounding of sums of products of magnitude mag; floor:
  * the absolute error of products that fall into the denormal range (a
  * product of two tiny bearing components loses precision there, then gets
@@ -77,14 +65,14 @@ static void fuzz_rows(fz_in *in)
         for (k = 0; k < n; ++k) {
             const double *r = rows + 7 * k;
             double u[3], d[3], lhs = r[6], mag = fabs(r[6]), rhs;
-            cross3(x[0] + 3 * k, x[1] + 3 * k, u);
+            fz_cross3(x[0] + 3 * k, x[1] + 3 * k, u);
             for (i = 0; i < 3; ++i) {
                 lhs += r[i] * c[0][i] + r[3 + i] * c[1][i];
                 mag += fabs(r[i] * c[0][i]) + fabs(r[3 + i] * c[1][i]);
                 d[i] = c[1][i] - c[0][i] +
                        (offsets ? w[1][3 * k + i] - w[0][3 * k + i] : 0.0);
             }
-            rhs = dot3(u, d);
+            rhs = fz_dot3(u, d);
             /* a bound on every product either side forms (cancellation
              * inside the row coefficients included) */
             mag += 8.0 * fz_maxabs(x[0] + 3 * k, 3) * fz_maxabs(x[1] + 3 * k, 3) *
@@ -127,10 +115,10 @@ static void fuzz_rows(fz_in *in)
         const double mx = fmax(fz_maxabs(x1, 3), fmax(fz_maxabs(x2, 3), fz_maxabs(x3, 3)));
         const double mc = fz_maxabs(A, 3) + fz_maxabs(B, 3) + fz_maxabs(c[0], 3) +
                           fz_maxabs(c[1], 3);
-        cross3(x1, x2, u);
-        cross3(x1, x3, v);
-        cross3(x3, B, xb);
-        cross3(x2, A, xa);
+        fz_cross3(x1, x2, u);
+        fz_cross3(x1, x3, v);
+        fz_cross3(x3, B, xb);
+        fz_cross3(x2, A, xa);
         for (s = 0; s < 3; ++s)
             for (t = 0; t < 3; ++t) {
                 const double *r = rows + 7 * (9 * k + 3 * s + t);
