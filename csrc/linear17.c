@@ -680,8 +680,9 @@ static int plain_svd_refine(const double *m, double e[9], double r[9])
 
 /* Linear step: the 9-vector e of E (and the R part r) minimising |A x|. */
 static int linear_step(const double *m, int gc_case,
-                       const double *wr, const double *vr, double rtol,
-                       double e[9], double r[9], mcg_linear17_result *res)
+                       const double *wr, const double *vr, double pinv_rtol,
+                       double rtol, double tr_m, double e[9], double r[9],
+                       mcg_linear17_result *res)
 {
     int i, j, k;
     {
@@ -693,7 +694,7 @@ static int linear_step(const double *m, int gc_case,
         memset(pinv, 0, sizeof pinv);
         if (gc_case != MCG_GC_CENTRAL) {
             for (k = 0; k < 9; k++) {
-                if (wr[k] <= rtol * wmax)
+                if (!(wr[k] > pinv_rtol * wmax))
                     continue;
                 for (i = 0; i < 9; i++)
                     for (j = 0; j < 9; j++)
@@ -720,8 +721,14 @@ static int linear_step(const double *m, int gc_case,
             return MCG_ENUMERIC;
         for (k = 0; k < 9; k++)
             res->schur_eig[k] = ws[8] > 0.0 ? ws[k] / ws[8] : 0.0;
-        if (!(ws[1] > rtol * ws[8]))
-            return MCG_EDEGENERATE; /* E not unique: e.g. no translation */
+        /* E not unique (e.g. no translation, or too few distinct rays: a
+         * duplicated ray adds no rank). The second eigenvalue is measured
+         * against the whole Gram matrix, not the Schur complement's own
+         * largest: when the reduced system is tiny next to M, ws[1] / ws[8]
+         * looked well above rtol for a rank-deficient A (16 distinct rays,
+         * second singular value 1e-11 of the largest; found by fuzz_linear17) */
+        if (!(ws[1] > rtol * tr_m))
+            return MCG_EDEGENERATE;
         for (i = 0; i < 9; i++)
             e[i] = vs[9 * i];
         for (i = 0; i < 9; i++) {
@@ -776,50 +783,24 @@ static int rotation_candidates(const double e[9], const double r[9], int use_r,
     return MCG_OK;
 }
 
-int mcg_linear17(int n, const double *origins1, const double *dirs1,
-                 const double *origins2, const double *dirs2,
-                 const mcg_linear17_options *opt, mcg_linear17_result *res)
+/* Everything after the case detection, for the kind gc (nullity of A_R):
+ * the linear step, the rotation candidates, the translation with scale, the
+ * alternation and polish, and the scale evidence; res (whose eigenvalue
+ * diagnostics are already filled) gets the motion in the rig frame.
+ * pinv_rtol: eigenvalues of M_RR at or below pinv_rtol * max are treated as
+ * structural zeros in the elimination of the R part (0: none is). */
+static int solve_case(int n, const double *origins1, const double *dirs1,
+                      const double *origins2, const double *dirs2,
+                      const mcg_linear17_options *opt, const double *m,
+                      const double *wr, const double *vr, double tr_m, int gc,
+                      int nullity, double pinv_rtol, mcg_linear17_result *res)
 {
-    mcg_linear17_options o;
-    double m[NX * NX], mrr[81], wr[9], vr[81], tr_m = 0.0;
+    mcg_linear17_options o = *opt;
     double e[9], rpart[9], cand[4][9], rbest[9], tbest[3], rlin[9], tlin[3];
-    double cost, tiny, costlin;
-    int st, i, k, nullity = 0, gc, ncand = 0, best = -1, unit_mode = 0;
+    double cost, tiny = 1e-26 * tr_m, costlin;
+    int st, i, k, ncand = 0, best = -1, unit_mode = 0;
     tsolve ts;
 
-    if (!res)
-        return MCG_EINVAL;
-    memset(res, 0, sizeof *res);
-    res->gc_case = MCG_GC_DEGENERATE;
-    if (!origins1 || !dirs1 || !origins2 || !dirs2)
-        return MCG_EINVAL;
-    if (n < 14 || n > MAX_RAYS)
-        return MCG_EINVAL;
-    if (opt) {
-        if (!check_options(opt))
-            return MCG_EINVAL;
-        o = *opt;
-    } else {
-        mcg_linear17_default_options(&o);
-    }
-
-    st = accumulate(n, origins1, dirs1, origins2, dirs2, m, res->norm_origin,
-                    &res->norm_scale);
-    if (st != MCG_OK)
-        return st;
-    for (i = 0; i < NX; i++)
-        tr_m += m[i * NX + i];
-    if (!(tr_m > 0.0) || !isfinite(tr_m))
-        return MCG_EINVAL;
-    tiny = 1e-26 * tr_m;
-
-    /* generalized camera kind from the structural null space of A_R */
-    block(m, 9, 9, mrr);
-    if (mcg_sym_eig_tridiag(9, mrr, wr, vr) != MCG_OK)
-        return MCG_ENUMERIC;
-    for (k = 0; k < 9; k++)
-        res->ar_eig[k] = wr[8] > 0.0 ? (wr[k] > 0.0 ? wr[k] / wr[8] : 0.0) : 0.0;
-    gc = classify(wr, vr, o.rank_rtol, tr_m, &nullity);
     res->gc_case = gc;
     res->rank_ar = 9 - nullity;
     res->rank_a = 17 - (gc == MCG_GC_CENTRAL ? 9 : nullity);
@@ -828,7 +809,7 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
     if (n < res->rank_a)
         return MCG_EDEGENERATE; /* too few rays for the detected kind */
 
-    st = linear_step(m, gc, wr, vr, o.rank_rtol, e, rpart, res);
+    st = linear_step(m, gc, wr, vr, pinv_rtol, o.rank_rtol, tr_m, e, rpart, res);
     if (st != MCG_OK)
         return st;
     {
@@ -1052,4 +1033,108 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
     res->n_in_front = count_in_front(n, origins1, dirs1, origins2, dirs2,
                                      res->R, res->t);
     return MCG_OK;
+}
+
+/* 1 if every ray pair has the same origin at both times (to 1e-12 of the
+ * normalised rig size): the rows of such pairs annihilate (0, I) exactly,
+ * the locally-central case of ch. 8.3. A cross-camera pair (distinct
+ * origins) annihilates it only by accident, e.g. when the rig hardly moves:
+ * then the eigenvalue can be as small as rounding (|t| ~ 3e-5 of the rig). */
+static int same_origins(int n, const double *o1, const double *o2, double scale)
+{
+    int i, k;
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++)
+            if (!(fabs(o1[3 * i + k] - o2[3 * i + k]) * scale <= 1e-12))
+                return 0;
+    return 1;
+}
+
+/* Below this ratio to the largest eigenvalue of A_R^T A_R an eigenvalue is a
+ * structural zero: the rows of a locally-central or axial camera annihilate
+ * (0, I) etc. exactly, so their eigenvalue is rounding (~1e-16 and below).
+ * Between it and rank_rtol the small eigenvalue may instead be accidental:
+ * a cross-camera rig that hardly moves (R ~ I, |t| ~ 1e-5 of the rig) makes
+ * (0, I) nearly annihilated by every row, as exact data with R = I, t = 0
+ * do, and treating it as structural then removes the true solution
+ * (found by fuzz_linear17: rotation 2 deg off on exact data, scale
+ * "observable"). */
+#define STRUCTURAL_RTOL 1e-14
+
+int mcg_linear17(int n, const double *origins1, const double *dirs1,
+                 const double *origins2, const double *dirs2,
+                 const mcg_linear17_options *opt, mcg_linear17_result *res)
+{
+    mcg_linear17_options o;
+    double m[NX * NX], mrr[81], wr[9], vr[81], tr_m = 0.0;
+    int st, i, k, nullity = 0, gc;
+
+    if (!res)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    res->gc_case = MCG_GC_DEGENERATE;
+    if (!origins1 || !dirs1 || !origins2 || !dirs2)
+        return MCG_EINVAL;
+    if (n < 14 || n > MAX_RAYS)
+        return MCG_EINVAL;
+    if (opt) {
+        if (!check_options(opt))
+            return MCG_EINVAL;
+        o = *opt;
+    } else {
+        mcg_linear17_default_options(&o);
+    }
+
+    st = accumulate(n, origins1, dirs1, origins2, dirs2, m, res->norm_origin,
+                    &res->norm_scale);
+    if (st != MCG_OK)
+        return st;
+    for (i = 0; i < NX; i++)
+        tr_m += m[i * NX + i];
+    if (!(tr_m > 0.0) || !isfinite(tr_m))
+        return MCG_EINVAL;
+
+    /* generalized camera kind from the structural null space of A_R */
+    block(m, 9, 9, mrr);
+    if (mcg_sym_eig_tridiag(9, mrr, wr, vr) != MCG_OK)
+        return MCG_ENUMERIC;
+    for (k = 0; k < 9; k++)
+        res->ar_eig[k] = wr[8] > 0.0 ? (wr[k] > 0.0 ? wr[k] / wr[8] : 0.0) : 0.0;
+    gc = classify(wr, vr, o.rank_rtol, tr_m, &nullity);
+    st = solve_case(n, origins1, dirs1, origins2, dirs2, &o, m, wr, vr, tr_m, gc,
+                    nullity, o.rank_rtol, res);
+    if (gc != MCG_GC_MOST_GENERAL && gc != MCG_GC_CENTRAL &&
+        (wr[0] > STRUCTURAL_RTOL * wr[8] ||
+         ((gc == MCG_GC_LOCALLY_CENTRAL || gc == MCG_GC_LOCALLY_CENTRAL_AXIAL) &&
+          !same_origins(n, origins1, origins2, res->norm_scale)))) {
+        /* the small eigenvalues may be accidental: solve also as the most
+         * general kind, with nothing eliminated as structural, and keep the
+         * motion of lower algebraic cost (both costs are x^T M x of a valid
+         * motion in the same normalised frame) */
+        mcg_linear17_result alt;
+        int st_alt = MCG_EDEGENERATE, unique;
+        double wm[NX], vm[NX * NX], mc[NX * NX];
+        memcpy(&alt, res, sizeof alt);
+        memcpy(mc, m, sizeof mc); /* the decomposition overwrites its input */
+        /* ... only where that kind's solution is unique: a second null
+         * vector of the whole M at rounding level means too few independent
+         * rays (duplicates add no rank), and the plain SVD would return an
+         * arbitrary mix of the two */
+        unique = mcg_sym_eig_tridiag(NX, mc, wm, vm) == MCG_OK &&
+                 wm[1] > STRUCTURAL_RTOL * tr_m;
+        if (unique)
+            st_alt = solve_case(n, origins1, dirs1, origins2, dirs2, &o, m, wr, vr,
+                            tr_m, MCG_GC_MOST_GENERAL, 0, 0.0, &alt);
+        if (st_alt == MCG_OK && (st != MCG_OK || alt.cost_final < res->cost_final)) {
+            memcpy(res, &alt, sizeof alt);
+            st = MCG_OK;
+        } else if (st_alt == MCG_EDEGENERATE && st == MCG_OK) {
+            /* neither reading is sound: the small eigenvalue of A_R is not
+             * (or need not be) structural, and without eliminating it E is
+             * not unique: too few independent rays for the most general
+             * kind (seen on exact data: residuals 4e-5 rad, "observable") */
+            st = MCG_EDEGENERATE;
+        }
+    }
+    return st;
 }

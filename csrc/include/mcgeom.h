@@ -309,7 +309,15 @@ void mcg_linear17_default_options(mcg_linear17_options *opt);
  * points on the rig axis (camera centres), not arbitrary points on the rays.
  * opt may be NULL (defaults). Returns MCG_EDEGENERATE when the data do not
  * determine E (e.g. no translation, or too few independent rays for the
- * detected case); res is then filled with the diagnostics known so far.
+ * detected case: repeated rays add no rank, and the test is against the
+ * whole Gram matrix); res is then filled with the diagnostics known so far.
+ * The kind (ch. 8.3) comes from the null space of A_R; a locally-central or
+ * axial reading is trusted as is only when its small eigenvalues are at
+ * rounding level (<= 1e-14 of the largest) and, for locally central, every
+ * pair has the same origin at both times. Otherwise (a cross-camera rig that
+ * hardly moves nearly annihilates (0, I) by accident) the most-general
+ * solve is run as well and the motion of lower algebraic cost is returned;
+ * MCG_EDEGENERATE if the most-general reading is not unique either.
  * The result is in the caller's rig frame (R, t: rig2_from_rig1, t in the
  * unit of the origins). n in [14, 2^26]. MCG_EINVAL: NULL, n, bad options,
  * NaN/inf, a zero direction; MCG_ENUMERIC: an inner decomposition failed.
