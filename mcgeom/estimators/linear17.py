@@ -136,6 +136,6 @@ def _raise(status: int, r: dict, rays: RayPairs, n: int) -> None:
                                   f"need {need}, got {n}")
         raise DegenerateError(
             f"linear17: E is not determined by the data ({kind} camera): the reduced system "
-            "has more than one null direction (no translation, or rays in a degenerate "
-            "configuration)")
+            "has more than one null direction (no translation or a rig that hardly moves, "
+            "repeated rays, or rays in a degenerate configuration)")
     _core.raise_for(status, "linear17")
