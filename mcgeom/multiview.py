@@ -20,10 +20,24 @@ storage (the view graph of a sequence is banded), never forming A or G.
 
 Solvers (gauge: the first view of the solved component at the origin):
 
-* ``"svd"`` (Kaucic et al., ch. 6.2.4): min |E c| s.t. |c| = 1;
+* ``"svd"`` (Kaucic et al., ch. 6.2.4): min |E c| s.t. |c| = 1, the last
+  right singular vector of E once view 0's columns are removed. E has an
+  exact 3-dim null space (all centres translated alike), so "the last column
+  of V" of the full E is a translation; fixing c_0 = 0 is the gauge of the
+  thesis's plots (Figs. 6.3, 6.5: circles through the origin of diameter
+  2 / sqrt(2 m) = 0.14 for m = 101 views, as sum |c_i - c_0|^2 = 1 gives);
 * ``"constrained"`` (ch. 6.3, Algorithm 1): min |A G c| s.t. |G c| = 1, the
   smallest eigenpair of the pencil (N, L); L is the Laplacian of the block
-  graph (each block counts once per view pair it contains) times I_3.
+  graph (each block counts once per view pair it contains) times I_3: up
+  to a factor the |G c|^2 of eq. 6.19, whose x = G c holds the entries of
+  the F_ji = [c_j - c_i]x (|F|^2 = 2 |t|^2) or of the trifocal tensors of
+  eq. 6.9 for the three reference views that the trilinear blocks stack
+  (sum 5 x the Laplacian; tests/test_ch6_thesis_form.py). Why it helps: the
+  expected noise part of E^T E is close to a multiple of G^T G (within a
+  factor 6.5-11 over all directions on the ch. 6.5.1 sequence), but spans
+  four orders of magnitude against |c|^2 (``experiment_ch6.py
+  --noise-metric``), so the plain solution is pulled toward small baselines
+  far from view 0 -- the spirals of Figs. 6.3 and 6.5.
 
 Without ``origins`` the result has no scale: it is normalised so that
 ``sum_i |c_i|^2 = 1`` (both solvers) with the sign that puts the

@@ -34,12 +34,18 @@ class ViewSequence:
 
 def circle_sequence(n_views: int = 101, n_points: int = 1000, radius: float = 100.0,
                     visible_range: float = 50.0, max_track: int = 3, sigma: float = 0.0,
-                    rng: RngLike = None, cameras: Optional[np.ndarray] = None) -> ViewSequence:
+                    rng: RngLike = None, cameras: Optional[np.ndarray] = None,
+                    closed_loop: bool = False) -> ViewSequence:
     """Views on a circle of ``radius`` in the plane z = 0 (one turn), random
     known rotations, ``n_points`` uniform in [-radius, radius]^3; a view sees
     the points within ``visible_range``; each point's run of views is cut into
     tracks of at most ``max_track`` consecutive views (thesis ch. 6.5.1);
-    bearings get angular noise ``sigma`` (radians). With ``cameras`` (K, 3):
+    bearings get angular noise ``sigma`` (radians). The views are an image
+    sequence: a track follows the capture order, so no track links the last
+    view to the first although they are neighbours on the circle (the open
+    chain of the thesis, whose plain-SVD failures are spirals, Figs. 6.3 and
+    6.5); ``closed_loop=True`` lets tracks run on across that closure (a
+    ring: far more rigid). With ``cameras`` (K, 3):
     each view is a rig of K cameras at these rig-frame centres, and a point is
     seen by the camera of the rig nearest to it (origins filled)."""
     gen = as_rng(rng)
@@ -57,9 +63,11 @@ def circle_sequence(n_views: int = 101, n_points: int = 1000, radius: float = 10
         vs = np.flatnonzero(sees[:, p])
         if vs.size < 2:
             continue
-        # runs of consecutive views, cyclic: the circle closes after view m - 1
+        # runs of consecutive views; with closed_loop the run through view
+        # m - 1 continues at view 0
         runs = np.split(vs, np.flatnonzero(np.diff(vs) > 1) + 1)
-        if len(runs) > 1 and runs[0][0] == 0 and runs[-1][-1] == n_views - 1:
+        if (closed_loop and len(runs) > 1 and runs[0][0] == 0
+                and runs[-1][-1] == n_views - 1):
             runs = [np.r_[runs[-1], runs[0]]] + runs[1:-1]
         for run in runs:
             start = int(gen.integers(0, max_track)) if run.size > max_track else 0

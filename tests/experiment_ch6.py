@@ -1,13 +1,16 @@
 """Thesis ch. 6.5.1 (Figs. 6.3-6.6): 101 views on a circle of radius 100 in a
 plane, known rotations, 1,000 uniform random points, each view sees the points
-within a limited range (50 units), tracks of at most three views; angular
-noise sigma on the unit sphere. For each variant (bilinear / trilinear x plain
-SVD / constrained) and sigma: the RMS centre error after a similarity
-alignment (units of the scene, circle radius 100) and the spiral measure
-(largest angle between an estimated and the true step, degrees), medians over
-trials, and one PNG per sigma with the four aligned trajectories (top view).
+within a limited range (50 units), tracks of at most three views along the
+image sequence (no track links the last view to the first: an open chain,
+``--closed-loop`` to close it); angular noise sigma on the unit sphere. For
+each variant (bilinear / trilinear x plain SVD / constrained) and sigma: the
+RMS centre error after a similarity alignment (units of the scene, circle
+radius 100), the spiral measure (largest angle between an estimated and the
+true step, degrees), the number of reversed steps (> 90 deg: folds), where the
+worst step is and how many tracks link it, medians over trials, and one PNG
+per sigma with the four aligned trajectories (top view).
 
-    python tests/experiment_ch6.py [--trials 10] [--out ch6_out]
+    python tests/experiment_ch6.py [--trials 10] [--out ch6_out] [--range 50] [--closed-loop]
 """
 
 from __future__ import annotations
@@ -27,25 +30,47 @@ COLOURS = {("bilinear", "svd"): (0, 140, 255), ("bilinear", "constrained"): (0, 
            ("trilinear", "svd"): (200, 0, 200), ("trilinear", "constrained"): (200, 120, 0)}
 
 
+def step_links(track: np.ndarray, view: np.ndarray, m: int) -> np.ndarray:
+    """(m - 1,) number of tracks that observe both view i and view i + 1."""
+    key = np.unique(np.c_[track, view], axis=0)          # sorted by track, then view
+    same = (key[1:, 0] == key[:-1, 0]) & (key[1:, 1] == key[:-1, 1] + 1)
+    return np.bincount(key[:-1, 1][same], minlength=m - 1)[:m - 1]
+
+
+def step_angles(aligned: np.ndarray, true: np.ndarray) -> np.ndarray:
+    """Angle (radians) between each estimated step c_{i+1} - c_i and the true one."""
+    a, t = np.diff(aligned, axis=0), np.diff(true, axis=0)
+    return np.arctan2(np.linalg.norm(np.cross(a, t), axis=1), np.einsum("ij,ij->i", a, t))
+
+
 def run(trials: int = 10, sigmas=SIGMAS, n_views: int = 101, n_points: int = 1000,
-        seed: int = 0, visible_range: float = 50.0) -> dict:
-    """{(relation, solver, sigma): dict(rms=[...], spiral=[...], seconds=[...],
-    rigidity=[...])} plus the aligned trajectories of the first trial under
-    key "paths"."""
+        seed: int = 0, visible_range: float = 50.0, closed_loop: bool = False) -> dict:
+    """{(relation, solver, sigma): dict(rms=[...], spiral=[...], folds=[...],
+    worst=[...], worst_links=[...], links=[...], seconds=[...], rigidity=[...])}
+    plus the aligned trajectories of the first trial under key "paths"."""
     out, paths = {}, {}
     for sigma in sigmas:
         for trial in range(trials):
             seq = circle_sequence(n_views=n_views, n_points=n_points, sigma=sigma,
-                                  rng=seed + 1000 * trial, visible_range=visible_range)
+                                  rng=seed + 1000 * trial, visible_range=visible_range,
+                                  closed_loop=closed_loop)
+            links = step_links(seq.track, seq.view, n_views)
             for rel, sol in VARIANTS:
                 r = multiview.translations_from_tracks(seq.track, seq.view, seq.bearings,
                                                        seq.rotations, relation=rel, solver=sol)
                 ok = r.connected
                 aligned, rms = similarity_align(r.centres[ok], seq.centres[ok])
-                rec = out.setdefault((rel, sol, sigma),
-                                     {"rms": [], "spiral": [], "seconds": [], "rigidity": []})
+                ang = step_angles(aligned, seq.centres[ok])
+                worst = int(np.flatnonzero(ok)[np.argmax(ang)])
+                rec = out.setdefault((rel, sol, sigma), {k: [] for k in (
+                    "rms", "spiral", "folds", "worst", "worst_links", "links", "seconds",
+                    "rigidity")})
                 rec["rms"].append(rms)
                 rec["spiral"].append(spiral_measure(aligned, seq.centres[ok]))
+                rec["folds"].append(int(np.count_nonzero(ang > np.pi / 2)))
+                rec["worst"].append(worst)
+                rec["worst_links"].append(int(links[min(worst, n_views - 2)]))
+                rec["links"].append(float(np.median(links)))
                 rec["seconds"].append(r.timing["total"])
                 rec["rigidity"].append(r.rigidity)
                 if trial == 0:
@@ -53,6 +78,36 @@ def run(trials: int = 10, sigmas=SIGMAS, n_views: int = 101, n_points: int = 100
                     paths[("truth", sigma)] = seq.centres[ok]
     out["paths"] = paths
     return out
+
+
+def noise_metric_spread(relation: str, sigma: float = 1e-3, draws: int = 20, seed: int = 0,
+                        visible_range: float = 50.0) -> dict:
+    """How well each solver's normalisation matches the noise: the expected
+    noise part D = E[dE^T dE] of E^T E (dense rows, ``draws`` noise draws on
+    one noise-free sequence, gauge c_0 = 0) against L = G^T G (constrained)
+    and I (plain). Returns the spread max/min of the generalized eigenvalues
+    of (D, L) and of (D, I): 1 would mean the noise adds the same cost to
+    every configuration of unit norm, i.e. no bias."""
+    from mcgeom import synth
+    from mcgeom.bench.known_rotation_numpy import dense_rows
+    seq = circle_sequence(sigma=0.0, rng=seed, visible_range=visible_range)
+    q = 2 if relation == "bilinear" else 3
+    idx = multiview._relations(seq.track, seq.view, q, "all", 1)
+    m = len(seq.rotations)
+
+    def rows(b):
+        x = np.einsum("kji,kj->ki", seq.rotations[seq.view], b)
+        return dense_rows(x[idx], seq.view[idx], m)
+
+    E0, L = rows(seq.bearings)
+    D = np.zeros_like(L)
+    for k in range(draws):
+        dE = rows(synth.perturb_directions(seq.bearings, sigma, seed + 1 + k))[0] - E0
+        D += dE.T @ dE / draws
+    D, L = D[3:, 3:], L[3:, 3:]
+    Ci = np.linalg.inv(np.linalg.cholesky(L))
+    wl, wi = np.linalg.eigvalsh(Ci @ D @ Ci.T), np.linalg.eigvalsh(D)
+    return {"constrained": float(wl[-1] / wl[0]), "svd": float(wi[-1] / wi[0])}
 
 
 def _poses(c):
@@ -81,24 +136,42 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="ch6_out")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--range", type=float, default=50.0, help="visible range of a view")
+    ap.add_argument("--closed-loop", action="store_true",
+                    help="tracks also link the last view to the first (a ring)")
+    ap.add_argument("--noise-metric", action="store_true",
+                    help="also print how far the noise part of E^T E is from each "
+                         "solver's normalisation (dense, a few seconds)")
     args = ap.parse_args(argv)
-    res = run(args.trials, seed=args.seed, visible_range=args.range)
+    res = run(args.trials, seed=args.seed, visible_range=args.range,
+              closed_loop=args.closed_loop)
     print(f"thesis ch. 6.5.1: 101 views, circle radius 100, 1000 points, range {args.range:g}, "
-          f"tracks <= 3 views; medians over {args.trials} trials; rigidity = second smallest "
-          "relative eigenvalue of the solver's pencil (near 0: scales of parts free)")
-    print(f"{'sigma':>8} {'variant':>24} {'rms err':>10} {'spiral[deg]':>12} {'rigidity':>9} "
-          f"{'ms':>6}")
+          f"tracks <= 3 views, {'closed loop' if args.closed_loop else 'open sequence'}; "
+          f"medians over {args.trials} trials; folds = steps reversed by > 90 deg; worst = "
+          "view of the worst step (tracks linking it / median per step); rigidity = second "
+          "smallest relative eigenvalue of the solver's pencil (near 0: scales of parts free)")
+    print(f"{'sigma':>8} {'variant':>24} {'rms err':>10} {'spiral[deg]':>12} {'folds':>6} "
+          f"{'worst (links)':>15} {'rigidity':>9} {'ms':>6}")
     for sigma in SIGMAS:
         for rel, sol in VARIANTS:
             r = res[(rel, sol, sigma)]
+            where = (f"{int(np.median(r['worst'])):3d} ({np.median(r['worst_links']):2.0f}/"
+                     f"{np.median(r['links']):2.0f})")
             print(f"{sigma:8.1e} {rel + ' + ' + sol:>24} {np.median(r['rms']):10.4g} "
-                  f"{np.degrees(np.median(r['spiral'])):12.4g} "
-                  f"{np.median(r['rigidity']):9.2e} {1000 * np.median(r['seconds']):6.1f}")
+                  f"{np.degrees(np.median(r['spiral'])):12.4g} {np.median(r['folds']):6.0f} "
+                  f"{where:>15} {np.median(r['rigidity']):9.2e} "
+                  f"{1000 * np.median(r['seconds']):6.1f}")
     print("constrained / plain SVD, median RMS error (< 1 = constrained better):")
     for sigma in SIGMAS:
         ratios = [np.median(res[(rel, 'constrained', sigma)]["rms"]) /
                   np.median(res[(rel, 'svd', sigma)]["rms"]) for rel in multiview.RELATIONS]
         print(f"{sigma:8.1e}  bilinear {ratios[0]:7.3f}  trilinear {ratios[1]:7.3f}")
+    if args.noise_metric:
+        print("spread max/min of the expected noise part of E^T E against each solver's "
+              "normalisation (sigma 1e-3; 1 = unbiased):")
+        for rel in multiview.RELATIONS:
+            sp = noise_metric_spread(rel, visible_range=args.range)
+            print(f"  {rel:9s} constrained (|Gc|^2) {sp['constrained']:8.3g}   "
+                  f"plain (|c|^2) {sp['svd']:8.3g}")
     files = write_pngs(res, Path(args.out))
     print("wrote " + ", ".join(str(f) for f in files))
     return 0
