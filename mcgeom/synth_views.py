@@ -35,7 +35,7 @@ class ViewSequence:
 def circle_sequence(n_views: int = 101, n_points: int = 1000, radius: float = 100.0,
                     visible_range: float = 50.0, max_track: int = 3, sigma: float = 0.0,
                     rng: RngLike = None, cameras: Optional[np.ndarray] = None,
-                    closed_loop: bool = False) -> ViewSequence:
+                    closed_loop: bool = False, track_views: str = "consecutive") -> ViewSequence:
     """Views on a circle of ``radius`` in the plane z = 0 (one turn), random
     known rotations, ``n_points`` uniform in [-radius, radius]^3; a view sees
     the points within ``visible_range``; each point's run of views is cut into
@@ -45,10 +45,16 @@ def circle_sequence(n_views: int = 101, n_points: int = 1000, radius: float = 10
     view to the first although they are neighbours on the circle (the open
     chain of the thesis, whose plain-SVD failures are spirals, Figs. 6.3 and
     6.5); ``closed_loop=True`` lets tracks run on across that closure (a
-    ring: far more rigid). With ``cameras`` (K, 3):
+    ring: far more rigid). ``track_views="any"``: each track's views are
+    drawn at random among all views that see the point instead (the point's
+    views split into random groups of at most ``max_track``): wide triangles,
+    a rigid problem without the spirals. With ``cameras`` (K, 3):
     each view is a rig of K cameras at these rig-frame centres, and a point is
     seen by the camera of the rig nearest to it (origins filled)."""
     gen = as_rng(rng)
+    if track_views not in ("consecutive", "any"):
+        raise ValueError(f"circle_sequence: track_views must be 'consecutive' or 'any', "
+                         f"got {track_views!r}")
     if n_views < 2 or n_points < 1 or max_track < 2 or not visible_range > 0:
         raise ValueError("circle_sequence: need n_views >= 2, n_points >= 1, max_track >= 2, "
                          "visible_range > 0")
@@ -69,7 +75,18 @@ def circle_sequence(n_views: int = 101, n_points: int = 1000, radius: float = 10
         if (closed_loop and len(runs) > 1 and runs[0][0] == 0
                 and runs[-1][-1] == n_views - 1):
             runs = [np.r_[runs[-1], runs[0]]] + runs[1:-1]
+        if track_views == "any":
+            # each track: up to max_track views drawn among all that see the point
+            groups = -(-vs.size // max_track)
+            runs = [np.sort(g) for g in np.array_split(gen.permutation(vs), groups)]
         for run in runs:
+            if track_views == "any":
+                if run.size >= 2:
+                    track += [next_id] * run.size
+                    view += list(run)
+                    pts += [p] * run.size
+                    next_id += 1
+                continue
             start = int(gen.integers(0, max_track)) if run.size > max_track else 0
             pieces = [run[:start]] if start >= 2 else []
             pieces += [run[s:s + max_track] for s in range(start, run.size, max_track)]

@@ -11,6 +11,7 @@ worst step is and how many tracks link it, medians over trials, and one PNG
 per sigma with the four aligned trajectories (top view).
 
     python tests/experiment_ch6.py [--trials 10] [--out ch6_out] [--range 50] [--closed-loop]
+                                   [--tracks consecutive|any] [--noise-metric]
 """
 
 from __future__ import annotations
@@ -44,7 +45,8 @@ def step_angles(aligned: np.ndarray, true: np.ndarray) -> np.ndarray:
 
 
 def run(trials: int = 10, sigmas=SIGMAS, n_views: int = 101, n_points: int = 1000,
-        seed: int = 0, visible_range: float = 50.0, closed_loop: bool = False) -> dict:
+        seed: int = 0, visible_range: float = 50.0, closed_loop: bool = False,
+        track_views: str = "consecutive") -> dict:
     """{(relation, solver, sigma): dict(rms=[...], spiral=[...], folds=[...],
     worst=[...], worst_links=[...], links=[...], seconds=[...], rigidity=[...])}
     plus the aligned trajectories of the first trial under key "paths"."""
@@ -53,7 +55,7 @@ def run(trials: int = 10, sigmas=SIGMAS, n_views: int = 101, n_points: int = 100
         for trial in range(trials):
             seq = circle_sequence(n_views=n_views, n_points=n_points, sigma=sigma,
                                   rng=seed + 1000 * trial, visible_range=visible_range,
-                                  closed_loop=closed_loop)
+                                  closed_loop=closed_loop, track_views=track_views)
             links = step_links(seq.track, seq.view, n_views)
             for rel, sol in VARIANTS:
                 r = multiview.translations_from_tracks(seq.track, seq.view, seq.bearings,
@@ -138,14 +140,18 @@ def main(argv=None) -> int:
     ap.add_argument("--range", type=float, default=50.0, help="visible range of a view")
     ap.add_argument("--closed-loop", action="store_true",
                     help="tracks also link the last view to the first (a ring)")
+    ap.add_argument("--tracks", choices=("consecutive", "any"), default="consecutive",
+                    help="a track's <= 3 views: consecutive along the sequence (default), or "
+                         "drawn among all views that see the point (wide triangles: rigid, "
+                         "no spirals for either solver)")
     ap.add_argument("--noise-metric", action="store_true",
                     help="also print how far the noise part of E^T E is from each "
                          "solver's normalisation (dense, a few seconds)")
     args = ap.parse_args(argv)
     res = run(args.trials, seed=args.seed, visible_range=args.range,
-              closed_loop=args.closed_loop)
+              closed_loop=args.closed_loop, track_views=args.tracks)
     print(f"thesis ch. 6.5.1: 101 views, circle radius 100, 1000 points, range {args.range:g}, "
-          f"tracks <= 3 views, {'closed loop' if args.closed_loop else 'open sequence'}; "
+          f"tracks <= 3 {args.tracks} views, {'closed loop' if args.closed_loop else 'open sequence'}; "
           f"medians over {args.trials} trials; folds = steps reversed by > 90 deg; worst = "
           "view of the worst step (tracks linking it / median per step); rigidity = second "
           "smallest relative eigenvalue of the solver's pencil (near 0: scales of parts free)")

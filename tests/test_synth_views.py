@@ -37,6 +37,18 @@ def test_tracks_are_short_runs_of_consecutive_views_open():
         np.testing.assert_array_equal(np.diff(v), 1)
 
 
+def test_tracks_drawn_from_any_seeing_views():
+    seq = circle_sequence(n_views=30, n_points=500, rng=6, track_views="any")
+    gaps = []
+    for t in np.unique(seq.track):
+        v = np.sort(seq.view[seq.track == t])
+        assert 2 <= v.size <= 3 and np.unique(v).size == v.size
+        gaps.append(np.diff(v).max())
+    assert max(gaps) > 1        # not only consecutive views
+    with pytest.raises(ValueError, match="track_views"):
+        circle_sequence(n_views=10, n_points=50, rng=1, track_views="wide")
+
+
 def test_similarity_align_undoes_a_similarity():
     rng = np.random.default_rng(0)
     true = rng.normal(size=(30, 3)) * 10.0
