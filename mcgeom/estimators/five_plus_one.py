@@ -686,42 +686,17 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
                 yield R, t0 + lam * w, stats.get("inlier_ratio", 1.0)
 
 
-def _sampson_in_scale(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.ndarray):
-    """Per correspondence, the Sampson angular residual as a function of the scale:
-    ``r(lam) = (a + lam b) / sqrt(A + 2 B lam + C lam^2)`` (radians).
-
-    With ``s(lam) = t0 + lam w + R o1 - o2`` the pair's essential matrix is
-    ``[s]x R``: ``F d1 = s x R d1`` and ``|P(d1) F^T d2| = |P(R d1) (d2 x s)|``
-    are affine in ``lam``, so the squared Sampson denominator is quadratic.
-    """
-    d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
-    d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
-    rd1 = d1 @ R.T
-    s0 = t0 + rays.origins1 @ R.T - rays.origins2
-
-    def tangent(v, d):                      # P(d) v, rows
-        return v - np.einsum("ij,ij->i", v, d)[:, None] * d
-
-    g0, g1 = _rcross(s0, rd1), _rcross(w, rd1)
-    a = np.einsum("ij,ij->i", d2, g0)
-    b = np.einsum("ij,ij->i", d2, g1)
-    pg0, pg1 = tangent(g0, d2), tangent(g1, d2)
-    pk0, pk1 = tangent(_rcross(d2, s0), rd1), tangent(_rcross(d2, w), rd1)
-    A = np.einsum("ij,ij->i", pg0, pg0) + np.einsum("ij,ij->i", pk0, pk0)
-    B = np.einsum("ij,ij->i", pg0, pg1) + np.einsum("ij,ij->i", pk0, pk1)
-    C = np.einsum("ij,ij->i", pg1, pg1) + np.einsum("ij,ij->i", pk1, pk1)
-    return a, b, A, B, C
-
-
 def scale_one_point_ransac(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.ndarray,
                            threshold: float, rng: np.random.Generator,
                            samples: int = 64, prob: float = 0.999) -> Optional[float]:
     """The scale ``lam`` of ``t = t0 + lam w`` by 1-point RANSAC (thesis ch. 7.4).
 
-    Each of up to ``samples`` correspondences proposes ``lam = -a / b`` (eq. 7.4);
-    all proposals are scored at once by MSAC on the Sampson angular residuals
-    (``threshold`` radians) of every correspondence; the best is re-estimated by
-    weighted least squares on its inliers. Only ``lam > 0`` is considered: the
+    Each of up to ``samples`` correspondences, in a random order, proposes
+    ``lam = -a / b`` (eq. 7.4); the proposals are scored by MSAC on the Sampson
+    angular residuals (``threshold`` radians) of every correspondence, in
+    batches of 16 with the adaptive stop of a 1-point sample (``prob``); the
+    best is re-estimated by weighted least squares on its inliers
+    (``_core.scale_ransac``). Only ``lam > 0`` is considered: the
     5-point camera's cheirality check fixed the sense of its own travel ``lam
     w``, and near the critical motion the Sampson error hardly tells ``lam``
     from ``-lam`` (each camera's epipolar constraint ignores the sign of its
@@ -730,42 +705,29 @@ def scale_one_point_ransac(rays: RayPairs, R: np.ndarray, t0: np.ndarray, w: np.
     infinity instead of crossing it; measured: a quarter of the Ladybug
     hypotheses). None if no correspondence proposes a positive scale.
     """
-    a, b, A, B, C = _sampson_in_scale(rays, R, t0, w)
+    # The search runs in C (csrc/scale_line.c): the proposals' MSAC scores
+    # over every correspondence and the least-squares step were ~0.5 ms of
+    # numpy per call, a tenth of a Ladybug problem. The random order is drawn
+    # here, among the correspondences that propose a positive scale, as the
+    # numpy search did: the same random stream gives the same hypotheses.
+    a, b = _scale_line_terms(rays, R, t0, w)
     ok = np.flatnonzero((np.abs(b) > 1e-9 * (1.0 + np.abs(a))) & (a * b < 0.0))
     if ok.size == 0:
         return None
-    order = rng.permutation(ok)[:samples]
-    lam, best, inl, used = 0.0, np.inf, None, 0
-    while used < order.size:      # batches of 16 proposals, adaptive stop (1-point)
-        pick = order[used:used + 16]
-        used += pick.size
-        lams = -a[pick] / b[pick]
-        num = a[None, :] + lams[:, None] * b[None, :]
-        den2 = A[None, :] + 2.0 * lams[:, None] * B[None, :] + (lams ** 2)[:, None] * C[None, :]
-        r2 = num ** 2 / np.maximum(den2, 1e-300)
-        score = np.minimum(r2, threshold ** 2).sum(axis=1)
-        k = int(np.argmin(score))
-        if score[k] < best:
-            lam, best, inl = float(lams[k]), float(score[k]), r2[k] < threshold ** 2
-        ratio = np.count_nonzero(inl) / inl.size      # np.mean without its overhead
-        needed = np.log1p(-prob) / np.log1p(-ratio) if 0.0 < ratio < 1.0 else (
-            1.0 if ratio >= 1.0 else np.inf)
-        if used >= needed:
-            break
-    for _ in range(2):
-        # weighted LS of eq. 7.4 on the inliers, kept only if the MSAC score
-        # improves: near the critical motion the linear equation is biased
-        # towards lam = 0 (noise in b), where the robust score is not
-        wts = 1.0 / np.maximum(A + 2.0 * B * lam + C * lam ** 2, 1e-300)
-        bb = float(np.sum(wts[inl] * b[inl] ** 2))
-        if not bb > 0.0:
-            break
-        cand = -float(np.sum(wts[inl] * a[inl] * b[inl])) / bb
-        if not cand > 0.0:
-            break
-        r2c = (a + cand * b) ** 2 / np.maximum(A + 2.0 * B * cand + C * cand ** 2, 1e-300)
-        sc = float(np.minimum(r2c, threshold ** 2).sum())
-        if not sc < best:
-            break
-        lam, best, inl = cand, sc, r2c < threshold ** 2
-    return lam
+    found = _core.scale_ransac(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t0, w,
+                               rng.permutation(ok)[:samples], threshold, prob, samples)
+    return None if found is None else found[0]
+
+
+def _scale_line_terms(rays: RayPairs, R: np.ndarray, t0: np.ndarray,
+                      w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The epipolar residual ``a + lam b`` (eq. 7.4) of each correspondence
+    along ``t = t0 + lam w``, unit bearings: ``e = d2 . (s x R d1)`` with ``s =
+    t0 + lam w + R o1 - o2`` (the numerator of the Sampson residual that
+    ``_core.scale_ransac`` scores)."""
+    d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
+    d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
+    rd1 = d1 @ R.T
+    s0 = t0 + rays.origins1 @ R.T - rays.origins2
+    return (np.einsum("ij,ij->i", d2, _rcross(s0, rd1)),
+            np.einsum("ij,ij->i", d2, _rcross(w, rd1)))
