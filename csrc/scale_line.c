@@ -11,7 +11,9 @@
  *             = A_k + 2 B_k lam + C_k lam^2      (P(v) = I - v v^T),
  *
  * both being affine in lam inside the norms, and the Sampson angular residual
- * is r_k(lam) = e / sqrt(D) (as mcg_gec_residuals, without its pi/2 cap).
+ * is r_k(lam) = e / sqrt(D) (D summed from the two tangent vectors, not from
+ * the expanded quadratic, which cancels where D is near 0; with the floors of mcg_gec_residuals: at most
+ * pi/2 in size, 0 where e = D = 0).
  * Each correspondence proposes lam = -a_k / b_k (eq. 7.4); proposals are
  * scored by MSAC over all correspondences in batches of 16 with the adaptive
  * stop of a 1-point sample, and the best is re-estimated by weighted least
@@ -20,6 +22,7 @@
 #include "mcgeom.h"
 #include "internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -28,21 +31,42 @@
 #define BATCH 16        /* proposals scored between two stopping tests */
 #define LS_ROUNDS 2     /* weighted least-squares re-estimations */
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction */
-#define DEN_MIN 1e-300  /* floor of D(lam) (no constraint: e = 0 there too) */
+#define DEN_MIN 1e-300  /* floor of D(lam) in the least-squares weights */
+#define INV_HALF_PI2 0.40528473456935109 /* (2 / pi)^2 */
+/* terms per pair: a, b and the tangent gradients P(d2) g0, P(d2) g1,
+ * P(a) k0, P(a) k1 (3 each) whose combinations at lam give D(lam) */
+#define NT 14
 
 size_t mcg_scale_ransac_work_size(int n)
 {
     if (n < 1 || n > MAX_PAIRS)
         return 0;
-    return 5 * (size_t)n;
+    return NT * (size_t)n;
 }
 
-/* squared residual of pair k at lam (terms in structure-of-arrays order) */
+/* D(lam) of pair k: |P(d2) (g0 + lam g1)|^2 + |P(a) (k0 + lam k1)|^2, summed
+ * from the vectors (the expanded quadratic A + 2 B lam + C lam^2 cancels
+ * where D is near 0, e.g. where the pair's camera centre stops moving) */
+static double den_at(const double *t, size_t n, size_t k, double lam)
+{
+    double d = 0.0;
+    int i;
+    for (i = 0; i < 6; i++) {
+        double v = t[(2 + i) * n + k] + lam * t[(8 + i) * n + k];
+        d += v * v;
+    }
+    return d;
+}
+
+/* squared residual of pair k at lam (terms in structure-of-arrays order):
+ * e^2 / max(D, (2/pi)^2 e^2, DBL_MIN), the floors of mcg_gec_residuals (its
+ * pi/2 cap where D -> 0 with e != 0; 0 where e = D = 0) */
 static double r2_at(const double *t, size_t n, size_t k, double lam)
 {
-    double e = t[k] + lam * t[n + k];
-    double d = t[2 * n + k] + 2.0 * lam * t[3 * n + k] + lam * lam * t[4 * n + k];
-    return e * e / (d > DEN_MIN ? d : DEN_MIN);
+    double e = t[k] + lam * t[n + k], ee = e * e, cap = ee * INV_HALF_PI2;
+    double d = den_at(t, n, k, lam);
+    d = d > cap ? d : cap;
+    return ee / (d > DBL_MIN ? d : DBL_MIN);
 }
 
 /* MSAC score sum_k min(r_k^2, thr2) at lam, and the number of inliers */
@@ -102,21 +126,18 @@ static int terms(size_t n, const double *o1, const double *d1, const double *o2,
             double e1 = b[0] * g1[0] + b[1] * g1[1] + b[2] * g1[2];
             double q0 = a[0] * k0[0] + a[1] * k0[1] + a[2] * k0[2];
             double q1 = a[0] * k1[0] + a[1] * k1[1] + a[2] * k1[2];
-            double AA = 0.0, BB = 0.0, CC = 0.0;
-            for (i = 0; i < 3; i++) {
-                /* tangent parts P(d2) g and P(a) k */
-                double pg0 = g0[i] - e0 * b[i], pg1 = g1[i] - e1 * b[i];
-                double pk0 = k0[i] - q0 * a[i], pk1 = k1[i] - q1 * a[i];
-                AA += pg0 * pg0 + pk0 * pk0;
-                BB += pg0 * pg1 + pk0 * pk1;
-                CC += pg1 * pg1 + pk1 * pk1;
-            }
             t[k] = e0;
             t[n + k] = e1;
-            t[2 * n + k] = AA;
-            t[3 * n + k] = BB;
-            t[4 * n + k] = CC;
-            x = e0 + e1 + AA + BB + CC;
+            x = e0 + e1;
+            for (i = 0; i < 3; i++) {
+                /* tangent parts P(d2) g and P(a) k, lam-free and lam parts */
+                t[(2 + i) * n + k] = g0[i] - e0 * b[i];
+                t[(5 + i) * n + k] = k0[i] - q0 * a[i];
+                t[(8 + i) * n + k] = g1[i] - e1 * b[i];
+                t[(11 + i) * n + k] = k1[i] - q1 * a[i];
+                x += t[(2 + i) * n + k] + t[(5 + i) * n + k] + t[(8 + i) * n + k] +
+                     t[(11 + i) * n + k];
+            }
             if (!isfinite(x))
                 return 0;
         }
@@ -212,8 +233,7 @@ int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2
             double den, wt;
             if (!(r2_at(work, nn, q, lam_best) < thr2))
                 continue;
-            den = work[2 * nn + q] + 2.0 * lam_best * work[3 * nn + q] +
-                  lam_best * lam_best * work[4 * nn + q];
+            den = den_at(work, nn, q, lam_best);
             wt = 1.0 / (den > DEN_MIN ? den : DEN_MIN);
             sab += wt * work[q] * work[nn + q];
             sbb += wt * work[nn + q] * work[nn + q];

@@ -811,7 +811,7 @@ int mcg_skyline_eig(int n, const int *first, const int *ptr, const double *a,
 
 /* ------------------------------------------------------------ scale_line.c */
 
-/* Doubles of workspace for mcg_scale_ransac: 5 n (0 for n outside [1, 2^26]). */
+/* Doubles of workspace for mcg_scale_ransac: 14 n (0 for n outside [1, 2^26]). */
 size_t mcg_scale_ransac_work_size(int n);
 
 /* The metric scale of the 5+1 method (thesis ch. 7.4) by 1-point RANSAC.
@@ -821,7 +821,8 @@ size_t mcg_scale_ransac_work_size(int n);
  * at times 1 and 2, metres, directions of any non-zero length) are the
  * other cameras' correspondences. Each pair's Sampson angular residual
  * (radians) is r_k(lam) = (a_k + lam b_k) / sqrt(A_k + 2 B_k lam + C_k
- * lam^2) (eq. 7.4 in the numerator; mcg_gec_residuals without its pi/2 cap).
+ * lam^2) (eq. 7.4 in the numerator; the residual of mcg_gec_residuals at
+ * t(lam), with its pi/2 cap).
  * The pairs order[0], order[1], ... (n_order indices in [0, n), e.g. a random
  * permutation) that propose a positive scale lam = -a_k / b_k (|b_k| >
  * 1e-9 (1 + |a_k|), a_k b_k < 0: the cheirality of the 5-point camera fixed

@@ -18,8 +18,9 @@
 #include <string.h>
 
 #define N 200
+#define LW (14 * N) /* mcg_scale_ransac_work_size(N) */
 
-static double o1[3 * N], d1[3 * N], o2[3 * N], d2[3 * N], work[5 * N];
+static double o1[3 * N], d1[3 * N], o2[3 * N], d2[3 * N], work[14 * N];
 static int order[N];
 
 /* a 4-camera rig moving by R, t = t0 + lam w, t0 = c0 - R c0 (camera 0 the
@@ -88,7 +89,7 @@ static void test_recovery(void)
         int m = -1, st;
         scene(R, t0, w, lam_true, 60);
         st = mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, thr, 0.999, &lam,
-                              &score, &m, work, 5 * N);
+                              &score, &m, work, LW);
         if (st != MCG_OK) {
             check_status(st, MCG_OK, "scale_ransac on a 4-camera scene");
             continue;
@@ -119,13 +120,13 @@ static void test_early_stop(void)
     int m, st;
     scene(R, t0, w, 1.0, 0);
     st = mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 0.999, &lam, &score,
-                          &m, work, 5 * N);
+                          &m, work, LW);
     check_status(st, MCG_OK, "scale_ransac on clean data");
     check(m == N && fabs(lam - 1.0) < 1e-9, "clean data: all inliers, lam = 1", fabs(lam - 1.0),
           1e-9);
     /* one allowed proposal gives the same answer (any exact pair is right) */
     st = mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 1, 1e-3, 0.999, &lam, &score,
-                          NULL, work, 5 * N);
+                          NULL, work, LW);
     check(st == MCG_OK && fabs(lam - 1.0) < 1e-9, "one proposal on clean data",
           fabs(lam - 1.0), 1e-9);
 }
@@ -136,54 +137,54 @@ static void test_degenerate_and_invalid(void)
     int m, bad[1] = {N};
     scene(R, t0, w, 1.0, 0);
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, z, N, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EDEGENERATE, "w = 0: no pair proposes a scale");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, 0, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EDEGENERATE, "empty order");
     check_status(mcg_scale_ransac(N, NULL, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "NULL o1");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 0.999, NULL,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "NULL lam");
     check_status(mcg_scale_ransac(0, o1, d1, o2, d2, R, t0, w, 0, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "n = 0");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, 1, bad, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "order index n");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 0, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "max_proposals 0");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 0.0, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "threshold 0");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, NAN, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "threshold NaN");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 1.0, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "prob 1");
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N - 1),
+                                  &score, &m, work, LW - 1),
                  MCG_ENOMEM, "workspace one double short");
     keep = d1[7];
     d1[7] = NAN;
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "NaN in d1");
     d1[7] = keep;
     d2[3] = d2[4] = d2[5] = 0.0;
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "zero-length d2");
     t0[1] = HUGE_VAL;
     check_status(mcg_scale_ransac(N, o1, d1, o2, d2, R, t0, w, N, order, 64, 1e-3, 0.999, &lam,
-                                  &score, &m, work, 5 * N),
+                                  &score, &m, work, LW),
                  MCG_EINVAL, "inf in t0");
-    check(mcg_scale_ransac_work_size(0) == 0 && mcg_scale_ransac_work_size(N) == 5 * N,
-          "work size: 0 for n = 0, 5 n otherwise", 0.0, 0.0);
+    check(mcg_scale_ransac_work_size(0) == 0 && mcg_scale_ransac_work_size(N) == LW,
+          "work size: 0 for n = 0, 14 n otherwise", 0.0, 0.0);
 }
 
 int main(void)
