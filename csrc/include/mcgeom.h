@@ -849,6 +849,32 @@ int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2
                      double threshold, double prob, double *lam, double *score,
                      int *n_inliers, double *work, size_t lwork);
 
+/* ----------------------------------------------------------- pixel_scale.c */
+
+/* Pixels per radian of each pair's Sampson angular residual (the residual of
+ * mcg_gec_residuals) at the motion (R, t), for undistorted pinhole cameras:
+ * the factor that makes it the image-plane Sampson error, the first-order
+ * maximum-likelihood residual under isotropic pixel noise. Pair k: rays
+ * (o1, d1) <-> (o2, d2) as for mcg_gec_residuals (n x 3 each, rig frames at
+ * times 1 and 2, metres, directions of any non-zero length), the optical
+ * axes axis1[k], axis2[k] (n x 3, unit, rig frames at times 1 and 2) and
+ * focal lengths f1[k], f2[k] (pixels, > 0) of its cameras. With unit
+ * bearings a = R d1, d2, the baseline c = t + R o1 - o2 and the tangent
+ * gradients g1 = P(a) (d2 x c), g2 = P(d2) (c x a) (P(v) = I - v v^T) of
+ * e = d2 . (c x a), pixel noise of unit variance moves e by the variance
+ * V = (a . R z1 / f1)^2 (|g1|^2 - (g1 . R z1)^2) + (d2 . z2 / f2)^2 (|g2|^2
+ * - (g2 . z2)^2) (a pinhole bearing's covariance: cos^4 / f^2 radially,
+ * cos^2 / f^2 tangentially); scale[k] = sqrt((|g1|^2 + |g2|^2) / V) when
+ * V > min_var_ratio (|g1|^2 + |g2|^2) and the ratio is finite, else 0 (no
+ * first-order constraint: the caller substitutes its own value). n = 0 is valid. MCG_EINVAL: NULL
+ * pointers, n outside [0, 2^26], NaN/inf in any input, f1 or f2 not > 0,
+ * min_var_ratio < 0, a zero-length direction (|d| < 1e-50), or magnitudes
+ * so large that the products overflow (scale is then unspecified). */
+int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const double *o2,
+                            const double *d2, const double R[9], const double t[3],
+                            const double *axis1, const double *axis2, const double *f1,
+                            const double *f2, double min_var_ratio, double *scale);
+
 /* MCG_CDEF_END */
 
 #if defined(__GNUC__) && __GNUC__ >= 4
