@@ -160,24 +160,27 @@ def _decompose(E: np.ndarray, x1: np.ndarray, x2: np.ndarray) -> tuple[int, np.n
     R1, R2, t = cv2.decomposeEssentialMat(E)
     t = t.ravel()
     h1, h2 = _homogeneous(x1), _homogeneous(x2)
-    bb = np.einsum("ij,ij->i", h2, h2)                 # the same for both rotations
-    best = (0, R1, t)
-    for R in (R1, R2):
-        a = h1 @ R.T                                   # R x1, in camera 2
-        aa = np.einsum("ij,ij->i", a, a)
-        ab = np.einsum("ij,ij->i", a, h2)
-        den = aa * bb - ab * ab
-        ok = den > 1e-14 * aa * bb
-        den = np.where(ok, den, 1.0)
-        for tt in (t, -t):
-            # s1 R x1 + tt = s2 x2 (least squares): w = -tt
-            aw, bw = -(a @ tt), -(h2 @ tt)
-            s1 = (aw * bb - bw * ab) / den
-            s2 = (aw * ab - bw * aa) / den
-            cnt = int(np.count_nonzero(ok & (s1 > 0) & (s2 > 0)))
-            if cnt > best[0]:
-                best = (cnt, R, tt)
-    return best
+    a = np.stack([h1 @ R1.T, h1 @ R2.T])               # R x1 in camera 2, both rotations
+    bb = np.einsum("ij,ij->i", h2, h2)
+    aa = np.einsum("kij,kij->ki", a, a)
+    ab = np.einsum("kij,ij->ki", a, h2)
+    den = aa * bb - ab * ab
+    ok = den > 1e-14 * aa * bb
+    den = np.where(ok, den, 1.0)
+    # s1 R x1 + t = s2 x2 (least squares, w = -t); with -t both depths flip
+    # sign exactly, so one solve serves t and -t
+    aw, bw = -(a @ t), -(h2 @ t)
+    s1 = (aw * bb - bw * ab) / den
+    s2 = (aw * ab - bw * aa) / den
+    front = np.count_nonzero(ok & (s1 > 0) & (s2 > 0), axis=1)
+    back = np.count_nonzero(ok & (s1 < 0) & (s2 < 0), axis=1)
+    # candidates in the order (R1, t), (R1, -t), (R2, t), (R2, -t); the first
+    # with most points in front wins, (R1, t) if none has any
+    counts = [int(front[0]), int(back[0]), int(front[1]), int(back[1])]
+    k = int(np.argmax(counts))
+    if counts[k] == 0:
+        return 0, R1, t
+    return counts[k], (R1, R2)[k // 2], (t, -t)[k % 2]
 
 
 def _homogeneous(x: np.ndarray) -> np.ndarray:
