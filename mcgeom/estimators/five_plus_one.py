@@ -31,7 +31,6 @@ Cross-camera correspondences do not have this limitation.
 
 from __future__ import annotations
 
-import math
 from typing import Optional, Sequence
 
 import cv2
@@ -95,22 +94,17 @@ def intra_counts(rays: RayPairs):
 
 def _local_frame(dirs: np.ndarray) -> np.ndarray:
     """A rotation Q with Q @ (mean direction of ``dirs``) = +z."""
-    u = dirs / np.sqrt(np.einsum("ij,ij->i", dirs, dirs))[:, None]
-    # the 3-vectors in Python floats: a dozen numpy calls on 3 numbers cost
-    # more than the whole projection
-    z0, z1, z2 = (u.sum(axis=0) / len(u)).tolist()
-    nz = math.sqrt(z0 * z0 + z1 * z1 + z2 * z2)
+    u = dirs / np.linalg.norm(dirs, axis=1, keepdims=True)
+    z = u.mean(axis=0)
+    nz = np.linalg.norm(z)
     if not nz > 1e-6:
         raise DegenerateError("five_plus_one: the rays of the 5-point camera point in all "
                               "directions; no common image plane")
-    z0, z1, z2 = z0 / nz, z1 / nz, z2 / nz
-    # x = e x z with e = +y (or +x when z is close to +-y), then y = z x x
-    x0, x1, x2 = (z2, 0.0, -z0) if abs(z1) < 0.9 else (0.0, -z2, z1)
-    nx = math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
-    x0, x1, x2 = x0 / nx, x1 / nx, x2 / nx
-    return np.array([[x0, x1, x2],
-                     [z1 * x2 - z2 * x1, z2 * x0 - z0 * x2, z0 * x1 - z1 * x0],
-                     [z0, z1, z2]])
+    z /= nz
+    x = _rcross([0.0, 1.0, 0.0] if abs(z[1]) < 0.9 else [1.0, 0.0, 0.0], z)
+    x /= np.linalg.norm(x)
+    y = _rcross(z, x)
+    return np.stack([x, y, z])
 
 
 def _project(Q: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
