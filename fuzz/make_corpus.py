@@ -32,7 +32,8 @@ SEEDS = FUZZ / "build" / "seeds"
 # routines selected by the first byte of each C harness's input
 MODES = {"fuzz_linalg": 8, "fuzz_rays": 3, "fuzz_cls": 3, "fuzz_linear17": 2, "fuzz_refine": 2,
          "fuzz_lp": 3, "fuzz_cone": 2, "fuzz_bnb": 2, "fuzz_linf_local": 1,
-         "fuzz_translation": 3}
+         "fuzz_translation": 3, "fuzz_scale_line": 2,
+         "fuzz_pixel_scale": 2}
 
 # the calibration files, in the order fuzz/python/fuzz_calibration.py indexes
 # them, with the sibling files its byte 1 can select instead (byte 1 % 4 >= 2:

@@ -26,7 +26,7 @@ __all__ = [
     "project_so3", "plucker_from_points", "gec_rows",
     "cls_general", "cls_partial", "cls_range",
     "Linear17Options", "linear17", "GC_CASE_NAMES",
-    "gec_residuals", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
+    "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
     "skyline_eig",
 ]
@@ -459,6 +459,85 @@ def gec_residuals(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any,
                                _p(rays[3]), _p(R), _p(t), _p(out))
     if st != lib.MCG_OK:
         _ray_error(st, "gec_residuals", rays, (("R", R), ("t", t)))
+    return out
+
+
+def scale_ransac(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any, t0: Any,
+                 w: Any, order: Any, threshold: float, prob: float = 0.999,
+                 max_proposals: int = 64) -> Optional[tuple[float, float, int]]:
+    """The scale ``lam`` of ``t = t0 + lam w`` by 1-point RANSAC (``mcg_scale_ransac``).
+
+    Rays as for :func:`gec_residuals` (the correspondences of the cameras
+    other than the 5-point camera, rig frames, metres); ``R`` and the line
+    ``t0 + lam w`` (metres per unit ``lam``) from the 5-point camera. The
+    correspondences ``order[0], order[1], ...`` (indices, e.g. a random
+    permutation) that propose a positive ``lam`` (eq. 7.4, thesis ch. 7.4) are
+    scored by MSAC on the Sampson angular residuals (``threshold`` radians),
+    at most ``max_proposals`` of them, with the adaptive stop of ``prob``;
+    the best is re-estimated by weighted least squares on its inliers.
+    Returns ``(lam, score, n_inliers)`` (score in rad^2), or None when no
+    correspondence proposes a positive scale.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 1)
+    R = _f64("R", R, (3, 3))
+    t0 = _f64("t0", t0, (3,))
+    w = _f64("w", w, (3,))
+    idx = np.asarray(order)
+    n = rays[0].shape[0]
+    if idx.ndim != 1 or (idx.size and (idx.dtype.kind not in "iu" or idx.min() < 0
+                                       or idx.max() >= n)):
+        raise ValueError(f"order must be a 1-D array of indices in [0, {n})")
+    idx = np.ascontiguousarray(idx, dtype=np.int32)
+    work = _work(lib.mcg_scale_ransac_work_size(n))
+    lam, score, m = ffi.new("double *"), ffi.new("double *"), ffi.new("int *")
+    st = lib.mcg_scale_ransac(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]), _p(R),
+                              _p(t0), _p(w), idx.size,
+                              ffi.from_buffer("int[]", idx) if idx.size else ffi.new("int[1]"),
+                              int(max_proposals), float(threshold), float(prob), lam, score, m,
+                              _p(work), work.size)
+    if st == lib.MCG_EDEGENERATE:
+        return None
+    if st != lib.MCG_OK:
+        if not (np.isfinite(threshold) and threshold > 0 and 0 < prob < 1
+                and 1 <= max_proposals <= 1 << 20):
+            raise ValueError(f"scale_ransac: threshold {threshold} must be > 0, prob {prob} in "
+                             f"(0, 1), max_proposals {max_proposals} in [1, 2^20]")
+        _ray_error(st, "scale_ransac", rays, (("R", R), ("t0", t0), ("w", w)))
+    return float(lam[0]), float(score[0]), int(m[0])
+
+
+def sampson_pixel_scale(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any, t: Any,
+                        axes1: Any, axes2: Any, focal1: Any, focal2: Any,
+                        min_var_ratio: float = 0.0) -> np.ndarray:
+    """Pixels per radian of each pair's Sampson angular residual at motion ``(R, t)``
+    for undistorted pinhole cameras (``mcg_sampson_pixel_scale``).
+
+    Rays as for :func:`gec_residuals`; ``axes1``/``axes2`` (N, 3) the unit
+    optical axes of each pair's cameras (rig frames at times 1 and 2),
+    ``focal1``/``focal2`` (N,) their focal lengths in pixels. ``|residual| *
+    scale`` is the image-plane Sampson error (pixels). 0 where the pixel-noise
+    variance of the constraint is at most ``min_var_ratio`` times its squared
+    angular gradient (no first-order constraint).
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    n = rays[0].shape[0]
+    R = _f64("R", R, (3, 3))
+    t = _f64("t", t, (3,))
+    z1, z2 = _f64("axes1", axes1, (n, 3)), _f64("axes2", axes2, (n, 3))
+    f1, f2 = _f64("focal1", focal1, (n,)), _f64("focal2", focal2, (n,))
+    out = np.empty(n)
+    st = lib.mcg_sampson_pixel_scale(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
+                                     _p(R), _p(t), _p(z1), _p(z2), _p(f1), _p(f2),
+                                     float(min_var_ratio), _p(out))
+    if st != lib.MCG_OK:
+        for name, f in (("focal1", f1), ("focal2", f2)):
+            if not (np.isfinite(f).all() and (f > 0).all()):
+                raise ValueError(f"sampson_pixel_scale: {name} must be finite and > 0")
+        if not (np.isfinite(min_var_ratio) and min_var_ratio >= 0):
+            raise ValueError(f"sampson_pixel_scale: min_var_ratio must be >= 0, got "
+                             f"{min_var_ratio}")
+        _ray_error(st, "sampson_pixel_scale", rays,
+                   (("R", R), ("t", t), ("axes1", z1), ("axes2", z2)))
     return out
 
 

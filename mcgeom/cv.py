@@ -22,9 +22,8 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from . import registry
+from . import _core, registry
 from . import robust as _robust
-from .observability import rcross
 from .rig import Rig
 from .types import RayPairs, RigMotion
 
@@ -112,11 +111,6 @@ def _effective_focal(rig: Rig, rays) -> np.ndarray:
     return 1.0 / np.sqrt(0.5 * var)
 
 
-def _rowdot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise dot products of two (N, 3) arrays."""
-    return np.einsum("ij,ij->i", a, b)
-
-
 def _motion_focal(rig: Rig) -> Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]:
     """Pixels per radian of each correspondence's Sampson residual at a given motion.
 
@@ -132,28 +126,24 @@ def _motion_focal(rig: Rig) -> Callable[[RayPairs, np.ndarray, np.ndarray], np.n
     pixels, i.e. the image-plane Sampson error -- the first-order maximum
     likelihood residual for isotropic pixel noise. Same lens assumption as
     :func:`_effective_focal` (undistorted pinhole), whose value is kept where
-    the pixel variance vanishes (no first-order constraint).
+    the pixel variance vanishes (no first-order constraint). Computed by
+    ``_core.sampson_pixel_scale``.
     """
     Ks = rig._Ks  # type: ignore[attr-defined]
     focal = 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])
     axes = rig._Rs[:, 2, :]  # type: ignore[attr-defined]  # optical axes, rig frame
 
+    min_var_ratio = 1e-12 / float(np.square(focal).max())
+
     def motion_focal(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> np.ndarray:
-        a = rays.dirs1 @ R.T                                # time-1 bearings, time-2 frame
-        c = t + rays.origins1 @ R.T - rays.origins2         # baseline of each camera pair
-        d2 = rays.dirs2
-        g2 = rcross(c, a)
-        g2 -= _rowdot(g2, d2)[:, None] * d2                 # tangent gradient at d2
-        g1 = rcross(d2, c)
-        g1 -= _rowdot(g1, a)[:, None] * a                   # tangent gradient at a
-        ax1, ax2 = axes[rays.cam1] @ R.T, axes[rays.cam2]
-        n1, n2 = _rowdot(g1, g1), _rowdot(g2, g2)
-        var = ((_rowdot(a, ax1) / focal[rays.cam1]) ** 2 * (n1 - _rowdot(g1, ax1) ** 2) +
-               (_rowdot(d2, ax2) / focal[rays.cam2]) ** 2 * (n2 - _rowdot(g2, ax2) ** 2))
-        ok = var > 1e-12 * (n1 + n2) / np.square(focal).max()
-        f = np.sqrt((n1 + n2) / np.where(ok, var, 1.0))
-        if not ok.all():
-            f[~ok] = _effective_focal(rig, rays)[~ok]
+        # in C (csrc/pixel_scale.c): ~30 array passes in numpy, ~0.4 ms of a
+        # Ladybug problem per call
+        f = _core.sampson_pixel_scale(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                      R, t, axes[rays.cam1], axes[rays.cam2],
+                                      focal[rays.cam1], focal[rays.cam2], min_var_ratio)
+        bad = f == 0.0                   # no first-order constraint
+        if bad.any():
+            f[bad] = _effective_focal(rig, rays)[bad]
         return f
 
     return motion_focal

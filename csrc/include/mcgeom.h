@@ -817,6 +817,72 @@ int mcg_skyline_eig(int n, const int *first, const int *ptr, const double *a,
                     double *vals, double *vecs, double *resid, int *iters,
                     double *work, size_t lwork);
 
+/* ------------------------------------------------------------ scale_line.c */
+
+/* Doubles of workspace for mcg_scale_ransac: 14 n (0 for n outside [1, 2^26]). */
+size_t mcg_scale_ransac_work_size(int n);
+
+/* The metric scale of the 5+1 method (thesis ch. 7.4) by 1-point RANSAC.
+ * The rotation R (any finite 3 x 3; a rotation in the method) and the line
+ * of translations t(lam) = t0 + lam w (metres per unit lam) come from the
+ * 5-point camera; the n pairs (o1, d1) <-> (o2, d2) (n x 3 each, rig frames
+ * at times 1 and 2, metres, directions of any non-zero length) are the
+ * other cameras' correspondences. Each pair's Sampson angular residual
+ * (radians) is r_k(lam) = (a_k + lam b_k) / sqrt(A_k + 2 B_k lam + C_k
+ * lam^2) (eq. 7.4 in the numerator; the residual of mcg_gec_residuals at
+ * t(lam), with its pi/2 cap).
+ * The pairs order[0], order[1], ... (n_order indices in [0, n), e.g. a random
+ * permutation) that propose a positive scale lam = -a_k / b_k (|b_k| >
+ * 1e-9 (1 + |a_k|), a_k b_k < 0: the cheirality of the 5-point camera fixed
+ * the sense of lam w) are scored, at most max_proposals (1..2^20) of them,
+ * in batches of 16 by MSAC, sum_k min(r_k^2, threshold^2) (threshold > 0,
+ * radians); after each batch the search stops once the proposals used
+ * reach log(1 - prob) / log(1 - m / n) (prob in (0, 1), m the inliers
+ * |r_k| < threshold of the best so far). The best lam is then re-estimated
+ * (at most twice) by least squares of eq. 7.4 on its inliers weighted by
+ * 1 / (A + 2 B lam + C lam^2), kept only while that lowers the score and
+ * stays positive. Outputs: *lam, *score (its MSAC score, rad^2) and
+ * *n_inliers (may be NULL). work: lwork >= mcg_scale_ransac_work_size(n)
+ * doubles. MCG_EDEGENERATE: no pair of order proposes a positive scale
+ * (e.g. w = 0, or every b_k = 0: a critical motion for these pairs).
+ * MCG_EINVAL: NULL pointers (n_inliers excepted), n outside [1, 2^26],
+ * n_order outside [0, 2^26], an index of order outside [0, n),
+ * max_proposals outside [1, 2^20], threshold not finite and > 0, prob not in
+ * (0, 1), NaN/inf in any input, a zero-length direction (|d| < 1e-50), or
+ * magnitudes so large that the terms overflow. MCG_ENOMEM: lwork too small.
+ * Cost: one pass over the pairs for the terms, one per proposal. */
+int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const double R[9], const double t0[3],
+                     const double w[3], int n_order, const int *order, int max_proposals,
+                     double threshold, double prob, double *lam, double *score,
+                     int *n_inliers, double *work, size_t lwork);
+
+/* ----------------------------------------------------------- pixel_scale.c */
+
+/* Pixels per radian of each pair's Sampson angular residual (the residual of
+ * mcg_gec_residuals) at the motion (R, t), for undistorted pinhole cameras:
+ * the factor that makes it the image-plane Sampson error, the first-order
+ * maximum-likelihood residual under isotropic pixel noise. Pair k: rays
+ * (o1, d1) <-> (o2, d2) as for mcg_gec_residuals (n x 3 each, rig frames at
+ * times 1 and 2, metres, directions of any non-zero length), the optical
+ * axes axis1[k], axis2[k] (n x 3, unit, rig frames at times 1 and 2) and
+ * focal lengths f1[k], f2[k] (pixels, > 0) of its cameras. With unit
+ * bearings a = R d1, d2, the baseline c = t + R o1 - o2 and the tangent
+ * gradients g1 = P(a) (d2 x c), g2 = P(d2) (c x a) (P(v) = I - v v^T) of
+ * e = d2 . (c x a), pixel noise of unit variance moves e by the variance
+ * V = (a . R z1 / f1)^2 (|g1|^2 - (g1 . R z1)^2) + (d2 . z2 / f2)^2 (|g2|^2
+ * - (g2 . z2)^2) (a pinhole bearing's covariance: cos^4 / f^2 radially,
+ * cos^2 / f^2 tangentially); scale[k] = sqrt((|g1|^2 + |g2|^2) / V) when
+ * V > min_var_ratio (|g1|^2 + |g2|^2) and the ratio is finite, else 0 (no
+ * first-order constraint: the caller substitutes its own value). n = 0 is valid. MCG_EINVAL: NULL
+ * pointers, n outside [0, 2^26], NaN/inf in any input, f1 or f2 not > 0,
+ * min_var_ratio < 0, a zero-length direction (|d| < 1e-50), or magnitudes
+ * so large that the products overflow (scale is then unspecified). */
+int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const double *o2,
+                            const double *d2, const double R[9], const double t[3],
+                            const double *axis1, const double *axis2, const double *f1,
+                            const double *f2, double min_var_ratio, double *scale);
+
 /* MCG_CDEF_END */
 
 #if defined(__GNUC__) && __GNUC__ >= 4
