@@ -89,7 +89,14 @@ def test_invariant_to_permutation(name, kind, seed):
     a = mcgeom.estimate(p.rays, name, **_given(name, p.R))
     b = mcgeom.estimate(p.rays.take(perm), name, **_given(name, p.R))
     assert rot_err(a.R, b.R) < 1e-9
-    assert np.linalg.norm(a.t - b.t) < 1e-8 * (1 + np.linalg.norm(a.t))
+    # Refinements solve normal equations: where |t| lies in a flat valley (a
+    # scale with a relative std of several %), the summation order moves it
+    # by ~cond * eps (3e-8 of |t| at rel_std 0.07, five_plus_one, stereo
+    # intra-camera rays). A change below 1e-5 of the estimate's own std is
+    # still invariance.
+    rel_std = a.scale.rel_std if np.isfinite(a.scale.rel_std) else 0.0
+    tol = 1e-8 * (1 + np.linalg.norm(a.t)) + 1e-5 * rel_std * np.linalg.norm(a.t)
+    assert np.linalg.norm(a.t - b.t) < tol
 
 
 @pytest.mark.parametrize("name,kind", CASES)

@@ -392,6 +392,10 @@ def minimal_solutions(sample: RayPairs) -> list[tuple[np.ndarray, np.ndarray]]:
     if rest.size == 0:
         return out
     six = sample.take(np.concatenate([five, rest[:1]]))
+    # five bearings in one plane through the centre (to rounding: points on a
+    # line) admit a one-parameter family of essential matrices: no solution
+    if _bearings_planar(sample.dirs1[five], sample.dirs2[five], 1e-9):
+        return out
     for R, t0, w in essential_motions(sample, five, centres[a]):
         ra, rb = scale_terms(sample.take(rest[:1]), R, t0, w)
         if not abs(rb[0]) > 1e-12 * (1.0 + abs(ra[0])):
@@ -633,6 +637,18 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
 _SEARCH_WIDENING = 2.0
 
 
+def _bearings_planar(d1: np.ndarray, d2: np.ndarray, tol: float) -> bool:
+    """True if all bearings at time 1, or all at time 2, lie within ``tol``
+    (RMS, radians) of one plane through the camera centre. Tested on every
+    ray of the camera, outliers included: if even they fit a plane, so do its
+    inliers, and the 5-point problem is degenerate (see _check_not_planar)."""
+    for d in (d1, d2):
+        u = d / np.linalg.norm(d, axis=1, keepdims=True)
+        if np.linalg.svd(u, compute_uv=False)[-1] <= tol * np.sqrt(len(u)):
+            return True
+    return False
+
+
 def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Generator,
             max_cameras: int = 3, scale_samples: int = 64):
     """Two-stage robust hypotheses of thesis ch. 7.4 (Fig. 7.6), camera after camera.
@@ -652,6 +668,8 @@ def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Genera
     order = [int(k) for k in np.argsort(-counts, kind="stable") if counts[k] >= 8][:max_cameras]
     for a in order:
         own = np.flatnonzero(intra & (cam1 == a))
+        if _bearings_planar(rays.dirs1[own], rays.dirs2[own], threshold):
+            continue   # every ray (outliers too) within the threshold of one plane
         stats: dict = {}
         try:
             # 0.99 is enough here: the motion is checked on every camera and the
