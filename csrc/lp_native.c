@@ -39,7 +39,6 @@
 #include <stdint.h>
 #include <string.h>
 
-#define PARALLEL 1e-12   /* projected row norm below: parallel to the plane */
 #define BOX_FACTOR 1e6
 #define TOL_FACTOR 1e-9
 
@@ -83,7 +82,7 @@ static int solve_line(const double *rows, int n, const double r[2], double h,
     int j, i;
 
     for (i = 0; i < 2; ++i) { /* the box */
-        if (fabs(e[i]) < PARALLEL) {
+        if (fabs(e[i]) * 4.0 * B <= tol) { /* as for the rows below */
             if (fabs(q0[i]) > B + tol)
                 return 0;
             continue;
@@ -105,7 +104,12 @@ static int solve_line(const double *rows, int n, const double r[2], double h,
         const double *rj = rows + 3 * j;
         double g = rj[0] * e[0] + rj[1] * e[1];
         double rhs = rj[2] - (rj[0] * q0[0] + rj[1] * q0[1]);
-        if (fabs(g) < PARALLEL) {
+        /* parallel only if the row changes by less than tol over the whole
+         * line within the box (|s| < 2 B): a nearly parallel row (g ~ 1e-13)
+         * can still cross the line inside the box, far from q0, and then
+         * bounds s like any other (found by fuzz_lp: a feasible cone with
+         * margin 1 S declared empty) */
+        if (fabs(g) * 4.0 * B <= tol) {
             if (rhs > tol)
                 return 0;
             continue;
@@ -122,8 +126,12 @@ static int solve_line(const double *rows, int n, const double r[2], double h,
     }
     ce = c[0] * e[0] + c[1] * e[1];
     if (lo > hi) {
-        /* empty up to rounding? verify the midpoint within the tolerance */
+        /* empty up to rounding? verify the midpoint within the tolerance
+         * (the box too: the line may miss it) */
         s = 0.5 * (lo + hi);
+        for (i = 0; i < 2; ++i)
+            if (fabs(q0[i] + s * e[i]) > B + tol)
+                return 0;
         for (j = 0; j < n; ++j) {
             const double *rj = rows + 3 * j;
             double yy0 = q0[0] + s * e[0], yy1 = q0[1] + s * e[1];
@@ -206,7 +214,10 @@ static int solve_3d(const double *rows, int n, double big, double tol,
             double rv = r[0] * e2[0] + r[1] * e2[1] + r[2] * e2[2];
             double rh = r[3] - (r[0] * p0[0] + r[1] * p0[1] + r[2] * p0[2]);
             double g = sqrt(ru * ru + rv * rv);
-            if (g < PARALLEL) {
+            /* parallel only if the row changes by less than tol over the
+             * plane within the box (|y_i| < 2 big, as solve_2d's box): see
+             * solve_line */
+            if (g * 6.0 * big <= tol) {
                 if (rh > tol)
                     return 0; /* a parallel constraint excludes the plane */
                 continue;

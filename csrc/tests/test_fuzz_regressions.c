@@ -293,8 +293,32 @@ static void test_linear17_near_static_and_repeated(void)
     check(wrong == 0, "linear17: an observable scale fits exact data", (double)wrong, 0.0);
 }
 
+/* fuzz_lp (CI run): a homogeneous cone {a_k . x >= 0} whose points within
+ * the box hug the face x + y + z = 0 (rows nearly parallel to each other):
+ * the native solver declared it empty (a row with projected norm 1e-13 was
+ * taken as parallel to the line although it crossed it inside the box) while
+ * GLPK returned a point with margin 1 S. */
+static void test_lp_native_nearly_parallel_rows(void)
+{
+    const double A[] = {6.0234375, 6.0234375, 6.0234375,  3.5859375, 6.0234375, 6.0234375,
+                        6.0234375, 6.0234375, 6.0234375,  6.0234375, 6.0234375, -6.0234375,
+                        6.037353515625, 6.0234375, 6.0234375,  6.0234375, 6.0234375, 0.0};
+    const double b[6] = {0, 0, 0, 0, 0, 0}, p[3] = {2.5774101875722408, 1e6, -1e6};
+    double x[3], work[128], worst = HUGE_VAL;
+    int k;
+    for (k = 0; k < 6; ++k) /* GLPK's point: inside every row by >= 1 S |a_k| */
+        worst = fmin(worst, (A[3 * k] * p[0] + A[3 * k + 1] * p[1] + A[3 * k + 2] * p[2]) /
+                                sqrt(A[3 * k] * A[3 * k] + A[3 * k + 1] * A[3 * k + 1] +
+                                     A[3 * k + 2] * A[3 * k + 2]));
+    check(worst >= 0.99, "lp: the finding's cone has an interior point", worst, 0.99);
+    check(mcg_lp_native_work_size(3, 6) <= 128, "lp: work size", 0.0, 0.0);
+    check_status(mcg_lp_native_feasible(3, 6, A, b, x, work, 128), MCG_OK,
+                 "lp native: nearly parallel rows, feasible cone");
+}
+
 int main(void)
 {
+    test_lp_native_nearly_parallel_rows();
     test_linear17_near_static_and_repeated();
     test_wedge_near_parallel();
     test_cone_iteration_budget();
