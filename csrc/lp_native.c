@@ -39,6 +39,14 @@
 #include <stdint.h>
 #include <string.h>
 
+/* A projected row norm below PARALLEL: the row is parallel to the line (plane)
+ * of the lower-dimensional step. It then excludes that line (plane) only if
+ * it is violated everywhere on it within the box (by more than tol plus its
+ * change g * extent there), else it is dropped there. The threshold sits
+ * above the rounding of exactly parallel rows (~1e-16: duplicated rows) and
+ * below rows that still cross the line inside the box (1e-12 was too large:
+ * fuzz_lp finding 9, a feasible cone declared empty). */
+#define PARALLEL 3e-14
 #define BOX_FACTOR 1e6
 #define TOL_FACTOR 1e-9
 
@@ -82,7 +90,7 @@ static int solve_line(const double *rows, int n, const double r[2], double h,
     int j, i;
 
     for (i = 0; i < 2; ++i) { /* the box */
-        if (fabs(e[i]) * 4.0 * B <= tol) { /* as for the rows below */
+        if (fabs(e[i]) < PARALLEL) { /* as for the rows below */
             if (fabs(q0[i]) > B + tol)
                 return 0;
             continue;
@@ -109,8 +117,8 @@ static int solve_line(const double *rows, int n, const double r[2], double h,
          * can still cross the line inside the box, far from q0, and then
          * bounds s like any other (found by fuzz_lp: a feasible cone with
          * margin 1 S declared empty) */
-        if (fabs(g) * 4.0 * B <= tol) {
-            if (rhs > tol)
+        if (fabs(g) < PARALLEL) {
+            if (rhs > tol + fabs(g) * 3.0 * B)
                 return 0;
             continue;
         }
@@ -217,8 +225,8 @@ static int solve_3d(const double *rows, int n, double big, double tol,
             /* parallel only if the row changes by less than tol over the
              * plane within the box (|y_i| < 2 big, as solve_2d's box): see
              * solve_line */
-            if (g * 6.0 * big <= tol) {
-                if (rh > tol)
+            if (g < PARALLEL) {
+                if (rh > tol + g * 6.0 * big)
                     return 0; /* a parallel constraint excludes the plane */
                 continue;
             }

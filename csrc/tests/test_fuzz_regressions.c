@@ -316,9 +316,33 @@ static void test_lp_native_nearly_parallel_rows(void)
                  "lp native: nearly parallel rows, feasible cone");
 }
 
+/* fuzz_lp, against the first fix of the finding above (a row parallel only
+ * when it changes by less than tol over the box): rows duplicated exactly
+ * have projected norms at rounding level (5e-17) whose offsets rh / g are
+ * noise; taken as crossing rows they cut a feasible slab (planted point with
+ * margin 0.059 S) to nothing. */
+static void test_lp_native_duplicated_rows(void)
+{
+    const double A[] = {0.78789959563591982, 0.78823529411764715, 0.78823529411764715,
+                        0.78823529411764715, 0.78823529411764715, 0.78823529411764715,
+                        0.78823529411764715, 0.78823529411764715, 0.78823529411764715,
+                        0.78823529411764715, 0.78823529411764715, 0.78823529411764715,
+                        0.78823529411764715, 0.78823529411764715, 0.78823529411764715,
+                        0.78823529411764715, 0.78823529411764715, -0.28990615701533529,
+                        -0.29411764705882348, -0.29411764705882348, -0.29411764705882348};
+    const double b[7] = {6.0768915759372408, 5.9305201237647847, 5.9305201237647847,
+                         5.9305201237647847, 5.9305201237647847, 2.516852942427116,
+                         -3.291666613307918};
+    double x[3], work[128];
+    check(mcg_lp_native_work_size(3, 7) <= 128, "lp: work size (7 rows)", 0.0, 0.0);
+    check_status(mcg_lp_native_feasible(3, 7, A, b, x, work, 128), MCG_OK,
+                 "lp native: duplicated rows, feasible slab");
+}
+
 int main(void)
 {
     test_lp_native_nearly_parallel_rows();
+    test_lp_native_duplicated_rows();
     test_linear17_near_static_and_repeated();
     test_wedge_near_parallel();
     test_cone_iteration_budget();
