@@ -197,12 +197,19 @@ int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2
             if (!proposes(work, nn, j))
                 continue;
             lj = -work[j] / work[nn + j];
+            taken++;
+            /* a ratio that underflowed to 0 (tiny a_k) or a score that
+             * overflowed (huge inputs) is no proposal: lam = 0 came out with
+             * MCG_OK (found by fuzz_scale_line in its 10-minute run) */
+            if (!(lj > 0.0))
+                continue;
             sj = msac(work, nn, lj, thr2, NULL);
+            if (!isfinite(sj))
+                continue;
             if (sj < bs) { /* the first of equal scores */
                 bs = sj;
                 bl = lj;
             }
-            taken++;
         }
         if (taken == 0)
             break;
@@ -219,7 +226,7 @@ int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2
         if ((double)used >= needed)
             break;
     }
-    if (used == 0)
+    if (used == 0 || !(best < HUGE_VAL))
         return MCG_EDEGENERATE;
 
     /* weighted least squares of eq. 7.4 on the inliers (weights 1 / D),

@@ -844,7 +844,8 @@ size_t mcg_scale_ransac_work_size(int n);
  * stays positive. Outputs: *lam, *score (its MSAC score, rad^2) and
  * *n_inliers (may be NULL). work: lwork >= mcg_scale_ransac_work_size(n)
  * doubles. MCG_EDEGENERATE: no pair of order proposes a positive scale
- * (e.g. w = 0, or every b_k = 0: a critical motion for these pairs).
+ * with a finite score (e.g. w = 0, or every b_k = 0: a critical motion for
+ * these pairs; or scores that overflow for huge inputs).
  * MCG_EINVAL: NULL pointers (n_inliers excepted), n outside [1, 2^26],
  * n_order outside [0, 2^26], an index of order outside [0, n),
  * max_proposals outside [1, 2^20], threshold not finite and > 0, prob not in

@@ -339,8 +339,27 @@ static void test_lp_native_duplicated_rows(void)
                  "lp native: duplicated rows, feasible slab");
 }
 
+/* fuzz_scale_line (10-minute run): a proposal lam = -a_k / b_k that
+ * underflows to 0 (a_k denormal) was scored, and with no other proposal
+ * lam = 0 came back with MCG_OK. Here e(t) = t_y: a = t0_y = -5e-324,
+ * b = w_y = 10. */
+static void test_scale_ransac_underflowing_proposal(void)
+{
+    const double o[3] = {0, 0, 0}, d1[3] = {0, 0, 1}, d2[3] = {1, 0, 1};
+    const double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t0[3] = {0, -4.9406564584124654e-324, 0};
+    const double w[3] = {0, 10, 0};
+    int order[1] = {0}, m = -1, st;
+    double lam = -1.0, score = -1.0, work[64];
+    check(mcg_scale_ransac_work_size(1) <= 64, "scale_ransac: work size", 0.0, 0.0);
+    st = mcg_scale_ransac(1, o, d1, o, d2, R, t0, w, 1, order, 10, 1e-3, 0.99, &lam, &score, &m,
+                          work, 64);
+    check(st == MCG_EDEGENERATE || (st == MCG_OK && lam > 0.0),
+          "scale_ransac: no lam = 0 with MCG_OK (underflowing proposal)", lam, 0.0);
+}
+
 int main(void)
 {
+    test_scale_ransac_underflowing_proposal();
     test_lp_native_nearly_parallel_rows();
     test_lp_native_duplicated_rows();
     test_linear17_near_static_and_repeated();
