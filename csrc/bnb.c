@@ -137,11 +137,6 @@ static void mat_vec(const double R[9], const double x[3], double y[3])
     y[2] = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
 }
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* The sines of the two half-angles at (eps, s), enlarged as in wedge.c so
  * that rounding never tightens a wedge; 0 if the cones are too wide to
  * constrain anything (then no rows). */

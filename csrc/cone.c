@@ -87,11 +87,6 @@ typedef struct {
     double R;      /* search-ball radius, normalised coordinates */
 } cone_ctx;
 
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* normalised apex c and unit axis v of cone i */
 static void cone_get(const cone_ctx *k, int q, double c[3], double v[3])
 {

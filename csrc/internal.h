@@ -40,6 +40,20 @@ static inline size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
 static inline size_t min_sz(size_t a, size_t b) { return a < b ? a : b; }
 
 /* 1 if none of the n values is NaN or +-inf */
+/* 3-vector dot and cross products, shared by the kernels (static inline:
+ * no exported symbols; each file used to carry its own copy) */
+static inline double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void cross3(const double a[3], const double b[3], double c[3])
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 static inline int all_finite(const double *x, size_t n)
 {
     size_t i;

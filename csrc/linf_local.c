@@ -44,18 +44,6 @@
 #define NR (NV + 1)     /* rows of the dual LP */
 #define LP_MAX_ITER 400 /* simplex pivots per step */
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static void mat_vec(const double R[9], const double x[3], double y[3])
 {
     y[0] = R[0] * x[0] + R[1] * x[1] + R[2] * x[2];

@@ -23,18 +23,6 @@
 #define MAX_PAIRS (1 << 26)
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction */
 
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 /* R v */
 static void rot3(const double R[9], const double v[3], double out[3])
 {

@@ -36,13 +36,6 @@
 #define MAX_SKY_ENV ((size_t)1 << 28)
 #define MAX_BLOCKS 2000000
 
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 /* [v]x as a row-major 3 x 3 matrix: [v]x y = v x y */
 static void skew3(const double v[3], double s[9])
 {

@@ -46,18 +46,6 @@
 #define HALF_PI 1.5707963267948966
 #define NORM2_MIN 1e-200
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 int mcg_wedge_normals(const double v[3], const double vp[3], double eps,
                       double epsp, double n1[3], double n2[3])
 {
