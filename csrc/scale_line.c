@@ -109,18 +109,10 @@ static int terms(size_t n, const double *o1, const double *d1, const double *o2,
                    p2[i];
         }
         /* g = s x a, w x a (its lam part); k = d2 x s, d2 x w */
-        g0[0] = s[1] * a[2] - s[2] * a[1];
-        g0[1] = s[2] * a[0] - s[0] * a[2];
-        g0[2] = s[0] * a[1] - s[1] * a[0];
-        g1[0] = w[1] * a[2] - w[2] * a[1];
-        g1[1] = w[2] * a[0] - w[0] * a[2];
-        g1[2] = w[0] * a[1] - w[1] * a[0];
-        k0[0] = b[1] * s[2] - b[2] * s[1];
-        k0[1] = b[2] * s[0] - b[0] * s[2];
-        k0[2] = b[0] * s[1] - b[1] * s[0];
-        k1[0] = b[1] * w[2] - b[2] * w[1];
-        k1[1] = b[2] * w[0] - b[0] * w[2];
-        k1[2] = b[0] * w[1] - b[1] * w[0];
+        cross3(s, a, g0);
+        cross3(w, a, g1);
+        cross3(b, s, k0);
+        cross3(b, w, k1);
         {
             double e0 = b[0] * g0[0] + b[1] * g0[1] + b[2] * g0[2];
             double e1 = b[0] * g1[0] + b[1] * g1[1] + b[2] * g1[2];
