@@ -308,6 +308,25 @@ static inline void fz_rotation(fz_in *in, double r[9])
     r[7] += k[0] * s;
 }
 
+/* Rays of n pairs (origins and directions at both times, each n x 3), each
+ * array decoded as an arbitrary layout (fz_matrix). */
+static inline void fz_rays(fz_in *in, size_t n, double *o1, double *d1, double *o2, double *d2)
+{
+    fz_matrix(in, o1, n, 3);
+    fz_matrix(in, d1, n, 3);
+    fz_matrix(in, o2, n, 3);
+    fz_matrix(in, d2, n, 3);
+}
+
+/* A 3 x 3 matrix: nine arbitrary doubles or a rotation, as a byte says. */
+static inline void fz_rotation_or_any(fz_in *in, double r[9])
+{
+    if (fz_u8(in) & 1)
+        fz_doubles(in, r, 9);
+    else
+        fz_rotation(in, r);
+}
+
 
 /* A synthetic rig problem that is consistent most of the time, so that the
  * estimators get past their input checks into the numerics: ncams camera

@@ -53,10 +53,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         ncams = fz_int(&in, 1, 8);
         exact = fz_scene(&in, n, ncams, fz_u8(&in) & 1, R, t, o1, d1, o2, d2, NULL);
     } else {
-        fz_matrix(&in, o1, (size_t)n, 3);
-        fz_matrix(&in, d1, (size_t)n, 3);
-        fz_matrix(&in, o2, (size_t)n, 3);
-        fz_matrix(&in, d2, (size_t)n, 3);
+        fz_rays(&in, (size_t)n, o1, d1, o2, d2);
     }
     st = mcg_linear17(n, o1, d1, o2, d2, (fz_u8(&in) & 7) == 0 && defaults ? NULL : &opt, &res);
     FZ_CHECK(fz_status_known(st), "linear17 status %d", st);

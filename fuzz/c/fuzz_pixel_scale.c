@@ -44,18 +44,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             f2[k] = fz_range(&in, 100.0, 2000.0);
         }
     } else {
-        fz_matrix(&in, o1, (size_t)n, 3);
-        fz_matrix(&in, d1, (size_t)n, 3);
-        fz_matrix(&in, o2, (size_t)n, 3);
-        fz_matrix(&in, d2, (size_t)n, 3);
+        fz_rays(&in, (size_t)n, o1, d1, o2, d2);
         fz_matrix(&in, z1, (size_t)n, 3);
         fz_matrix(&in, z2, (size_t)n, 3);
         fz_doubles(&in, f1, (size_t)n);
         fz_doubles(&in, f2, (size_t)n);
-        if (fz_u8(&in) & 1)
-            fz_doubles(&in, R, 9);
-        else
-            fz_rotation(&in, R);
+        fz_rotation_or_any(&in, R);
         fz_doubles(&in, t, 3);
     }
     mvr = (fz_u8(&in) % 8 == 0) ? fz_double(&in) : fz_range(&in, 0.0, 1e-6);

@@ -52,14 +52,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (i = 0; i < 3; ++i)
             w[i] = nd > 0.0 ? dt[i] / nd : 0.0;
     } else {
-        fz_matrix(&in, o1, (size_t)n, 3);
-        fz_matrix(&in, d1, (size_t)n, 3);
-        fz_matrix(&in, o2, (size_t)n, 3);
-        fz_matrix(&in, d2, (size_t)n, 3);
-        if (fz_u8(&in) & 1)
-            fz_doubles(&in, R, 9);
-        else
-            fz_rotation(&in, R);
+        fz_rays(&in, (size_t)n, o1, d1, o2, d2);
+        fz_rotation_or_any(&in, R);
         fz_doubles(&in, t0, 3);
         fz_doubles(&in, w, 3);
     }
