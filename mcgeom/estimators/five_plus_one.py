@@ -251,14 +251,20 @@ def _check_not_planar(d1: np.ndarray, d2: np.ndarray) -> None:
     Only for more than 5 outlier-free rays: a minimal sample, and data with
     outliers, are the robust layer's to judge."""
     for when, d in (("time 1", d1), ("time 2", d2)):
-        u = d / np.linalg.norm(d, axis=1, keepdims=True)
-        s_min = np.linalg.svd(u, compute_uv=False)[-1]
-        if s_min < _PLANAR_BEARINGS * np.sqrt(len(u)):
+        rms = _plane_rms(d)
+        if rms < _PLANAR_BEARINGS:
             raise DegenerateError(
-                f"five_plus_one: the {len(u)} bearings of the 5-point camera at {when} lie in "
-                f"one plane through its centre (RMS {s_min / np.sqrt(len(u)):.2g} rad off it: "
+                f"five_plus_one: the {len(d)} bearings of the 5-point camera at {when} lie in "
+                f"one plane through its centre (RMS {rms:.2g} rad off it: "
                 "points on a line or a plane through the camera): its essential matrix is "
                 "not determined")
+
+
+def _plane_rms(d: np.ndarray) -> float:
+    """RMS distance (radians, small angles) of the unit bearings ``d`` (N, 3)
+    from their best-fitting plane through the camera centre."""
+    u = d / np.linalg.norm(d, axis=1, keepdims=True)
+    return float(np.linalg.svd(u, compute_uv=False)[-1] / np.sqrt(len(u)))
 
 
 def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
@@ -642,11 +648,7 @@ def _bearings_planar(d1: np.ndarray, d2: np.ndarray, tol: float) -> bool:
     (RMS, radians) of one plane through the camera centre. Tested on every
     ray of the camera, outliers included: if even they fit a plane, so do its
     inliers, and the 5-point problem is degenerate (see _check_not_planar)."""
-    for d in (d1, d2):
-        u = d / np.linalg.norm(d, axis=1, keepdims=True)
-        if np.linalg.svd(u, compute_uv=False)[-1] <= tol * np.sqrt(len(u)):
-            return True
-    return False
+    return _plane_rms(d1) <= tol or _plane_rms(d2) <= tol
 
 
 def propose(rays: RayPairs, threshold: float, prob: float, rng: np.random.Generator,
