@@ -8,15 +8,26 @@ RMS centre error after a similarity alignment (units of the scene, circle
 radius 100), the spiral measure (largest angle between an estimated and the
 true step, degrees), the number of reversed steps (> 90 deg: folds), where the
 worst step is and how many tracks link it, medians over trials, and one PNG
-per sigma with the four aligned trajectories (top view).
+per sigma with the four aligned trajectories (top view). Then, per relation
+and sigma, how often the constrained variant beats the plain one in the same
+trial (paired: same sequence, same noise) on RMS and on the spiral measure,
+with the one-sided sign-test p-value of that count.
+
+``--pairwise-reference`` also runs an estimator that is not one of the
+thesis's variants, to show how far the bilinear data themselves go: each view
+pair's baseline direction on its own (smallest eigenvector of the pair's
+epipolar rows, eq. 6.13), then the centres that best fit those directions
+(min sum |(I - d d^T)(c_j - c_i)|^2 subject to sum |c_j - c_i|^2 = 1).
 
     python tests/experiment_ch6.py [--trials 10] [--out ch6_out] [--range 50] [--closed-loop]
                                    [--tracks consecutive|any] [--noise-metric]
+                                   [--pairwise-reference]
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -79,6 +90,59 @@ def run(trials: int = 10, sigmas=SIGMAS, n_views: int = 101, n_points: int = 100
                     paths[(rel, sol, sigma)] = aligned
                     paths[("truth", sigma)] = seq.centres[ok]
     out["paths"] = paths
+    return out
+
+
+def paired_wins(res: dict, relation: str, sigma: float, metric: str) -> tuple[int, int, float]:
+    """(wins, trials, p): in how many trials the constrained variant's
+    ``metric`` ("rms" or "spiral") is below the plain SVD's on the same data,
+    and the one-sided sign-test p-value of at least that many wins if neither
+    variant were better (ties count half a win each way)."""
+    con = np.asarray(res[(relation, "constrained", sigma)][metric])
+    svd = np.asarray(res[(relation, "svd", sigma)][metric])
+    n = len(con)
+    wins = int(np.count_nonzero(con < svd)) + int(np.count_nonzero(con == svd)) // 2
+    p = sum(math.comb(n, k) for k in range(wins, n + 1)) / 2.0 ** n
+    return wins, n, float(p)
+
+
+def pairwise_direction_centres(seq) -> np.ndarray:
+    """(m, 3) centres (view 0 at the origin, sum |c_j - c_i|^2 = 1 over the
+    linked pairs) from each view pair's baseline direction estimated on its
+    own: not a thesis variant, a reference for what the bilinear data of the
+    sequence fix. Dense (3m unknowns): for experiments only."""
+    m = len(seq.rotations)
+    x = np.einsum("kji,kj->ki", seq.rotations[seq.view], seq.bearings)
+    idx = multiview._relations(seq.track, seq.view, 2, "all", 1)
+    keys, block = np.unique(seq.view[idx], axis=0, return_inverse=True)
+    rows = np.cross(x[idx[:, 0]], x[idx[:, 1]])       # eq. 6.5 rows in c_j - c_i
+    gram = np.zeros((len(keys), 3, 3))
+    np.add.at(gram, block.reshape(-1), rows[:, :, None] * rows[:, None, :])
+    d = np.linalg.eigh(gram)[1][:, :, 0]              # each pair's baseline direction
+    H, B = np.zeros((3 * m, 3 * m)), np.zeros((3 * m, 3 * m))
+    for (i, j), dd in zip(keys, d):
+        P = np.eye(3) - np.outer(dd, dd)
+        for a, b, sgn in ((i, i, 1.0), (j, j, 1.0), (i, j, -1.0), (j, i, -1.0)):
+            H[3 * a:3 * a + 3, 3 * b:3 * b + 3] += sgn * P
+            B[3 * a:3 * a + 3, 3 * b:3 * b + 3] += sgn * np.eye(3)
+    Ci = np.linalg.inv(np.linalg.cholesky(B[3:, 3:]))  # gauge c_0 = 0
+    vec = np.linalg.eigh(Ci @ H[3:, 3:] @ Ci.T)[1][:, 0]
+    return np.r_[np.zeros(3), Ci.T @ vec].reshape(-1, 3)
+
+
+def pairwise_reference(trials: int = 10, sigmas=SIGMAS, seed: int = 0,
+                       visible_range: float = 50.0) -> dict:
+    """{sigma: dict(rms=[...], spiral=[...])} of ``pairwise_direction_centres``
+    on the sequences of ``run`` (same seeds)."""
+    out = {}
+    for sigma in sigmas:
+        rec = out.setdefault(sigma, {"rms": [], "spiral": []})
+        for trial in range(trials):
+            seq = circle_sequence(sigma=sigma, rng=seed + 1000 * trial,
+                                  visible_range=visible_range)
+            aligned, rms = similarity_align(pairwise_direction_centres(seq), seq.centres)
+            rec["rms"].append(rms)
+            rec["spiral"].append(spiral_measure(aligned, seq.centres))
     return out
 
 
@@ -147,6 +211,9 @@ def main(argv=None) -> int:
     ap.add_argument("--noise-metric", action="store_true",
                     help="also print how far the noise part of E^T E is from each "
                          "solver's normalisation (dense, a few seconds)")
+    ap.add_argument("--pairwise-reference", action="store_true",
+                    help="also run pairwise directions + centres, a reference for how far "
+                         "the bilinear data go (dense, about a second per trial)")
     args = ap.parse_args(argv)
     res = run(args.trials, seed=args.seed, visible_range=args.range,
               closed_loop=args.closed_loop, track_views=args.tracks)
@@ -171,6 +238,22 @@ def main(argv=None) -> int:
         ratios = [np.median(res[(rel, 'constrained', sigma)]["rms"]) /
                   np.median(res[(rel, 'svd', sigma)]["rms"]) for rel in multiview.RELATIONS]
         print(f"{sigma:8.1e}  bilinear {ratios[0]:7.3f}  trilinear {ratios[1]:7.3f}")
+    print("paired: trials in which constrained beats plain SVD on the same data "
+          "(one-sided sign-test p):")
+    for rel in multiview.RELATIONS:
+        for sigma in SIGMAS:
+            cells = []
+            for metric in ("rms", "spiral"):
+                w, n, p = paired_wins(res, rel, sigma, metric)
+                cells.append(f"{metric} {w:3d}/{n:<3d} p {p:8.2g}")
+            print(f"  {rel:9s} {sigma:8.1e}  " + "   ".join(cells))
+    if args.pairwise_reference:
+        ref = pairwise_reference(args.trials, seed=args.seed, visible_range=args.range)
+        print("reference, not a thesis variant: pairwise baseline directions, then centres "
+              "(median RMS / spiral[deg]):")
+        for sigma in SIGMAS:
+            print(f"  {sigma:8.1e}  {np.median(ref[sigma]['rms']):10.4g} "
+                  f"{np.degrees(np.median(ref[sigma]['spiral'])):10.4g}")
     if args.noise_metric:
         print("spread max/min of the expected noise part of E^T E against each solver's "
               "normalisation (sigma 1e-3; 1 = unbiased):")
