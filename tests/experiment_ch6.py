@@ -97,11 +97,11 @@ def paired_wins(res: dict, relation: str, sigma: float, metric: str) -> tuple[in
     """(wins, trials, p): in how many trials the constrained variant's
     ``metric`` ("rms" or "spiral") is below the plain SVD's on the same data,
     and the one-sided sign-test p-value of at least that many wins if neither
-    variant were better (ties count half a win each way)."""
+    variant were better (a tie is no win: conservative)."""
     con = np.asarray(res[(relation, "constrained", sigma)][metric])
     svd = np.asarray(res[(relation, "svd", sigma)][metric])
     n = len(con)
-    wins = int(np.count_nonzero(con < svd)) + int(np.count_nonzero(con == svd)) // 2
+    wins = int(np.count_nonzero(con < svd))
     p = sum(math.comb(n, k) for k in range(wins, n + 1)) / 2.0 ** n
     return wins, n, float(p)
 
@@ -131,7 +131,8 @@ def pairwise_direction_centres(seq) -> np.ndarray:
 
 
 def pairwise_reference(trials: int = 10, sigmas=SIGMAS, seed: int = 0,
-                       visible_range: float = 50.0) -> dict:
+                       visible_range: float = 50.0, closed_loop: bool = False,
+                       track_views: str = "consecutive") -> dict:
     """{sigma: dict(rms=[...], spiral=[...])} of ``pairwise_direction_centres``
     on the sequences of ``run`` (same seeds)."""
     out = {}
@@ -139,7 +140,8 @@ def pairwise_reference(trials: int = 10, sigmas=SIGMAS, seed: int = 0,
         rec = out.setdefault(sigma, {"rms": [], "spiral": []})
         for trial in range(trials):
             seq = circle_sequence(sigma=sigma, rng=seed + 1000 * trial,
-                                  visible_range=visible_range)
+                                  visible_range=visible_range, closed_loop=closed_loop,
+                                  track_views=track_views)
             aligned, rms = similarity_align(pairwise_direction_centres(seq), seq.centres)
             rec["rms"].append(rms)
             rec["spiral"].append(spiral_measure(aligned, seq.centres))
@@ -248,7 +250,8 @@ def main(argv=None) -> int:
                 cells.append(f"{metric} {w:3d}/{n:<3d} p {p:8.2g}")
             print(f"  {rel:9s} {sigma:8.1e}  " + "   ".join(cells))
     if args.pairwise_reference:
-        ref = pairwise_reference(args.trials, seed=args.seed, visible_range=args.range)
+        ref = pairwise_reference(args.trials, seed=args.seed, visible_range=args.range,
+                                 closed_loop=args.closed_loop, track_views=args.tracks)
         print("reference, not a thesis variant: pairwise baseline directions, then centres "
               "(median RMS / spiral[deg]):")
         for sigma in SIGMAS:

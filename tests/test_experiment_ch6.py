@@ -45,7 +45,7 @@ def test_paired_wins_counts_and_sign_test():
     res = {("bilinear", "constrained", 1e-3): {"rms": [1.0, 2.0, 3.0, 4.0]},
            ("bilinear", "svd", 1e-3): {"rms": [2.0, 3.0, 3.0, 1.0]}}
     wins, n, p = ex.paired_wins(res, "bilinear", 1e-3, "rms")
-    # two wins, one tie (no half counted down to 0), one loss
+    # two wins, one tie (no win), one loss
     assert (wins, n) == (2, 4)
     assert abs(p - (6 + 4 + 1) / 16) < 1e-15
     res[("bilinear", "svd", 1e-3)]["rms"] = [9.0] * 4
