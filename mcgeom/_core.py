@@ -981,6 +981,10 @@ def trilinear_rows(x1: Any, x2: Any, x3: Any, w1: Any = None, w2: Any = None,
     return rows
 
 
+#: relations per call of mcg_relation_grams (its limit n <= 2^20, csrc/internal.h MAX_ROWS)
+RELATION_CHUNK = 1 << 20
+
+
 def relation_grams(x: Any, w: Any, block: Any, n_blocks: int) -> np.ndarray:
     """Per-block Gram matrices (n_blocks, 3q+1, 3q+1) of the relation rows of
     ``x`` (N, q, 3) world-aligned bearings (q = 2 bilinear, 3 trilinear), ray
@@ -1000,11 +1004,19 @@ def relation_grams(x: Any, w: Any, block: Any, n_blocks: int) -> np.ndarray:
     if n_blocks < 1:
         raise ValueError(f"n_blocks must be >= 1, got {n_blocks}")
     d = 3 * q + 1
-    grams = np.empty((n_blocks, d, d))
-    _check(lib.mcg_relation_grams(q, n, _p(x) if n else _p(np.zeros(1)),
-                                  ffi.NULL if w is None else _p(w),
-                                  ffi.from_buffer("int[]", b) if n else ffi.new("int[1]"),
-                                  n_blocks, _p(grams)), "relation_grams")
+    grams = np.zeros((n_blocks, d, d))
+    part = np.empty_like(grams)
+    # the kernel takes at most RELATION_CHUNK relations a call (its size
+    # guard); the Grams are sums over relations, so larger sets (a real
+    # sequence with long tracks) are added up chunk by chunk
+    for s in range(0, max(n, 1), RELATION_CHUNK):
+        e = min(n, s + RELATION_CHUNK)
+        _check(lib.mcg_relation_grams(q, e - s, _p(x[s:e]) if n else _p(np.zeros(1)),
+                                      ffi.NULL if w is None else _p(w[s:e]),
+                                      ffi.from_buffer("int[]", b[s:e]) if n
+                                      else ffi.new("int[1]"),
+                                      n_blocks, _p(part)), "relation_grams")
+        grams += part
     return grams
 
 

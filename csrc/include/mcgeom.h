@@ -775,8 +775,9 @@ int mcg_trilinear_rows(int n, const double *x1, const double *x2, const double *
  * of the q centres, constant). For q = 3 the 9 rows of each of the three
  * choices of reference view are added (27 rows), so that a block does not
  * depend on the order of its views. n may be 0. MCG_EINVAL: q not 2 or 3,
- * n < 0 or too large, n_blocks outside [1, 2e6], a NULL array (w may be
- * NULL), NaN/inf, a block index out of range, or Grams that overflow. */
+ * n outside [0, 2^20] (callers add up the Grams of larger sets chunk by
+ * chunk), n_blocks outside [1, 2e6], a NULL array (w may be NULL), NaN/inf,
+ * a block index out of range, or Grams that overflow. */
 int mcg_relation_grams(int q, int n, const double *x, const double *w,
                        const int *block, int n_blocks, double *grams);
 
