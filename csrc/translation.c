@@ -140,17 +140,115 @@ int mcg_trilinear_rows(int n, const double *x1, const double *x2, const double *
     return MCG_OK;
 }
 
-/* g += r r^T for a row r of length d (g: d x d, row-major) */
-static void add_outer(int d, const double *r, double *g)
+/* upper triangle of g += r r^T for a row r of length d (g: d x d,
+ * row-major); the lower triangle is filled once per block at the end
+ * (mirror_lower): half the work of the full outer product */
+static void add_outer_upper(int d, const double *r, double *g)
 {
     int a, b;
     for (a = 0; a < d; ++a) {
         double ra = r[a];
         if (ra == 0.0)
             continue;
-        for (b = 0; b < d; ++b)
+        for (b = a; b < d; ++b)
             g[a * d + b] += ra * r[b];
     }
+}
+
+static void mirror_lower(int d, double *g)
+{
+    int a, b;
+    for (a = 1; a < d; ++a)
+        for (b = 0; b < a; ++b)
+            g[a * d + b] = g[b * d + a];
+}
+
+/* Upper triangle of g (10 x 10 over (c_ref, c_o1, c_o2, 1)) += the sum of
+ * r r^T over the 9 trilinear rows of trilinear_rows9(x_ref, x_o1, x_o2), in
+ * closed form: with u = x_r x x_1, v = x_r x x_2, alpha_st = -v_t [x_1]x_s
+ * and beta_st = u_s [x_2]x_t (the a- and b-parts of row 3 s + t),
+ *   sum alpha alpha^T = |v|^2 ([x_1]x^T [x_1]x) = |v|^2 (|x_1|^2 I - x_1 x_1^T),
+ *   sum beta beta^T   = |u|^2 (|x_2|^2 I - x_2 x_2^T),
+ *   sum alpha beta^T  = -([x_1]x^T u)([x_2]x^T v)^T = -(u x x_1)(v x x_2)^T,
+ * and the constant of each row is (alpha, beta) . z, z = (a0, b0) the
+ * offsets. A row over the centres is (-(alpha + beta), alpha, beta, const).
+ * About 6x fewer operations than the 9 explicit outer products of 10-rows;
+ * the same sums up to rounding (tests/test_multiview.py checks them against
+ * the rows of mcg_trilinear_rows). */
+static void add_trilinear_gram(const double *xr, const double *x1, const double *x2,
+                               const double *wr, const double *w1, const double *w2,
+                               int ref, int o1, int o2, double *g)
+{
+    double u[3], v[3], p[3], q[3], z[6] = {0, 0, 0, 0, 0, 0};
+    double G[6][6], Gz[6], zGz = 0.0, uu, vv, n1, n2;
+    double blk[3][3][3][3]; /* blk[P][Q]: 3 x 3 block between positions P, Q */
+    double col[3][3];       /* constant column of each position */
+    const int pos[3] = {ref, o1, o2};
+    int a, b, P, Q;
+    cross3(xr, x1, u);
+    cross3(xr, x2, v);
+    cross3(u, x1, p);
+    cross3(v, x2, q);
+    uu = dot3(u, u);
+    vv = dot3(v, v);
+    n1 = dot3(x1, x1);
+    n2 = dot3(x2, x2);
+    if (wr != NULL)
+        for (a = 0; a < 3; ++a) {
+            z[a] = w1[a] - wr[a];
+            z[3 + a] = w2[a] - wr[a];
+        }
+    for (a = 0; a < 3; ++a)
+        for (b = 0; b < 3; ++b) {
+            G[a][b] = vv * ((a == b ? n1 : 0.0) - x1[a] * x1[b]);
+            G[3 + a][3 + b] = uu * ((a == b ? n2 : 0.0) - x2[a] * x2[b]);
+            G[a][3 + b] = -p[a] * q[b];
+            G[3 + b][a] = G[a][3 + b];
+        }
+    for (a = 0; a < 6; ++a) {
+        Gz[a] = 0.0;
+        for (b = 0; b < 6; ++b)
+            Gz[a] += G[a][b] * z[b];
+        zGz += z[a] * Gz[a];
+    }
+    /* positions 1 (alpha), 2 (beta), 0 (-(alpha + beta)) */
+    for (a = 0; a < 3; ++a) {
+        for (b = 0; b < 3; ++b) {
+            const double A = G[a][b], B = G[a][3 + b], Bt = G[3 + a][b], C = G[3 + a][3 + b];
+            blk[1][1][a][b] = A;
+            blk[2][2][a][b] = C;
+            blk[1][2][a][b] = B;
+            blk[2][1][a][b] = Bt;
+            blk[0][0][a][b] = A + B + Bt + C;
+            blk[0][1][a][b] = -(A + Bt);
+            blk[1][0][a][b] = -(A + B);
+            blk[0][2][a][b] = -(B + C);
+            blk[2][0][a][b] = -(Bt + C);
+        }
+        col[1][a] = Gz[a];
+        col[2][a] = Gz[3 + a];
+        col[0][a] = -(Gz[a] + Gz[3 + a]);
+    }
+    /* the diagonal entries and zGz are sums of squares: a closed form can
+     * round them below 0 (A + B + B^T + C where alpha ~ -beta), so they are
+     * clamped at 0, within rounding of the exact sums and keeping every
+     * diagonal of the block Gram >= 0 as the explicit sum does */
+    for (P = 0; P < 3; ++P)
+        for (a = 0; a < 3; ++a)
+            if (blk[P][P][a][a] < 0.0)
+                blk[P][P][a][a] = 0.0;
+    for (P = 0; P < 3; ++P)
+        for (Q = 0; Q < 3; ++Q)
+            for (a = 0; a < 3; ++a)
+                for (b = 0; b < 3; ++b) {
+                    const int r = 3 * pos[P] + a, c = 3 * pos[Q] + b;
+                    if (r <= c)
+                        g[10 * r + c] += blk[P][Q][a][b];
+                }
+    for (P = 0; P < 3; ++P)
+        for (a = 0; a < 3; ++a)
+            g[10 * (3 * pos[P] + a) + 9] += col[P][a];
+    g[99] += zGz > 0.0 ? zGz : 0.0;
 }
 
 int mcg_relation_grams(int q, int n, const double *x, const double *w,
@@ -176,34 +274,22 @@ int mcg_relation_grams(int q, int n, const double *x, const double *w,
         if (q == 2) {
             double row[7];
             bilinear_row(xk, xk + 3, wk, wk ? wk + 3 : NULL, row);
-            add_outer(7, row, g);
+            add_outer_upper(7, row, g);
         } else {
             /* all three choices of the reference view: the block's rows, and
              * so the solution, do not depend on the order of its views */
             int ref;
             for (ref = 0; ref < 3; ++ref) {
                 const int o1 = (ref + 1) % 3, o2 = (ref + 2) % 3;
-                double r9[63];
-                int e;
-                trilinear_rows9(xk + 3 * ref, xk + 3 * o1, xk + 3 * o2,
-                                wk ? wk + 3 * ref : NULL, wk ? wk + 3 * o1 : NULL,
-                                wk ? wk + 3 * o2 : NULL, r9);
-                for (e = 0; e < 9; ++e) {
-                    const double *ab = r9 + 7 * e;
-                    double row[10];
-                    int c;
-                    /* a = c_o1 - c_ref, b = c_o2 - c_ref */
-                    for (c = 0; c < 3; ++c) {
-                        row[3 * ref + c] = -(ab[c] + ab[3 + c]);
-                        row[3 * o1 + c] = ab[c];
-                        row[3 * o2 + c] = ab[3 + c];
-                    }
-                    row[9] = ab[6];
-                    add_outer(10, row, g);
-                }
+                /* a = c_o1 - c_ref, b = c_o2 - c_ref */
+                add_trilinear_gram(xk + 3 * ref, xk + 3 * o1, xk + 3 * o2,
+                                   wk ? wk + 3 * ref : NULL, wk ? wk + 3 * o1 : NULL,
+                                   wk ? wk + 3 * o2 : NULL, ref, o1, o2, g);
             }
         }
     }
+    for (i = 0; i < n_blocks; ++i)
+        mirror_lower(d, grams + (size_t)i * (size_t)(d * d));
     if (!all_finite(grams, (size_t)n_blocks * (size_t)(d * d)))
         return MCG_EINVAL;
     return MCG_OK;

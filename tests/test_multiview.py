@@ -248,3 +248,49 @@ def test_relation_grams_rejects_bad_block_indices():
         _core.relation_grams(x, None, np.array([0, 1, 2, 3.0]), 4)
     with pytest.raises(ValueError, match="block"):
         _core.relation_grams(x, None, np.array([0, 1, 2, 4]), 4)
+
+
+@pytest.mark.parametrize("q", [2, 3])
+def test_relation_grams_in_chunks_equal_one_call(q, monkeypatch):
+    """More relations than the kernel takes in a call (2^20: a real sequence
+    with long tracks gives more trilinear ones) are added up chunk by chunk."""
+    rng = np.random.default_rng(q)
+    x = rng.normal(size=(50, q, 3))
+    w = rng.normal(size=(50, q, 3))
+    block = rng.integers(0, 6, size=50)
+    whole = _core.relation_grams(x, w, block, 6)
+    monkeypatch.setattr(_core, "RELATION_CHUNK", 7)
+    chunked = _core.relation_grams(x, w, block, 6)
+    assert np.allclose(chunked, whole, rtol=1e-13, atol=1e-13 * np.abs(whole).max())
+
+
+@pytest.mark.parametrize("q", [2, 3])
+def test_grams_with_offsets_are_sums_of_explicit_row_outer_products(q):
+    """Each block Gram, constant column included, against sum r r^T of the
+    explicit rows of mcg_bilinear_rows / mcg_trilinear_rows (themselves checked
+    against numpy above): the trilinear Gram is summed in closed form, not
+    from the 27 rows, so this pins the closed form down."""
+    rng = np.random.default_rng(10 + q)
+    n, nb = 40, 5
+    x = rng.normal(size=(n, q, 3))
+    w = rng.normal(size=(n, q, 3))
+    block = rng.integers(0, nb, size=n)
+    grams = _core.relation_grams(x, w, block, nb)
+    d = 3 * q + 1
+    ref = np.zeros((nb, d, d))
+    if q == 2:
+        rows = _core.bilinear_rows(x[:, 0], x[:, 1], w[:, 0], w[:, 1])
+        np.add.at(ref, block, rows[:, :, None] * rows[:, None, :])
+    else:
+        for r0 in range(3):
+            o1, o2 = (r0 + 1) % 3, (r0 + 2) % 3
+            r9 = _core.trilinear_rows(x[:, r0], x[:, o1], x[:, o2],
+                                      w[:, r0], w[:, o1], w[:, o2])     # (n, 9, 7)
+            full = np.zeros((n, 9, 10))
+            full[:, :, 3 * r0:3 * r0 + 3] = -(r9[:, :, 0:3] + r9[:, :, 3:6])
+            full[:, :, 3 * o1:3 * o1 + 3] = r9[:, :, 0:3]
+            full[:, :, 3 * o2:3 * o2 + 3] = r9[:, :, 3:6]
+            full[:, :, 9] = r9[:, :, 6]
+            np.add.at(ref, block, np.einsum("kea,keb->kab", full, full))
+    np.testing.assert_allclose(grams, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+    assert np.array_equal(grams, np.transpose(grams, (0, 2, 1)))
