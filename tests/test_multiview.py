@@ -294,3 +294,17 @@ def test_grams_with_offsets_are_sums_of_explicit_row_outer_products(q):
             np.add.at(ref, block, np.einsum("kea,keb->kab", full, full))
     np.testing.assert_allclose(grams, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
     assert np.array_equal(grams, np.transpose(grams, (0, 2, 1)))
+
+
+@pytest.mark.parametrize("q", [2, 3])
+def test_blocks_coded_sort_equals_unique_rows(q):
+    """The 1-D coded sort of the view tuples gives np.unique's rows and inverse,
+    also on the record-sort fallback for view counts whose code would overflow."""
+    rng = np.random.default_rng(q)
+    for m in (7, 3_000_000):
+        v = np.sort(rng.choice(m, size=(500, q)), axis=1)
+        keys, block = multiview._blocks(v, m)
+        ref, inv = np.unique(v, axis=0, return_inverse=True)
+        assert np.array_equal(keys, ref)
+        assert np.array_equal(block, inv.reshape(-1))
+        assert np.array_equal(keys[block], v)
