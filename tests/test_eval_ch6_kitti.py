@@ -46,3 +46,29 @@ def test_solver_choice_does_not_change_a_metric_solution(results):
         for where in ("all", "window 1" if rel == "bilinear" else "window 2"):
             a, b = results[f"{rel} + svd, {where}"], results[f"{rel} + constrained, {where}"]
             assert np.isclose(a["rms"], b["rms"], rtol=1e-6), (rel, where)
+
+
+def test_constrained_beats_plain_trilinear_on_real_short_tracks():
+    """Thesis ch. 6.3 on real noise: cam0 alone (no scale), the tracks cut to
+    <= 3 consecutive frames as in ch. 6.5.1. Measured on frames 13-76 (error
+    after a similarity, path 59.5 m): trilinear plain SVD 2.01 m, constrained
+    0.43 m. (Bilinear relations are near-degenerate for a car driving almost
+    straight -- pairwise directions of nearly collinear centres fix no step
+    lengths --: 4.0 m plain, 8.8 m constrained, which collapses onto a few
+    steps; reported by the evaluation script, not asserted.)"""
+    res = ev.evaluate_monocular(13, 76, max_lens=(3,), out=lambda *a: None)
+    svd = res["cam0 trilinear + svd, tracks <= 3 frames"]
+    con = res["cam0 trilinear + constrained, tracks <= 3 frames"]
+    assert not con["observable"] and not svd["observable"]   # one central camera: no scale
+    assert con["rms_sim"] < 0.7
+    assert con["rms_sim"] < 0.4 * svd["rms_sim"]
+
+
+def test_cut_tracks_makes_short_consecutive_pieces():
+    track = np.array([5, 5, 5, 5, 5, 5, 5, 9, 9])
+    view = np.array([0, 1, 2, 3, 4, 6, 7, 2, 3])
+    new = ev.cut_tracks(track, view, 3)
+    # pieces: {0,1,2}, {3,4}, {6,7} (a gap starts a new piece), {2,3} of track 9
+    groups = {tuple(view[new == t]) for t in np.unique(new)}
+    assert groups == {(0, 1, 2), (3, 4), (6, 7), (2, 3)}
+    assert len(np.unique(new[track == 9])) == 1
