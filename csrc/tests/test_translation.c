@@ -197,7 +197,7 @@ static void test_grams(void)
         }
     {   /* relative to the largest entry: the Gram is summed in closed form,
          * the reference from the explicit rows, so they agree to rounding of
-         * the entries' size (here ~1e5) */
+         * the entries' size (here ~3e6) */
         double rmax = 0.0;
         for (i = 0; i < 100; ++i) {
             err3 = fmax(err3, fabs(g3[i] - ref3[i]));
