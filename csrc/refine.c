@@ -726,7 +726,12 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
         }
     }
 
-    /* statistics at the solution */
+    /* statistics at the solution; with weights (or coordinates) near the
+     * top of the double range the information matrix J^T W J overflows
+     * although every step's cost stayed finite: no statistics can be given,
+     * and a motion without them is not returned as MCG_OK */
+    if (!all_finite(cur.h, 36) || !isfinite(cur.cost))
+        return MCG_ENUMERIC;
     res->final_cost = cur.cost;
     res->converged = converged;
     res->reason = reason;

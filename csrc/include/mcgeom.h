@@ -445,8 +445,10 @@ void mcg_refine_default_options(mcg_refine_options *opt);
  * mcg_gec_residuals, also for pairs of weight 0), or fix_scale with t = 0.
  * MCG_EDEGENERATE: all weights zero, or no ray constrains the motion at the
  * start (e.g. R = I, t = 0 for a rig whose correspondences stay in
- * one camera: every F = 0). Not converging within max_iterations is not an
- * error: see res->converged and res->reason. */
+ * one camera: every F = 0). MCG_ENUMERIC: the information matrix (or the
+ * cost) at the solution overflows the double range (weights or coordinates
+ * near 1e300); R, t untouched. Not converging within max_iterations is not
+ * an error: see res->converged and res->reason. */
 int mcg_refine_motion(int n, const double *o1, const double *d1,
                       const double *o2, const double *d2,
                       const double *weights, const mcg_refine_options *opt,
