@@ -1229,13 +1229,21 @@ int mcg_rot_from_quat(const double q[4], double r[9])
     double nq, w, x, y, z;
     if (q == NULL || r == NULL || !all_finite(q, 4))
         return MCG_EINVAL;
-    nq = norm_small(q, 4);
+    /* normalised through q / max|q_i| (exact ratios, all <= 1): dividing by
+     * the norm itself would round it to a denormal for a denormal q, and the
+     * matrix would be orthogonal only to that precision (fuzz finding 12) */
+    nq = max_abs(q, 4);
     if (nq == 0.0)
         return MCG_EINVAL;
     w = q[0] / nq;
     x = q[1] / nq;
     y = q[2] / nq;
     z = q[3] / nq;
+    nq = sqrt(w * w + x * x + y * y + z * z); /* in [1, 2] */
+    w /= nq;
+    x /= nq;
+    y /= nq;
+    z /= nq;
     r[0] = 1.0 - 2.0 * (y * y + z * z);
     r[1] = 2.0 * (x * y - w * z);
     r[2] = 2.0 * (x * z + w * y);
