@@ -68,7 +68,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             }
         for (k = fz_u8(&in) % 3; k > 0; --k) {
             double *arr = (fz_u8(&in) & 1) ? apex : axis;
-            arr[fz_int(&in, 0, 3 * n - 1)] = fz_double(&in);
+            const int at = fz_int(&in, 0, 3 * n - 1); /* decoded before the value */
+            arr[at] = fz_double(&in);
         }
     } else {
         fz_matrix(&in, apex, (size_t)n, 3);

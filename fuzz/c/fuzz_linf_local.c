@@ -67,7 +67,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fz_rotation(&in, Rt);
     for (i = 0; i < 3; ++i)
         tt[i] = fz_range(&in, -1.0, 1.0);
-    fz_scene(&in, n, fz_int(&in, 1, 6), fz_u8(&in) & 1, Rt, tt, a1, u1, a2, u2, NULL);
+    {   /* decoded in this order (arguments of one call would be evaluated in
+         * an order that depends on the compiler) */
+        const int ncams = fz_int(&in, 1, 6), cross = fz_u8(&in) & 1;
+        fz_scene(&in, n, ncams, cross, Rt, tt, a1, u1, a2, u2, NULL);
+    }
     finite_rows(a1, n);
     finite_rows(a2, n);
     unit_rows(u1, n);

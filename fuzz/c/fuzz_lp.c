@@ -139,7 +139,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (k = 0; k < m; ++k) {
             double v = 0.0, slack = fz_range(&in, -0.5, 2.0);
             for (i = 0; i < dim; ++i) {
-                A[k * dim + i] = fz_range(&in, -1.0, 1.0) * (mode == 2 ? fz_range(&in, 0.0, 1e3) : 1.0);
+                const double a = fz_range(&in, -1.0, 1.0); /* decoded before the scale */
+                A[k * dim + i] = a * (mode == 2 ? fz_range(&in, 0.0, 1e3) : 1.0);
                 v += A[k * dim + i] * p[i];
             }
             b[k] = v - slack * row_norm(dim, A, k) * scale;

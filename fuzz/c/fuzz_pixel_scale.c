@@ -33,7 +33,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fz_rotation(&in, R);
         for (i = 0; i < 3; ++i)
             t[i] = fz_range(&in, -2.0, 2.0);
-        fz_scene(&in, n, fz_int(&in, 1, 8), fz_u8(&in) & 1, R, t, o1, d1, o2, d2, NULL);
+        {   /* decoded in this order (not as arguments of one call) */
+            const int ncams = fz_int(&in, 1, 8), cross = fz_u8(&in) & 1;
+            fz_scene(&in, n, ncams, cross, R, t, o1, d1, o2, d2, NULL);
+        }
         for (k = 0; k < n; ++k) {
             /* the axis of each camera: roughly along its bearing */
             for (i = 0; i < 3; ++i) {

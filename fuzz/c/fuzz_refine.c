@@ -62,7 +62,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fz_rotation(&in, Rt);
         for (i = 0; i < 3; ++i)
             tt[i] = fz_range(&in, -2.0, 2.0);
-        fz_scene(&in, n, fz_int(&in, 1, 8), fz_u8(&in) & 1, Rt, tt, o1, d1, o2, d2, NULL);
+        {   /* decoded in this order (not as arguments of one call) */
+            const int ncams = fz_int(&in, 1, 8), cross = fz_u8(&in) & 1;
+            fz_scene(&in, n, ncams, cross, Rt, tt, o1, d1, o2, d2, NULL);
+        }
         /* the start: the truth moved by a decoded small rotation and shift */
         for (i = 0; i < 3; ++i)
             dw[i] = fz_range(&in, -0.2, 0.2);

@@ -43,7 +43,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fz_rotation(&in, R);
         for (i = 0; i < 3; ++i)
             tt[i] = fz_range(&in, -2.0, 2.0);
-        fz_scene(&in, n, fz_int(&in, 1, 8), fz_u8(&in) & 1, R, tt, o1, d1, o2, d2, NULL);
+        {   /* decoded in this order (not as arguments of one call) */
+            const int ncams = fz_int(&in, 1, 8), cross = fz_u8(&in) & 1;
+            fz_scene(&in, n, ncams, cross, R, tt, o1, d1, o2, d2, NULL);
+        }
         for (i = 0; i < 3; ++i) {
             t0[i] = fz_range(&in, -1.0, 1.0);
             dt[i] = tt[i] - t0[i];
