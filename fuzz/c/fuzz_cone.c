@@ -18,15 +18,26 @@
 #define MAXN 40
 #define HALF_PI 1.5707963267948966
 
-static double angle(const double *u, const double *v)
+static double angle(const double *u0, const double *v0)
 {
-    /* atan2(|u x v|, u . v): accurate for every angle; 0 when u = 0 */
-    double c[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                   u[0] * v[1] - u[1] * v[0]};
-    double s = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    double d = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-    if (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0)
+    /* atan2(|u x v|, u . v): accurate for every angle; 0 when u = 0. Both
+     * vectors are first divided by their largest component (the angle does
+     * not change): for apexes near 1e-160 the squares of the cross product
+     * would be denormals of a few significant bits (a false finding) */
+    double u[3], v[3], mu = fmax(fabs(u0[0]), fmax(fabs(u0[1]), fabs(u0[2])));
+    double mv = fmax(fabs(v0[0]), fmax(fabs(v0[1]), fabs(v0[2]))), c[3], s, d;
+    int i;
+    if (mu == 0.0)
         return 0.0;
+    for (i = 0; i < 3; ++i) {
+        u[i] = u0[i] / mu;
+        v[i] = v0[i] / mv;
+    }
+    c[0] = u[1] * v[2] - u[2] * v[1];
+    c[1] = u[2] * v[0] - u[0] * v[2];
+    c[2] = u[0] * v[1] - u[1] * v[0];
+    s = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    d = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     return atan2(s, d);
 }
 
