@@ -116,37 +116,6 @@ static double angle_of(const double w[3], const double v[3])
     return atan2(sqrt(dot3(p, p)), vw);
 }
 
-/* largest angle at the world point X itself, each X - C_i and v_i divided
- * by its largest component first (no underflow for apexes near 1e-160);
- * X on an apex counts as angle 0 */
-static double world_max_angle(int n, const double *apex, const double *axis,
-                              const double X[3])
-{
-    double best = 0.0;
-    int i, j;
-    for (i = 0; i < n; ++i) {
-        double u[3], v[3], mu = 0.0, mv = 0.0, nv, a;
-        for (j = 0; j < 3; ++j) {
-            u[j] = X[j] - apex[3 * i + j];
-            mu = fmax(mu, fabs(u[j]));
-            mv = fmax(mv, fabs(axis[3 * i + j]));
-        }
-        if (mu == 0.0)
-            continue;
-        for (j = 0; j < 3; ++j) {
-            u[j] /= mu;
-            v[j] = axis[3 * i + j] / mv;
-        }
-        nv = sqrt(dot3(v, v));
-        for (j = 0; j < 3; ++j)
-            v[j] /= nv;
-        a = angle_of(u, v);
-        if (a > best)
-            best = a;
-    }
-    return best;
-}
-
 /* largest angle at the normalised point x; *imax its cone */
 static double max_angle(const cone_ctx *k, const double x[3], int *imax)
 {
@@ -819,14 +788,5 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
         res->flags |= MCG_CONE_NONUNIQUE;
     if (!res->converged)
         res->flags |= MCG_CONE_NOT_CONVERGED;
-    if (!(res->flags & MCG_CONE_AT_INFINITY)) {
-        /* gamma as the header promises it, the angle at the returned X:
-         * X = m + L x is rounded to world coordinates, and where the optimum
-         * sits within ~1e-9 |C| of an apex the angle at the rounded point
-         * differs from the normalised one (fuzz: 6e-12 inside, 2.8e-7 at
-         * X). A lower bound stays one when lowered. */
-        res->gamma = world_max_angle(n, apex, axis, res->X);
-        res->gamma_lower = fmin(res->gamma_lower, res->gamma);
-    }
     return status;
 }

@@ -494,12 +494,7 @@ typedef struct {
 typedef struct {
     double X[3];        /* the minimax point */
     double gamma;       /* max_i angle(X - C_i, v_i) at X (radians): the
-                           optimal bound gamma*, an upper bound of it;
-                           evaluated at the returned X itself (except with
-                           MCG_CONE_AT_INFINITY), so where the optimum lies
-                           within ~1e-9 |C| of an apex the rounding of X
-                           shows in gamma (converged still refers to the
-                           bisection) */
+                           optimal bound gamma*, an upper bound of it */
     double gamma_lower; /* certified lower bound of gamma* (the last
                            infeasible bisection step; 0 if none) */
     int n_active;       /* cones whose angle at X equals gamma (within the
