@@ -494,7 +494,13 @@ typedef struct {
 typedef struct {
     double X[3];        /* the minimax point */
     double gamma;       /* max_i angle(X - C_i, v_i) at X (radians): the
-                           optimal bound gamma*, an upper bound of it */
+                           optimal bound gamma*, an upper bound of it. It
+                           is evaluated at the optimum before X is rounded
+                           to world coordinates: the angle at the returned
+                           X differs by up to ~eps |X| / min_i |X - C_i|,
+                           which matters only for an optimum within ~1e-8
+                           |X| of an apex (or apexes far out relative to
+                           their spread) */
     double gamma_lower; /* certified lower bound of gamma* (the last
                            infeasible bisection step; 0 if none) */
     int n_active;       /* cones whose angle at X equals gamma (within the
