@@ -453,8 +453,73 @@ static void test_rot_from_quat_denormal(void)
     check(worst < 1e-14, "rot_from_quat of denormal quaternions is a rotation", worst, 1e-14);
 }
 
+/* fuzz_cone (300 s runs): (a) two nearly opposite rays whose optimum lies
+ * 1e-9 from an apex at |C| = 6.9: gamma 6e-12 at the optimum, 2.8e-7 at the
+ * returned X after rounding -- within the header's bound eps |X| / min|X -
+ * C_i|; (b) coincident apexes at 1e150, where the rounded X is on the apexes'
+ * grid: gamma must stay the optimum (a first fix that evaluated gamma at the
+ * rounded X returned 2.19 rad with "converged"). */
+static double cone_angle_at(const double *X, const double *c, const double *a, double *dist)
+{
+    double u[3], v[3], mu = 0.0, mv = 0.0, cr[3];
+    int j;
+    for (j = 0; j < 3; ++j) {
+        u[j] = X[j] - c[j];
+        mu = fmax(mu, fabs(u[j]));
+        mv = fmax(mv, fabs(a[j]));
+    }
+    *dist = mu == 0.0 ? 0.0 : mu * sqrt((u[0] / mu) * (u[0] / mu) + (u[1] / mu) * (u[1] / mu) +
+                                        (u[2] / mu) * (u[2] / mu));
+    if (mu == 0.0)
+        return 0.0;
+    for (j = 0; j < 3; ++j) {
+        u[j] /= mu;
+        v[j] = a[j] / mv;
+    }
+    cr[0] = u[1] * v[2] - u[2] * v[1];
+    cr[1] = u[2] * v[0] - u[0] * v[2];
+    cr[2] = u[0] * v[1] - u[1] * v[0];
+    return atan2(sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]),
+                 u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
+}
+
+static void test_cone_gamma_and_rounded_point(void)
+{
+    static const double apex_a[6] = {6.90185546875, 6.90185546875, 6.90185546875,
+                                     6.90185546875, 6.9013671875, 6.90185546875};
+    static const double axis_a[6] = {6.90185546875, -9.9999999999999998e+149, -4.78564453125,
+                                     0.0, 1000000.0, 3.0625};
+    static const double apex_b[6] = {1e150, 1.0, 1e150, 1e150, -1.426025390625, 1e150};
+    static const double axis_b[6] = {1e150, 1e150, 1e150, 1e150, 1e150, 1e150};
+    mcg_cone_options o;
+    mcg_cone_result res;
+    double worst = 0.0, dmin = HUGE_VAL, xmax = 0.0, d;
+    int st, i;
+    mcg_cone_default_options(&o);
+    o.tolerance = 0.0043137254901960784;
+    o.max_iterations = 16;
+    o.max_newton = 126;
+    st = mcg_cone_linf(2, apex_a, axis_a, &o, &res);
+    check(st == MCG_OK, "cone near an apex: solved", (double)st, 0.0);
+    for (i = 0; i < 2; ++i) {
+        worst = fmax(worst, cone_angle_at(res.X, apex_a + 3 * i, axis_a + 3 * i, &d));
+        dmin = fmin(dmin, d);
+    }
+    for (i = 0; i < 3; ++i)
+        xmax = fmax(xmax, fabs(res.X[i]));
+    check(res.gamma < 1e-9, "cone near an apex: gamma is the optimum", res.gamma, 1e-9);
+    check(fabs(worst - res.gamma) <= 1e-7 + 4.0 * DBL_EPSILON * xmax / dmin,
+          "cone near an apex: the angle at the rounded X within eps |X| / dist",
+          fabs(worst - res.gamma), 4.0 * DBL_EPSILON * xmax / dmin);
+    st = mcg_cone_linf(2, apex_b, axis_b, NULL, &res);
+    check(st == MCG_OK && res.gamma <= 1.5707963267948966 && res.gamma_lower <= res.gamma,
+          "cone with apexes at 1e150: gamma stays the optimum (<= pi/2)", res.gamma,
+          1.5707963267948966);
+}
+
 int main(void)
 {
+    test_cone_gamma_and_rounded_point();
     test_rot_from_quat_denormal();
     test_refine_overflowing_information();
     test_scale_ransac_underflowing_proposal();
