@@ -36,6 +36,7 @@ The data are read in place from ../shared/data (MCGEOM_REAL_DATA overrides).
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 import time
 from pathlib import Path
@@ -54,6 +55,7 @@ from mcgeom.types import RayPairs  # noqa: E402
 FIRST_GOOD_FRAME = 13
 
 
+@functools.lru_cache(maxsize=4)
 def load_tracks(first: int = FIRST_GOOD_FRAME, last: int = 76, root: Path = erd.DATA_ROOT):
     """Observations of frames ``first..last`` as tracks.
 
@@ -61,7 +63,8 @@ def load_tracks(first: int = FIRST_GOOD_FRAME, last: int = 76, root: Path = erd.
     ray (both cameras of every stereo observation), view = frame - first,
     bearings and origins in the rig frame (metres), rotations (m, 3, 3)
     view_from_world and the true centres (m, 3) in the world frame relative to
-    view 0 (metres)."""
+    view 0 (metres). Cached: the stereo and the cam0 evaluations read the
+    recording once (callers select from the arrays, never write to them)."""
     seq = erd.load_sequences(["kitti00_tracks"], root=root)[0]
     frames = seq.d["frames"][first:last + 1]
     names = seq.d["cameras"]
