@@ -335,7 +335,7 @@ def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
     """Run ``mcg_linear17``; returns (status, result dict) without raising.
 
     The arrays must already be float64 C-contiguous (N, 3) (see
-    :func:`mcgeom.types.as_vectors`); finiteness is checked by the kernel.
+    :func:`mcgeom.validation.as_vectors`); finiteness is checked by the kernel.
     The caller decides how to report a non-OK status (``raise_for``).
     """
     n = origins1.shape[0]

@@ -146,7 +146,8 @@ from typing import Any, Callable
 import cv2
 import numpy as np
 
-from mcgeom.rig import RIG_FORMAT, Camera, Rig, _check_int, _check_rotation, _numeric
+from mcgeom.rig import RIG_FORMAT, Camera, Rig
+from mcgeom.validation import check_int, check_rotation, numeric
 
 __all__ = [
     "FORMATS", "OPENCV_RIG_FORMAT", "detect_format", "load_rig", "load_mcgeom_json",
@@ -198,7 +199,7 @@ def _vector(where: str, what: str, value: Any, n: int | None = None) -> np.ndarr
     if value is None:
         raise ValueError(f"{where}: {what} is empty")
     try:
-        arr = _numeric(what, value)
+        arr = numeric(what, value)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
     if arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape and arr.size != 0):
@@ -213,7 +214,7 @@ def _vector(where: str, what: str, value: Any, n: int | None = None) -> np.ndarr
 
 def _matrix(where: str, what: str, value: Any, shape: tuple[int, int]) -> np.ndarray:
     try:
-        arr = _numeric(what, value)
+        arr = numeric(what, value)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
     if arr.shape != shape:
@@ -225,14 +226,14 @@ def _matrix(where: str, what: str, value: Any, shape: tuple[int, int]) -> np.nda
 
 def _rotation(where: str, what: str, value: Any) -> np.ndarray:
     try:
-        return _check_rotation(what, value)
+        return check_rotation(what, value)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
 
 
 def _integer(where: str, what: str, value: Any) -> int:
     try:
-        return _check_int(what, value)
+        return check_int(what, value)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
 
@@ -441,7 +442,7 @@ def _check_image_size_arg(image_size: Any) -> tuple[int, int] | None:
         w, h = image_size
     except (TypeError, ValueError):
         raise ValueError(f"image_size must be (width, height), got {image_size!r}") from None
-    return (_check_int("image_size width", w), _check_int("image_size height", h))
+    return (check_int("image_size width", w), check_int("image_size height", h))
 
 
 def _check_model_arg(model: Any) -> str | None:

@@ -52,6 +52,8 @@ import cv2
 import numpy as np
 
 from mcgeom.types import RayPairs
+from mcgeom.validation import (check_int, check_pixels, check_points, check_rotation,
+                               check_vector3, numeric)
 
 __all__ = ["Camera", "Rig", "RIG_FORMAT", "RIG_FORMAT_VERSION"]
 
@@ -62,7 +64,6 @@ CameraModel = Literal["pinhole", "fisheye"]
 PathLike = Union[str, "os.PathLike[str]"]
 
 _DIST_LENGTHS = {"pinhole": (0, 4, 5, 8, 12, 14), "fisheye": (4,)}
-_ROTATION_TOL = 1e-6
 # OpenCV's default undistortion stops after 5 (pinhole) / 10 (fisheye) iterations, far
 # from double precision with real distortion; these criteria are in normalized units
 # because OpenCV is called with an identity camera matrix.
@@ -80,86 +81,6 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     out = np.array(a, dtype=np.float64, order="C", copy=True)
     out.setflags(write=False)
     return out
-
-
-def _numeric(what: str, value: Any) -> np.ndarray:
-    """``value`` as a float64 array, refusing strings, booleans and ragged lists."""
-    try:
-        arr = np.asarray(value)
-    except (ValueError, TypeError) as exc:  # ragged nested lists
-        raise ValueError(f"{what} must be a numeric array ({exc})") from None
-    if arr.dtype.kind not in "iuf":
-        raise ValueError(f"{what} must be a numeric array, got dtype {arr.dtype}")
-    return arr.astype(np.float64)
-
-
-def _rotation_problem(R: np.ndarray) -> str | None:
-    """Why ``R`` (3x3 float64) is not a rotation, or None if it is one."""
-    if not np.all(np.isfinite(R)):
-        return "(non-finite entries)"
-    ortho = float(np.max(np.abs(R.T @ R - np.eye(3))))
-    if ortho >= _ROTATION_TOL:
-        return f"(not orthonormal: max |R^T R - I| = {ortho:.3g})"
-    det = float(np.linalg.det(R))
-    if det <= 0:
-        return f"(det = {round(det, 6)})"
-    return None
-
-
-def _check_rotation(what: str, value: Any) -> np.ndarray:
-    """``value`` as a 3x3 rotation matrix or ValueError('<what> is not a rotation ...')."""
-    R = _numeric(what, value)
-    if R.shape != (3, 3):
-        raise ValueError(f"{what} must have shape (3, 3), got {R.shape}")
-    problem = _rotation_problem(R)
-    if problem is not None:
-        raise ValueError(f"{what} is not a rotation {problem}")
-    return R
-
-
-def _check_vector3(what: str, value: Any) -> np.ndarray:
-    """``value`` ((3,), (3, 1) or (1, 3)) as a finite (3,) vector."""
-    t = _numeric(what, value)
-    if t.size != 3 or t.ndim > 2 or (t.ndim == 2 and 1 not in t.shape):
-        raise ValueError(f"{what} must have 3 elements, got shape {t.shape}")
-    t = t.reshape(3)
-    if not np.all(np.isfinite(t)):
-        raise ValueError(f"{what} has non-finite entries")
-    return t
-
-
-def _check_pixels(what: str, pixels: Any, n: int | None = None) -> np.ndarray:
-    """``pixels`` as a finite (N, 2) float64 array or ValueError naming the problem."""
-    px = _numeric(what, pixels)
-    if px.ndim != 2 or px.shape[1] != 2:
-        raise ValueError(f"{what} must have shape (N, 2), got {px.shape}")
-    if n is not None and px.shape[0] != n:
-        raise ValueError(f"{what} has {px.shape[0]} rows, expected {n}")
-    bad = ~np.all(np.isfinite(px), axis=1)
-    if np.any(bad):
-        k = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"{what} has {int(bad.sum())} non-finite row(s) (first: row {k})")
-    return np.ascontiguousarray(px)
-
-
-def _check_points(what: str, points: Any) -> np.ndarray:
-    """``points`` as a finite (N, 3) float64 array or ValueError naming the problem."""
-    P = _numeric(what, points)
-    if P.ndim != 2 or P.shape[1] != 3:
-        raise ValueError(f"{what} must have shape (N, 3), got {P.shape}")
-    if not np.all(np.isfinite(P)):
-        raise ValueError(f"{what} has non-finite entries")
-    return np.ascontiguousarray(P)
-
-
-def _check_int(what: str, value: Any) -> int:
-    """A plain Python int from an int-like value (not bool, not float)."""
-    if isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{what} must be an integer, got {value!r}")
-    try:
-        return operator.index(value)
-    except TypeError:
-        raise ValueError(f"{what} must be an integer, got {value!r}") from None
 
 
 def _normalize_rows(v: np.ndarray) -> np.ndarray:
@@ -234,16 +155,16 @@ class Camera:
         set_ = lambda field, value: object.__setattr__(self, field, value)  # noqa: E731
         set_("K", _frozen(self._checked_K(who)))
         set_("dist", _frozen(self._checked_dist(who)))
-        set_("R", _frozen(_check_rotation(f"{who}: extrinsic R", self.R)))
-        set_("t", _frozen(_check_vector3(f"{who}: extrinsic t", self.t)))
+        set_("R", _frozen(check_rotation(f"{who}: extrinsic R", self.R)))
+        set_("t", _frozen(check_vector3(f"{who}: extrinsic t", self.t)))
         for field in ("width", "height"):
-            value = _check_int(f"{who}: {field}", getattr(self, field))
+            value = check_int(f"{who}: {field}", getattr(self, field))
             if value <= 0:
                 raise ValueError(f"{who}: {field} must be positive, got {value}")
             set_(field, value)
 
     def _checked_K(self, who: str) -> np.ndarray:
-        K = _numeric(f"{who}: K", self.K)
+        K = numeric(f"{who}: K", self.K)
         if K.shape != (3, 3):
             raise ValueError(f"{who}: K must have shape (3, 3), got {K.shape}")
         if not np.all(np.isfinite(K)):
@@ -258,7 +179,7 @@ class Camera:
 
     def _checked_dist(self, who: str) -> np.ndarray:
         # None is the common spelling of "no distortion" in OpenCV code.
-        dist = _numeric(f"{who}: dist", [] if self.dist is None else self.dist)
+        dist = numeric(f"{who}: dist", [] if self.dist is None else self.dist)
         # calibrateCamera returns (1, n); accept row/column vectors, store 1-D.
         if dist.ndim > 2 or (dist.ndim == 2 and 1 not in dist.shape):
             raise ValueError(f"{who}: dist must be a 1-D array, got shape {dist.shape}")
@@ -310,7 +231,7 @@ class Camera:
             ValueError: bad shape or non-finite pixels; fisheye pixels outside the range
                 where the distortion polynomial can be inverted.
         """
-        px = _check_pixels(f"camera {self.name!r}: pixels", pixels)
+        px = check_pixels(f"camera {self.name!r}: pixels", pixels)
         rays_cam = self._unproject(self._pixels_to_normalized(px), px)
         return _normalize_rows(rays_cam @ self.R)  # row-wise R^T d
 
@@ -328,7 +249,7 @@ class Camera:
             back to the point's direction (guards against the fold-over of the
             distortion polynomial outside its calibrated range).
         """
-        P = _check_points(f"camera {self.name!r}: points_rig", points_rig)
+        P = check_points(f"camera {self.name!r}: points_rig", points_rig)
         X = P @ self.R.T + self.t
         pixels = np.full((P.shape[0], 2), np.nan)
         front = X[:, 2] > 0
@@ -430,8 +351,8 @@ class Camera:
         ``cam_from_new = cam_from_old o old_from_new``: ``R' = R_c R^T``,
         ``t' = t_c - R_c R^T t``.
         """
-        Rm = _check_rotation("in_frame: R", R)
-        tv = _check_vector3("in_frame: t", t)
+        Rm = check_rotation("in_frame: R", R)
+        tv = check_vector3("in_frame: t", t)
         R_new = self.R @ Rm.T
         return replace(self, R=R_new, t=self.t - R_new @ tv)
 
@@ -556,7 +477,7 @@ class Rig:
             ``(origins, dirs)``: (N, 3) camera centres (metres) and (N, 3) unit bearings,
             both in the rig frame. The Plücker moment is ``origins x dirs``.
         """
-        px = _check_pixels("pixels", pixels)
+        px = check_pixels("pixels", pixels)
         ids = self._check_ids("cam_ids", cam_ids, px.shape[0])
         return self._rays_checked(ids, px)
 
@@ -606,8 +527,8 @@ class Rig:
         Returns:
             :class:`RayPairs` in the rig frame (metres, unit directions) with camera ids.
         """
-        px1 = _check_pixels("pixels1", pixels1)
-        px2 = _check_pixels("pixels2", pixels2)
+        px1 = check_pixels("pixels1", pixels1)
+        px2 = check_pixels("pixels2", pixels2)
         if px2.shape[0] != px1.shape[0]:
             raise ValueError(f"pixels2 has {px2.shape[0]} rows but pixels1 has {px1.shape[0]}")
         ids1 = self._check_ids("cam1", cam1, px1.shape[0])
@@ -633,8 +554,8 @@ class Rig:
         Each camera's extrinsics become ``cam_from_new = cam_from_old o old_from_new``;
         rays of the new rig are the old rays mapped by ``(R, t)``.
         """
-        Rm = _check_rotation("in_frame: R", R)  # checked once, not once per camera
-        tv = _check_vector3("in_frame: t", t)
+        Rm = check_rotation("in_frame: R", R)  # checked once, not once per camera
+        tv = check_vector3("in_frame: t", t)
         return Rig(tuple(c.in_frame(Rm, tv) for c in self.cameras))
 
     # -- serialisation (format in the module docstring)

@@ -11,48 +11,9 @@ from typing import Any, Optional
 
 import numpy as np
 
-__all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "as_vectors"]
+from .validation import as_camera_ids, as_vectors, check_rotation, check_vector3
 
-
-#: largest camera id of a RayPairs (2^20 - 1, the C core's size limit)
-MAX_CAMERA_ID = 2 ** 20 - 1
-
-
-def as_vectors(name: str, a: Any, n: Optional[int] = None) -> np.ndarray:
-    """Return ``a`` as a C-contiguous float64 (N, 3) array or raise ValueError.
-
-    Finiteness is not checked here (the C kernels check it without an extra
-    pass over the data); shape and dtype are.
-    """
-    arr = np.asarray(a)
-    if arr.dtype.kind not in "fiu":
-        raise ValueError(f"{name} must be a numeric array, got dtype {arr.dtype}")
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (N, 3), got {arr.shape}")
-    if n is not None and arr.shape[0] != n:
-        raise ValueError(f"{name} has {arr.shape[0]} rows, expected {n}")
-    return np.ascontiguousarray(arr, dtype=np.float64)
-
-
-def _as_ids(name: str, a: Any, n: int) -> Optional[np.ndarray]:
-    if a is None:
-        return None
-    arr = np.asarray(a)
-    if arr.ndim != 1 or arr.shape[0] != n:
-        raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
-    if arr.dtype.kind not in "iu":
-        if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
-            arr = arr.astype(np.int64)
-        else:
-            raise ValueError(f"{name} must hold integer camera ids, got dtype {arr.dtype}")
-    if arr.size and arr.min() < 0:
-        raise ValueError(f"{name} holds a negative camera id ({int(arr.min())})")
-    # ids index per-camera tables (centres, counts) in the estimators: a huge
-    # label would allocate terabytes. The C core's size limit bounds them.
-    if arr.size and arr.max() > MAX_CAMERA_ID:
-        raise ValueError(f"{name} holds camera id {int(arr.max())}, above the largest "
-                         f"supported {MAX_CAMERA_ID} (ids are 0-based camera indices)")
-    return np.ascontiguousarray(arr, dtype=np.int64)
+__all__ = ["RayPairs", "ScaleVerdict", "RigMotion"]
 
 
 @dataclass(frozen=True)
@@ -81,8 +42,8 @@ class RayPairs:
         object.__setattr__(self, "dirs1", as_vectors("dirs1", self.dirs1, n))
         object.__setattr__(self, "origins2", as_vectors("origins2", self.origins2, n))
         object.__setattr__(self, "dirs2", as_vectors("dirs2", self.dirs2, n))
-        object.__setattr__(self, "cam1", _as_ids("cam1", self.cam1, n))
-        object.__setattr__(self, "cam2", _as_ids("cam2", self.cam2, n))
+        object.__setattr__(self, "cam1", as_camera_ids("cam1", self.cam1, n))
+        object.__setattr__(self, "cam2", as_camera_ids("cam2", self.cam2, n))
 
     def __len__(self) -> int:
         return self.origins1.shape[0]
@@ -170,9 +131,8 @@ class RayPairs:
     def in_frame(self, R: np.ndarray, t: np.ndarray) -> "RayPairs":
         """Re-express the rays in a new rig frame ``X_new = R @ X_old + t``
         (``R`` a rotation, ``t`` in metres; ValueError otherwise)."""
-        from .rig import _check_rotation, _check_vector3  # rig builds on this module
-        R = _check_rotation("in_frame: R", R)
-        t = _check_vector3("in_frame: t", t)
+        R = check_rotation("in_frame: R", R)
+        t = check_vector3("in_frame: t", t)
         return RayPairs(
             self.origins1 @ R.T + t, self.dirs1 @ R.T,
             self.origins2 @ R.T + t, self.dirs2 @ R.T,

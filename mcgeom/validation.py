@@ -1,0 +1,143 @@
+"""Argument validators shared by every layer: numeric arrays, rotations,
+3-vectors, pixels, points, integers, ray arrays and camera ids.
+
+Each returns the value in the canonical form (float64, C-contiguous where it
+matters) or raises ``ValueError`` with a message that names the argument
+(``what``) and what is wrong with it. They sit below ``types`` and ``rig``,
+which both use them, so neither has to import the other.
+"""
+
+from __future__ import annotations
+
+import operator
+from typing import Any, Optional
+
+import numpy as np
+
+__all__ = ["MAX_CAMERA_ID", "ROTATION_TOL", "numeric", "rotation_problem", "check_rotation",
+           "check_vector3", "check_pixels", "check_points", "check_int", "as_vectors",
+           "as_camera_ids"]
+
+#: tolerance of max |R^T R - I| for a matrix to count as a rotation
+ROTATION_TOL = 1e-6
+
+
+def numeric(what: str, value: Any) -> np.ndarray:
+    """``value`` as a float64 array, refusing strings, booleans and ragged lists."""
+    try:
+        arr = np.asarray(value)
+    except (ValueError, TypeError) as exc:  # ragged nested lists
+        raise ValueError(f"{what} must be a numeric array ({exc})") from None
+    if arr.dtype.kind not in "iuf":
+        raise ValueError(f"{what} must be a numeric array, got dtype {arr.dtype}")
+    return arr.astype(np.float64)
+
+
+def rotation_problem(R: np.ndarray) -> str | None:
+    """Why ``R`` (3x3 float64) is not a rotation, or None if it is one."""
+    if not np.all(np.isfinite(R)):
+        return "(non-finite entries)"
+    ortho = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    if ortho >= ROTATION_TOL:
+        return f"(not orthonormal: max |R^T R - I| = {ortho:.3g})"
+    det = float(np.linalg.det(R))
+    if det <= 0:
+        return f"(det = {round(det, 6)})"
+    return None
+
+
+def check_rotation(what: str, value: Any) -> np.ndarray:
+    """``value`` as a 3x3 rotation matrix or ValueError('<what> is not a rotation ...')."""
+    R = numeric(what, value)
+    if R.shape != (3, 3):
+        raise ValueError(f"{what} must have shape (3, 3), got {R.shape}")
+    problem = rotation_problem(R)
+    if problem is not None:
+        raise ValueError(f"{what} is not a rotation {problem}")
+    return R
+
+
+def check_vector3(what: str, value: Any) -> np.ndarray:
+    """``value`` ((3,), (3, 1) or (1, 3)) as a finite (3,) vector."""
+    t = numeric(what, value)
+    if t.size != 3 or t.ndim > 2 or (t.ndim == 2 and 1 not in t.shape):
+        raise ValueError(f"{what} must have 3 elements, got shape {t.shape}")
+    t = t.reshape(3)
+    if not np.all(np.isfinite(t)):
+        raise ValueError(f"{what} has non-finite entries")
+    return t
+
+
+def check_pixels(what: str, pixels: Any, n: int | None = None) -> np.ndarray:
+    """``pixels`` as a finite (N, 2) float64 array or ValueError naming the problem."""
+    px = numeric(what, pixels)
+    if px.ndim != 2 or px.shape[1] != 2:
+        raise ValueError(f"{what} must have shape (N, 2), got {px.shape}")
+    if n is not None and px.shape[0] != n:
+        raise ValueError(f"{what} has {px.shape[0]} rows, expected {n}")
+    bad = ~np.all(np.isfinite(px), axis=1)
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{what} has {int(bad.sum())} non-finite row(s) (first: row {k})")
+    return np.ascontiguousarray(px)
+
+
+def check_points(what: str, points: Any) -> np.ndarray:
+    """``points`` as a finite (N, 3) float64 array or ValueError naming the problem."""
+    P = numeric(what, points)
+    if P.ndim != 2 or P.shape[1] != 3:
+        raise ValueError(f"{what} must have shape (N, 3), got {P.shape}")
+    if not np.all(np.isfinite(P)):
+        raise ValueError(f"{what} has non-finite entries")
+    return np.ascontiguousarray(P)
+
+
+def check_int(what: str, value: Any) -> int:
+    """A plain Python int from an int-like value (not bool, not float)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{what} must be an integer, got {value!r}")
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise ValueError(f"{what} must be an integer, got {value!r}") from None
+
+
+#: largest camera id of a RayPairs (2^20 - 1, the C core's size limit)
+MAX_CAMERA_ID = 2 ** 20 - 1
+
+
+def as_vectors(name: str, a: Any, n: Optional[int] = None) -> np.ndarray:
+    """Return ``a`` as a C-contiguous float64 (N, 3) array or raise ValueError.
+
+    Finiteness is not checked here (the C kernels check it without an extra
+    pass over the data); shape and dtype are.
+    """
+    arr = np.asarray(a)
+    if arr.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must be a numeric array, got dtype {arr.dtype}")
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (N, 3), got {arr.shape}")
+    if n is not None and arr.shape[0] != n:
+        raise ValueError(f"{name} has {arr.shape[0]} rows, expected {n}")
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
+def as_camera_ids(name: str, a: Any, n: int) -> Optional[np.ndarray]:
+    if a is None:
+        return None
+    arr = np.asarray(a)
+    if arr.ndim != 1 or arr.shape[0] != n:
+        raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
+    if arr.dtype.kind not in "iu":
+        if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
+            arr = arr.astype(np.int64)
+        else:
+            raise ValueError(f"{name} must hold integer camera ids, got dtype {arr.dtype}")
+    if arr.size and arr.min() < 0:
+        raise ValueError(f"{name} holds a negative camera id ({int(arr.min())})")
+    # ids index per-camera tables (centres, counts) in the estimators: a huge
+    # label would allocate terabytes. The C core's size limit bounds them.
+    if arr.size and arr.max() > MAX_CAMERA_ID:
+        raise ValueError(f"{name} holds camera id {int(arr.max())}, above the largest "
+                         f"supported {MAX_CAMERA_ID} (ids are 0-based camera indices)")
+    return np.ascontiguousarray(arr, dtype=np.int64)
