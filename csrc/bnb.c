@@ -130,13 +130,6 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void mat_vec(const double R[9], const double x[3], double y[3])
-{
-    y[0] = R[0] * x[0] + R[1] * x[1] + R[2] * x[2];
-    y[1] = R[3] * x[0] + R[4] * x[1] + R[5] * x[2];
-    y[2] = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-}
-
 /* The sines of the two half-angles at (eps, s), enlarged as in wedge.c so
  * that rounding never tightens a wedge; 0 if the cones are too wide to
  * constrain anything (then no rows). */
@@ -332,9 +325,7 @@ static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3
         if (fabs(zc[k]) < fabs(zc[imin]))
             imin = k;
     e[imin] = 1.0;
-    P[0] = zc[1] * e[2] - zc[2] * e[1];
-    P[1] = zc[2] * e[0] - zc[0] * e[2];
-    P[2] = zc[0] * e[1] - zc[1] * e[0];
+    cross3(zc, e, P);
     nn = sqrt(dot3(P, P));
     for (k = 0; k < 3; ++k)
         P[k] /= nn;
@@ -947,9 +938,7 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
         double v[3], cr[3];
         const double *q = d2 + 3 * i;
         mat_vec(Rb, d1 + 3 * i, v);
-        cr[0] = v[1] * q[2] - v[2] * q[1];
-        cr[1] = v[2] * q[0] - v[0] * q[2];
-        cr[2] = v[0] * q[1] - v[1] * q[0];
+        cross3(v, q, cr);
         alpha[i] = atan2(sqrt(dot3(cr, cr)), dot3(v, q));
     }
     for (g = 0; g < n_groups; ++g)

@@ -662,9 +662,7 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
         for (i = 1; i < n && all_parallel; ++i) {
             double cr[3];
             cone_get(&k, i, c, v);
-            cr[0] = v0[1] * v[2] - v0[2] * v[1];
-            cr[1] = v0[2] * v[0] - v0[0] * v[2];
-            cr[2] = v0[0] * v[1] - v0[1] * v[0];
+            cross3(v0, v, cr);
             if (dot3(cr, cr) > 1e-24 || dot3(v0, v) < 0.0)
                 all_parallel = 0;
         }

@@ -52,8 +52,8 @@
  * two columns count as orthogonal when |g_i . g_j| <= tol |g_i| |g_j|. A few
  * ulps above the rounding noise of a dot product so that sweeps terminate. */
 #define JACOBI_TOL_FACTOR 4.0
-/* Deviation from orthogonality (max |R R^T - I|) accepted for a rotation. */
-#define ROT_TOL 1e-6
+/* (the deviation from orthogonality accepted for a rotation: SO3_ROT_TOL,
+ * so3.h, shared with refine.c) */
 
 /* ------------------------------------------------------------- helpers */
 
@@ -1100,47 +1100,13 @@ int mcg_spd_solve(int n, const double *a, const double *b, double *x)
 
 /* ----------------------------------------------------------- rotations */
 
-/* |x| of a 3- or 4-vector without overflow or underflow */
-static double norm_small(const double *x, size_t n)
-{
-    double mx = max_abs(x, n), acc = 0.0;
-    size_t i;
-    if (mx == 0.0)
-        return 0.0;
-    for (i = 0; i < n; ++i) {
-        double t = x[i] / mx;
-        acc += t * t;
-    }
-    return mx * sqrt(acc);
-}
-
-/* Is r a rotation to ROT_TOL? Guards the conversions below, which would
- * otherwise return a plausible-looking answer for any 3 x 3 matrix. */
-static int is_rotation(const double r[9])
-{
-    size_t i, j, k;
-    double det;
-    for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j) {
-            double acc = 0.0;
-            for (k = 0; k < 3; ++k)
-                acc += r[i * 3 + k] * r[j * 3 + k];
-            if (fabs(acc - (i == j ? 1.0 : 0.0)) > ROT_TOL)
-                return 0;
-        }
-    det = r[0] * (r[4] * r[8] - r[5] * r[7]) -
-          r[1] * (r[3] * r[8] - r[5] * r[6]) +
-          r[2] * (r[3] * r[7] - r[4] * r[6]);
-    return det > 0.0;
-}
-
 int mcg_rot_from_angle_axis(const double w[3], double r[9])
 {
     double theta, k[3], c, s, h;
     size_t i, j;
     if (w == NULL || r == NULL || !all_finite(w, 3))
         return MCG_EINVAL;
-    theta = norm_small(w, 3);
+    theta = norm_scaled(w, 3);
     if (!isfinite(theta))
         return MCG_EINVAL; /* |w| > DBL_MAX: the angle overflows (found by fuzz_linalg) */
     if (theta == 0.0) {
@@ -1195,7 +1161,7 @@ static void quat_of_rotation(const double r[9], double q[4])
         q[2] = r[5] + r[7];
         q[3] = 1.0 + 2.0 * r[8] - tr;
     }
-    nq = norm_small(q, 4); /* >= 1 for a rotation: the chosen entry is */
+    nq = norm_scaled(q, 4); /* >= 1 for a rotation: the chosen entry is */
     if (q[0] < 0.0)
         nq = -nq;
     for (i = 0; i < 4; ++i)
@@ -1213,7 +1179,7 @@ int mcg_angle_axis_from_rot(const double r[9], double w[3])
     quat_of_rotation(r, q);
     /* angle = 2 atan2(|v|, q0) is well conditioned everywhere (unlike acos
      * near 0 or asin near pi); q0 >= 0 gives angle in [0, pi] */
-    nv = norm_small(q + 1, 3);
+    nv = norm_scaled(q + 1, 3);
     if (nv == 0.0) {
         w[0] = w[1] = w[2] = 0.0;
         return MCG_OK;
@@ -1266,13 +1232,6 @@ int mcg_quat_from_rot(const double r[9], double q[4])
     return MCG_OK;
 }
 
-static double det3(const double a[9])
-{
-    return a[0] * (a[4] * a[8] - a[5] * a[7]) -
-           a[1] * (a[3] * a[8] - a[5] * a[6]) +
-           a[2] * (a[3] * a[7] - a[4] * a[6]);
-}
-
 int mcg_project_so3(const double m[9], double r[9])
 {
     double u[9], s[3], v[9], work[64], d;
@@ -1289,7 +1248,7 @@ int mcg_project_so3(const double m[9], double r[9])
      * unique; with rank <= 1 a whole family of rotations is equally near. */
     if (!(s[1] > 4.0 * DBL_EPSILON * s[0]))
         return MCG_EDEGENERATE;
-    d = (det3(u) * det3(v) < 0.0) ? -1.0 : 1.0;
+    d = (det33(u) * det33(v) < 0.0) ? -1.0 : 1.0;
     for (i = 0; i < 3; ++i)
         for (j = 0; j < 3; ++j)
             r[i * 3 + j] = u[i * 3 + 0] * v[j * 3 + 0] +

@@ -31,39 +31,6 @@
 
 /* ---------------------------------------------------------- small helpers */
 
-static void mul33(const double *a, const double *b, double *c)
-{
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] +
-                           a[3 * i + 2] * b[6 + j];
-}
-
-static void mul33_abt(const double *a, const double *b, double *c)
-{   /* c = a b^T */
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            c[3 * i + j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] +
-                           a[3 * i + 2] * b[3 * j + 2];
-}
-
-static double det33(const double *a)
-{
-    return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-           a[2] * (a[3] * a[7] - a[4] * a[6]);
-}
-
-static void skew_times(const double w[3], const double *r, double *out)
-{   /* out = [w]x r */
-    double s[9];
-    s[0] = 0.0;   s[1] = -w[2]; s[2] = w[1];
-    s[3] = w[2];  s[4] = 0.0;   s[5] = -w[0];
-    s[6] = -w[1]; s[7] = w[0];  s[8] = 0.0;
-    mul33(s, r, out);
-}
-
 static void matvec(int n, const double *m, const double *x, double *y)
 {
     int i, j;

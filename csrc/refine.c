@@ -65,7 +65,6 @@
 #define MAX_RAYS (1 << 26)
 #define HALF_PI 1.5707963267948966
 #define INV_HALF_PI2 0.40528473456935109 /* (2 / pi)^2 */
-#define ROT_TOL 1e-6                     /* |R R^T - I| accepted as a rotation */
 #define LAMBDA_MAX 1e32                  /* damping beyond: no descent exists */
 #define SING_RTOL 1e-10                  /* eigenvalue ratio treated as singular */
 #define MAX_TURN 0.5                     /* largest rotation step, radians */
@@ -73,34 +72,6 @@
  * ones count as zero-length; keeps the products of the residual far from
  * underflow (overflow is detected) */
 #define DIR2_MIN 1e-100
-
-/* ---------------------------------------------------------- small helpers */
-
-static void mul33(const double *a, const double *b, double *c)
-{
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] +
-                           a[3 * i + 2] * b[6 + j];
-}
-
-/* 1 if r is a rotation to ROT_TOL (orthonormal rows, det > 0) */
-static int is_rotation(const double r[9])
-{
-    int i, j;
-    double det;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++) {
-            double acc = r[3 * i] * r[3 * j] + r[3 * i + 1] * r[3 * j + 1] +
-                         r[3 * i + 2] * r[3 * j + 2];
-            if (!(fabs(acc - (i == j ? 1.0 : 0.0)) <= ROT_TOL))
-                return 0;
-        }
-    det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
-          r[2] * (r[3] * r[7] - r[4] * r[6]);
-    return det > 0.0;
-}
 
 /* ------------------------------------------------------------- residuals */
 
