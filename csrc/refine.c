@@ -75,11 +75,75 @@
 
 /* ------------------------------------------------------------- residuals */
 
+/* The terms of one pair's Sampson angular residual, in the raw form of the
+ * header comment of mcg_gec_residuals (thesis eq. 8.15 applied to the
+ * generalized epipolar constraint, eq. 8.16): A = R d1, B = d2 (both
+ * unnormalised), p = R o1, c = t + p - o2, Q = c x A, H = B x c,
+ * E = B.Q, den = |B|^2 |Q|^2 + |A|^2 |H|^2 - 2 E^2 (|A|^2 = |d1|^2), and
+ * the residual r = E / sqrt(m) with m = max(den, (2/pi)^2 E^2, DBL_MIN)
+ * (the pi/2 cap). One definition for the residual pass and for the
+ * residual + Jacobian rows of the refinement, so the two cannot drift
+ * apart. Static inline and branch-free (selects only): the callers' loops
+ * over the pairs vectorise. */
+typedef struct {
+    double a0, a1, a2;    /* A = R d1 */
+    double p0, p1, p2;    /* p = R o1 */
+    double c0, c1, c2;    /* c = t + p - o2 */
+    double b0, b1, b2;    /* B = d2 */
+    double q0, q1, q2;    /* Q = c x A */
+    double h0, h1, h2;    /* H = B x c */
+    double n1, n2;        /* |d1|^2, |d2|^2 */
+    double e, dd;         /* E and den */
+    double lo, m;         /* max((2/pi)^2 E^2, DBL_MIN) and max(den, lo) */
+    double marker;        /* 0, or NaN for an invalid pair (see below) */
+} sampson_terms;
+
+static inline void sampson_pair(const double *rm, const double *tv, const double *o1,
+                                const double *d1, const double *o2, const double *d2,
+                                sampson_terms *s)
+{
+    double ee, cap, x, mm;
+    s->b0 = d2[0];
+    s->b1 = d2[1];
+    s->b2 = d2[2];
+    s->n1 = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2];
+    s->n2 = s->b0 * s->b0 + s->b1 * s->b1 + s->b2 * s->b2;
+    s->a0 = rm[0] * d1[0] + rm[1] * d1[1] + rm[2] * d1[2];
+    s->a1 = rm[3] * d1[0] + rm[4] * d1[1] + rm[5] * d1[2];
+    s->a2 = rm[6] * d1[0] + rm[7] * d1[1] + rm[8] * d1[2];
+    s->p0 = rm[0] * o1[0] + rm[1] * o1[1] + rm[2] * o1[2];
+    s->p1 = rm[3] * o1[0] + rm[4] * o1[1] + rm[5] * o1[2];
+    s->p2 = rm[6] * o1[0] + rm[7] * o1[1] + rm[8] * o1[2];
+    s->c0 = tv[0] + s->p0 - o2[0];
+    s->c1 = tv[1] + s->p1 - o2[1];
+    s->c2 = tv[2] + s->p2 - o2[2];
+    s->q0 = s->c1 * s->a2 - s->c2 * s->a1;
+    s->q1 = s->c2 * s->a0 - s->c0 * s->a2;
+    s->q2 = s->c0 * s->a1 - s->c1 * s->a0;
+    s->h0 = s->b1 * s->c2 - s->b2 * s->c1;
+    s->h1 = s->b2 * s->c0 - s->b0 * s->c2;
+    s->h2 = s->b0 * s->c1 - s->b1 * s->c0;
+    s->e = s->b0 * s->q0 + s->b1 * s->q1 + s->b2 * s->q2;
+    ee = s->e * s->e;
+    s->dd = s->n2 * (s->q0 * s->q0 + s->q1 * s->q1 + s->q2 * s->q2) +
+            s->n1 * (s->h0 * s->h0 + s->h1 * s->h1 + s->h2 * s->h2) - 2.0 * ee;
+    cap = ee * INV_HALF_PI2;
+    s->lo = cap > DBL_MIN ? cap : DBL_MIN;
+    s->m = s->dd > s->lo ? s->dd : s->lo;
+    /* validation folded in as a NaN marker, which keeps the loops
+     * branch-free and vectorisable: n1, n2 >= DIR2_MIN rules out zero
+     * directions, and 0 * x is NaN iff x is not finite, where a NaN/inf
+     * in any input or an overflow makes x = n1 + n2 + dd NaN or inf.
+     * (Vectorised only with -fno-math-errno, see meson.build.) */
+    x = s->n1 + s->n2 + s->dd;
+    mm = s->n1 < s->n2 ? s->n1 : s->n2;
+    s->marker = 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+}
+
 int mcg_gec_residuals(int n, const double *o1, const double *d1,
                       const double *o2, const double *d2, const double R[9],
                       const double t[3], double *res)
 {
-    double r0, r1, r2, r3, r4, r5, r6, r7, r8, t0, t1, t2;
     int k, bad = 0;
 
     if (!o1 || !d1 || !o2 || !d2 || !R || !t || !res)
@@ -88,41 +152,12 @@ int mcg_gec_residuals(int n, const double *o1, const double *d1,
         return MCG_EINVAL;
     if (!all_finite(R, 9) || !all_finite(t, 3))
         return MCG_EINVAL;
-    r0 = R[0]; r1 = R[1]; r2 = R[2];
-    r3 = R[3]; r4 = R[4]; r5 = R[5];
-    r6 = R[6]; r7 = R[7]; r8 = R[8];
-    t0 = t[0]; t1 = t[1]; t2 = t[2];
 
-    /* One branch-free pass in the raw form of the header comment: one
-     * square root and one division per pair, validation folded in. */
+    /* One branch-free pass: one square root and one division per pair. */
     for (k = 0; k < n; k++) {
-        const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k;
-        const double *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
-        double b0 = u2[0], b1 = u2[1], b2 = u2[2];
-        double n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2];
-        double n2 = b0 * b0 + b1 * b1 + b2 * b2;
-        double a0 = r0 * u1[0] + r1 * u1[1] + r2 * u1[2];
-        double a1 = r3 * u1[0] + r4 * u1[1] + r5 * u1[2];
-        double a2 = r6 * u1[0] + r7 * u1[1] + r8 * u1[2];
-        double c0 = t0 + r0 * p1[0] + r1 * p1[1] + r2 * p1[2] - p2[0];
-        double c1 = t1 + r3 * p1[0] + r4 * p1[1] + r5 * p1[2] - p2[1];
-        double c2 = t2 + r6 * p1[0] + r7 * p1[1] + r8 * p1[2] - p2[2];
-        double q0 = c1 * a2 - c2 * a1, q1 = c2 * a0 - c0 * a2, q2 = c0 * a1 - c1 * a0;
-        double h0 = b1 * c2 - b2 * c1, h1 = b2 * c0 - b0 * c2, h2 = b0 * c1 - b1 * c0;
-        double e = b0 * q0 + b1 * q1 + b2 * q2, ee = e * e;
-        double dd = n2 * (q0 * q0 + q1 * q1 + q2 * q2) +
-                    n1 * (h0 * h0 + h1 * h1 + h2 * h2) - 2.0 * ee;
-        /* r = e / sqrt(max(dd, (2/pi)^2 e^2, DBL_MIN)) (max as selects) */
-        double cap = ee * INV_HALF_PI2, m = dd > cap ? dd : cap;
-        m = m > DBL_MIN ? m : DBL_MIN;
-        /* validation folded in as a NaN marker, which keeps the loop
-         * branch-free and vectorisable: n1, n2 >= DIR2_MIN rules out zero
-         * directions, and 0 * x is NaN iff x is not finite, where a NaN/inf
-         * in any input or an overflow makes x = n1 + n2 + dd NaN or inf.
-         * (Vectorised only with -fno-math-errno, see meson.build.) */
-        double x = n1 + n2 + dd;
-        double mm = n1 < n2 ? n1 : n2;
-        res[k] = e / sqrt(m) + 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+        sampson_terms s;
+        sampson_pair(R, t, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k, &s);
+        res[k] = s.e / sqrt(s.m) + s.marker;
     }
     for (k = 0; k < n; k++) /* the markers (a short contiguous scan) */
         bad |= res[k] != res[k];
@@ -175,56 +210,35 @@ static void block_rows(int nb, const double *o1, const double *d1,
                        const double *o2, const double *d2, const double *rm,
                        const double *tv, double *rb, double (*jb)[BLK], double *ok)
 {
-    const double r0 = rm[0], r1 = rm[1], r2 = rm[2], r3 = rm[3], r4 = rm[4];
-    const double r5 = rm[5], r6 = rm[6], r7 = rm[7], r8 = rm[8];
-    const double t0 = tv[0], t1 = tv[1], t2 = tv[2];
     int k;
     for (k = 0; k < nb; k++) {
-        const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k;
-        const double *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
-        double b0 = u2[0], b1 = u2[1], b2 = u2[2];
-        double n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2];
-        double n2 = b0 * b0 + b1 * b1 + b2 * b2;
-        double a0 = r0 * u1[0] + r1 * u1[1] + r2 * u1[2];
-        double a1 = r3 * u1[0] + r4 * u1[1] + r5 * u1[2];
-        double a2 = r6 * u1[0] + r7 * u1[1] + r8 * u1[2];
-        double pp0 = r0 * p1[0] + r1 * p1[1] + r2 * p1[2];
-        double pp1 = r3 * p1[0] + r4 * p1[1] + r5 * p1[2];
-        double pp2 = r6 * p1[0] + r7 * p1[1] + r8 * p1[2];
-        double c0 = t0 + pp0 - p2[0], c1 = t1 + pp1 - p2[1], c2 = t2 + pp2 - p2[2];
-        double q0 = c1 * a2 - c2 * a1, q1 = c2 * a0 - c0 * a2, q2 = c0 * a1 - c1 * a0;
-        double h0 = b1 * c2 - b2 * c1, h1 = b2 * c0 - b0 * c2, h2 = b0 * c1 - b1 * c0;
-        double e = b0 * q0 + b1 * q1 + b2 * q2, ee = e * e;
-        double dd = n2 * (q0 * q0 + q1 * q1 + q2 * q2) +
-                    n1 * (h0 * h0 + h1 * h1 + h2 * h2) - 2.0 * ee;
-        double cap = ee * INV_HALF_PI2, lo = cap > DBL_MIN ? cap : DBL_MIN;
-        double m = dd > lo ? dd : lo, s, rr, f1, f2;
-        double ac, bc, k0, k1, k2, v0, v1, v2, jt0, jt1, jt2, x, mm, f3;
+        sampson_terms p;
+        double s, rr, f1, f2, f3, ac, bc, k0, k1, k2, v0, v1, v2, jt0, jt1, jt2, on;
+        sampson_pair(rm, tv, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k, &p);
         /* 1 on the Sampson branch (a select, not a branch: vectorisable) */
-        double on = dd > lo ? 1.0 : 0.0;
-        s = 1.0 / sqrt(m);
-        rr = e * s;
-        /* the NaN marker of mcg_gec_residuals */
-        x = n1 + n2 + dd;
-        mm = n1 < n2 ? n1 : n2;
-        rb[k] = rr + 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+        on = p.dd > p.lo ? 1.0 : 0.0;
+        s = 1.0 / sqrt(p.m);
+        rr = p.e * s;
+        rb[k] = rr + p.marker;
         ok[k] = on;
         f1 = on * s * (1.0 + 2.0 * rr * rr);
         f2 = on * rr * s * s;
-        ac = a0 * c0 + a1 * c1 + a2 * c2;
-        bc = b0 * c0 + b1 * c1 + b2 * c2;
-        k0 = a1 * b2 - a2 * b1; k1 = a2 * b0 - a0 * b2; k2 = a0 * b1 - a1 * b0;
-        v0 = 2.0 * n1 * n2 * c0 - n2 * ac * a0 - n1 * bc * b0;
-        v1 = 2.0 * n1 * n2 * c1 - n2 * ac * a1 - n1 * bc * b1;
-        v2 = 2.0 * n1 * n2 * c2 - n2 * ac * a2 - n1 * bc * b2;
+        ac = p.a0 * p.c0 + p.a1 * p.c1 + p.a2 * p.c2;
+        bc = p.b0 * p.c0 + p.b1 * p.c1 + p.b2 * p.c2;
+        k0 = p.a1 * p.b2 - p.a2 * p.b1;
+        k1 = p.a2 * p.b0 - p.a0 * p.b2;
+        k2 = p.a0 * p.b1 - p.a1 * p.b0;
+        v0 = 2.0 * p.n1 * p.n2 * p.c0 - p.n2 * ac * p.a0 - p.n1 * bc * p.b0;
+        v1 = 2.0 * p.n1 * p.n2 * p.c1 - p.n2 * ac * p.a1 - p.n1 * bc * p.b1;
+        v2 = 2.0 * p.n1 * p.n2 * p.c2 - p.n2 * ac * p.a2 - p.n1 * bc * p.b2;
         jt0 = f1 * k0 - f2 * v0;
         jt1 = f1 * k1 - f2 * v1;
         jt2 = f1 * k2 - f2 * v2;
-        f3 = f2 * n2 * ac;
+        f3 = f2 * p.n2 * ac;
         /* dr/dw = p x dr/dt + f1 A x H - f3 Q */
-        jb[0][k] = pp1 * jt2 - pp2 * jt1 + f1 * (a1 * h2 - a2 * h1) - f3 * q0;
-        jb[1][k] = pp2 * jt0 - pp0 * jt2 + f1 * (a2 * h0 - a0 * h2) - f3 * q1;
-        jb[2][k] = pp0 * jt1 - pp1 * jt0 + f1 * (a0 * h1 - a1 * h0) - f3 * q2;
+        jb[0][k] = p.p1 * jt2 - p.p2 * jt1 + f1 * (p.a1 * p.h2 - p.a2 * p.h1) - f3 * p.q0;
+        jb[1][k] = p.p2 * jt0 - p.p0 * jt2 + f1 * (p.a2 * p.h0 - p.a0 * p.h2) - f3 * p.q1;
+        jb[2][k] = p.p0 * jt1 - p.p1 * jt0 + f1 * (p.a0 * p.h1 - p.a1 * p.h0) - f3 * p.q2;
         jb[3][k] = jt0;
         jb[4][k] = jt1;
         jb[5][k] = jt2;
