@@ -465,22 +465,14 @@ static void scale_evidence(const double *h, const double t[3], double *cond,
     }
 }
 
-int mcg_refine_motion(int n, const double *o1, const double *d1,
-                      const double *o2, const double *d2, const double *weights,
-                      const mcg_refine_options *opt, double R[9], double t[3],
-                      mcg_refine_result *res)
+/* The argument checks of mcg_refine_motion (its header comment lists them);
+ * *o receives the options (the defaults for NULL). */
+static int check_inputs(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const double *weights,
+                        const mcg_refine_options *opt, const double R[9],
+                        const double t[3], mcg_refine_options *o)
 {
-    mcg_refine_options o;
-    lossfn lf;
-    accum cur, trial;
-    double r[9], tv[3], rho0 = 0.0, lambda, nu = 2.0, ell, pdim;
-    int i, k, it, fix, reason = MCG_REFINE_STOP_MAX_ITERATIONS, converged = 0;
-
-    if (!res)
-        return MCG_EINVAL;
-    memset(res, 0, sizeof *res);
-    res->sigma2 = HUGE_VAL;
-    res->scale_rel_std = HUGE_VAL;
+    int k;
     if (!o1 || !d1 || !o2 || !d2 || !R || !t)
         return MCG_EINVAL;
     if (n < 6 || n > MAX_RAYS)
@@ -488,9 +480,9 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
     if (opt) {
         if (!check_options(opt))
             return MCG_EINVAL;
-        o = *opt;
+        *o = *opt;
     } else {
-        mcg_refine_default_options(&o);
+        mcg_refine_default_options(o);
     }
     if (!all_finite(R, 9) || !all_finite(t, 3) || !is_rotation(R))
         return MCG_EINVAL;
@@ -501,16 +493,299 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
             if (weights[k] < 0.0)
                 return MCG_EINVAL;
     }
+    return MCG_OK;
+}
+
+/* The Gauss-Newton system of one iteration in the step's parameters: with
+ * P (6 x m) the parametrisation of the step [dw; dt] (the identity, or
+ * [dw; B u] with fix_scale, B an orthonormal basis of the tangent plane of
+ * the sphere |t| = rho0 at t), hm = P^T H P and gm = P^T g (m x m, m).
+ * Returns m. */
+static int reduced_system(const accum *cur, int fix, const double tv[3], double rho0,
+                          double pm[6][6], double *hm, double *gm)
+{
+    int i, m = fix ? 5 : 6;
+    memset(pm, 0, 36 * sizeof(double));
+    for (i = 0; i < 3; i++)
+        pm[i][i] = 1.0;
+    if (fix) {
+        double u[3], b1[3] = {0, 0, 0}, b2[3] = {0, 0, 0};
+        for (i = 0; i < 3; i++)
+            u[i] = tv[i] / rho0;
+        tangent_basis(u, b1, b2);
+        for (i = 0; i < 3; i++) {
+            pm[3 + i][3] = b1[i];
+            pm[3 + i][4] = b2[i];
+        }
+    } else {
+        for (i = 3; i < 6; i++)
+            pm[i][i] = 1.0;
+    }
+    if (!fix) {
+        memcpy(hm, cur->h, 36 * sizeof(double));
+        memcpy(gm, cur->g, 6 * sizeof(double));
+    } else { /* hm = P^T H P, gm = P^T g */
+        double hp[6][5];
+        int jj, p;
+        for (p = 0; p < 6; p++)
+            for (jj = 0; jj < m; jj++) {
+                double acc = 0.0;
+                for (i = 0; i < 6; i++)
+                    acc += cur->h[6 * p + i] * pm[i][jj];
+                hp[p][jj] = acc;
+            }
+        for (i = 0; i < m; i++) {
+            gm[i] = 0.0;
+            for (p = 0; p < 6; p++)
+                gm[i] += pm[p][i] * cur->g[p];
+            for (jj = 0; jj < m; jj++) {
+                double acc = 0.0;
+                for (p = 0; p < 6; p++)
+                    acc += pm[p][i] * hp[p][jj];
+                hm[m * i + jj] = acc;
+            }
+        }
+    }
+    return m;
+}
+
+/* The Levenberg-Marquardt step dx of (hm + lambda D) dx = -gm, D = diag(hm)
+ * floored at 1e-12 maxd so that directions the data do not constrain at all
+ * still get a finite step. gm is negated in place (the predicted decrease
+ * uses -g). Returns the status of the Cholesky solve. */
+static int marquardt_step(const double *hm, double *gm, int m, double maxd,
+                          double lambda, double *dx)
+{
+    double a[36], dmp;
+    int i;
+    memcpy(a, hm, sizeof a);
+    for (i = 0; i < m; i++) {
+        dmp = hm[m * i + i] > 1e-12 * maxd ? hm[m * i + i] : 1e-12 * maxd;
+        a[m * i + i] += lambda * dmp;
+    }
+    for (i = 0; i < m; i++)
+        gm[i] = -gm[i];
+    return mcg_spd_solve(m, a, gm, dx);
+}
+
+/* dfull = P dx, then the trust region on top of the damping: a step may
+ * turn R by at most MAX_TURN and move t by at most max(|t|, L) / 2
+ * (L = rig size); dx and dfull are scaled together. In weakly
+ * scale-observable configurations a step along the flat |t| direction
+ * otherwise overshoots, even through t = 0. */
+static void limit_step(double pm[6][6], int m, const double tv[3], double ell,
+                       double *dx, double dfull[6])
+{
+    double nw0, nt0, ntv, alpha = 1.0, lim;
+    int i, jj;
+    for (i = 0; i < 6; i++) {
+        dfull[i] = 0.0;
+        for (jj = 0; jj < m; jj++)
+            dfull[i] += pm[i][jj] * dx[jj];
+    }
+    nw0 = sqrt(dot3(dfull, dfull));
+    nt0 = sqrt(dot3(dfull + 3, dfull + 3));
+    ntv = sqrt(dot3(tv, tv));
+    lim = 0.5 * (ntv > ell ? ntv : ell);
+    if (nw0 > MAX_TURN)
+        alpha = MAX_TURN / nw0;
+    if (lim > 0.0 && nt0 * alpha > lim)
+        alpha = lim / nt0;
+    for (i = 0; i < m; i++)
+        dx[i] *= alpha;
+    for (i = 0; i < 6; i++)
+        dfull[i] *= alpha;
+}
+
+/* predicted decrease of the IRLS model, -2 g.dx - dx^T H dx (ngm = -g) */
+static double predicted_decrease(const double *hm, const double *ngm, const double *dx,
+                                 int m)
+{
+    double pred = 0.0;
+    int i, jj;
+    for (i = 0; i < m; i++) {
+        double acc = 0.0;
+        for (jj = 0; jj < m; jj++)
+            acc += hm[m * i + jj] * dx[jj];
+        pred += 2.0 * ngm[i] * dx[i] - dx[i] * acc;
+    }
+    return pred;
+}
+
+/* The candidate motion: R <- exp([dw]x) R, t <- t + dt, retracted onto the
+ * sphere |t| = rho0 with fix_scale. 0 if the rotation cannot be formed. */
+static int candidate_motion(const double dfull[6], const double r[9], const double tv[3],
+                            int fix, double rho0, double rn[9], double tn[3])
+{
+    double dr[9];
+    int i;
+    if (mcg_rot_from_angle_axis(dfull, dr) != MCG_OK)
+        return 0;
+    mul33(dr, r, rn);
+    for (i = 0; i < 3; i++)
+        tn[i] = tv[i] + dfull[3 + i];
+    if (fix) {
+        double nn = sqrt(dot3(tn, tn));
+        for (i = 0; i < 3; i++)
+            tn[i] *= rho0 / nn;
+    }
+    return 1;
+}
+
+/* The damping and stopping state of the Levenberg-Marquardt loop. */
+typedef struct {
+    double lambda, nu;
+    int reason, converged;
+    int trials; /* steps tried, accepted or not (res->iterations) */
+} lm_state;
+
+/* A failed step (not solvable, or not decreasing the cost): raise the
+ * damping (Nielsen's rule); 1 when it exceeds LAMBDA_MAX (stalled). */
+static int lm_reject(lm_state *lm)
+{
+    lm->lambda = lm->lambda > 0.0 ? lm->lambda * lm->nu : 1e-12;
+    lm->nu *= 2.0;
+    if (lm->lambda > LAMBDA_MAX) {
+        lm->reason = MCG_REFINE_STOP_STALLED;
+        return 1;
+    }
+    return 0;
+}
+
+/* One Levenberg-Marquardt iteration from (r, tv) with the normal equations
+ * *cur at it: reduced system, damped step, trust region, candidate, and its
+ * acceptance (gain ratio update of lambda). Returns 1 when the loop stops
+ * (lm->reason, lm->converged set), else 0. */
+static int lm_iteration(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const double *weights, const lossfn *lf,
+                        const mcg_refine_options *o, double ell, double rho0, double r[9],
+                        double tv[3], accum *cur, lm_state *lm)
+{
+    double pm[6][6], hm[36], gm[6], dx[6], dfull[6], rn[9], tn[3];
+    double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual;
+    int i, m, accepted, small, fix = o->fix_scale;
+    accum trial;
+
+    m = reduced_system(cur, fix, tv, rho0, pm, hm, gm);
+    for (i = 0; i < m; i++) {
+        if (hm[m * i + i] > maxd)
+            maxd = hm[m * i + i];
+        if (fabs(gm[i]) > gmax)
+            gmax = fabs(gm[i]);
+    }
+    if (gmax == 0.0) { /* exact stationary point (e.g. zero cost) */
+        lm->converged = 1;
+        lm->reason = MCG_REFINE_STOP_GRADIENT;
+        return 1;
+    }
+    if (!(maxd > 0.0)) {
+        lm->reason = MCG_REFINE_STOP_STALLED;
+        return 1;
+    }
+    lm->trials++;
+    if (marquardt_step(hm, gm, m, maxd, lm->lambda, dx) != MCG_OK)
+        return lm_reject(lm);
+    limit_step(pm, m, tv, ell, dx, dfull);
+    pred = predicted_decrease(hm, gm, dx, m);
+    if (!candidate_motion(dfull, r, tv, fix, rho0, rn, tn)) {
+        lm->reason = MCG_REFINE_STOP_STALLED;
+        return 1;
+    }
+    evaluate(n, o1, d1, o2, d2, weights, lf, rn, tn, &trial);
+    actual = cur->cost - trial.cost;
+    nw = sqrt(dot3(dfull, dfull));
+    ndt = sqrt(dot3(dfull + 3, dfull + 3));
+    nt = sqrt(dot3(tv, tv));
+    small = nw <= o->step_tolerance &&
+            ndt <= o->step_tolerance * (nt + ell > 0.0 ? nt + ell : 1.0);
+    accepted = !trial.bad && trial.cost <= cur->cost;
+    if (accepted) {
+        double gain = pred > 0.0 ? actual / pred : 0.0, f;
+        double c0 = cur->cost;
+        memcpy(r, rn, sizeof rn);
+        memcpy(tv, tn, sizeof tn);
+        *cur = trial;
+        f = 2.0 * gain - 1.0;
+        f = 1.0 - f * f * f;
+        lm->lambda *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
+        lm->nu = 2.0;
+        if (small) {
+            lm->converged = 1;
+            lm->reason = MCG_REFINE_STOP_STEP;
+            return 1;
+        }
+        if (actual <= o->cost_tolerance * c0) {
+            lm->converged = 1;
+            lm->reason = MCG_REFINE_STOP_COST;
+            return 1;
+        }
+        return 0;
+    }
+    if (small) { /* even a negligible step does not help: at the floor */
+        lm->converged = 1;
+        lm->reason = MCG_REFINE_STOP_STEP;
+        return 1;
+    }
+    return lm_reject(lm);
+}
+
+/* Statistics at the solution: information matrix, rms, the residual
+ * variance sigma2 = sum W r^2 / (sum W - p) and the first-order relative
+ * std of |t| (scale_evidence). With weights (or coordinates) near the top
+ * of the double range the information matrix J^T W J overflows although
+ * every step's cost stayed finite: no statistics can be given, and a motion
+ * without them is not returned as MCG_OK. */
+static int final_statistics(const accum *cur, const double tv[3], double pdim,
+                            const lm_state *lm, mcg_refine_result *res)
+{
+    double var, nt;
+    if (!all_finite(cur->h, 36) || !isfinite(cur->cost))
+        return MCG_ENUMERIC;
+    res->final_cost = cur->cost;
+    res->converged = lm->converged;
+    res->reason = lm->reason;
+    res->n_used = cur->n_used;
+    memcpy(res->info, cur->h, sizeof res->info);
+    res->rms = sqrt(cur->swr2 / cur->sw);
+    res->sigma2 = cur->som > pdim ? cur->somr2 / (cur->som - pdim) : HUGE_VAL;
+    nt = sqrt(dot3(tv, tv));
+    scale_evidence(cur->h, tv, &res->info_cond, &var);
+    if (isfinite(var) && isfinite(res->sigma2) && nt > 0.0)
+        res->scale_rel_std = sqrt(res->sigma2 * var) / nt;
+    else
+        res->scale_rel_std = HUGE_VAL;
+    return MCG_OK;
+}
+
+int mcg_refine_motion(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2, const double *weights,
+                      const mcg_refine_options *opt, double R[9], double t[3],
+                      mcg_refine_result *res)
+{
+    mcg_refine_options o;
+    lossfn lf;
+    accum cur;
+    lm_state lm;
+    double r[9], tv[3], rho0 = 0.0, ell, pdim, c[3];
+    int i, it, st;
+
+    if (!res)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    res->sigma2 = HUGE_VAL;
+    res->scale_rel_std = HUGE_VAL;
+    st = check_inputs(n, o1, d1, o2, d2, weights, opt, R, t, &o);
+    if (st != MCG_OK)
+        return st;
     if (mcg_project_so3(R, r) != MCG_OK) /* exact rotation from here on */
         return MCG_EINVAL;
     memcpy(tv, t, sizeof tv);
-    fix = o.fix_scale;
-    if (fix) {
+    if (o.fix_scale) {
         rho0 = sqrt(dot3(tv, tv));
         if (!(rho0 > 0.0))
             return MCG_EINVAL; /* no sphere to stay on */
     }
-    pdim = fix ? 5.0 : 6.0;
+    pdim = o.fix_scale ? 5.0 : 6.0;
     lf.loss = o.loss;
     lf.s = o.loss_scale;
     lf.s2 = o.loss_scale * o.loss_scale;
@@ -533,205 +808,22 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
         if (!(tr > 0.0))
             return MCG_EDEGENERATE; /* no ray constrains the motion here */
     }
-    {
-        /* characteristic length L of the rig (independent of the rig frame) */
-        double c[3];
-        ell = origin_spread(n, o1, o2, c);
-    }
-    lambda = o.initial_lambda;
+    /* characteristic length L of the rig (independent of the rig frame) */
+    ell = origin_spread(n, o1, o2, c);
 
-    for (it = 0; it < o.max_iterations; it++) {
-        double pm[6][6], a[36], hm[36], gm[6], dx[6], dfull[6], dmp[6];
-        double b1[3] = {0, 0, 0}, b2[3] = {0, 0, 0}, rn[9], tn[3], dr[9];
-        double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual;
-        int m = fix ? 5 : 6, accepted, small;
+    lm.lambda = o.initial_lambda;
+    lm.nu = 2.0;
+    lm.reason = MCG_REFINE_STOP_MAX_ITERATIONS;
+    lm.converged = 0;
+    lm.trials = 0;
+    for (it = 0; it < o.max_iterations; it++)
+        if (lm_iteration(n, o1, d1, o2, d2, weights, &lf, &o, ell, rho0, r, tv, &cur, &lm))
+            break;
+    res->iterations = lm.trials;
 
-        /* parametrisation P (6 x m): identity, or [dw; B u] with fix_scale */
-        memset(pm, 0, sizeof pm);
-        for (i = 0; i < 3; i++)
-            pm[i][i] = 1.0;
-        if (fix) {
-            double u[3];
-            for (i = 0; i < 3; i++)
-                u[i] = tv[i] / rho0;
-            tangent_basis(u, b1, b2);
-            for (i = 0; i < 3; i++) {
-                pm[3 + i][3] = b1[i];
-                pm[3 + i][4] = b2[i];
-            }
-        } else {
-            for (i = 3; i < 6; i++)
-                pm[i][i] = 1.0;
-        }
-        if (!fix) {
-            memcpy(hm, cur.h, sizeof hm);
-            memcpy(gm, cur.g, sizeof gm);
-        } else { /* hm = P^T H P, gm = P^T g */
-            double hp[6][5];
-            int jj, p;
-            for (p = 0; p < 6; p++)
-                for (jj = 0; jj < m; jj++) {
-                    double acc = 0.0;
-                    for (i = 0; i < 6; i++)
-                        acc += cur.h[6 * p + i] * pm[i][jj];
-                    hp[p][jj] = acc;
-                }
-            for (i = 0; i < m; i++) {
-                gm[i] = 0.0;
-                for (p = 0; p < 6; p++)
-                    gm[i] += pm[p][i] * cur.g[p];
-                for (jj = 0; jj < m; jj++) {
-                    double acc = 0.0;
-                    for (p = 0; p < 6; p++)
-                        acc += pm[p][i] * hp[p][jj];
-                    hm[m * i + jj] = acc;
-                }
-            }
-        }
-        for (i = 0; i < m; i++) {
-            if (hm[m * i + i] > maxd)
-                maxd = hm[m * i + i];
-            if (fabs(gm[i]) > gmax)
-                gmax = fabs(gm[i]);
-        }
-        if (gmax == 0.0) { /* exact stationary point (e.g. zero cost) */
-            converged = 1;
-            reason = MCG_REFINE_STOP_GRADIENT;
-            break;
-        }
-        if (!(maxd > 0.0)) {
-            reason = MCG_REFINE_STOP_STALLED;
-            break;
-        }
-        /* Marquardt damping lambda diag(H), floored so that directions the
-         * data do not constrain at all still get a finite step */
-        memcpy(a, hm, sizeof a);
-        for (i = 0; i < m; i++) {
-            dmp[i] = hm[m * i + i] > 1e-12 * maxd ? hm[m * i + i] : 1e-12 * maxd;
-            a[m * i + i] += lambda * dmp[i];
-        }
-        for (i = 0; i < m; i++)
-            gm[i] = -gm[i];
-        res->iterations = it + 1;
-        if (mcg_spd_solve(m, a, gm, dx) != MCG_OK) {
-            lambda = lambda > 0.0 ? lambda * nu : 1e-12;
-            nu *= 2.0;
-            if (lambda > LAMBDA_MAX) {
-                reason = MCG_REFINE_STOP_STALLED;
-                break;
-            }
-            continue;
-        }
-        for (i = 0; i < 6; i++) {
-            int jj;
-            dfull[i] = 0.0;
-            for (jj = 0; jj < m; jj++)
-                dfull[i] += pm[i][jj] * dx[jj];
-        }
-        /* trust region on top of the damping: a step may turn R by at most
-         * MAX_TURN and move t by at most max(|t|, L) / 2 (L = rig size). In
-         * weakly scale-observable configurations a step along the flat |t|
-         * direction otherwise overshoots, even through t = 0. */
-        {
-            double nw0 = sqrt(dot3(dfull, dfull)), nt0 = sqrt(dot3(dfull + 3, dfull + 3));
-            double ntv = sqrt(dot3(tv, tv)), alpha = 1.0;
-            double lim = 0.5 * (ntv > ell ? ntv : ell);
-            if (nw0 > MAX_TURN)
-                alpha = MAX_TURN / nw0;
-            if (lim > 0.0 && nt0 * alpha > lim)
-                alpha = lim / nt0;
-            for (i = 0; i < m; i++)
-                dx[i] *= alpha;
-            for (i = 0; i < 6; i++)
-                dfull[i] *= alpha;
-        }
-        /* predicted decrease of the IRLS model, -2 g.dx - dx^T H dx
-         * (gm holds -g) */
-        pred = 0.0;
-        for (i = 0; i < m; i++) {
-            int jj;
-            double acc = 0.0;
-            for (jj = 0; jj < m; jj++)
-                acc += hm[m * i + jj] * dx[jj];
-            pred += 2.0 * gm[i] * dx[i] - dx[i] * acc;
-        }
-        /* candidate: R <- exp([dw]x) R, t <- t + dt (or the sphere retraction) */
-        if (mcg_rot_from_angle_axis(dfull, dr) != MCG_OK) {
-            reason = MCG_REFINE_STOP_STALLED;
-            break;
-        }
-        mul33(dr, r, rn);
-        for (i = 0; i < 3; i++)
-            tn[i] = tv[i] + dfull[3 + i];
-        if (fix) {
-            double nn = sqrt(dot3(tn, tn));
-            for (i = 0; i < 3; i++)
-                tn[i] *= rho0 / nn;
-        }
-        evaluate(n, o1, d1, o2, d2, weights, &lf, rn, tn, &trial);
-        actual = cur.cost - trial.cost;
-        nw = sqrt(dot3(dfull, dfull));
-        ndt = sqrt(dot3(dfull + 3, dfull + 3));
-        nt = sqrt(dot3(tv, tv));
-        small = nw <= o.step_tolerance &&
-                ndt <= o.step_tolerance * (nt + ell > 0.0 ? nt + ell : 1.0);
-        accepted = !trial.bad && trial.cost <= cur.cost;
-        if (accepted) {
-            double gain = pred > 0.0 ? actual / pred : 0.0, f;
-            double c0 = cur.cost;
-            memcpy(r, rn, sizeof r);
-            memcpy(tv, tn, sizeof tv);
-            cur = trial;
-            f = 2.0 * gain - 1.0;
-            f = 1.0 - f * f * f;
-            lambda *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
-            nu = 2.0;
-            if (small) {
-                converged = 1;
-                reason = MCG_REFINE_STOP_STEP;
-                break;
-            }
-            if (actual <= o.cost_tolerance * c0) {
-                converged = 1;
-                reason = MCG_REFINE_STOP_COST;
-                break;
-            }
-        } else {
-            if (small) { /* even a negligible step does not help: at the floor */
-                converged = 1;
-                reason = MCG_REFINE_STOP_STEP;
-                break;
-            }
-            lambda = lambda > 0.0 ? lambda * nu : 1e-12;
-            nu *= 2.0;
-            if (lambda > LAMBDA_MAX) {
-                reason = MCG_REFINE_STOP_STALLED;
-                break;
-            }
-        }
-    }
-
-    /* statistics at the solution; with weights (or coordinates) near the
-     * top of the double range the information matrix J^T W J overflows
-     * although every step's cost stayed finite: no statistics can be given,
-     * and a motion without them is not returned as MCG_OK */
-    if (!all_finite(cur.h, 36) || !isfinite(cur.cost))
-        return MCG_ENUMERIC;
-    res->final_cost = cur.cost;
-    res->converged = converged;
-    res->reason = reason;
-    res->n_used = cur.n_used;
-    memcpy(res->info, cur.h, sizeof res->info);
-    res->rms = sqrt(cur.swr2 / cur.sw);
-    res->sigma2 = cur.som > pdim ? cur.somr2 / (cur.som - pdim) : HUGE_VAL;
-    {
-        double var, nt = sqrt(dot3(tv, tv));
-        scale_evidence(cur.h, tv, &res->info_cond, &var);
-        if (isfinite(var) && isfinite(res->sigma2) && nt > 0.0)
-            res->scale_rel_std = sqrt(res->sigma2 * var) / nt;
-        else
-            res->scale_rel_std = HUGE_VAL;
-    }
+    st = final_statistics(&cur, tv, pdim, &lm, res);
+    if (st != MCG_OK)
+        return st;
     memcpy(R, r, sizeof r);
     memcpy(t, tv, sizeof tv);
     return MCG_OK;
