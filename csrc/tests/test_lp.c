@@ -1,5 +1,5 @@
 /*
- * test_lp_native.c -- plain-C checks of the LP feasibility backends (lp_native.c,
+ * test_lp.c -- plain-C checks of the LP feasibility backends (lp_native.c,
  * and lp_glpk.c when it is built and libglpk loads: MCG_GLPK_LIBRARY): known feasible / infeasible
  * instances (empty, unbounded, redundant, nearly parallel, zero rows),
  * random instances with m <= 8 against brute-force vertex enumeration,
