@@ -130,13 +130,6 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void mat_vec(const double R[9], const double x[3], double y[3])
-{
-    y[0] = R[0] * x[0] + R[1] * x[1] + R[2] * x[2];
-    y[1] = R[3] * x[0] + R[4] * x[1] + R[5] * x[2];
-    y[2] = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-}
-
 /* The sines of the two half-angles at (eps, s), enlarged as in wedge.c so
  * that rounding never tightens a wedge; 0 if the cones are too wide to
  * constrain anything (then no rows). */
@@ -332,9 +325,7 @@ static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3
         if (fabs(zc[k]) < fabs(zc[imin]))
             imin = k;
     e[imin] = 1.0;
-    P[0] = zc[1] * e[2] - zc[2] * e[1];
-    P[1] = zc[2] * e[0] - zc[0] * e[2];
-    P[2] = zc[0] * e[1] - zc[1] * e[0];
+    cross3(zc, e, P);
     nn = sqrt(dot3(P, P));
     for (k = 0; k < 3; ++k)
         P[k] /= nn;
@@ -790,35 +781,21 @@ static void sort_desc(int *order, const double *key, int lo, int hi)
     }
 }
 
-int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
-                 const double *a2, const int *group, int n_groups,
-                 const double R_init[9], const mcg_bnb_options *opt,
-                 mcg_bnb_result *res, double *work, size_t lwork)
+/* The argument checks of mcg_bnb_linf (its header comment lists them). */
+static int check_inputs(int n, const double *d1, const double *a1, const double *d2,
+                        const double *a2, const int *group, int n_groups,
+                        const double R_init[9], const mcg_bnb_options *o,
+                        const double *work, size_t lwork)
 {
-    mcg_bnb_options o;
-    mcg_lp_backend native;
-    bnb_ctx c;
-    double *w = work, *heap, *alpha, eps, lo, t[3], Rb[9], blk[BLOCK_DOUBLES];
-    double leaf_lb = INFINITY, prune_lb = INFINITY, t0, leaf_gap, L, oc[3], deadline;
-    int *order, *gstart, i, g, k, st, r, hsize = 0, gi, gj, gk;
-    long blocks = 0, leaves = 0;
     size_t need;
-
-    t0 = now_seconds();
-    if (!res)
-        return MCG_EINVAL;
-    memset(res, 0, sizeof *res);
-    if (opt)
-        o = *opt;
-    else
-        mcg_bnb_default_options(&o);
-    if (!check_options(&o))
+    int i, k;
+    if (!check_options(o))
         return MCG_EINVAL;
     if (n < 1 || n > (1 << 20) || n_groups < 1 || n_groups > n)
         return MCG_EINVAL;
     if (!d1 || !a1 || !d2 || !a2 || !group || !R_init || !work)
         return MCG_EINVAL;
-    need = mcg_bnb_work_size(n, n_groups, &o);
+    need = mcg_bnb_work_size(n, n_groups, o);
     if (need == 0)
         return MCG_EINVAL;
     if (lwork < need)
@@ -839,99 +816,118 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
                 fabs(d1[3 * i + k]) > 1e150 || fabs(d2[3 * i + k]) > 1e150)
                 return MCG_EINVAL;
     }
-    leaf_gap = o.leaf_gap < 0.0 ? 0.5 * o.resolution : o.leaf_gap;
-    deadline = o.max_seconds > 0.0 ? t0 + o.max_seconds : INFINITY;
-    if (!o.lp) {
-        mcg_lp_native_backend(&native);
-        o.lp = &native;
-    }
-    st = mcg_project_so3(R_init, Rb);
-    if (st != MCG_OK)
-        return st;
+    return MCG_OK;
+}
 
-    /* carve the workspace */
-    c.n = n;
-    c.G = n_groups;
-    c.a1 = w;
+/* Carve the caller's workspace (sized by mcg_bnb_work_size) into the arrays
+ * of the context, the correspondence order, the group offsets and the block
+ * heap, and reset the counters and working sets. */
+static void carve_workspace(bnb_ctx *c, int n, int n_groups, const mcg_bnb_options *o,
+                            double *work, size_t lwork, int **order, int **gstart,
+                            double **heap)
+{
+    double *w = work;
+    int i, g;
+    c->n = n;
+    c->G = n_groups;
+    c->a1 = w;
     w += 3 * (size_t)n;
-    c.a2 = w;
+    c->a2 = w;
     w += 3 * (size_t)n;
-    c.A3 = w;
+    c->A3 = w;
     w += 6 * (size_t)n;
-    c.b3 = w;
+    c->b3 = w;
     w += 2 * (size_t)n;
-    c.A2 = w;
+    c->A2 = w;
     w += 4 * (size_t)n;
-    c.b2 = w;
+    c->b2 = w;
     w += 2 * (size_t)n;
-    c.a1n = w;
+    c->a1n = w;
     w += (size_t)n;
-    c.u1 = w;
+    c->u1 = w;
     w += 3 * (size_t)n;
-    c.u2 = w;
+    c->u2 = w;
     w += 3 * (size_t)n;
-    c.rid = (int *)w;
+    c->rid = (int *)w;
     w += 2 * (size_t)n;
-    c.where = (int *)w;
+    c->where = (int *)w;
     w += 2 * (size_t)n;
-    c.ws = (int *)w;
+    c->ws = (int *)w;
     w += WS_CAP * ((size_t)n_groups + 1);
-    c.nws = (int *)w;
+    c->nws = (int *)w;
     w += (size_t)n_groups + 1;
-    c.Asub = w;
+    c->Asub = w;
     w += 3 * WS_CAP;
-    c.bsub = w;
+    c->bsub = w;
     w += WS_CAP;
-    c.zsum = w;
+    c->zsum = w;
     w += 3 * (size_t)n_groups;
-    c.gapex = w;
+    c->gapex = w;
     w += 3 * (size_t)n_groups;
-    order = (int *)w;
+    *order = (int *)w;
     w += (size_t)n;
-    gstart = (int *)w;
+    *gstart = (int *)w;
     w += (size_t)n_groups + 1;
-    c.grows = (int *)w;
+    c->grows = (int *)w;
     w += (size_t)n_groups;
-    c.gfirst = (int *)w;
+    c->gfirst = (int *)w;
     w += (size_t)n_groups;
-    heap = w;
-    w += BLOCK_DOUBLES * (size_t)o.max_queue;
-    c.lpw = w;
-    c.lplen = lwork - (size_t)(w - work);
-    c.lp = o.lp;
-    c.preemptive = o.preemptive != 0;
-    c.working_sets = o.working_sets != 0;
-    c.lp2 = c.lp3 = c.hints = c.undecided = 0;
+    *heap = w;
+    w += BLOCK_DOUBLES * (size_t)o->max_queue;
+    c->lpw = w;
+    c->lplen = lwork - (size_t)(w - work);
+    c->lp = o->lp;
+    c->preemptive = o->preemptive != 0;
+    c->working_sets = o->working_sets != 0;
+    c->lp2 = c->lp3 = c->hints = c->undecided = 0;
     for (i = 0; i < 2 * n; ++i)
-        c.where[i] = -1;
+        c->where[i] = -1;
     for (g = 0; g <= n_groups; ++g)
-        c.nws[g] = 0;
-    c.have_hint = 0;
-    c.order = order;
-    c.gstart = gstart;
-    /* Work in a frame centred on the ray origins and scaled by their spread
-     * (t' = (t + R oc - oc) / L): the LPs' tolerances are relative to the
-     * scene, so the answers do not depend on the rig frame's origin or unit
-     * (up to rounding). */
-    L = origin_spread(n, a1, a2, oc);
+        c->nws[g] = 0;
+    c->have_hint = 0;
+    c->order = *order;
+    c->gstart = *gstart;
+}
+
+/* Work in a frame centred on the ray origins and scaled by their spread
+ * (t' = (t + R oc - oc) / L): the LPs' tolerances are relative to the
+ * scene, so the answers do not depend on the rig frame's origin or unit
+ * (up to rounding). Fills the centred origins, their norms |a1| (the apex
+ * motion bound s |a1| of ch. 10.1-10.2) and the unit bearings; returns L,
+ * oc the centroid. */
+static double to_search_frame(bnb_ctx *c, int n, const double *d1, const double *a1,
+                              const double *d2, const double *a2, double oc[3])
+{
+    double L = origin_spread(n, a1, a2, oc);
+    int i, k;
     if (!(L > 1e-150))
         L = 1.0;
     for (i = 0; i < n; ++i) {
         double n1 = sqrt(dot3(d1 + 3 * i, d1 + 3 * i));
         double n2 = sqrt(dot3(d2 + 3 * i, d2 + 3 * i));
         for (k = 0; k < 3; ++k) {
-            c.a1[3 * i + k] = (a1[3 * i + k] - oc[k]) / L;
-            c.a2[3 * i + k] = (a2[3 * i + k] - oc[k]) / L;
+            c->a1[3 * i + k] = (a1[3 * i + k] - oc[k]) / L;
+            c->a2[3 * i + k] = (a2[3 * i + k] - oc[k]) / L;
         }
-        c.a1n[i] = sqrt(dot3(c.a1 + 3 * i, c.a1 + 3 * i));
+        c->a1n[i] = sqrt(dot3(c->a1 + 3 * i, c->a1 + 3 * i));
         for (k = 0; k < 3; ++k) {
-            c.u1[3 * i + k] = d1[3 * i + k] / n1;
-            c.u2[3 * i + k] = d2[3 * i + k] / n2;
+            c->u1[3 * i + k] = d1[3 * i + k] / n1;
+            c->u2[3 * i + k] = d2[3 * i + k] / n2;
         }
     }
+    return L;
+}
 
-    /* order: by group, then by alpha at R_init descending (ch. 10.3); the
-     * alphas live in the 2-variable rows' slot until the search starts */
+/* The correspondence order: by group, then by the angle alpha between
+ * R_init d1 and d2 descending (the widest, narrowest wedges first: the
+ * preemptive test of ch. 10.3); the alphas live in the 2-variable rows'
+ * slot until the search starts. */
+static void order_correspondences(bnb_ctx *c, int n, int n_groups, const int *group,
+                                  const double Rb[9], const double *d1, const double *d2,
+                                  int *order, int *gstart)
+{
+    double *alpha;
+    int i, g;
     for (g = 0; g <= n_groups; ++g)
         gstart[g] = 0;
     for (i = 0; i < n; ++i)
@@ -939,27 +935,30 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
     for (g = 0; g < n_groups; ++g)
         gstart[g + 1] += gstart[g];
     for (g = 0; g < n_groups; ++g)
-        c.grows[g] = gstart[g];
+        c->grows[g] = gstart[g];
     for (i = 0; i < n; ++i)
-        order[c.grows[group[i]]++] = i;
-    alpha = c.A2;
+        order[c->grows[group[i]]++] = i;
+    alpha = c->A2;
     for (i = 0; i < n; ++i) {
         double v[3], cr[3];
         const double *q = d2 + 3 * i;
         mat_vec(Rb, d1 + 3 * i, v);
-        cr[0] = v[1] * q[2] - v[2] * q[1];
-        cr[1] = v[2] * q[0] - v[0] * q[2];
-        cr[2] = v[0] * q[1] - v[1] * q[0];
+        cross3(v, q, cr);
         alpha[i] = atan2(sqrt(dot3(cr, cr)), dot3(v, q));
     }
     for (g = 0; g < n_groups; ++g)
         sort_desc(order, alpha, gstart[g], gstart[g + 1]);
+}
 
-    /* incumbent: f(R_init) by doubling then bisection (Algorithm 5, line 1) */
-    eps = 1e-3;
-    lo = 0.0;
+/* The incumbent f(R_init) by doubling then bisection (Algorithm 5, line 1):
+ * res->R, t, linf and initial_linf. */
+static int initial_incumbent(bnb_ctx *c, const double Rb[9], double tol,
+                             mcg_bnb_result *res)
+{
+    double eps = 1e-3, lo = 0.0, t[3];
+    int r, st;
     for (;;) {
-        r = feasible(&c, Rb, eps, 0.0, t);
+        r = feasible(c, Rb, eps, 0.0, t);
         if (r < 0)
             return -r;
         if (r == 1)
@@ -969,142 +968,255 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
         if (eps >= EPS_MAX)
             return MCG_ENUMERIC; /* every bound up to ~86 deg infeasible */
     }
-    st = find_min_error(&c, Rb, 0.0, lo, &eps, t, o.tol, 0);
+    st = find_min_error(c, Rb, 0.0, lo, &eps, t, tol, 0);
     if (st != MCG_OK)
         return st;
-    memcpy(res->R, Rb, sizeof Rb);
-    memcpy(res->t, t, sizeof t);
+    memcpy(res->R, Rb, sizeof res->R);
+    memcpy(res->t, t, sizeof res->t);
     res->linf = eps;
     res->initial_linf = eps;
+    return MCG_OK;
+}
 
-    /* the initial tiling of [-pi, pi]^3, or of the region cube */
-    {
-        double half = o.half_side > 0.0 ? o.half_side : PI, sig = half / o.grid;
-        const double zero[3] = {0.0, 0.0, 0.0};
-        const double *ctr = o.half_side > 0.0 ? o.centre : zero;
-        for (gi = 0; gi < o.grid; ++gi)
-            for (gj = 0; gj < o.grid; ++gj)
-                for (gk = 0; gk < o.grid; ++gk) {
-                    blk[0] = ctr[0] - half + (2 * gi + 1) * sig;
-                    blk[1] = ctr[1] - half + (2 * gj + 1) * sig;
-                    blk[2] = ctr[2] - half + (2 * gk + 1) * sig;
-                    blk[3] = sig;
-                    blk[4] = 0.0;
-                    if (cube_distance(blk, sig) > PI)
-                        continue;
-                    if (hsize < o.max_queue)
-                        heap_push(heap, &hsize, blk);
-                    else if (leaf_lb > 0.0)
-                        leaf_lb = 0.0; /* no room: an unexplored block */
-                }
-    }
+/* The state of the best-first search: the block heap and the bounds of the
+ * blocks that left it (the certified lower bound is the smallest of these
+ * and of the queued blocks' bounds). */
+typedef struct {
+    double *heap;
+    int hsize;
+    long blocks, leaves;
+    double leaf_lb;  /* smallest bound of a block closed as a leaf */
+    double prune_lb; /* smallest level at which a block was discarded */
+} bnb_search;
 
-    res->stop = MCG_BNB_CONVERGED;
-    while (hsize > 0) {
-        double R0[9], s, target, lb, hi, tt[3];
-        if (heap[4] >= res->linf - o.gap)
-            break; /* best-first: no queued block can improve by > gap */
-        if (blocks >= o.max_blocks) {
-            res->stop = MCG_BNB_MAX_BLOCKS;
-            break;
-        }
-        if (o.max_seconds > 0.0 && blocks % CLOCK_EVERY == 0 && now_seconds() > deadline) {
-            res->stop = MCG_BNB_TIME_LIMIT; /* the queue's bounds stay certified */
-            break;
-        }
-        heap_pop(heap, &hsize, blk);
-        ++blocks;
-        s = SQRT3 * blk[3];
-        st = mcg_rot_from_angle_axis(blk, R0);
-        if (st != MCG_OK)
-            return st;
-        target = res->linf - o.gap;
-        r = feasible(&c, R0, target, s, tt);
+/* The initial tiling of [-pi, pi]^3 (or of the region cube) into grid^3
+ * cubes, those outside the ball of radius pi dropped. */
+static void initial_tiling(bnb_search *q, const mcg_bnb_options *o)
+{
+    double half = o->half_side > 0.0 ? o->half_side : PI, sig = half / o->grid;
+    double blk[BLOCK_DOUBLES];
+    const double zero[3] = {0.0, 0.0, 0.0};
+    const double *ctr = o->half_side > 0.0 ? o->centre : zero;
+    int gi, gj, gk;
+    for (gi = 0; gi < o->grid; ++gi)
+        for (gj = 0; gj < o->grid; ++gj)
+            for (gk = 0; gk < o->grid; ++gk) {
+                blk[0] = ctr[0] - half + (2 * gi + 1) * sig;
+                blk[1] = ctr[1] - half + (2 * gj + 1) * sig;
+                blk[2] = ctr[2] - half + (2 * gk + 1) * sig;
+                blk[3] = sig;
+                blk[4] = 0.0;
+                if (cube_distance(blk, sig) > PI)
+                    continue;
+                if (q->hsize < o->max_queue)
+                    heap_push(q->heap, &q->hsize, blk);
+                else if (q->leaf_lb > 0.0)
+                    q->leaf_lb = 0.0; /* no room: an unexplored block */
+            }
+}
+
+/* A block at the resolution (or with no queue space for its children):
+ * close it at linf - leaf_gap with one relaxed test if it fails there, else
+ * bisect its bound to the tolerance (FindMinError on the relaxed test). */
+static int close_leaf(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
+                      bnb_search *q, const double R0[9], double s, double lb,
+                      double target, double leaf_gap)
+{
+    double level = res->linf - leaf_gap, hi, tt[3];
+    int r, st;
+    ++q->leaves;
+    if (q->hsize + 8 > o->max_queue && s > o->resolution)
+        res->stop = MCG_BNB_QUEUE_FULL;
+    if (level > lb) {
+        r = feasible(c, R0, level, s, tt);
         if (r < 0)
             return -r;
         if (!r) {
-            if (target < prune_lb)
-                prune_lb = target;
-            continue;
+            if (level < q->leaf_lb)
+                q->leaf_lb = level;
+            return MCG_OK;
         }
-        /* try the centre against the incumbent (Algorithm 5, lines 11-13) */
-        r = feasible(&c, R0, res->linf, 0.0, tt);
+        hi = level;
+    } else {
+        hi = target;
+    }
+    st = find_min_error(c, R0, s, lb, &hi, tt, o->tol, 1);
+    if (st != MCG_OK)
+        return st;
+    lb = hi - o->tol;
+    if (lb < q->leaf_lb)
+        q->leaf_lb = lb;
+    return MCG_OK;
+}
+
+/* Split a surviving block: tighten its lower bound (the best-first key) by
+ * bound_steps bisection steps of the relaxed test, then queue the children
+ * that meet the ball of radius pi with that bound. */
+static int split_block(bnb_ctx *c, const mcg_bnb_options *o, bnb_search *q,
+                       const double blk[BLOCK_DOUBLES], const double R0[9], double s,
+                       double target)
+{
+    double lb = blk[4], hi = target, tt[3];
+    int k, gi, r;
+    for (k = 0; k < o->bound_steps && hi > lb; ++k) {
+        double mid = 0.5 * (lb + hi);
+        r = feasible(c, R0, mid, s, tt);
         if (r < 0)
             return -r;
-        if (r == 1) {
-            hi = res->linf;
-            st = find_min_error(&c, R0, 0.0, blk[4], &hi, tt, o.tol, 0);
-            if (st != MCG_OK)
-                return st;
-            if (hi < res->linf) {
-                res->linf = hi;
-                memcpy(res->R, R0, sizeof R0);
-                memcpy(res->t, tt, sizeof tt);
-                target = res->linf - o.gap;
-            }
-        }
-        lb = blk[4];
-        if (s <= o.resolution || hsize + 8 > o.max_queue) {
-            /* a leaf: close it at linf - leaf_gap with one relaxed test if
-             * it fails there, else bisect its bound to the tolerance */
-            double level = res->linf - leaf_gap;
-            ++leaves;
-            if (hsize + 8 > o.max_queue && s > o.resolution)
-                res->stop = MCG_BNB_QUEUE_FULL;
-            if (level > lb) {
-                r = feasible(&c, R0, level, s, tt);
-                if (r < 0)
-                    return -r;
-                if (!r) {
-                    if (level < leaf_lb)
-                        leaf_lb = level;
-                    continue;
-                }
-                hi = level;
-            } else {
-                hi = target;
-            }
-            st = find_min_error(&c, R0, s, lb, &hi, tt, o.tol, 1);
-            if (st != MCG_OK)
-                return st;
-            lb = hi - o.tol;
-            if (lb < leaf_lb)
-                leaf_lb = lb;
-            continue;
-        }
-        /* tighten the block's lower bound (best-first key) */
-        hi = target;
-        for (k = 0; k < o.bound_steps && hi > lb; ++k) {
-            double mid = 0.5 * (lb + hi);
-            r = feasible(&c, R0, mid, s, tt);
-            if (r < 0)
-                return -r;
-            if (r)
-                hi = mid;
-            else
-                lb = mid;
-        }
-        for (gi = 0; gi < 8; ++gi) {
-            double ch[BLOCK_DOUBLES], hs = 0.5 * blk[3];
-            ch[0] = blk[0] + ((gi & 1) ? hs : -hs);
-            ch[1] = blk[1] + ((gi & 2) ? hs : -hs);
-            ch[2] = blk[2] + ((gi & 4) ? hs : -hs);
-            ch[3] = hs;
-            ch[4] = lb;
-            if (cube_distance(ch, hs) <= PI)
-                heap_push(heap, &hsize, ch);
+        if (r)
+            hi = mid;
+        else
+            lb = mid;
+    }
+    for (gi = 0; gi < 8; ++gi) {
+        double ch[BLOCK_DOUBLES], hs = 0.5 * blk[3];
+        ch[0] = blk[0] + ((gi & 1) ? hs : -hs);
+        ch[1] = blk[1] + ((gi & 2) ? hs : -hs);
+        ch[2] = blk[2] + ((gi & 4) ? hs : -hs);
+        ch[3] = hs;
+        ch[4] = lb;
+        if (cube_distance(ch, hs) <= PI)
+            heap_push(q->heap, &q->hsize, ch);
+    }
+    return MCG_OK;
+}
+
+/* One block of the search (Algorithm 5's loop body): discard it if the
+ * relaxed test (eps + s on the rotated bearings, right-hand sides lowered
+ * by s |a1|, ch. 10.1-10.2) fails at linf - gap; else try its centre
+ * against the incumbent (lines 11-13), then close it as a leaf or split it. */
+static int process_block(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
+                         bnb_search *q, const double blk[BLOCK_DOUBLES], double leaf_gap)
+{
+    double R0[9], s = SQRT3 * blk[3], target, hi, tt[3];
+    int r, st;
+    st = mcg_rot_from_angle_axis(blk, R0);
+    if (st != MCG_OK)
+        return st;
+    target = res->linf - o->gap;
+    r = feasible(c, R0, target, s, tt);
+    if (r < 0)
+        return -r;
+    if (!r) {
+        if (target < q->prune_lb)
+            q->prune_lb = target;
+        return MCG_OK;
+    }
+    r = feasible(c, R0, res->linf, 0.0, tt);
+    if (r < 0)
+        return -r;
+    if (r == 1) {
+        hi = res->linf;
+        st = find_min_error(c, R0, 0.0, blk[4], &hi, tt, o->tol, 0);
+        if (st != MCG_OK)
+            return st;
+        if (hi < res->linf) {
+            res->linf = hi;
+            memcpy(res->R, R0, sizeof R0);
+            memcpy(res->t, tt, sizeof tt);
+            target = res->linf - o->gap;
         }
     }
-    /* the certified lower bound over all rotations */
-    lo = res->linf;
-    if (hsize > 0 && heap[4] < lo)
-        lo = heap[4];
-    if (leaf_lb < lo)
-        lo = leaf_lb;
-    if (prune_lb < lo)
-        lo = prune_lb;
+    if (s <= o->resolution || q->hsize + 8 > o->max_queue)
+        return close_leaf(c, o, res, q, R0, s, blk[4], target, leaf_gap);
+    return split_block(c, o, q, blk, R0, s, target);
+}
+
+/* The best-first search (Algorithm 7): pop the block of smallest lower bound
+ * until none can improve the incumbent by more than gap or a budget
+ * (max_blocks, max_seconds) is spent; res->stop says which. */
+static int best_first_search(bnb_ctx *c, const mcg_bnb_options *o, mcg_bnb_result *res,
+                             bnb_search *q, double deadline)
+{
+    double leaf_gap = o->leaf_gap < 0.0 ? 0.5 * o->resolution : o->leaf_gap;
+    double blk[BLOCK_DOUBLES];
+    int st;
+    res->stop = MCG_BNB_CONVERGED;
+    while (q->hsize > 0) {
+        if (q->heap[4] >= res->linf - o->gap)
+            break; /* best-first: no queued block can improve by > gap */
+        if (q->blocks >= o->max_blocks) {
+            res->stop = MCG_BNB_MAX_BLOCKS;
+            break;
+        }
+        if (o->max_seconds > 0.0 && q->blocks % CLOCK_EVERY == 0 &&
+            now_seconds() > deadline) {
+            res->stop = MCG_BNB_TIME_LIMIT; /* the queue's bounds stay certified */
+            break;
+        }
+        heap_pop(q->heap, &q->hsize, blk);
+        ++q->blocks;
+        st = process_block(c, o, res, q, blk, leaf_gap);
+        if (st != MCG_OK)
+            return st;
+    }
+    return MCG_OK;
+}
+
+/* The certified lower bound over all rotations: the smallest of the
+ * incumbent, the queued blocks' bounds, the leaves' bounds and the levels
+ * at which blocks were discarded (never below 0). */
+static double certified_lower_bound(const bnb_search *q, double linf)
+{
+    double lo = linf;
+    if (q->hsize > 0 && q->heap[4] < lo)
+        lo = q->heap[4];
+    if (q->leaf_lb < lo)
+        lo = q->leaf_lb;
+    if (q->prune_lb < lo)
+        lo = q->prune_lb;
     if (lo < 0.0)
         lo = 0.0;
+    return lo;
+}
+
+int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
+                 const double *a2, const int *group, int n_groups,
+                 const double R_init[9], const mcg_bnb_options *opt,
+                 mcg_bnb_result *res, double *work, size_t lwork)
+{
+    mcg_bnb_options o;
+    mcg_lp_backend native;
+    bnb_ctx c;
+    bnb_search q;
+    double lo, Rb[9], t0, L, oc[3], deadline;
+    int *order, *gstart, k, st;
+
+    t0 = now_seconds();
+    if (!res)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    if (opt)
+        o = *opt;
+    else
+        mcg_bnb_default_options(&o);
+    st = check_inputs(n, d1, a1, d2, a2, group, n_groups, R_init, &o, work, lwork);
+    if (st != MCG_OK)
+        return st;
+    deadline = o.max_seconds > 0.0 ? t0 + o.max_seconds : INFINITY;
+    if (!o.lp) {
+        mcg_lp_native_backend(&native);
+        o.lp = &native;
+    }
+    st = mcg_project_so3(R_init, Rb);
+    if (st != MCG_OK)
+        return st;
+
+    carve_workspace(&c, n, n_groups, &o, work, lwork, &order, &gstart, &q.heap);
+    L = to_search_frame(&c, n, d1, a1, d2, a2, oc);
+    order_correspondences(&c, n, n_groups, group, Rb, d1, d2, order, gstart);
+    st = initial_incumbent(&c, Rb, o.tol, res);
+    if (st != MCG_OK)
+        return st;
+
+    q.hsize = 0;
+    q.blocks = q.leaves = 0;
+    q.leaf_lb = q.prune_lb = INFINITY;
+    initial_tiling(&q, &o);
+    st = best_first_search(&c, &o, res, &q, deadline);
+    if (st != MCG_OK)
+        return st;
+    lo = certified_lower_bound(&q, res->linf);
     res->lower_bound = lo;
     /* the polish bisects f from this floor: below the certified bound by the
      * tolerance, but never below 0 (f is an angle; a negative floor let the
@@ -1128,13 +1240,13 @@ int mcg_bnb_linf(int n, const double *d1, const double *a1, const double *d2,
         for (k = 0; k < 3; ++k)
             res->t[k] = L * res->t[k] - ro[k] + oc[k];
     }
-    res->blocks = blocks;
-    res->queued = hsize;
+    res->blocks = q.blocks;
+    res->queued = q.hsize;
     res->lps_2var = c.lp2;
     res->lps_3var = c.lp3;
     res->hints = c.hints;
     res->undecided = c.undecided;
-    res->leaves = leaves;
+    res->leaves = q.leaves;
     res->seconds = now_seconds() - t0;
     return MCG_OK;
 }

@@ -38,23 +38,6 @@ static size_t svd_ws0(size_t m, size_t n)
     return mcg_svd_work_size((int)m, (int)n);
 }
 
-/* |y| without overflow */
-static double norm2(const double *y, size_t n)
-{
-    double mx = 0.0, acc = 0.0;
-    size_t i;
-    for (i = 0; i < n; ++i)
-        if (fabs(y[i]) > mx)
-            mx = fabs(y[i]);
-    if (mx == 0.0 || !isfinite(mx))
-        return mx;
-    for (i = 0; i < n; ++i) {
-        double t = y[i] / mx;
-        acc += t * t;
-    }
-    return mx * sqrt(acc);
-}
-
 /* y (m) = a (m x n, row stride lda) x */
 static void matvec(size_t m, size_t n, const double *a, size_t lda,
                    const double *x, double *y)
@@ -273,7 +256,7 @@ int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
         return MCG_ENUMERIC;
     if (resid != NULL) {
         matvec(mm, nn, a, nn, x, z);
-        *resid = norm2(z, mm);
+        *resid = norm_scaled(z, mm);
     }
     return MCG_OK;
 }
@@ -377,7 +360,7 @@ int mcg_cls_partial(int m, int n, int p, const double *a, double rcond,
         *rank2 = (int)r2;
     if (resid != NULL) {
         matvec(mm, nn, a, nn, x, z);
-        *resid = norm2(z, mm);
+        *resid = norm_scaled(z, mm);
     }
     return MCG_OK;
 }
@@ -469,7 +452,7 @@ int mcg_cls_range(int m, int n, int r, const double *a, const double *g,
         return MCG_ENUMERIC;
     if (resid != NULL) {
         matvec(mm, nn, a, nn, x, z);
-        *resid = norm2(z, mm);
+        *resid = norm_scaled(z, mm);
     }
     return MCG_OK;
 }

@@ -601,14 +601,211 @@ static int add_violators(const cone_ctx *kf, const double x[3], double thr,
     return nt;
 }
 
+/* The argument checks of mcg_cone_linf (its header comment lists them). */
+static int check_inputs(int n, const double *apex, const double *axis,
+                        const mcg_cone_options *o)
+{
+    int i;
+    if (!options_ok(o))
+        return MCG_EINVAL;
+    for (i = 0; i < 3 * n; ++i)
+        if (!isfinite(apex[i]) || !isfinite(axis[i]) ||
+            fabs(apex[i]) > COORD_MAX || fabs(axis[i]) > COORD_MAX)
+            return MCG_EINVAL;
+    for (i = 0; i < n; ++i)
+        if (!(dot3(axis + 3 * i, axis + 3 * i) > AXIS2_MIN))
+            return MCG_EINVAL;
+    return MCG_OK;
+}
+
+/* The normalised problem: apexes centred on their centroid m and scaled by
+ * their RMS distance L from it (X = m + L x), the search ball of radius
+ * max_radius. Returns 1 when all apexes coincide (to rounding): a
+ * homogeneous problem whose optimum is a ray from the apex, solved in a
+ * unit frame. */
+static int normalise(cone_ctx *k, int n, const double *apex, const double *axis,
+                     double max_radius)
+{
+    double L2 = 0.0;
+    int i, j, coincident = 0;
+    k->n = n;
+    k->idx = NULL;
+    k->cache = NULL;
+    k->apex = apex;
+    k->axis = axis;
+    k->m[0] = k->m[1] = k->m[2] = 0.0;
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < 3; ++j)
+            k->m[j] += apex[3 * i + j];
+    for (j = 0; j < 3; ++j)
+        k->m[j] /= n;
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < 3; ++j) {
+            double dd = apex[3 * i + j] - k->m[j];
+            L2 += dd * dd;
+        }
+    k->L = sqrt(L2 / n);
+    if (!(k->L > 1e-13 * sqrt(dot3(k->m, k->m))) || !(k->L > 1e-300)) {
+        coincident = 1;
+        k->L = 1.0;
+    }
+    k->invL = 1.0 / k->L;
+    k->R = max_radius;
+    return coincident;
+}
+
+/* 1 if every axis is parallel (same sense) to the first: then gamma* = 0
+ * with overlapping rays is not unique (flagged). */
+static int axes_parallel(const cone_ctx *k)
+{
+    double c0[3], v0[3], c[3], v[3];
+    int i;
+    cone_get(k, 0, c0, v0);
+    for (i = 1; i < k->n; ++i) {
+        double cr[3];
+        cone_get(k, i, c, v);
+        cross3(v0, v, cr);
+        if (dot3(cr, cr) > 1e-24 || dot3(v0, v) < 0.0)
+            return 0;
+    }
+    return 1;
+}
+
+/* The start of the bisection: the better of the centroid and the
+ * least-squares point nearest to the lines (for coincident apexes, the unit
+ * mean axis: the common apex is trivially "inside" every cone). Returns its
+ * largest angle. */
+static double initial_point(const cone_ctx *k, int coincident, double xbest[3])
+{
+    double x[3], fbest;
+    int i;
+    x[0] = x[1] = x[2] = 0.0;
+    xbest[0] = xbest[1] = xbest[2] = 0.0;
+    fbest = max_angle(k, xbest, NULL);
+    if (coincident) {
+        double s[3] = {0, 0, 0}, c[3], v[3], r;
+        for (i = 0; i < k->n; ++i) {
+            cone_get(k, i, c, v);
+            s[0] += v[0]; s[1] += v[1]; s[2] += v[2];
+        }
+        r = sqrt(dot3(s, s));
+        if (r > 1e-12 * k->n) {
+            xbest[0] = s[0] / r; xbest[1] = s[1] / r; xbest[2] = s[2] / r;
+        } else {
+            cone_get(k, 0, c, v);
+            memcpy(xbest, v, 3 * sizeof(double));
+        }
+        fbest = max_angle(k, xbest, NULL);
+    } else if (nearest_point(k, x)) {
+        double f;
+        clamp_ball(k, x, 0.5);
+        f = max_angle(k, x, NULL);
+        if (f < fbest) {
+            fbest = f;
+            memcpy(xbest, x, sizeof(x));
+        }
+    }
+    return fbest;
+}
+
+/* The bisection of ch. 9.4 (eq. 9.3) in active-set rounds: solve a subset
+ * (a relaxation: its optimum is a certified lower bound of gamma*), stop
+ * when its solution satisfies every cone, else add the most violated cones;
+ * past MAX_SUB cones the full set is solved. *ks: the last (sub)problem
+ * (its subset in sub, its cache in cache); *lo the certified lower bound,
+ * *conv whether the last bisection converged. Returns the status. */
+static int active_set_rounds(const cone_ctx *k, const mcg_cone_options *o, cone_ctx *ks,
+                             int *sub, double *cache, double xbest[3], double *fbest,
+                             double *lo, int *conv, mcg_cone_result *res)
+{
+    double x[3];
+    int ns = 0, round, status = MCG_OK;
+    *lo = 0.0;
+    *ks = *k;
+    ks->idx = sub;
+    ks->n = 0;
+    if (k->n <= 2 * ADD_PER_ROUND)
+        *ks = *k; /* small problems: the full set at once */
+    else
+        ns = 0, add_violators(k, xbest, -1.0, sub, &ns), ks->n = ns;
+    for (round = 0; round <= MAX_SUB; ++round) {
+        double fs, ff, tol;
+        ks->cache = NULL;
+        if (ks->n <= MAX_SUB)
+            fill_cache(ks, cache);
+        memcpy(x, xbest, sizeof(x));
+        status = solve_sub(ks, o, lo, x, &fs, &res->iterations,
+                           &res->newton_steps, conv);
+        if (status != MCG_OK)
+            break;
+        ff = ks->idx ? max_angle(k, x, NULL) : fs;
+        tol = fmax(o->abs_tolerance, o->tolerance * fs);
+        if (ff < *fbest || ks->idx == NULL) {
+            *fbest = ff;
+            memcpy(xbest, x, sizeof(x));
+        }
+        if (ks->idx == NULL || ff <= fs + tol)
+            break;
+        if (!*conv)
+            break; /* out of iterations */
+        if (ns + ADD_PER_ROUND > MAX_SUB) {
+            *ks = *k;
+            continue;
+        }
+        add_violators(k, x, fs + tol, sub, &ns);
+        ks->n = ns;
+    }
+    return status;
+}
+
+/* The result in world coordinates (X = m + L x), the active cones (angle
+ * within the active tolerance of gamma) and the flags. */
+static void report_result(const cone_ctx *k, const mcg_cone_options *o, int coincident,
+                          int all_parallel, double xbest[3], double fbest, double lo,
+                          mcg_cone_result *res)
+{
+    double thr, c[3], v[3], w[3];
+    int i, j;
+    if (coincident) {
+        double r = sqrt(dot3(xbest, xbest));
+        if (r > 0.0)
+            for (j = 0; j < 3; ++j)
+                xbest[j] /= r;
+    }
+    for (j = 0; j < 3; ++j)
+        res->X[j] = k->m[j] + k->L * xbest[j];
+    res->gamma = fbest;
+    res->gamma_lower = fmin(lo, fbest);
+    thr = fbest - fmax(o->active_tolerance,
+                       10.0 * fmax(o->abs_tolerance, o->tolerance * fbest));
+    for (i = 0; i < k->n; ++i) {
+        cone_get(k, i, c, v);
+        w[0] = xbest[0] - c[0]; w[1] = xbest[1] - c[1];
+        w[2] = xbest[2] - c[2];
+        if (angle_of(w, v) >= thr) {
+            if (res->n_active < 8)
+                res->active[res->n_active] = i;
+            ++res->n_active;
+        }
+    }
+    if (coincident)
+        res->flags |= MCG_CONE_COINCIDENT_APEXES | MCG_CONE_NONUNIQUE;
+    else if (sqrt(dot3(xbest, xbest)) > 0.5 * k->R)
+        res->flags |= MCG_CONE_AT_INFINITY | MCG_CONE_NONUNIQUE;
+    if (all_parallel && fbest <= 100.0 * fmax(o->abs_tolerance, 1e-12))
+        res->flags |= MCG_CONE_NONUNIQUE;
+    if (!res->converged)
+        res->flags |= MCG_CONE_NOT_CONVERGED;
+}
+
 int mcg_cone_linf(int n, const double *apex, const double *axis,
                   const mcg_cone_options *opt, mcg_cone_result *res)
 {
     mcg_cone_options o;
     cone_ctx k, ks;
-    double lo, fbest, xbest[3], x[3], L2 = 0.0;
-    int i, j, status = MCG_OK, coincident = 0, all_parallel = 1, conv = 0;
-    int sub[MAX_SUB], ns = 0, round;
+    double lo, fbest, xbest[3];
+    int j, status, coincident, all_parallel, conv = 0;
+    int sub[MAX_SUB];
     double cache[6 * MAX_SUB];
 
     if (!res)
@@ -620,55 +817,11 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
         o = *opt;
     else
         mcg_cone_default_options(&o);
-    if (!options_ok(&o))
-        return MCG_EINVAL;
-    for (i = 0; i < 3 * n; ++i)
-        if (!isfinite(apex[i]) || !isfinite(axis[i]) ||
-            fabs(apex[i]) > COORD_MAX || fabs(axis[i]) > COORD_MAX)
-            return MCG_EINVAL;
-    for (i = 0; i < n; ++i)
-        if (!(dot3(axis + 3 * i, axis + 3 * i) > AXIS2_MIN))
-            return MCG_EINVAL;
-
-    /* normalisation */
-    k.n = n;
-    k.idx = NULL;
-    k.cache = NULL;
-    k.apex = apex;
-    k.axis = axis;
-    k.m[0] = k.m[1] = k.m[2] = 0.0;
-    for (i = 0; i < n; ++i)
-        for (j = 0; j < 3; ++j)
-            k.m[j] += apex[3 * i + j];
-    for (j = 0; j < 3; ++j)
-        k.m[j] /= n;
-    for (i = 0; i < n; ++i)
-        for (j = 0; j < 3; ++j) {
-            double dd = apex[3 * i + j] - k.m[j];
-            L2 += dd * dd;
-        }
-    k.L = sqrt(L2 / n);
-    if (!(k.L > 1e-13 * sqrt(dot3(k.m, k.m))) || !(k.L > 1e-300)) {
-        /* all apexes coincide (to rounding): a homogeneous problem, the
-         * optimum is a ray from the apex; solved in a unit frame */
-        coincident = 1;
-        k.L = 1.0;
-    }
-    k.invL = 1.0 / k.L;
-    k.R = o.max_radius;
-    {
-        double c0[3], v0[3], c[3], v[3];
-        cone_get(&k, 0, c0, v0);
-        for (i = 1; i < n && all_parallel; ++i) {
-            double cr[3];
-            cone_get(&k, i, c, v);
-            cr[0] = v0[1] * v[2] - v0[2] * v[1];
-            cr[1] = v0[2] * v[0] - v0[0] * v[2];
-            cr[2] = v0[0] * v[1] - v0[1] * v[0];
-            if (dot3(cr, cr) > 1e-24 || dot3(v0, v) < 0.0)
-                all_parallel = 0;
-        }
-    }
+    status = check_inputs(n, apex, axis, &o);
+    if (status != MCG_OK)
+        return status;
+    coincident = normalise(&k, n, apex, axis, o.max_radius);
+    all_parallel = axes_parallel(&k);
 
     if (n == 1) {
         /* any point of the ray is optimal (gamma* = 0): apex + unit axis */
@@ -685,116 +838,13 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
         return MCG_OK;
     }
 
-    /* initial point: the better of the centroid and the least-squares point
-     * nearest to the lines */
-    x[0] = x[1] = x[2] = 0.0;
-    xbest[0] = xbest[1] = xbest[2] = 0.0;
-    fbest = max_angle(&k, xbest, NULL);
-    if (coincident) {
-        /* the common apex is trivially "inside" every cone: start on the
-         * unit sphere in the mean axis direction instead */
-        double s[3] = {0, 0, 0}, c[3], v[3], r;
-        for (i = 0; i < n; ++i) {
-            cone_get(&k, i, c, v);
-            s[0] += v[0]; s[1] += v[1]; s[2] += v[2];
-        }
-        r = sqrt(dot3(s, s));
-        if (r > 1e-12 * n) {
-            xbest[0] = s[0] / r; xbest[1] = s[1] / r; xbest[2] = s[2] / r;
-        } else {
-            cone_get(&k, 0, c, v);
-            memcpy(xbest, v, sizeof(xbest));
-        }
-        fbest = max_angle(&k, xbest, NULL);
-    } else if (nearest_point(&k, x)) {
-        double f;
-        clamp_ball(&k, x, 0.5);
-        f = max_angle(&k, x, NULL);
-        if (f < fbest) {
-            fbest = f;
-            memcpy(xbest, x, sizeof(x));
-        }
-    }
-
-    /* active-set rounds: solve a subset (a relaxation: its optimum is a
-     * certified lower bound of gamma*), stop when its solution satisfies
-     * every cone, else add the most violated cones; past MAX_SUB cones the
-     * full set is solved. */
-    lo = 0.0;
-    ks = k;
-    ks.idx = sub;
-    ks.n = 0;
-    if (n <= 2 * ADD_PER_ROUND)
-        ks = k; /* small problems: the full set at once */
-    else
-        ns = 0, add_violators(&k, xbest, -1.0, sub, &ns), ks.n = ns;
-    for (round = 0; round <= MAX_SUB; ++round) {
-        double fs, ff, tol;
-        ks.cache = NULL;
-        if (ks.n <= MAX_SUB)
-            fill_cache(&ks, cache);
-        memcpy(x, xbest, sizeof(x));
-        status = solve_sub(&ks, &o, &lo, x, &fs, &res->iterations,
-                           &res->newton_steps, &conv);
-        if (status != MCG_OK)
-            break;
-        ff = ks.idx ? max_angle(&k, x, NULL) : fs;
-        tol = fmax(o.abs_tolerance, o.tolerance * fs);
-        if (ff < fbest || ks.idx == NULL) {
-            fbest = ff;
-            memcpy(xbest, x, sizeof(x));
-        }
-        if (ks.idx == NULL || ff <= fs + tol)
-            break;
-        if (!conv)
-            break; /* out of iterations */
-        if (ns + ADD_PER_ROUND > MAX_SUB) {
-            ks = k;
-            continue;
-        }
-        add_violators(&k, x, fs + tol, sub, &ns);
-        ks.n = ns;
-    }
+    fbest = initial_point(&k, coincident, xbest);
+    status = active_set_rounds(&k, &o, &ks, sub, cache, xbest, &fbest, &lo, &conv, res);
     if (status == MCG_OK && fbest > 0.0)
         polish(&ks, &k, &o, xbest, &fbest, &res->newton_steps);
     res->converged = status == MCG_OK && conv;
     if (status == MCG_ENUMERIC)
         return status;
-
-    /* result */
-    if (coincident) {
-        double r = sqrt(dot3(xbest, xbest));
-        if (r > 0.0)
-            for (j = 0; j < 3; ++j)
-                xbest[j] /= r;
-    }
-    for (j = 0; j < 3; ++j)
-        res->X[j] = k.m[j] + k.L * xbest[j];
-    res->gamma = fbest;
-    res->gamma_lower = fmin(lo, fbest);
-    {
-        double thr = fbest - fmax(o.active_tolerance,
-                                  10.0 * fmax(o.abs_tolerance,
-                                              o.tolerance * fbest));
-        double c[3], v[3], w[3];
-        for (i = 0; i < n; ++i) {
-            cone_get(&k, i, c, v);
-            w[0] = xbest[0] - c[0]; w[1] = xbest[1] - c[1];
-            w[2] = xbest[2] - c[2];
-            if (angle_of(w, v) >= thr) {
-                if (res->n_active < 8)
-                    res->active[res->n_active] = i;
-                ++res->n_active;
-            }
-        }
-    }
-    if (coincident)
-        res->flags |= MCG_CONE_COINCIDENT_APEXES | MCG_CONE_NONUNIQUE;
-    else if (sqrt(dot3(xbest, xbest)) > 0.5 * k.R)
-        res->flags |= MCG_CONE_AT_INFINITY | MCG_CONE_NONUNIQUE;
-    if (all_parallel && fbest <= 100.0 * fmax(o.abs_tolerance, 1e-12))
-        res->flags |= MCG_CONE_NONUNIQUE;
-    if (!res->converged)
-        res->flags |= MCG_CONE_NOT_CONVERGED;
+    report_result(&k, &o, coincident, all_parallel, xbest, fbest, lo, res);
     return status;
 }

@@ -2,7 +2,8 @@
  * internal.h -- helpers shared by the kernels of libmcgeom (not installed,
  * not part of the public API): the size limits every entry point enforces,
  * overflow-checked size arithmetic for workspace sizes, and the finiteness
- * test of the inputs.
+ * test of the inputs. The 3-vector / 3 x 3 / SO(3) helpers are in so3.h,
+ * included here.
  */
 #ifndef MCGEOM_INTERNAL_H
 #define MCGEOM_INTERNAL_H
@@ -10,6 +11,8 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+
+#include "so3.h" /* dot3, cross3, mat_vec, mul33, det33, skew3, is_rotation, ... */
 
 /* Size limits. They keep every work-size computation far from overflow and
  * reject absurd sizes (usually a mix-up of arguments) up front. */
@@ -40,20 +43,6 @@ static inline size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
 static inline size_t min_sz(size_t a, size_t b) { return a < b ? a : b; }
 
 /* 1 if none of the n values is NaN or +-inf */
-/* 3-vector dot and cross products, shared by the kernels (static inline:
- * no exported symbols; each file used to carry its own copy) */
-static inline double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void cross3(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static inline int all_finite(const double *x, size_t n)
 {
     size_t i;
@@ -61,6 +50,26 @@ static inline int all_finite(const double *x, size_t n)
         if (!isfinite(x[i]))
             return 0;
     return 1;
+}
+
+/* |y| without overflow or harmful underflow: the entries are divided by
+ * the largest magnitude first (returned as is when 0 or not finite). Shared
+ * by the least-squares residuals of cls.c and the rotation conversions of
+ * linalg.c. */
+static inline double norm_scaled(const double *y, size_t n)
+{
+    double mx = 0.0, acc = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (fabs(y[i]) > mx)
+            mx = fabs(y[i]);
+    if (mx == 0.0 || !isfinite(mx))
+        return mx;
+    for (i = 0; i < n; ++i) {
+        double t = y[i] / mx;
+        acc += t * t;
+    }
+    return mx * sqrt(acc);
 }
 
 /* Centroid c of the 2n ray origins o1, o2 (n x 3 each, n >= 1) and the RMS

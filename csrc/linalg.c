@@ -52,8 +52,8 @@
  * two columns count as orthogonal when |g_i . g_j| <= tol |g_i| |g_j|. A few
  * ulps above the rounding noise of a dot product so that sweeps terminate. */
 #define JACOBI_TOL_FACTOR 4.0
-/* Deviation from orthogonality (max |R R^T - I|) accepted for a rotation. */
-#define ROT_TOL 1e-6
+/* (the deviation from orthogonality accepted for a rotation: SO3_ROT_TOL,
+ * so3.h, shared with refine.c) */
 
 /* ------------------------------------------------------------- helpers */
 
@@ -711,13 +711,126 @@ static int scaled_symmetric_part(size_t n, double *a)
     return e;
 }
 
-int mcg_sym_eig(int n, double *a, double *w, double *v)
+/* One round of the tournament ordering (see jacobi_sweeps): the np / 2
+ * disjoint pairs (p, q) of round `round`, each rotation annihilating a_pq
+ * of the upper triangle of a (nn x nn) and accumulated into the rows of v
+ * (V^T). The rotation parameters of a pair depend only on a_pp, a_qq,
+ * a_pq, which the other rotations of the same round do not touch, so they
+ * are computed in chunks of EIG_CHUNK before being applied: the square
+ * roots and divisions of a chunk overlap instead of forming one long
+ * dependency chain. Results equal applying the rotations one by one. */
+static void jacobi_round(size_t nn, size_t np, size_t round, double thresh, double *a,
+                         double *v)
 {
-    size_t nn, np, i, j, p, q, r;
     size_t rp_[EIG_CHUNK], rq_[EIG_CHUNK];
     double rc_[EIG_CHUNK], rs_[EIG_CHUNK], rt_[EIG_CHUNK];
-    int sweep, e, converged = 0;
-    double off;
+    size_t pi = 0, half = np / 2, p, q, r;
+    while (pi < half) {
+        size_t cnt = 0, jj;
+        /* gather: parameters of up to EIG_CHUNK rotations */
+        for (; pi < half && cnt < EIG_CHUNK; ++pi) {
+            size_t x0 = (pi == 0) ? 0 : 1 + (pi - 1 + round) % (np - 1);
+            size_t y0 = 1 + (np - 2 - pi + round) % (np - 1);
+            double apq, g, app, aqq, d, h, den, t, c;
+            if (x0 >= nn || y0 >= nn)
+                continue;
+            p = x0 < y0 ? x0 : y0;
+            q = x0 < y0 ? y0 : x0;
+            apq = a[p * nn + q];
+            g = fabs(apq);
+            if (g == 0.0)
+                continue;
+            app = a[p * nn + p];
+            aqq = a[q * nn + q];
+            /* Relative criterion (Demmel & Veselic): zeroing a_pq
+             * moves the eigenvalues by at most eps sqrt|a_pp a_qq|,
+             * which keeps the small eigenvalues of graded PSD
+             * matrices (A^T A near a null space) accurate, and
+             * guarantees termination. Squared to save a square
+             * root; g^2 underflows only for g < 1e-154 max|a|. */
+            if (g * g <= DBL_EPSILON * DBL_EPSILON * fabs(app * aqq)) {
+                a[p * nn + q] = 0.0;
+                continue;
+            }
+            if (g <= thresh)
+                continue;
+            /* t = tan of the smaller angle that annihilates a_pq
+             * (Rutishauser), as 2 a_pq sgn(d) / (|d| + h) with
+             * d = a_qq - a_pp, h = sqrt(d^2 + 4 a_pq^2); no overflow
+             * since |a_ij| <= n after scaling */
+            d = aqq - app;
+            h = sqrt(d * d + 4.0 * apq * apq);
+            den = d + copysign(h, d);
+            t = (den != 0.0) ? 2.0 * apq / den : copysign(1.0, apq);
+            c = 1.0 / sqrt(1.0 + t * t);
+            rp_[cnt] = p;
+            rq_[cnt] = q;
+            rc_[cnt] = c;
+            rs_[cnt] = t * c;
+            rt_[cnt] = t * apq;
+            ++cnt;
+        }
+        /* apply */
+        for (jj = 0; jj < cnt; ++jj) {
+            double c = rc_[jj], s = rs_[jj];
+            p = rp_[jj];
+            q = rq_[jj];
+            a[p * nn + p] -= rt_[jj];
+            a[q * nn + q] += rt_[jj];
+            a[p * nn + q] = 0.0;
+#define MCG_JROT(x, y)                                                        \
+    do {                                                                      \
+        double xx_ = (x), yy_ = (y);                                          \
+        (x) = c * xx_ - s * yy_;                                              \
+        (y) = s * xx_ + c * yy_;                                              \
+    } while (0)
+            for (r = 0; r < p; ++r)
+                MCG_JROT(a[r * nn + p], a[r * nn + q]);
+            for (r = p + 1; r < q; ++r)
+                MCG_JROT(a[p * nn + r], a[r * nn + q]);
+            for (r = q + 1; r < nn; ++r)
+                MCG_JROT(a[p * nn + r], a[q * nn + r]);
+            for (r = 0; r < nn; ++r)
+                MCG_JROT(v[p * nn + r], v[q * nn + r]);
+#undef MCG_JROT
+        }
+    }
+}
+
+/* Cyclic Jacobi on the upper triangle of a (nn x nn), rotations accumulated
+ * into v (V^T, rows = eigenvectors, so that they touch contiguous memory),
+ * in the round-robin ("tournament") ordering: each sweep is np - 1 rounds
+ * of np / 2 disjoint pairs (np = n rounded up to even, pairs with the dummy
+ * index n skipped); chunking the rounds removed the dependency chain that
+ * dominated the run time of the row-cyclic order at n = 9 and 18. Returns
+ * 1 once the off-diagonal part is exactly 0, 0 after MAX_SWEEPS. */
+static int jacobi_sweeps(size_t nn, double *a, double *v)
+{
+    size_t np = nn + (nn & 1), p, q, round;
+    int sweep;
+    for (sweep = 0; sweep <= MAX_SWEEPS; ++sweep) {
+        double thresh, off = 0.0;
+        for (p = 0; p + 1 < nn; ++p)
+            for (q = p + 1; q < nn; ++q)
+                off += fabs(a[p * nn + q]);
+        if (off == 0.0)
+            return 1;
+        if (sweep == MAX_SWEEPS)
+            break;
+        /* threshold Jacobi (Rutishauser): during the first sweeps skip the
+         * rotations that would gain little; saves work on dense matrices
+         * without changing the (quadratic) final convergence */
+        thresh = (sweep < 3) ? 0.2 * off / (double)(nn * nn) : 0.0;
+        for (round = 0; round + 1 < np; ++round)
+            jacobi_round(nn, np, round, thresh, a, v);
+    }
+    return 0;
+}
+
+int mcg_sym_eig(int n, double *a, double *w, double *v)
+{
+    size_t nn, i, j;
+    int e;
 
     if (n < 1 || (size_t)n > MAX_COLS)
         return MCG_EINVAL;
@@ -732,114 +845,11 @@ int mcg_sym_eig(int n, double *a, double *w, double *v)
      * Only the upper triangle is used from here on: each rotation then
      * updates n - 2 pairs of entries instead of mirroring 2 (n - 2). */
     e = scaled_symmetric_part(nn, a);
-    /* v holds V^T during the iteration (rows = eigenvectors) so that the
-     * rotations touch contiguous memory; transposed at the end. */
+    /* v holds V^T during the iteration; transposed at the end. */
     memset(v, 0, nn * nn * sizeof(double));
     for (i = 0; i < nn; ++i)
         v[i * nn + i] = 1.0;
-
-    /* Cyclic Jacobi in the round-robin ("tournament") ordering: each sweep
-     * is np - 1 rounds of np / 2 disjoint pairs (np = n rounded up to even,
-     * pairs with the dummy index n skipped). The rotation parameters of a
-     * pair depend only on a_pp, a_qq, a_pq, which the other rotations of the
-     * same round do not touch, so they are computed in chunks before being
-     * applied: the square roots and divisions of a chunk overlap instead of
-     * forming one long dependency chain, which dominated the run time of the
-     * row-cyclic order at n = 9 and 18. Results equal applying the rotations
-     * one by one. */
-    np = nn + (nn & 1);
-    for (sweep = 0; sweep <= MAX_SWEEPS; ++sweep) {
-        double thresh;
-        size_t round;
-        off = 0.0;
-        for (p = 0; p + 1 < nn; ++p)
-            for (q = p + 1; q < nn; ++q)
-                off += fabs(a[p * nn + q]);
-        if (off == 0.0) {
-            converged = 1;
-            break;
-        }
-        if (sweep == MAX_SWEEPS)
-            break;
-        /* threshold Jacobi (Rutishauser): during the first sweeps skip the
-         * rotations that would gain little; saves work on dense matrices
-         * without changing the (quadratic) final convergence */
-        thresh = (sweep < 3) ? 0.2 * off / (double)(nn * nn) : 0.0;
-        for (round = 0; round + 1 < np; ++round) {
-            size_t pi = 0, half = np / 2;
-            while (pi < half) {
-                size_t cnt = 0, jj;
-                /* gather: parameters of up to EIG_CHUNK rotations */
-                for (; pi < half && cnt < EIG_CHUNK; ++pi) {
-                    size_t x0 = (pi == 0) ? 0 : 1 + (pi - 1 + round) % (np - 1);
-                    size_t y0 = 1 + (np - 2 - pi + round) % (np - 1);
-                    double apq, g, app, aqq, d, h, den, t, c;
-                    if (x0 >= nn || y0 >= nn)
-                        continue;
-                    p = x0 < y0 ? x0 : y0;
-                    q = x0 < y0 ? y0 : x0;
-                    apq = a[p * nn + q];
-                    g = fabs(apq);
-                    if (g == 0.0)
-                        continue;
-                    app = a[p * nn + p];
-                    aqq = a[q * nn + q];
-                    /* Relative criterion (Demmel & Veselic): zeroing a_pq
-                     * moves the eigenvalues by at most eps sqrt|a_pp a_qq|,
-                     * which keeps the small eigenvalues of graded PSD
-                     * matrices (A^T A near a null space) accurate, and
-                     * guarantees termination. Squared to save a square
-                     * root; g^2 underflows only for g < 1e-154 max|a|. */
-                    if (g * g <= DBL_EPSILON * DBL_EPSILON * fabs(app * aqq)) {
-                        a[p * nn + q] = 0.0;
-                        continue;
-                    }
-                    if (g <= thresh)
-                        continue;
-                    /* t = tan of the smaller angle that annihilates a_pq
-                     * (Rutishauser), as 2 a_pq sgn(d) / (|d| + h) with
-                     * d = a_qq - a_pp, h = sqrt(d^2 + 4 a_pq^2); no overflow
-                     * since |a_ij| <= n after scaling */
-                    d = aqq - app;
-                    h = sqrt(d * d + 4.0 * apq * apq);
-                    den = d + copysign(h, d);
-                    t = (den != 0.0) ? 2.0 * apq / den : copysign(1.0, apq);
-                    c = 1.0 / sqrt(1.0 + t * t);
-                    rp_[cnt] = p;
-                    rq_[cnt] = q;
-                    rc_[cnt] = c;
-                    rs_[cnt] = t * c;
-                    rt_[cnt] = t * apq;
-                    ++cnt;
-                }
-                /* apply */
-                for (jj = 0; jj < cnt; ++jj) {
-                    double c = rc_[jj], s = rs_[jj];
-                    p = rp_[jj];
-                    q = rq_[jj];
-                    a[p * nn + p] -= rt_[jj];
-                    a[q * nn + q] += rt_[jj];
-                    a[p * nn + q] = 0.0;
-#define MCG_JROT(x, y)                                                        \
-    do {                                                                      \
-        double xx_ = (x), yy_ = (y);                                          \
-        (x) = c * xx_ - s * yy_;                                              \
-        (y) = s * xx_ + c * yy_;                                              \
-    } while (0)
-                    for (r = 0; r < p; ++r)
-                        MCG_JROT(a[r * nn + p], a[r * nn + q]);
-                    for (r = p + 1; r < q; ++r)
-                        MCG_JROT(a[p * nn + r], a[r * nn + q]);
-                    for (r = q + 1; r < nn; ++r)
-                        MCG_JROT(a[p * nn + r], a[q * nn + r]);
-                    for (r = 0; r < nn; ++r)
-                        MCG_JROT(v[p * nn + r], v[q * nn + r]);
-#undef MCG_JROT
-                }
-            }
-        }
-    }
-    if (!converged)
+    if (!jacobi_sweeps(nn, a, v))
         return MCG_ENUMERIC;
 
     for (i = 0; i < nn; ++i)
@@ -1100,47 +1110,13 @@ int mcg_spd_solve(int n, const double *a, const double *b, double *x)
 
 /* ----------------------------------------------------------- rotations */
 
-/* |x| of a 3- or 4-vector without overflow or underflow */
-static double norm_small(const double *x, size_t n)
-{
-    double mx = max_abs(x, n), acc = 0.0;
-    size_t i;
-    if (mx == 0.0)
-        return 0.0;
-    for (i = 0; i < n; ++i) {
-        double t = x[i] / mx;
-        acc += t * t;
-    }
-    return mx * sqrt(acc);
-}
-
-/* Is r a rotation to ROT_TOL? Guards the conversions below, which would
- * otherwise return a plausible-looking answer for any 3 x 3 matrix. */
-static int is_rotation(const double r[9])
-{
-    size_t i, j, k;
-    double det;
-    for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j) {
-            double acc = 0.0;
-            for (k = 0; k < 3; ++k)
-                acc += r[i * 3 + k] * r[j * 3 + k];
-            if (fabs(acc - (i == j ? 1.0 : 0.0)) > ROT_TOL)
-                return 0;
-        }
-    det = r[0] * (r[4] * r[8] - r[5] * r[7]) -
-          r[1] * (r[3] * r[8] - r[5] * r[6]) +
-          r[2] * (r[3] * r[7] - r[4] * r[6]);
-    return det > 0.0;
-}
-
 int mcg_rot_from_angle_axis(const double w[3], double r[9])
 {
     double theta, k[3], c, s, h;
     size_t i, j;
     if (w == NULL || r == NULL || !all_finite(w, 3))
         return MCG_EINVAL;
-    theta = norm_small(w, 3);
+    theta = norm_scaled(w, 3);
     if (!isfinite(theta))
         return MCG_EINVAL; /* |w| > DBL_MAX: the angle overflows (found by fuzz_linalg) */
     if (theta == 0.0) {
@@ -1195,7 +1171,7 @@ static void quat_of_rotation(const double r[9], double q[4])
         q[2] = r[5] + r[7];
         q[3] = 1.0 + 2.0 * r[8] - tr;
     }
-    nq = norm_small(q, 4); /* >= 1 for a rotation: the chosen entry is */
+    nq = norm_scaled(q, 4); /* >= 1 for a rotation: the chosen entry is */
     if (q[0] < 0.0)
         nq = -nq;
     for (i = 0; i < 4; ++i)
@@ -1213,7 +1189,7 @@ int mcg_angle_axis_from_rot(const double r[9], double w[3])
     quat_of_rotation(r, q);
     /* angle = 2 atan2(|v|, q0) is well conditioned everywhere (unlike acos
      * near 0 or asin near pi); q0 >= 0 gives angle in [0, pi] */
-    nv = norm_small(q + 1, 3);
+    nv = norm_scaled(q + 1, 3);
     if (nv == 0.0) {
         w[0] = w[1] = w[2] = 0.0;
         return MCG_OK;
@@ -1266,13 +1242,6 @@ int mcg_quat_from_rot(const double r[9], double q[4])
     return MCG_OK;
 }
 
-static double det3(const double a[9])
-{
-    return a[0] * (a[4] * a[8] - a[5] * a[7]) -
-           a[1] * (a[3] * a[8] - a[5] * a[6]) +
-           a[2] * (a[3] * a[7] - a[4] * a[6]);
-}
-
 int mcg_project_so3(const double m[9], double r[9])
 {
     double u[9], s[3], v[9], work[64], d;
@@ -1289,7 +1258,7 @@ int mcg_project_so3(const double m[9], double r[9])
      * unique; with rank <= 1 a whole family of rotations is equally near. */
     if (!(s[1] > 4.0 * DBL_EPSILON * s[0]))
         return MCG_EDEGENERATE;
-    d = (det3(u) * det3(v) < 0.0) ? -1.0 : 1.0;
+    d = (det33(u) * det33(v) < 0.0) ? -1.0 : 1.0;
     for (i = 0; i < 3; ++i)
         for (j = 0; j < 3; ++j)
             r[i * 3 + j] = u[i * 3 + 0] * v[j * 3 + 0] +

@@ -31,39 +31,6 @@
 
 /* ---------------------------------------------------------- small helpers */
 
-static void mul33(const double *a, const double *b, double *c)
-{
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] +
-                           a[3 * i + 2] * b[6 + j];
-}
-
-static void mul33_abt(const double *a, const double *b, double *c)
-{   /* c = a b^T */
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            c[3 * i + j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] +
-                           a[3 * i + 2] * b[3 * j + 2];
-}
-
-static double det33(const double *a)
-{
-    return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-           a[2] * (a[3] * a[7] - a[4] * a[6]);
-}
-
-static void skew_times(const double w[3], const double *r, double *out)
-{   /* out = [w]x r */
-    double s[9];
-    s[0] = 0.0;   s[1] = -w[2]; s[2] = w[1];
-    s[3] = w[2];  s[4] = 0.0;   s[5] = -w[0];
-    s[6] = -w[1]; s[7] = w[0];  s[8] = 0.0;
-    mul33(s, r, out);
-}
-
 static void matvec(int n, const double *m, const double *x, double *y)
 {
     int i, j;
@@ -771,10 +738,261 @@ static int rotation_candidates(const double e[9], const double r[9], int use_r,
     return MCG_OK;
 }
 
+/* The rays of a problem with their normalisation (Algorithm 2 step 1):
+ * what the phases below need besides the Gram matrix. */
+typedef struct {
+    int n;
+    const double *o1, *d1, *o2, *d2;
+} rayset;
+
+/* The motion being estimated, in the normalised frame: R, t, the algebraic
+ * cost x^T M x at them, and unit_mode: 1 when |t| is not determined (only
+ * its direction is solved for, ch. 7.3.2). */
+typedef struct {
+    double r[9], t[3], cost;
+    int unit_mode;
+} motion;
+
+/* A translation in the normalised frame (t' = s (t - o + R o)) back to the
+ * rig frame: t = t' / s + o - R o (Algorithm 2 step 1 undone). */
+static void to_rig_frame(const mcg_linear17_result *res, const double r[9],
+                         const double tn[3], double t[3])
+{
+    double ro[3];
+    int i;
+    matvec(3, r, res->norm_origin, ro);
+    for (i = 0; i < 3; i++)
+        t[i] = tn[i] / res->norm_scale + res->norm_origin[i] - ro[i];
+}
+
+/* The translation with scale of each rotation candidate (eq. 8.15), the
+ * candidate of least algebraic cost kept. For a critical motion (ch. 7.3.2)
+ * or a central camera |t| is not determined: then (unit mode) the rotation
+ * is chosen among the equally good candidates, and the sign of the unit
+ * direction, by cheirality. */
+static int choose_candidate(const double *m, const rayset *rays,
+                            const mcg_linear17_options *o, int gc, double tiny,
+                            double cand[4][9], int ncand, mcg_linear17_result *res,
+                            motion *mo)
+{
+    double bestcost = HUGE_VAL;
+    int k, i, best = -1;
+    tsolve ts;
+    res->n_candidates = ncand;
+    mo->unit_mode = 0;
+    for (k = 0; k < ncand; k++) {
+        if (solve_t(m, cand[k], 0, NULL, 0, &ts) != MCG_OK)
+            return MCG_ENUMERIC;
+        res->candidate_cost[k] = ts.cost;
+        if (ts.cost < bestcost) {
+            bestcost = ts.cost;
+            best = k;
+        }
+    }
+    memcpy(mo->r, cand[best], sizeof mo->r);
+    if (solve_t(m, mo->r, 0, NULL, 1, &ts) != MCG_OK)
+        return MCG_ENUMERIC;
+    memcpy(mo->t, ts.t, sizeof mo->t);
+    mo->cost = ts.cost;
+    if (gc == MCG_GC_CENTRAL || ts.cond < o->min_scale_conditioning) {
+        /* critical motion (ch. 7.3.2) or a central camera: |t| is not
+         * determined. (A central camera has g = 0 and c0 = 0, so the
+         * free solve returns t = 0 for every candidate and cannot tell
+         * them apart; with noise its H is well conditioned, so cond
+         * alone does not flag it.) Choose the rotation among equally
+         * good candidates and the sign of the direction by cheirality,
+         * in the normalised frame. */
+        int bestcnt = -1;
+        mo->unit_mode = 1;
+        for (k = 0; k < ncand; k++) {
+            int sg;
+            if (res->candidate_cost[k] > 10.0 * bestcost + tiny)
+                continue;
+            if (solve_t(m, cand[k], 1, NULL, 1, &ts) != MCG_OK)
+                return MCG_ENUMERIC;
+            for (sg = -1; sg <= 1; sg += 2) {
+                double tt[3], tr[3];
+                int cnt;
+                for (i = 0; i < 3; i++)
+                    tt[i] = sg * ts.t[i];
+                /* undo normalisation of the translation direction */
+                to_rig_frame(res, cand[k], tt, tr);
+                cnt = count_in_front(rays->n, rays->o1, rays->d1, rays->o2, rays->d2,
+                                     cand[k], tr);
+                if (cnt > bestcnt) {
+                    bestcnt = cnt;
+                    memcpy(mo->r, cand[k], sizeof mo->r);
+                    for (i = 0; i < 3; i++)
+                        mo->t[i] = sg * ts.t[i];
+                    mo->cost = ts.cost;
+                }
+            }
+        }
+    }
+    return MCG_OK;
+}
+
+/* The alternation of ch. 8.4.3 (R given t, then t given R) from the linear
+ * estimate, then (metric mode) the joint Gauss-Newton polish; a refinement
+ * that slid towards the trivial solution is discarded. */
+static int alternate_and_polish(const double *m, const rayset *rays,
+                                const mcg_linear17_options *o, double tiny,
+                                mcg_linear17_result *res, motion *mo)
+{
+    double rlin[9], tlin[3], costlin = mo->cost;
+    int k;
+    tsolve ts;
+    memcpy(rlin, mo->r, sizeof rlin);
+    memcpy(tlin, mo->t, sizeof tlin);
+    for (k = 0; k < o->max_iterations; k++) {
+        double prev = mo->cost;
+        if (mo->cost <= tiny) {
+            res->converged = 1;
+            break;
+        }
+        if (step_r(m, mo->r, mo->t, &mo->cost) != MCG_OK)
+            return MCG_ENUMERIC;
+        if (solve_t(m, mo->r, mo->unit_mode, mo->t, 0, &ts) != MCG_OK)
+            return MCG_ENUMERIC;
+        if (ts.cost <= mo->cost || !mo->unit_mode) {
+            memcpy(mo->t, ts.t, sizeof mo->t);
+            mo->cost = ts.cost;
+        }
+        res->iterations = k + 1;
+        if (prev - mo->cost <= o->tolerance * prev) {
+            res->converged = 1;
+            break;
+        }
+    }
+    if (!mo->unit_mode) {
+        raydata rd;
+        rd.n = rays->n;
+        rd.o1 = rays->o1; rd.d1 = rays->d1; rd.o2 = rays->o2; rd.d2 = rays->d2;
+        rd.origin = res->norm_origin;
+        rd.scale = res->norm_scale;
+        res->polish_steps = polish(m, mo->r, mo->t, &mo->cost, &rd);
+    }
+    /* Guard: for locally-central rigs (0, I) is in the null space of A,
+     * so the algebraic cost has a trivial zero at R = I, t = 0 and a
+     * descent from a poor start can slide towards it. The linear step
+     * minimised the cost with |E| = 1 fixed; a refinement that shrinks
+     * |t| (|E| = sqrt(2)|t|) by half or raises that normalised cost
+     * (f / |t|^2) fourfold went the wrong way: keep the linear estimate. */
+    if (!mo->unit_mode) {
+        double nl = dot3(tlin, tlin), nr = dot3(mo->t, mo->t);
+        if (!(nr >= 0.25 * nl) || !(mo->cost / nr <= 4.0 * costlin / nl)) {
+            memcpy(mo->r, rlin, sizeof rlin);
+            memcpy(mo->t, tlin, sizeof tlin);
+            mo->cost = costlin;
+            res->converged = 0;
+            res->refine_rejected = 1;
+        }
+    }
+    return MCG_OK;
+}
+
+/* Scale observability: the conditioning of the scale equation (eq. 8.15)
+ * and the relative std of |t|, the larger of the first-order std from the
+ * residual and the errors-in-variables bias bound (normalised frame). */
+static int scale_evidence(const double *m, const mcg_linear17_options *o, int n,
+                          const motion *mo, mcg_linear17_result *res)
+{
+    double nt = sqrt(dot3(mo->t, mo->t)), var = 0.0, sigma2;
+    int dof = n > 6 ? n - 6 : 1, i, k;
+    tsolve ts;
+    if (solve_t(m, mo->r, mo->unit_mode, mo->t, 1, &ts) != MCG_OK)
+        return MCG_ENUMERIC;
+    /* (t stays as refined: ts only supplies H for the evidence) */
+    res->scale_conditioning = ts.cond;
+    sigma2 = mo->cost / dof;
+    if (mo->unit_mode || !(nt > 0.0)) {
+        res->scale_rel_std = HUGE_VAL;
+    } else {
+        double u[3], hu[3], uhu, gu, rho2;
+        for (k = 0; k < 3; k++) {
+            double vk[3] = {ts.hv[k], ts.hv[3 + k], ts.hv[6 + k]};
+            double c = dot3(vk, mo->t) / nt;
+            if (ts.h[k] > 0.0)
+                var += c * c / ts.h[k];
+            else if (c != 0.0)
+                var = HUGE_VAL;
+        }
+        res->scale_rel_std = sqrt(sigma2 * var) / nt;
+        /* Errors-in-variables check: along u = t/|t|, eq. 8.15 reads
+         * (J u) s = b. Regressing b on J u (least squares, what we do)
+         * and J u on b bracket the true s when both are noisy; their
+         * ratio is rho^2 = (g.u)^2 / ((u^T H u) c0). 1 - rho^2 bounds the
+         * relative bias of |t| that the first-order std cannot see. */
+        for (i = 0; i < 3; i++)
+            u[i] = mo->t[i] / nt;
+        matvec(3, ts.hm, u, hu);
+        uhu = dot3(u, hu);
+        gu = dot3(ts.g, u);
+        rho2 = (uhu > 0.0 && ts.c0 > 0.0) ? gu * gu / (uhu * ts.c0) : 1.0;
+        if (rho2 > 1.0)
+            rho2 = 1.0;
+        if (1.0 - rho2 > res->scale_rel_std)
+            res->scale_rel_std = 1.0 - rho2;
+    }
+    res->scale_observable = !mo->unit_mode &&
+                            res->scale_conditioning >= o->min_scale_conditioning &&
+                            res->scale_rel_std <= o->max_scale_rel_std;
+    return MCG_OK;
+}
+
+/* An unobservable scale from the free solve (near-critical motion, e.g. a
+ * pure translation seen by intra-camera rays: e = t . (R d1 x d2) is
+ * nearly homogeneous in t) leaves the sign of t to the noise. Only the
+ * direction is reported then: choose its sign by cheirality, as unit
+ * mode does, at a length (100 in the normalised frame, where the origins
+ * spread over ~1) that dwarfs the rotation-induced part o - R o. */
+static void orient_by_cheirality(const rayset *rays, const mcg_linear17_result *res,
+                                 motion *mo)
+{
+    double nt = sqrt(dot3(mo->t, mo->t)), ro[3], tp[3], tm[3];
+    int i;
+    if (!(nt > 0.0))
+        return;
+    matvec(3, mo->r, res->norm_origin, ro);
+    for (i = 0; i < 3; i++) {
+        double step = 100.0 * mo->t[i] / nt / res->norm_scale;
+        tp[i] = step + res->norm_origin[i] - ro[i];
+        tm[i] = -step + res->norm_origin[i] - ro[i];
+    }
+    if (count_in_front(rays->n, rays->o1, rays->d1, rays->o2, rays->d2, mo->r, tm) >
+        count_in_front(rays->n, rays->o1, rays->d1, rays->o2, rays->d2, mo->r, tp))
+        for (i = 0; i < 3; i++)
+            mo->t[i] = -mo->t[i];
+}
+
+/* The motion into res in the rig frame: t_metric always (metric mode), t
+ * with unit norm when only its direction is meaningful. */
+static void report_motion(const rayset *rays, const motion *mo, mcg_linear17_result *res)
+{
+    int i;
+    memcpy(res->R, mo->r, sizeof mo->r);
+    to_rig_frame(res, mo->r, mo->t, res->t);
+    if (!mo->unit_mode)
+        memcpy(res->t_metric, res->t, sizeof res->t_metric);
+    if (!res->scale_observable) {
+        /* only the direction is meaningful: report it with unit norm */
+        double nt;
+        if (mo->unit_mode)
+            memcpy(res->t, mo->t, sizeof mo->t);
+        nt = sqrt(dot3(res->t, res->t));
+        if (nt > 0.0)
+            for (i = 0; i < 3; i++)
+                res->t[i] /= nt;
+    }
+    res->n_in_front = count_in_front(rays->n, rays->o1, rays->d1, rays->o2, rays->d2,
+                                     res->R, res->t);
+}
+
 /* Everything after the case detection, for the kind gc (nullity of A_R):
- * the linear step, the rotation candidates, the translation with scale, the
- * alternation and polish, and the scale evidence; res (whose eigenvalue
- * diagnostics are already filled) gets the motion in the rig frame.
+ * the linear step (Algorithm 2), the rotation candidates, the translation
+ * with scale (eq. 8.15), the alternation and polish (ch. 8.4.3), and the
+ * scale evidence; res (whose eigenvalue diagnostics are already filled)
+ * gets the motion in the rig frame.
  * pinv_rtol: eigenvalues of M_RR at or below pinv_rtol * max are treated as
  * structural zeros in the elimination of the R part (0: none is). */
 static int solve_case(int n, const double *origins1, const double *dirs1,
@@ -783,12 +1001,13 @@ static int solve_case(int n, const double *origins1, const double *dirs1,
                       const double *wr, const double *vr, double tr_m, int gc,
                       int nullity, double pinv_rtol, mcg_linear17_result *res)
 {
-    mcg_linear17_options o = *opt;
-    double e[9], rpart[9], cand[4][9], rbest[9], tbest[3], rlin[9], tlin[3];
-    double cost, tiny = 1e-26 * tr_m, costlin;
-    int st, i, k, ncand = 0, best = -1, unit_mode = 0;
-    tsolve ts;
+    double e[9], rpart[9], cand[4][9], tiny = 1e-26 * tr_m, ne = 0.0;
+    int st, i, ncand = 0;
+    rayset rays;
+    motion mo;
 
+    rays.n = n;
+    rays.o1 = origins1; rays.d1 = dirs1; rays.o2 = origins2; rays.d2 = dirs2;
     res->gc_case = gc;
     res->rank_ar = 9 - nullity;
     res->rank_a = 17 - (gc == MCG_GC_CENTRAL ? 9 : nullity);
@@ -797,229 +1016,41 @@ static int solve_case(int n, const double *origins1, const double *dirs1,
     if (n < res->rank_a)
         return MCG_EDEGENERATE; /* too few rays for the detected kind */
 
-    st = linear_step(m, gc, wr, vr, pinv_rtol, o.rank_rtol, tr_m, e, rpart, res);
+    st = linear_step(m, gc, wr, vr, pinv_rtol, opt->rank_rtol, tr_m, e, rpart, res);
     if (st != MCG_OK)
         return st;
-    {
-        double ne = 0.0;
-        for (i = 0; i < 9; i++)
-            ne += e[i] * e[i];
-        ne = sqrt(ne);
-        for (i = 0; i < 9; i++)
-            res->E[i] = e[i] / ne;
-    }
+    for (i = 0; i < 9; i++)
+        ne += e[i] * e[i];
+    ne = sqrt(ne);
+    for (i = 0; i < 9; i++)
+        res->E[i] = e[i] / ne;
     st = rotation_candidates(res->E, rpart, gc == MCG_GC_MOST_GENERAL, cand, &ncand);
     if (st != MCG_OK)
         return st;
-
-    /* translation with scale for each candidate (eq. 8.15), pick by cost */
-    res->n_candidates = ncand;
-    {
-        double bestcost = HUGE_VAL;
-        for (k = 0; k < ncand; k++) {
-            if (solve_t(m, cand[k], 0, NULL, 0, &ts) != MCG_OK)
-                return MCG_ENUMERIC;
-            res->candidate_cost[k] = ts.cost;
-            if (ts.cost < bestcost) {
-                bestcost = ts.cost;
-                best = k;
-            }
-        }
-        memcpy(rbest, cand[best], sizeof rbest);
-        if (solve_t(m, rbest, 0, NULL, 1, &ts) != MCG_OK)
-            return MCG_ENUMERIC;
-        memcpy(tbest, ts.t, sizeof tbest);
-        cost = ts.cost;
-        if (gc == MCG_GC_CENTRAL || ts.cond < o.min_scale_conditioning) {
-            /* critical motion (ch. 7.3.2) or a central camera: |t| is not
-             * determined. (A central camera has g = 0 and c0 = 0, so the
-             * free solve returns t = 0 for every candidate and cannot tell
-             * them apart; with noise its H is well conditioned, so cond
-             * alone does not flag it.) Choose the rotation among equally
-             * good candidates and the sign of the direction by cheirality,
-             * in the normalised frame. */
-            int bestcnt = -1;
-            unit_mode = 1;
-            for (k = 0; k < ncand; k++) {
-                int sg;
-                if (res->candidate_cost[k] > 10.0 * bestcost + tiny)
-                    continue;
-                if (solve_t(m, cand[k], 1, NULL, 1, &ts) != MCG_OK)
-                    return MCG_ENUMERIC;
-                for (sg = -1; sg <= 1; sg += 2) {
-                    double tt[3], tr[3], rc[3];
-                    int cnt;
-                    for (i = 0; i < 3; i++)
-                        tt[i] = sg * ts.t[i] / res->norm_scale;
-                    /* undo normalisation of the translation direction */
-                    matvec(3, cand[k], res->norm_origin, rc);
-                    for (i = 0; i < 3; i++)
-                        tr[i] = tt[i] + res->norm_origin[i] - rc[i];
-                    cnt = count_in_front(n, origins1, dirs1, origins2, dirs2,
-                                         cand[k], tr);
-                    if (cnt > bestcnt) {
-                        bestcnt = cnt;
-                        memcpy(rbest, cand[k], sizeof rbest);
-                        for (i = 0; i < 3; i++)
-                            tbest[i] = sg * ts.t[i];
-                        cost = ts.cost;
-                    }
-                }
-            }
-        }
-    }
+    st = choose_candidate(m, &rays, opt, gc, tiny, cand, ncand, res, &mo);
+    if (st != MCG_OK)
+        return st;
     /* the cost is the quadratic form x^T M x of the Gram matrix: on exact
      * data it rounds to a tiny negative number (found by fuzz_linear17) */
-    if (cost < 0.0)
-        cost = 0.0;
-    res->cost_linear = sqrt(cost / n);
-    memcpy(rlin, rbest, sizeof rlin);
-    memcpy(tlin, tbest, sizeof tlin);
-    costlin = cost;
+    if (mo.cost < 0.0)
+        mo.cost = 0.0;
+    res->cost_linear = sqrt(mo.cost / n);
 
-    /* alternation (ch. 8.4.3): R given t, then t given R */
     res->converged = 0;
-    if (o.refine) {
-        for (k = 0; k < o.max_iterations; k++) {
-            double prev = cost;
-            if (cost <= tiny) {
-                res->converged = 1;
-                break;
-            }
-            if (step_r(m, rbest, tbest, &cost) != MCG_OK)
-                return MCG_ENUMERIC;
-            if (solve_t(m, rbest, unit_mode, tbest, 0, &ts) != MCG_OK)
-                return MCG_ENUMERIC;
-            if (ts.cost <= cost || !unit_mode) {
-                memcpy(tbest, ts.t, sizeof tbest);
-                cost = ts.cost;
-            }
-            res->iterations = k + 1;
-            if (prev - cost <= o.tolerance * prev) {
-                res->converged = 1;
-                break;
-            }
-        }
-        if (!unit_mode) {
-            raydata rd;
-            rd.n = n;
-            rd.o1 = origins1; rd.d1 = dirs1; rd.o2 = origins2; rd.d2 = dirs2;
-            rd.origin = res->norm_origin;
-            rd.scale = res->norm_scale;
-            res->polish_steps = polish(m, rbest, tbest, &cost, &rd);
-        }
-        /* Guard: for locally-central rigs (0, I) is in the null space of A,
-         * so the algebraic cost has a trivial zero at R = I, t = 0 and a
-         * descent from a poor start can slide towards it. The linear step
-         * minimised the cost with |E| = 1 fixed; a refinement that shrinks
-         * |t| (|E| = sqrt(2)|t|) by half or raises that normalised cost
-         * (f / |t|^2) fourfold went the wrong way: keep the linear estimate. */
-        if (!unit_mode) {
-            double nl = dot3(tlin, tlin), nr = dot3(tbest, tbest);
-            if (!(nr >= 0.25 * nl) || !(cost / nr <= 4.0 * costlin / nl)) {
-                memcpy(rbest, rlin, sizeof rlin);
-                memcpy(tbest, tlin, sizeof tlin);
-                cost = costlin;
-                res->converged = 0;
-                res->refine_rejected = 1;
-            }
-        }
+    if (opt->refine) {
+        st = alternate_and_polish(m, &rays, opt, tiny, res, &mo);
+        if (st != MCG_OK)
+            return st;
     }
-
-    if (cost < 0.0)
-        cost = 0.0; /* rounding of x^T M x, as above */
-    /* scale observability: conditioning of the scale equation and the
-     * first-order std of |t| from the residual (normalised frame) */
-    if (solve_t(m, rbest, unit_mode, tbest, 1, &ts) != MCG_OK)
-        return MCG_ENUMERIC;
-    /* (t stays as refined: ts only supplies H for the evidence) */
-    res->scale_conditioning = ts.cond;
-    {
-        double nt = sqrt(dot3(tbest, tbest)), var = 0.0, sigma2;
-        int dof = n > 6 ? n - 6 : 1;
-        sigma2 = cost / dof;
-        if (unit_mode || !(nt > 0.0)) {
-            res->scale_rel_std = HUGE_VAL;
-        } else {
-            for (k = 0; k < 3; k++) {
-                double vk[3] = {ts.hv[k], ts.hv[3 + k], ts.hv[6 + k]};
-                double c = dot3(vk, tbest) / nt;
-                if (ts.h[k] > 0.0)
-                    var += c * c / ts.h[k];
-                else if (c != 0.0)
-                    var = HUGE_VAL;
-            }
-            res->scale_rel_std = sqrt(sigma2 * var) / nt;
-            /* Errors-in-variables check: along u = t/|t|, eq. 8.15 reads
-             * (J u) s = b. Regressing b on J u (least squares, what we do)
-             * and J u on b bracket the true s when both are noisy; their
-             * ratio is rho^2 = (g.u)^2 / ((u^T H u) c0). 1 - rho^2 bounds the
-             * relative bias of |t| that the first-order std cannot see. */
-            {
-                double u[3], hu[3], uhu, gu, rho2;
-                for (i = 0; i < 3; i++)
-                    u[i] = tbest[i] / nt;
-                matvec(3, ts.hm, u, hu);
-                uhu = dot3(u, hu);
-                gu = dot3(ts.g, u);
-                rho2 = (uhu > 0.0 && ts.c0 > 0.0) ? gu * gu / (uhu * ts.c0) : 1.0;
-                if (rho2 > 1.0)
-                    rho2 = 1.0;
-                if (1.0 - rho2 > res->scale_rel_std)
-                    res->scale_rel_std = 1.0 - rho2;
-            }
-        }
-    }
-    res->scale_observable = !unit_mode &&
-                            res->scale_conditioning >= o.min_scale_conditioning &&
-                            res->scale_rel_std <= o.max_scale_rel_std;
-    res->cost_final = sqrt(cost / n);
-
-    /* An unobservable scale from the free solve (near-critical motion, e.g. a
-     * pure translation seen by intra-camera rays: e = t . (R d1 x d2) is
-     * nearly homogeneous in t) leaves the sign of t to the noise. Only the
-     * direction is reported then: choose its sign by cheirality, as unit
-     * mode does, at a length (100 in the normalised frame, where the origins
-     * spread over ~1) that dwarfs the rotation-induced part o - R o. */
-    if (!unit_mode && !res->scale_observable) {
-        double nt = sqrt(dot3(tbest, tbest));
-        if (nt > 0.0) {
-            double ro[3], tp[3], tm[3];
-            matvec(3, rbest, res->norm_origin, ro);
-            for (i = 0; i < 3; i++) {
-                double step = 100.0 * tbest[i] / nt / res->norm_scale;
-                tp[i] = step + res->norm_origin[i] - ro[i];
-                tm[i] = -step + res->norm_origin[i] - ro[i];
-            }
-            if (count_in_front(n, origins1, dirs1, origins2, dirs2, rbest, tm) >
-                count_in_front(n, origins1, dirs1, origins2, dirs2, rbest, tp))
-                for (i = 0; i < 3; i++)
-                    tbest[i] = -tbest[i];
-        }
-    }
-
-    /* back to the rig frame: t = t'/s + o - R o */
-    memcpy(res->R, rbest, sizeof rbest);
-    {
-        double ro[3];
-        matvec(3, rbest, res->norm_origin, ro);
-        for (i = 0; i < 3; i++)
-            res->t[i] = tbest[i] / res->norm_scale + res->norm_origin[i] - ro[i];
-        if (!unit_mode)
-            memcpy(res->t_metric, res->t, sizeof res->t_metric);
-        if (!res->scale_observable) {
-            /* only the direction is meaningful: report it with unit norm */
-            double nt;
-            if (unit_mode)
-                memcpy(res->t, tbest, sizeof tbest);
-            nt = sqrt(dot3(res->t, res->t));
-            if (nt > 0.0)
-                for (i = 0; i < 3; i++)
-                    res->t[i] /= nt;
-        }
-    }
-    res->n_in_front = count_in_front(n, origins1, dirs1, origins2, dirs2,
-                                     res->R, res->t);
+    if (mo.cost < 0.0)
+        mo.cost = 0.0; /* rounding of x^T M x, as above */
+    st = scale_evidence(m, opt, n, &mo, res);
+    if (st != MCG_OK)
+        return st;
+    res->cost_final = sqrt(mo.cost / n);
+    if (!mo.unit_mode && !res->scale_observable)
+        orient_by_cheirality(&rays, res, &mo);
+    report_motion(&rays, &mo, res);
     return MCG_OK;
 }
 

@@ -44,13 +44,6 @@
 #define NR (NV + 1)     /* rows of the dual LP */
 #define LP_MAX_ITER 400 /* simplex pivots per step */
 
-static void mat_vec(const double R[9], const double x[3], double y[3])
-{
-    y[0] = R[0] * x[0] + R[1] * x[1] + R[2] * x[2];
-    y[1] = R[3] * x[0] + R[4] * x[1] + R[5] * x[2];
-    y[2] = R[6] * x[0] + R[7] * x[1] + R[8] * x[2];
-}
-
 /* g of one correspondence from the rotated bearing v, the rotated origin
  * ra1 = R a1 and t, and its gradient in (omega, t) (grad may be NULL):
  * 1 and *g set where m^.b > 0 and the rays are not parallel, else 0 (then

@@ -188,13 +188,11 @@ static void plane_basis(const double a[3], double e1[3], double e2[3])
     e1[0] = t[0] - a[i] * a[0];
     e1[1] = t[1] - a[i] * a[1];
     e1[2] = t[2] - a[i] * a[2];
-    n = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    n = sqrt(dot3(e1, e1));
     e1[0] /= n;
     e1[1] /= n;
     e1[2] /= n;
-    e2[0] = a[1] * e1[2] - a[2] * e1[1];
-    e2[1] = a[2] * e1[0] - a[0] * e1[2];
-    e2[2] = a[0] * e1[1] - a[1] * e1[0];
+    cross3(a, e1, e2);
 }
 
 /*
@@ -211,16 +209,16 @@ static int solve_3d(const double *rows, int n, double big, double tol,
         const double *a = rows + 4 * k;
         double e1[3], e2[3], p0[3], c2[2], y[2];
         int np = 0;
-        if (a[0] * x[0] + a[1] * x[1] + a[2] * x[2] >= a[3] - tol)
+        if (dot3(a, x) >= a[3] - tol)
             continue;
         plane_basis(a, e1, e2);
         for (i = 0; i < 3; ++i)
             p0[i] = a[3] * a[i];
         for (j = 0; j < k; ++j) {
             const double *r = rows + 4 * j;
-            double ru = r[0] * e1[0] + r[1] * e1[1] + r[2] * e1[2];
-            double rv = r[0] * e2[0] + r[1] * e2[1] + r[2] * e2[2];
-            double rh = r[3] - (r[0] * p0[0] + r[1] * p0[1] + r[2] * p0[2]);
+            double ru = dot3(r, e1);
+            double rv = dot3(r, e2);
+            double rh = r[3] - dot3(r, p0);
             double g = sqrt(ru * ru + rv * rv);
             /* parallel only if the row changes by less than tol over the
              * plane within the box (|y_i| < 2 big, as solve_2d's box): see
@@ -235,8 +233,8 @@ static int solve_3d(const double *rows, int n, double big, double tol,
             proj[3 * np + 2] = rh / g;
             ++np;
         }
-        c2[0] = OBJ3[0] * e1[0] + OBJ3[1] * e1[1] + OBJ3[2] * e1[2];
-        c2[1] = OBJ3[0] * e2[0] + OBJ3[1] * e2[1] + OBJ3[2] * e2[2];
+        c2[0] = dot3(OBJ3, e1);
+        c2[1] = dot3(OBJ3, e2);
         /* the box |x_i| <= big maps into |y_i| <= sqrt(3) big < 2 big */
         if (!solve_2d(proj, np, 2.0 * big, c2, tol, y))
             return 0;

@@ -23,14 +23,6 @@
 #define MAX_PAIRS (1 << 26)
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction */
 
-/* R v */
-static void rot3(const double R[9], const double v[3], double out[3])
-{
-    int i;
-    for (i = 0; i < 3; i++)
-        out[i] = R[3 * i] * v[0] + R[3 * i + 1] * v[1] + R[3 * i + 2] * v[2];
-}
-
 int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const double *o2,
                             const double *d2, const double R[9], const double t[3],
                             const double *axis1, const double *axis2, const double *f1,
@@ -58,8 +50,8 @@ int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const dou
             return MCG_EINVAL;
         m1 = 1.0 / sqrt(m1);
         m2 = 1.0 / sqrt(m2);
-        rot3(R, u1, a);
-        rot3(R, o1 + 3 * k, p1);
+        mat_vec(R, u1, a);
+        mat_vec(R, o1 + 3 * k, p1);
         for (i = 0; i < 3; i++) {
             a[i] *= m1;
             b[i] = u2[i] * m2;
@@ -73,7 +65,7 @@ int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const dou
         x = dot3(g1, a);
         for (i = 0; i < 3; i++)
             g1[i] -= x * a[i];
-        rot3(R, z1, rz1);
+        mat_vec(R, z1, rz1);
         n1 = dot3(g1, g1);
         n2 = dot3(g2, g2);
         {

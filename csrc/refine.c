@@ -65,7 +65,6 @@
 #define MAX_RAYS (1 << 26)
 #define HALF_PI 1.5707963267948966
 #define INV_HALF_PI2 0.40528473456935109 /* (2 / pi)^2 */
-#define ROT_TOL 1e-6                     /* |R R^T - I| accepted as a rotation */
 #define LAMBDA_MAX 1e32                  /* damping beyond: no descent exists */
 #define SING_RTOL 1e-10                  /* eigenvalue ratio treated as singular */
 #define MAX_TURN 0.5                     /* largest rotation step, radians */
@@ -74,41 +73,77 @@
  * underflow (overflow is detected) */
 #define DIR2_MIN 1e-100
 
-/* ---------------------------------------------------------- small helpers */
-
-static void mul33(const double *a, const double *b, double *c)
-{
-    int i, j;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++)
-            c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] +
-                           a[3 * i + 2] * b[6 + j];
-}
-
-/* 1 if r is a rotation to ROT_TOL (orthonormal rows, det > 0) */
-static int is_rotation(const double r[9])
-{
-    int i, j;
-    double det;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++) {
-            double acc = r[3 * i] * r[3 * j] + r[3 * i + 1] * r[3 * j + 1] +
-                         r[3 * i + 2] * r[3 * j + 2];
-            if (!(fabs(acc - (i == j ? 1.0 : 0.0)) <= ROT_TOL))
-                return 0;
-        }
-    det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
-          r[2] * (r[3] * r[7] - r[4] * r[6]);
-    return det > 0.0;
-}
-
 /* ------------------------------------------------------------- residuals */
+
+/* The terms of one pair's Sampson angular residual, in the raw form of the
+ * header comment of mcg_gec_residuals (thesis eq. 8.15 applied to the
+ * generalized epipolar constraint, eq. 8.16): A = R d1, B = d2 (both
+ * unnormalised), p = R o1, c = t + p - o2, Q = c x A, H = B x c,
+ * E = B.Q, den = |B|^2 |Q|^2 + |A|^2 |H|^2 - 2 E^2 (|A|^2 = |d1|^2), and
+ * the residual r = E / sqrt(m) with m = max(den, (2/pi)^2 E^2, DBL_MIN)
+ * (the pi/2 cap). One definition for the residual pass and for the
+ * residual + Jacobian rows of the refinement, so the two cannot drift
+ * apart. Static inline and branch-free (selects only): the callers' loops
+ * over the pairs vectorise. */
+typedef struct {
+    double a0, a1, a2;    /* A = R d1 */
+    double p0, p1, p2;    /* p = R o1 */
+    double c0, c1, c2;    /* c = t + p - o2 */
+    double b0, b1, b2;    /* B = d2 */
+    double q0, q1, q2;    /* Q = c x A */
+    double h0, h1, h2;    /* H = B x c */
+    double n1, n2;        /* |d1|^2, |d2|^2 */
+    double e, dd;         /* E and den */
+    double lo, m;         /* max((2/pi)^2 E^2, DBL_MIN) and max(den, lo) */
+    double marker;        /* 0, or NaN for an invalid pair (see below) */
+} sampson_terms;
+
+static inline void sampson_pair(const double *rm, const double *tv, const double *o1,
+                                const double *d1, const double *o2, const double *d2,
+                                sampson_terms *s)
+{
+    double ee, cap, x, mm;
+    s->b0 = d2[0];
+    s->b1 = d2[1];
+    s->b2 = d2[2];
+    s->n1 = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2];
+    s->n2 = s->b0 * s->b0 + s->b1 * s->b1 + s->b2 * s->b2;
+    s->a0 = rm[0] * d1[0] + rm[1] * d1[1] + rm[2] * d1[2];
+    s->a1 = rm[3] * d1[0] + rm[4] * d1[1] + rm[5] * d1[2];
+    s->a2 = rm[6] * d1[0] + rm[7] * d1[1] + rm[8] * d1[2];
+    s->p0 = rm[0] * o1[0] + rm[1] * o1[1] + rm[2] * o1[2];
+    s->p1 = rm[3] * o1[0] + rm[4] * o1[1] + rm[5] * o1[2];
+    s->p2 = rm[6] * o1[0] + rm[7] * o1[1] + rm[8] * o1[2];
+    s->c0 = tv[0] + s->p0 - o2[0];
+    s->c1 = tv[1] + s->p1 - o2[1];
+    s->c2 = tv[2] + s->p2 - o2[2];
+    s->q0 = s->c1 * s->a2 - s->c2 * s->a1;
+    s->q1 = s->c2 * s->a0 - s->c0 * s->a2;
+    s->q2 = s->c0 * s->a1 - s->c1 * s->a0;
+    s->h0 = s->b1 * s->c2 - s->b2 * s->c1;
+    s->h1 = s->b2 * s->c0 - s->b0 * s->c2;
+    s->h2 = s->b0 * s->c1 - s->b1 * s->c0;
+    s->e = s->b0 * s->q0 + s->b1 * s->q1 + s->b2 * s->q2;
+    ee = s->e * s->e;
+    s->dd = s->n2 * (s->q0 * s->q0 + s->q1 * s->q1 + s->q2 * s->q2) +
+            s->n1 * (s->h0 * s->h0 + s->h1 * s->h1 + s->h2 * s->h2) - 2.0 * ee;
+    cap = ee * INV_HALF_PI2;
+    s->lo = cap > DBL_MIN ? cap : DBL_MIN;
+    s->m = s->dd > s->lo ? s->dd : s->lo;
+    /* validation folded in as a NaN marker, which keeps the loops
+     * branch-free and vectorisable: n1, n2 >= DIR2_MIN rules out zero
+     * directions, and 0 * x is NaN iff x is not finite, where a NaN/inf
+     * in any input or an overflow makes x = n1 + n2 + dd NaN or inf.
+     * (Vectorised only with -fno-math-errno, see meson.build.) */
+    x = s->n1 + s->n2 + s->dd;
+    mm = s->n1 < s->n2 ? s->n1 : s->n2;
+    s->marker = 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+}
 
 int mcg_gec_residuals(int n, const double *o1, const double *d1,
                       const double *o2, const double *d2, const double R[9],
                       const double t[3], double *res)
 {
-    double r0, r1, r2, r3, r4, r5, r6, r7, r8, t0, t1, t2;
     int k, bad = 0;
 
     if (!o1 || !d1 || !o2 || !d2 || !R || !t || !res)
@@ -117,41 +152,12 @@ int mcg_gec_residuals(int n, const double *o1, const double *d1,
         return MCG_EINVAL;
     if (!all_finite(R, 9) || !all_finite(t, 3))
         return MCG_EINVAL;
-    r0 = R[0]; r1 = R[1]; r2 = R[2];
-    r3 = R[3]; r4 = R[4]; r5 = R[5];
-    r6 = R[6]; r7 = R[7]; r8 = R[8];
-    t0 = t[0]; t1 = t[1]; t2 = t[2];
 
-    /* One branch-free pass in the raw form of the header comment: one
-     * square root and one division per pair, validation folded in. */
+    /* One branch-free pass: one square root and one division per pair. */
     for (k = 0; k < n; k++) {
-        const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k;
-        const double *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
-        double b0 = u2[0], b1 = u2[1], b2 = u2[2];
-        double n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2];
-        double n2 = b0 * b0 + b1 * b1 + b2 * b2;
-        double a0 = r0 * u1[0] + r1 * u1[1] + r2 * u1[2];
-        double a1 = r3 * u1[0] + r4 * u1[1] + r5 * u1[2];
-        double a2 = r6 * u1[0] + r7 * u1[1] + r8 * u1[2];
-        double c0 = t0 + r0 * p1[0] + r1 * p1[1] + r2 * p1[2] - p2[0];
-        double c1 = t1 + r3 * p1[0] + r4 * p1[1] + r5 * p1[2] - p2[1];
-        double c2 = t2 + r6 * p1[0] + r7 * p1[1] + r8 * p1[2] - p2[2];
-        double q0 = c1 * a2 - c2 * a1, q1 = c2 * a0 - c0 * a2, q2 = c0 * a1 - c1 * a0;
-        double h0 = b1 * c2 - b2 * c1, h1 = b2 * c0 - b0 * c2, h2 = b0 * c1 - b1 * c0;
-        double e = b0 * q0 + b1 * q1 + b2 * q2, ee = e * e;
-        double dd = n2 * (q0 * q0 + q1 * q1 + q2 * q2) +
-                    n1 * (h0 * h0 + h1 * h1 + h2 * h2) - 2.0 * ee;
-        /* r = e / sqrt(max(dd, (2/pi)^2 e^2, DBL_MIN)) (max as selects) */
-        double cap = ee * INV_HALF_PI2, m = dd > cap ? dd : cap;
-        m = m > DBL_MIN ? m : DBL_MIN;
-        /* validation folded in as a NaN marker, which keeps the loop
-         * branch-free and vectorisable: n1, n2 >= DIR2_MIN rules out zero
-         * directions, and 0 * x is NaN iff x is not finite, where a NaN/inf
-         * in any input or an overflow makes x = n1 + n2 + dd NaN or inf.
-         * (Vectorised only with -fno-math-errno, see meson.build.) */
-        double x = n1 + n2 + dd;
-        double mm = n1 < n2 ? n1 : n2;
-        res[k] = e / sqrt(m) + 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+        sampson_terms s;
+        sampson_pair(R, t, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k, &s);
+        res[k] = s.e / sqrt(s.m) + s.marker;
     }
     for (k = 0; k < n; k++) /* the markers (a short contiguous scan) */
         bad |= res[k] != res[k];
@@ -204,56 +210,35 @@ static void block_rows(int nb, const double *o1, const double *d1,
                        const double *o2, const double *d2, const double *rm,
                        const double *tv, double *rb, double (*jb)[BLK], double *ok)
 {
-    const double r0 = rm[0], r1 = rm[1], r2 = rm[2], r3 = rm[3], r4 = rm[4];
-    const double r5 = rm[5], r6 = rm[6], r7 = rm[7], r8 = rm[8];
-    const double t0 = tv[0], t1 = tv[1], t2 = tv[2];
     int k;
     for (k = 0; k < nb; k++) {
-        const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k;
-        const double *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
-        double b0 = u2[0], b1 = u2[1], b2 = u2[2];
-        double n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2];
-        double n2 = b0 * b0 + b1 * b1 + b2 * b2;
-        double a0 = r0 * u1[0] + r1 * u1[1] + r2 * u1[2];
-        double a1 = r3 * u1[0] + r4 * u1[1] + r5 * u1[2];
-        double a2 = r6 * u1[0] + r7 * u1[1] + r8 * u1[2];
-        double pp0 = r0 * p1[0] + r1 * p1[1] + r2 * p1[2];
-        double pp1 = r3 * p1[0] + r4 * p1[1] + r5 * p1[2];
-        double pp2 = r6 * p1[0] + r7 * p1[1] + r8 * p1[2];
-        double c0 = t0 + pp0 - p2[0], c1 = t1 + pp1 - p2[1], c2 = t2 + pp2 - p2[2];
-        double q0 = c1 * a2 - c2 * a1, q1 = c2 * a0 - c0 * a2, q2 = c0 * a1 - c1 * a0;
-        double h0 = b1 * c2 - b2 * c1, h1 = b2 * c0 - b0 * c2, h2 = b0 * c1 - b1 * c0;
-        double e = b0 * q0 + b1 * q1 + b2 * q2, ee = e * e;
-        double dd = n2 * (q0 * q0 + q1 * q1 + q2 * q2) +
-                    n1 * (h0 * h0 + h1 * h1 + h2 * h2) - 2.0 * ee;
-        double cap = ee * INV_HALF_PI2, lo = cap > DBL_MIN ? cap : DBL_MIN;
-        double m = dd > lo ? dd : lo, s, rr, f1, f2;
-        double ac, bc, k0, k1, k2, v0, v1, v2, jt0, jt1, jt2, x, mm, f3;
+        sampson_terms p;
+        double s, rr, f1, f2, f3, ac, bc, k0, k1, k2, v0, v1, v2, jt0, jt1, jt2, on;
+        sampson_pair(rm, tv, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k, &p);
         /* 1 on the Sampson branch (a select, not a branch: vectorisable) */
-        double on = dd > lo ? 1.0 : 0.0;
-        s = 1.0 / sqrt(m);
-        rr = e * s;
-        /* the NaN marker of mcg_gec_residuals */
-        x = n1 + n2 + dd;
-        mm = n1 < n2 ? n1 : n2;
-        rb[k] = rr + 0.0 * x + (mm >= DIR2_MIN ? 0.0 : NAN);
+        on = p.dd > p.lo ? 1.0 : 0.0;
+        s = 1.0 / sqrt(p.m);
+        rr = p.e * s;
+        rb[k] = rr + p.marker;
         ok[k] = on;
         f1 = on * s * (1.0 + 2.0 * rr * rr);
         f2 = on * rr * s * s;
-        ac = a0 * c0 + a1 * c1 + a2 * c2;
-        bc = b0 * c0 + b1 * c1 + b2 * c2;
-        k0 = a1 * b2 - a2 * b1; k1 = a2 * b0 - a0 * b2; k2 = a0 * b1 - a1 * b0;
-        v0 = 2.0 * n1 * n2 * c0 - n2 * ac * a0 - n1 * bc * b0;
-        v1 = 2.0 * n1 * n2 * c1 - n2 * ac * a1 - n1 * bc * b1;
-        v2 = 2.0 * n1 * n2 * c2 - n2 * ac * a2 - n1 * bc * b2;
+        ac = p.a0 * p.c0 + p.a1 * p.c1 + p.a2 * p.c2;
+        bc = p.b0 * p.c0 + p.b1 * p.c1 + p.b2 * p.c2;
+        k0 = p.a1 * p.b2 - p.a2 * p.b1;
+        k1 = p.a2 * p.b0 - p.a0 * p.b2;
+        k2 = p.a0 * p.b1 - p.a1 * p.b0;
+        v0 = 2.0 * p.n1 * p.n2 * p.c0 - p.n2 * ac * p.a0 - p.n1 * bc * p.b0;
+        v1 = 2.0 * p.n1 * p.n2 * p.c1 - p.n2 * ac * p.a1 - p.n1 * bc * p.b1;
+        v2 = 2.0 * p.n1 * p.n2 * p.c2 - p.n2 * ac * p.a2 - p.n1 * bc * p.b2;
         jt0 = f1 * k0 - f2 * v0;
         jt1 = f1 * k1 - f2 * v1;
         jt2 = f1 * k2 - f2 * v2;
-        f3 = f2 * n2 * ac;
+        f3 = f2 * p.n2 * ac;
         /* dr/dw = p x dr/dt + f1 A x H - f3 Q */
-        jb[0][k] = pp1 * jt2 - pp2 * jt1 + f1 * (a1 * h2 - a2 * h1) - f3 * q0;
-        jb[1][k] = pp2 * jt0 - pp0 * jt2 + f1 * (a2 * h0 - a0 * h2) - f3 * q1;
-        jb[2][k] = pp0 * jt1 - pp1 * jt0 + f1 * (a0 * h1 - a1 * h0) - f3 * q2;
+        jb[0][k] = p.p1 * jt2 - p.p2 * jt1 + f1 * (p.a1 * p.h2 - p.a2 * p.h1) - f3 * p.q0;
+        jb[1][k] = p.p2 * jt0 - p.p0 * jt2 + f1 * (p.a2 * p.h0 - p.a0 * p.h2) - f3 * p.q1;
+        jb[2][k] = p.p0 * jt1 - p.p1 * jt0 + f1 * (p.a0 * p.h1 - p.a1 * p.h0) - f3 * p.q2;
         jb[3][k] = jt0;
         jb[4][k] = jt1;
         jb[5][k] = jt2;
@@ -480,22 +465,14 @@ static void scale_evidence(const double *h, const double t[3], double *cond,
     }
 }
 
-int mcg_refine_motion(int n, const double *o1, const double *d1,
-                      const double *o2, const double *d2, const double *weights,
-                      const mcg_refine_options *opt, double R[9], double t[3],
-                      mcg_refine_result *res)
+/* The argument checks of mcg_refine_motion (its header comment lists them);
+ * *o receives the options (the defaults for NULL). */
+static int check_inputs(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const double *weights,
+                        const mcg_refine_options *opt, const double R[9],
+                        const double t[3], mcg_refine_options *o)
 {
-    mcg_refine_options o;
-    lossfn lf;
-    accum cur, trial;
-    double r[9], tv[3], rho0 = 0.0, lambda, nu = 2.0, ell, pdim;
-    int i, k, it, fix, reason = MCG_REFINE_STOP_MAX_ITERATIONS, converged = 0;
-
-    if (!res)
-        return MCG_EINVAL;
-    memset(res, 0, sizeof *res);
-    res->sigma2 = HUGE_VAL;
-    res->scale_rel_std = HUGE_VAL;
+    int k;
     if (!o1 || !d1 || !o2 || !d2 || !R || !t)
         return MCG_EINVAL;
     if (n < 6 || n > MAX_RAYS)
@@ -503,9 +480,9 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
     if (opt) {
         if (!check_options(opt))
             return MCG_EINVAL;
-        o = *opt;
+        *o = *opt;
     } else {
-        mcg_refine_default_options(&o);
+        mcg_refine_default_options(o);
     }
     if (!all_finite(R, 9) || !all_finite(t, 3) || !is_rotation(R))
         return MCG_EINVAL;
@@ -516,16 +493,299 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
             if (weights[k] < 0.0)
                 return MCG_EINVAL;
     }
+    return MCG_OK;
+}
+
+/* The Gauss-Newton system of one iteration in the step's parameters: with
+ * P (6 x m) the parametrisation of the step [dw; dt] (the identity, or
+ * [dw; B u] with fix_scale, B an orthonormal basis of the tangent plane of
+ * the sphere |t| = rho0 at t), hm = P^T H P and gm = P^T g (m x m, m).
+ * Returns m. */
+static int reduced_system(const accum *cur, int fix, const double tv[3], double rho0,
+                          double pm[6][6], double *hm, double *gm)
+{
+    int i, m = fix ? 5 : 6;
+    memset(pm, 0, 36 * sizeof(double));
+    for (i = 0; i < 3; i++)
+        pm[i][i] = 1.0;
+    if (fix) {
+        double u[3], b1[3] = {0, 0, 0}, b2[3] = {0, 0, 0};
+        for (i = 0; i < 3; i++)
+            u[i] = tv[i] / rho0;
+        tangent_basis(u, b1, b2);
+        for (i = 0; i < 3; i++) {
+            pm[3 + i][3] = b1[i];
+            pm[3 + i][4] = b2[i];
+        }
+    } else {
+        for (i = 3; i < 6; i++)
+            pm[i][i] = 1.0;
+    }
+    if (!fix) {
+        memcpy(hm, cur->h, 36 * sizeof(double));
+        memcpy(gm, cur->g, 6 * sizeof(double));
+    } else { /* hm = P^T H P, gm = P^T g */
+        double hp[6][5];
+        int jj, p;
+        for (p = 0; p < 6; p++)
+            for (jj = 0; jj < m; jj++) {
+                double acc = 0.0;
+                for (i = 0; i < 6; i++)
+                    acc += cur->h[6 * p + i] * pm[i][jj];
+                hp[p][jj] = acc;
+            }
+        for (i = 0; i < m; i++) {
+            gm[i] = 0.0;
+            for (p = 0; p < 6; p++)
+                gm[i] += pm[p][i] * cur->g[p];
+            for (jj = 0; jj < m; jj++) {
+                double acc = 0.0;
+                for (p = 0; p < 6; p++)
+                    acc += pm[p][i] * hp[p][jj];
+                hm[m * i + jj] = acc;
+            }
+        }
+    }
+    return m;
+}
+
+/* The Levenberg-Marquardt step dx of (hm + lambda D) dx = -gm, D = diag(hm)
+ * floored at 1e-12 maxd so that directions the data do not constrain at all
+ * still get a finite step. gm is negated in place (the predicted decrease
+ * uses -g). Returns the status of the Cholesky solve. */
+static int marquardt_step(const double *hm, double *gm, int m, double maxd,
+                          double lambda, double *dx)
+{
+    double a[36], dmp;
+    int i;
+    memcpy(a, hm, sizeof a);
+    for (i = 0; i < m; i++) {
+        dmp = hm[m * i + i] > 1e-12 * maxd ? hm[m * i + i] : 1e-12 * maxd;
+        a[m * i + i] += lambda * dmp;
+    }
+    for (i = 0; i < m; i++)
+        gm[i] = -gm[i];
+    return mcg_spd_solve(m, a, gm, dx);
+}
+
+/* dfull = P dx, then the trust region on top of the damping: a step may
+ * turn R by at most MAX_TURN and move t by at most max(|t|, L) / 2
+ * (L = rig size); dx and dfull are scaled together. In weakly
+ * scale-observable configurations a step along the flat |t| direction
+ * otherwise overshoots, even through t = 0. */
+static void limit_step(double pm[6][6], int m, const double tv[3], double ell,
+                       double *dx, double dfull[6])
+{
+    double nw0, nt0, ntv, alpha = 1.0, lim;
+    int i, jj;
+    for (i = 0; i < 6; i++) {
+        dfull[i] = 0.0;
+        for (jj = 0; jj < m; jj++)
+            dfull[i] += pm[i][jj] * dx[jj];
+    }
+    nw0 = sqrt(dot3(dfull, dfull));
+    nt0 = sqrt(dot3(dfull + 3, dfull + 3));
+    ntv = sqrt(dot3(tv, tv));
+    lim = 0.5 * (ntv > ell ? ntv : ell);
+    if (nw0 > MAX_TURN)
+        alpha = MAX_TURN / nw0;
+    if (lim > 0.0 && nt0 * alpha > lim)
+        alpha = lim / nt0;
+    for (i = 0; i < m; i++)
+        dx[i] *= alpha;
+    for (i = 0; i < 6; i++)
+        dfull[i] *= alpha;
+}
+
+/* predicted decrease of the IRLS model, -2 g.dx - dx^T H dx (ngm = -g) */
+static double predicted_decrease(const double *hm, const double *ngm, const double *dx,
+                                 int m)
+{
+    double pred = 0.0;
+    int i, jj;
+    for (i = 0; i < m; i++) {
+        double acc = 0.0;
+        for (jj = 0; jj < m; jj++)
+            acc += hm[m * i + jj] * dx[jj];
+        pred += 2.0 * ngm[i] * dx[i] - dx[i] * acc;
+    }
+    return pred;
+}
+
+/* The candidate motion: R <- exp([dw]x) R, t <- t + dt, retracted onto the
+ * sphere |t| = rho0 with fix_scale. 0 if the rotation cannot be formed. */
+static int candidate_motion(const double dfull[6], const double r[9], const double tv[3],
+                            int fix, double rho0, double rn[9], double tn[3])
+{
+    double dr[9];
+    int i;
+    if (mcg_rot_from_angle_axis(dfull, dr) != MCG_OK)
+        return 0;
+    mul33(dr, r, rn);
+    for (i = 0; i < 3; i++)
+        tn[i] = tv[i] + dfull[3 + i];
+    if (fix) {
+        double nn = sqrt(dot3(tn, tn));
+        for (i = 0; i < 3; i++)
+            tn[i] *= rho0 / nn;
+    }
+    return 1;
+}
+
+/* The damping and stopping state of the Levenberg-Marquardt loop. */
+typedef struct {
+    double lambda, nu;
+    int reason, converged;
+    int trials; /* steps tried, accepted or not (res->iterations) */
+} lm_state;
+
+/* A failed step (not solvable, or not decreasing the cost): raise the
+ * damping (Nielsen's rule); 1 when it exceeds LAMBDA_MAX (stalled). */
+static int lm_reject(lm_state *lm)
+{
+    lm->lambda = lm->lambda > 0.0 ? lm->lambda * lm->nu : 1e-12;
+    lm->nu *= 2.0;
+    if (lm->lambda > LAMBDA_MAX) {
+        lm->reason = MCG_REFINE_STOP_STALLED;
+        return 1;
+    }
+    return 0;
+}
+
+/* One Levenberg-Marquardt iteration from (r, tv) with the normal equations
+ * *cur at it: reduced system, damped step, trust region, candidate, and its
+ * acceptance (gain ratio update of lambda). Returns 1 when the loop stops
+ * (lm->reason, lm->converged set), else 0. */
+static int lm_iteration(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const double *weights, const lossfn *lf,
+                        const mcg_refine_options *o, double ell, double rho0, double r[9],
+                        double tv[3], accum *cur, lm_state *lm)
+{
+    double pm[6][6], hm[36], gm[6], dx[6], dfull[6], rn[9], tn[3];
+    double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual;
+    int i, m, accepted, small, fix = o->fix_scale;
+    accum trial;
+
+    m = reduced_system(cur, fix, tv, rho0, pm, hm, gm);
+    for (i = 0; i < m; i++) {
+        if (hm[m * i + i] > maxd)
+            maxd = hm[m * i + i];
+        if (fabs(gm[i]) > gmax)
+            gmax = fabs(gm[i]);
+    }
+    if (gmax == 0.0) { /* exact stationary point (e.g. zero cost) */
+        lm->converged = 1;
+        lm->reason = MCG_REFINE_STOP_GRADIENT;
+        return 1;
+    }
+    if (!(maxd > 0.0)) {
+        lm->reason = MCG_REFINE_STOP_STALLED;
+        return 1;
+    }
+    lm->trials++;
+    if (marquardt_step(hm, gm, m, maxd, lm->lambda, dx) != MCG_OK)
+        return lm_reject(lm);
+    limit_step(pm, m, tv, ell, dx, dfull);
+    pred = predicted_decrease(hm, gm, dx, m);
+    if (!candidate_motion(dfull, r, tv, fix, rho0, rn, tn)) {
+        lm->reason = MCG_REFINE_STOP_STALLED;
+        return 1;
+    }
+    evaluate(n, o1, d1, o2, d2, weights, lf, rn, tn, &trial);
+    actual = cur->cost - trial.cost;
+    nw = sqrt(dot3(dfull, dfull));
+    ndt = sqrt(dot3(dfull + 3, dfull + 3));
+    nt = sqrt(dot3(tv, tv));
+    small = nw <= o->step_tolerance &&
+            ndt <= o->step_tolerance * (nt + ell > 0.0 ? nt + ell : 1.0);
+    accepted = !trial.bad && trial.cost <= cur->cost;
+    if (accepted) {
+        double gain = pred > 0.0 ? actual / pred : 0.0, f;
+        double c0 = cur->cost;
+        memcpy(r, rn, sizeof rn);
+        memcpy(tv, tn, sizeof tn);
+        *cur = trial;
+        f = 2.0 * gain - 1.0;
+        f = 1.0 - f * f * f;
+        lm->lambda *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
+        lm->nu = 2.0;
+        if (small) {
+            lm->converged = 1;
+            lm->reason = MCG_REFINE_STOP_STEP;
+            return 1;
+        }
+        if (actual <= o->cost_tolerance * c0) {
+            lm->converged = 1;
+            lm->reason = MCG_REFINE_STOP_COST;
+            return 1;
+        }
+        return 0;
+    }
+    if (small) { /* even a negligible step does not help: at the floor */
+        lm->converged = 1;
+        lm->reason = MCG_REFINE_STOP_STEP;
+        return 1;
+    }
+    return lm_reject(lm);
+}
+
+/* Statistics at the solution: information matrix, rms, the residual
+ * variance sigma2 = sum W r^2 / (sum W - p) and the first-order relative
+ * std of |t| (scale_evidence). With weights (or coordinates) near the top
+ * of the double range the information matrix J^T W J overflows although
+ * every step's cost stayed finite: no statistics can be given, and a motion
+ * without them is not returned as MCG_OK. */
+static int final_statistics(const accum *cur, const double tv[3], double pdim,
+                            const lm_state *lm, mcg_refine_result *res)
+{
+    double var, nt;
+    if (!all_finite(cur->h, 36) || !isfinite(cur->cost))
+        return MCG_ENUMERIC;
+    res->final_cost = cur->cost;
+    res->converged = lm->converged;
+    res->reason = lm->reason;
+    res->n_used = cur->n_used;
+    memcpy(res->info, cur->h, sizeof res->info);
+    res->rms = sqrt(cur->swr2 / cur->sw);
+    res->sigma2 = cur->som > pdim ? cur->somr2 / (cur->som - pdim) : HUGE_VAL;
+    nt = sqrt(dot3(tv, tv));
+    scale_evidence(cur->h, tv, &res->info_cond, &var);
+    if (isfinite(var) && isfinite(res->sigma2) && nt > 0.0)
+        res->scale_rel_std = sqrt(res->sigma2 * var) / nt;
+    else
+        res->scale_rel_std = HUGE_VAL;
+    return MCG_OK;
+}
+
+int mcg_refine_motion(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2, const double *weights,
+                      const mcg_refine_options *opt, double R[9], double t[3],
+                      mcg_refine_result *res)
+{
+    mcg_refine_options o;
+    lossfn lf;
+    accum cur;
+    lm_state lm;
+    double r[9], tv[3], rho0 = 0.0, ell, pdim, c[3];
+    int i, it, st;
+
+    if (!res)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    res->sigma2 = HUGE_VAL;
+    res->scale_rel_std = HUGE_VAL;
+    st = check_inputs(n, o1, d1, o2, d2, weights, opt, R, t, &o);
+    if (st != MCG_OK)
+        return st;
     if (mcg_project_so3(R, r) != MCG_OK) /* exact rotation from here on */
         return MCG_EINVAL;
     memcpy(tv, t, sizeof tv);
-    fix = o.fix_scale;
-    if (fix) {
+    if (o.fix_scale) {
         rho0 = sqrt(dot3(tv, tv));
         if (!(rho0 > 0.0))
             return MCG_EINVAL; /* no sphere to stay on */
     }
-    pdim = fix ? 5.0 : 6.0;
+    pdim = o.fix_scale ? 5.0 : 6.0;
     lf.loss = o.loss;
     lf.s = o.loss_scale;
     lf.s2 = o.loss_scale * o.loss_scale;
@@ -548,205 +808,22 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
         if (!(tr > 0.0))
             return MCG_EDEGENERATE; /* no ray constrains the motion here */
     }
-    {
-        /* characteristic length L of the rig (independent of the rig frame) */
-        double c[3];
-        ell = origin_spread(n, o1, o2, c);
-    }
-    lambda = o.initial_lambda;
+    /* characteristic length L of the rig (independent of the rig frame) */
+    ell = origin_spread(n, o1, o2, c);
 
-    for (it = 0; it < o.max_iterations; it++) {
-        double pm[6][6], a[36], hm[36], gm[6], dx[6], dfull[6], dmp[6];
-        double b1[3] = {0, 0, 0}, b2[3] = {0, 0, 0}, rn[9], tn[3], dr[9];
-        double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual;
-        int m = fix ? 5 : 6, accepted, small;
+    lm.lambda = o.initial_lambda;
+    lm.nu = 2.0;
+    lm.reason = MCG_REFINE_STOP_MAX_ITERATIONS;
+    lm.converged = 0;
+    lm.trials = 0;
+    for (it = 0; it < o.max_iterations; it++)
+        if (lm_iteration(n, o1, d1, o2, d2, weights, &lf, &o, ell, rho0, r, tv, &cur, &lm))
+            break;
+    res->iterations = lm.trials;
 
-        /* parametrisation P (6 x m): identity, or [dw; B u] with fix_scale */
-        memset(pm, 0, sizeof pm);
-        for (i = 0; i < 3; i++)
-            pm[i][i] = 1.0;
-        if (fix) {
-            double u[3];
-            for (i = 0; i < 3; i++)
-                u[i] = tv[i] / rho0;
-            tangent_basis(u, b1, b2);
-            for (i = 0; i < 3; i++) {
-                pm[3 + i][3] = b1[i];
-                pm[3 + i][4] = b2[i];
-            }
-        } else {
-            for (i = 3; i < 6; i++)
-                pm[i][i] = 1.0;
-        }
-        if (!fix) {
-            memcpy(hm, cur.h, sizeof hm);
-            memcpy(gm, cur.g, sizeof gm);
-        } else { /* hm = P^T H P, gm = P^T g */
-            double hp[6][5];
-            int jj, p;
-            for (p = 0; p < 6; p++)
-                for (jj = 0; jj < m; jj++) {
-                    double acc = 0.0;
-                    for (i = 0; i < 6; i++)
-                        acc += cur.h[6 * p + i] * pm[i][jj];
-                    hp[p][jj] = acc;
-                }
-            for (i = 0; i < m; i++) {
-                gm[i] = 0.0;
-                for (p = 0; p < 6; p++)
-                    gm[i] += pm[p][i] * cur.g[p];
-                for (jj = 0; jj < m; jj++) {
-                    double acc = 0.0;
-                    for (p = 0; p < 6; p++)
-                        acc += pm[p][i] * hp[p][jj];
-                    hm[m * i + jj] = acc;
-                }
-            }
-        }
-        for (i = 0; i < m; i++) {
-            if (hm[m * i + i] > maxd)
-                maxd = hm[m * i + i];
-            if (fabs(gm[i]) > gmax)
-                gmax = fabs(gm[i]);
-        }
-        if (gmax == 0.0) { /* exact stationary point (e.g. zero cost) */
-            converged = 1;
-            reason = MCG_REFINE_STOP_GRADIENT;
-            break;
-        }
-        if (!(maxd > 0.0)) {
-            reason = MCG_REFINE_STOP_STALLED;
-            break;
-        }
-        /* Marquardt damping lambda diag(H), floored so that directions the
-         * data do not constrain at all still get a finite step */
-        memcpy(a, hm, sizeof a);
-        for (i = 0; i < m; i++) {
-            dmp[i] = hm[m * i + i] > 1e-12 * maxd ? hm[m * i + i] : 1e-12 * maxd;
-            a[m * i + i] += lambda * dmp[i];
-        }
-        for (i = 0; i < m; i++)
-            gm[i] = -gm[i];
-        res->iterations = it + 1;
-        if (mcg_spd_solve(m, a, gm, dx) != MCG_OK) {
-            lambda = lambda > 0.0 ? lambda * nu : 1e-12;
-            nu *= 2.0;
-            if (lambda > LAMBDA_MAX) {
-                reason = MCG_REFINE_STOP_STALLED;
-                break;
-            }
-            continue;
-        }
-        for (i = 0; i < 6; i++) {
-            int jj;
-            dfull[i] = 0.0;
-            for (jj = 0; jj < m; jj++)
-                dfull[i] += pm[i][jj] * dx[jj];
-        }
-        /* trust region on top of the damping: a step may turn R by at most
-         * MAX_TURN and move t by at most max(|t|, L) / 2 (L = rig size). In
-         * weakly scale-observable configurations a step along the flat |t|
-         * direction otherwise overshoots, even through t = 0. */
-        {
-            double nw0 = sqrt(dot3(dfull, dfull)), nt0 = sqrt(dot3(dfull + 3, dfull + 3));
-            double ntv = sqrt(dot3(tv, tv)), alpha = 1.0;
-            double lim = 0.5 * (ntv > ell ? ntv : ell);
-            if (nw0 > MAX_TURN)
-                alpha = MAX_TURN / nw0;
-            if (lim > 0.0 && nt0 * alpha > lim)
-                alpha = lim / nt0;
-            for (i = 0; i < m; i++)
-                dx[i] *= alpha;
-            for (i = 0; i < 6; i++)
-                dfull[i] *= alpha;
-        }
-        /* predicted decrease of the IRLS model, -2 g.dx - dx^T H dx
-         * (gm holds -g) */
-        pred = 0.0;
-        for (i = 0; i < m; i++) {
-            int jj;
-            double acc = 0.0;
-            for (jj = 0; jj < m; jj++)
-                acc += hm[m * i + jj] * dx[jj];
-            pred += 2.0 * gm[i] * dx[i] - dx[i] * acc;
-        }
-        /* candidate: R <- exp([dw]x) R, t <- t + dt (or the sphere retraction) */
-        if (mcg_rot_from_angle_axis(dfull, dr) != MCG_OK) {
-            reason = MCG_REFINE_STOP_STALLED;
-            break;
-        }
-        mul33(dr, r, rn);
-        for (i = 0; i < 3; i++)
-            tn[i] = tv[i] + dfull[3 + i];
-        if (fix) {
-            double nn = sqrt(dot3(tn, tn));
-            for (i = 0; i < 3; i++)
-                tn[i] *= rho0 / nn;
-        }
-        evaluate(n, o1, d1, o2, d2, weights, &lf, rn, tn, &trial);
-        actual = cur.cost - trial.cost;
-        nw = sqrt(dot3(dfull, dfull));
-        ndt = sqrt(dot3(dfull + 3, dfull + 3));
-        nt = sqrt(dot3(tv, tv));
-        small = nw <= o.step_tolerance &&
-                ndt <= o.step_tolerance * (nt + ell > 0.0 ? nt + ell : 1.0);
-        accepted = !trial.bad && trial.cost <= cur.cost;
-        if (accepted) {
-            double gain = pred > 0.0 ? actual / pred : 0.0, f;
-            double c0 = cur.cost;
-            memcpy(r, rn, sizeof r);
-            memcpy(tv, tn, sizeof tv);
-            cur = trial;
-            f = 2.0 * gain - 1.0;
-            f = 1.0 - f * f * f;
-            lambda *= f > 1.0 / 3.0 ? f : 1.0 / 3.0;
-            nu = 2.0;
-            if (small) {
-                converged = 1;
-                reason = MCG_REFINE_STOP_STEP;
-                break;
-            }
-            if (actual <= o.cost_tolerance * c0) {
-                converged = 1;
-                reason = MCG_REFINE_STOP_COST;
-                break;
-            }
-        } else {
-            if (small) { /* even a negligible step does not help: at the floor */
-                converged = 1;
-                reason = MCG_REFINE_STOP_STEP;
-                break;
-            }
-            lambda = lambda > 0.0 ? lambda * nu : 1e-12;
-            nu *= 2.0;
-            if (lambda > LAMBDA_MAX) {
-                reason = MCG_REFINE_STOP_STALLED;
-                break;
-            }
-        }
-    }
-
-    /* statistics at the solution; with weights (or coordinates) near the
-     * top of the double range the information matrix J^T W J overflows
-     * although every step's cost stayed finite: no statistics can be given,
-     * and a motion without them is not returned as MCG_OK */
-    if (!all_finite(cur.h, 36) || !isfinite(cur.cost))
-        return MCG_ENUMERIC;
-    res->final_cost = cur.cost;
-    res->converged = converged;
-    res->reason = reason;
-    res->n_used = cur.n_used;
-    memcpy(res->info, cur.h, sizeof res->info);
-    res->rms = sqrt(cur.swr2 / cur.sw);
-    res->sigma2 = cur.som > pdim ? cur.somr2 / (cur.som - pdim) : HUGE_VAL;
-    {
-        double var, nt = sqrt(dot3(tv, tv));
-        scale_evidence(cur.h, tv, &res->info_cond, &var);
-        if (isfinite(var) && isfinite(res->sigma2) && nt > 0.0)
-            res->scale_rel_std = sqrt(res->sigma2 * var) / nt;
-        else
-            res->scale_rel_std = HUGE_VAL;
-    }
+    st = final_statistics(&cur, tv, pdim, &lm, res);
+    if (st != MCG_OK)
+        return st;
     memcpy(R, r, sizeof r);
     memcpy(t, tv, sizeof tv);
     return MCG_OK;

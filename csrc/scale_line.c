@@ -95,8 +95,8 @@ static int terms(size_t n, const double *o1, const double *d1, const double *o2,
     int i;
     for (k = 0; k < n; k++) {
         const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k, *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
-        double n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2];
-        double n2 = u2[0] * u2[0] + u2[1] * u2[1] + u2[2] * u2[2];
+        double n1 = dot3(u1, u1);
+        double n2 = dot3(u2, u2);
         double a[3], b[3], s[3], g0[3], g1[3], k0[3], k1[3], x;
         if (!(n1 >= DIR2_MIN && n2 >= DIR2_MIN) || !isfinite(n1) || !isfinite(n2))
             return 0;
@@ -114,10 +114,10 @@ static int terms(size_t n, const double *o1, const double *d1, const double *o2,
         cross3(b, s, k0);
         cross3(b, w, k1);
         {
-            double e0 = b[0] * g0[0] + b[1] * g0[1] + b[2] * g0[2];
-            double e1 = b[0] * g1[0] + b[1] * g1[1] + b[2] * g1[2];
-            double q0 = a[0] * k0[0] + a[1] * k0[1] + a[2] * k0[2];
-            double q1 = a[0] * k1[0] + a[1] * k1[1] + a[2] * k1[2];
+            double e0 = dot3(b, g0);
+            double e1 = dot3(b, g1);
+            double q0 = dot3(a, k0);
+            double q1 = dot3(a, k1);
             t[k] = e0;
             t[n + k] = e1;
             x = e0 + e1;

@@ -36,14 +36,6 @@
 #define MAX_SKY_ENV ((size_t)1 << 28)
 #define MAX_BLOCKS 2000000
 
-/* [v]x as a row-major 3 x 3 matrix: [v]x y = v x y */
-static void skew3(const double v[3], double s[9])
-{
-    s[0] = 0.0;   s[1] = -v[2]; s[2] = v[1];
-    s[3] = v[2];  s[4] = 0.0;   s[5] = -v[0];
-    s[6] = -v[1]; s[7] = v[0];  s[8] = 0.0;
-}
-
 static int valid_pts(int n, const double *p, int need)
 {
     if (p == NULL)

@@ -7,7 +7,8 @@ Seeds are generated, never committed: deterministic (fixed RNG seed) byte
 strings in the input format the harness decodes.
 
 - C harnesses (fuzz/c/fuzz_input.h): the first byte selects the routine
-  (``MODES`` gives how many each harness has), the rest is a stream the
+  (each harness declares how many with ``#define FUZZ_MODES N``, read here:
+  a new harness needs no edit of this script), the rest is a stream the
   decoder reads as sizes and doubles; each seed is encoded with the
   decoder's "nice" double format (selector byte < 224, then a 16-bit integer
   / 4096), a few with special values (NaN, inf, denormals, 1e150, DBL_MAX).
@@ -21,6 +22,7 @@ strings in the input format the harness decodes.
 from __future__ import annotations
 
 import random
+import re
 import struct
 import sys
 from pathlib import Path
@@ -29,11 +31,21 @@ FUZZ = Path(__file__).resolve().parent
 ROOT = FUZZ.parent
 SEEDS = FUZZ / "build" / "seeds"
 
-# routines selected by the first byte of each C harness's input
-MODES = {"fuzz_linalg": 8, "fuzz_rays": 3, "fuzz_cls": 3, "fuzz_linear17": 2, "fuzz_refine": 2,
-         "fuzz_lp": 3, "fuzz_cone": 2, "fuzz_bnb": 2, "fuzz_linf_local": 1,
-         "fuzz_translation": 3, "fuzz_scale_line": 2,
-         "fuzz_pixel_scale": 2}
+
+
+def c_modes() -> dict[str, int]:
+    """Routines selected by the first byte of each C harness's input: its
+    ``#define FUZZ_MODES N`` (every fuzz/c/fuzz_*.c must declare it)."""
+    modes = {}
+    for src in sorted((FUZZ / "c").glob("fuzz_*.c")):
+        m = re.search(r"^#define FUZZ_MODES (\d+)\b", src.read_text(), re.M)
+        if m is None:
+            sys.exit(f"make_corpus: {src.relative_to(ROOT)} declares no '#define FUZZ_MODES N'")
+        modes[src.stem] = int(m.group(1))
+    return modes
+
+
+MODES = c_modes()
 
 # the calibration files, in the order fuzz/python/fuzz_calibration.py indexes
 # them, with the sibling files its byte 1 can select instead (byte 1 % 4 >= 2:

@@ -15,6 +15,10 @@
 #include "fuzz_input.h"
 #include "mcgeom.h"
 
+/* routines selected by the first input byte (fuzz/make_corpus.py writes
+ * seeds for each) */
+#define FUZZ_MODES 8
+
 #define MAXD 12 /* matrices up to 12 x 12: every code path, fast */
 
 /* |A - B|_max over n entries relative to scale, for finite inputs */
@@ -407,7 +411,7 @@ static void fuzz_rotations(fz_in *in)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_in in = fz_make(data, size);
-    switch (fz_u8(&in) % 8) {
+    switch (fz_u8(&in) % FUZZ_MODES) {
     case 0:
         fuzz_qr(&in);
         break;

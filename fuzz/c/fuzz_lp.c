@@ -19,6 +19,10 @@
 #include "fuzz_input.h"
 #include "mcgeom.h"
 
+/* routines selected by the first input byte (fuzz/make_corpus.py writes
+ * seeds for each) */
+#define FUZZ_MODES 3
+
 #define MAXM 48
 
 static int glpk_ok = 0;
@@ -112,7 +116,7 @@ static int solve(int glpk, int dim, int m, const double *A, const double *b, dou
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_in in = fz_make(data, size);
-    int mode = fz_u8(&in) % 3, dim, m, vm, k, i, st[2], planted = 0, contradiction = -1;
+    int mode = fz_u8(&in) % FUZZ_MODES, dim, m, vm, k, i, st[2], planted = 0, contradiction = -1;
     int short_work = (fz_u8(&in) % 32) == 0;
     double A[MAXM * 3], b[MAXM], x[2][3], p[3], S, mp = -INFINITY;
     uint8_t dsel = fz_u8(&in);

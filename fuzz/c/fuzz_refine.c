@@ -15,6 +15,10 @@
 #include "fuzz_input.h"
 #include "mcgeom.h"
 
+/* routines selected by the first input byte (fuzz/make_corpus.py writes
+ * seeds for each) */
+#define FUZZ_MODES 2
+
 #define MAXN 64
 
 static double norm3(const double *v)
@@ -25,7 +29,7 @@ static double norm3(const double *v)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_in in = fz_make(data, size);
-    int mode = fz_u8(&in) % 2, valid, st, i, use_w, use_opt;
+    int mode = fz_u8(&in) % FUZZ_MODES, valid, st, i, use_w, use_opt;
     int n = fz_size(&in, 6, MAXN, &valid);
     static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], w[MAXN];
     double Rt[9], tt[3], R[9], t[3], R0[9], t0[3];
