@@ -31,8 +31,12 @@ import numpy as np
 
 from . import _core, registry
 from .errors import DegenerateError
-from .observability import (refine_centred, rotation_only_fit, rotation_only_residuals,
-                            scale_profile, scale_verdict, travel_direction)
+# travel_direction: the direction an estimator reports when |t| is not
+# observable; the robust layer finishes any estimator's motion and must report
+# the same (see mcgeom.estimators._common: no estimator imports this module)
+from .estimators._common import travel_direction
+from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
+from .observability import scale_profile, scale_verdict
 from .types import RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
