@@ -67,11 +67,11 @@ class EstimatorInfo:
     objective: Optional[Callable] = None
 
     def __call__(self, rays, **options):
-        _check_distinct(rays, self.min_sample, self.name)
+        check_distinct(rays, self.min_sample, self.name)
         return self.func(rays, **options)
 
 
-def _check_distinct(rays, need: int, name: str) -> None:
+def check_distinct(rays, need: int, name: str) -> None:
     """DegenerateError when repeated correspondences leave fewer distinct ones
     than ``need`` (the minimal sample): copies of one correspondence constrain
     no more than it does, and estimators would otherwise return a motion the
