@@ -111,7 +111,7 @@ def test_layers():
 
 
 _ALLOWED_OWNERS = {"self", "cls", "_core", "lib", "ffi"}   # _core: the cffi wrapper
-#: files this change may not edit (tracked in issue 16 with their owners)
+#: known exceptions in files outside this restructuring (synth.py, bench/), left to their owners
 _KNOWN = {("synth.py", "cam", "_round_trip_ok"),
           ("bench/known_rotation.py", "multiview", "_relations")}
 
