@@ -1,5 +1,10 @@
 """OpenCV-style façade: rig motion from pixel correspondences, like ``cv2.findEssentialMat``.
 
+This module only converts OpenCV-style arguments and calls the library: the
+rays come from :meth:`mcgeom.rig.Rig.ray_pairs_prechecked`, the pixel-noise
+model from :mod:`mcgeom.pixel_noise`, the search from :func:`mcgeom.robust.ransac`
+or the registered estimator.
+
 ``estimateRigMotion`` takes pixels of a calibrated rig (the cameras of
 :class:`mcgeom.rig.Rig`), a ``prob``/``threshold`` (pixels)/``maxIters`` triple
 and an optional input mask, and returns ``retval, R, t, mask`` in the
@@ -18,14 +23,15 @@ name may be passed as a string instead. Estimators that can drive RANSAC
 
 from __future__ import annotations
 
-from typing import Any, Callable, Optional, Union
+from typing import Any, Optional
 
 import numpy as np
 
-from . import _core, registry
-from . import robust as _robust
+from . import registry
+from . import robust as _robust   # (the name robust is estimate()'s flag)
+from .pixel_noise import pixels_per_radian, sampson_pixel_scale
 from .rig import Rig
-from .types import RayPairs, RigMotion
+from .types import RigMotion
 
 __all__ = [
     "RIG_5P1_RANSAC", "RIG_LINEAR17", "RIG_LINEAR17_RANSAC", "RIG_5P1_DIRECT",
@@ -91,64 +97,6 @@ def _resolve(method: str, robust_flag: Optional[bool]) -> tuple[str, bool]:
     return method, bool(robust_flag)
 
 
-def _effective_focal(rig: Rig, rays) -> np.ndarray:
-    """Pixels per radian of Sampson residual, per correspondence.
-
-    A pixel error at angle theta from a pinhole camera's axis moves the bearing
-    by cos^2(theta) / f radians radially and cos(theta) / f tangentially; the
-    mean variance of the two bearings of a correspondence, (cos^4 + cos^2) / 2
-    per bearing, gives f_eff = f / sqrt(mean). Thresholds in pixels then mean
-    pixels across the whole image, and the refinement weights residuals by
-    their pixel-noise variance.
-    """
-    Ks = rig._Ks  # type: ignore[attr-defined]  # stacked once by the Rig
-    focal = 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])
-    axes = rig._Rs[:, 2, :]  # type: ignore[attr-defined]  # optical axes, rig frame
-    var = np.zeros(len(rays))
-    for ids, d in ((rays.cam1, rays.dirs1), (rays.cam2, rays.dirs2)):
-        cz = np.clip(np.einsum("ij,ij->i", axes[ids], d), 1e-3, 1.0)
-        var += 0.5 * (cz ** 4 + cz ** 2) / focal[ids] ** 2
-    return 1.0 / np.sqrt(0.5 * var)
-
-
-def _motion_focal(rig: Rig) -> Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]:
-    """Pixels per radian of each correspondence's Sampson residual at a given motion.
-
-    :func:`_effective_focal` averages the pixel-noise variance of a bearing over
-    the directions in the image; the Sampson error (thesis eq. 8.15 and
-    ``csrc/refine.c``) only feels the noise along the gradient of the epipolar
-    constraint, whose direction the motion fixes. With the tangent gradients
-    ``g1 = P(a) (d2 x c)`` (bearing ``a = R d1``) and ``g2 = P(d2) (c x a)``,
-    the angular residual is ``e / sqrt(|g1|^2 + |g2|^2)``, while unit pixel
-    noise moves ``e`` by a variance ``sum_k cz_k^2 / f_k^2 (|g_k|^2 -
-    (g_k . axis_k)^2)`` (a pinhole bearing's covariance: ``cos^4 / f^2``
-    radially, ``cos^2 / f^2`` tangentially); their ratio gives the residual in
-    pixels, i.e. the image-plane Sampson error -- the first-order maximum
-    likelihood residual for isotropic pixel noise. Same lens assumption as
-    :func:`_effective_focal` (undistorted pinhole), whose value is kept where
-    the pixel variance vanishes (no first-order constraint). Computed by
-    ``_core.sampson_pixel_scale``.
-    """
-    Ks = rig._Ks  # type: ignore[attr-defined]
-    focal = 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])
-    axes = rig._Rs[:, 2, :]  # type: ignore[attr-defined]  # optical axes, rig frame
-
-    min_var_ratio = 1e-12 / float(np.square(focal).max())
-
-    def motion_focal(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> np.ndarray:
-        # in C (csrc/pixel_scale.c): ~30 array passes in numpy, ~0.4 ms of a
-        # Ladybug problem per call
-        f = _core.sampson_pixel_scale(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
-                                      R, t, axes[rays.cam1], axes[rays.cam2],
-                                      focal[rays.cam1], focal[rays.cam2], min_var_ratio)
-        bad = f == 0.0                   # no first-order constraint
-        if bad.any():
-            f[bad] = _effective_focal(rig, rays)[bad]
-        return f
-
-    return motion_focal
-
-
 def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
@@ -184,14 +132,15 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     name, run_robust = _resolve(method, robust)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
-    rays_all = rig._ray_pairs_checked(p1, p2, ids1, ids2)
+    rays_all = rig.ray_pairs_prechecked(p1, p2, ids1, ids2)
     # without a mask every correspondence is used: no copy of the rays
     keep = None if use.all() else np.flatnonzero(use)
     rays = rays_all if keep is None else rays_all.take(keep)
     if run_robust:
-        f = _effective_focal(rig, rays)
+        # thresholds in pixels: the pixel-noise model of the rig converts them
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
-                          seed=seed, focal=f, motion_focal=_motion_focal(rig), **options)
+                           seed=seed, focal=pixels_per_radian(rig, rays),
+                           motion_focal=sampson_pixel_scale(rig), **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:

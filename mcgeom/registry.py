@@ -6,6 +6,16 @@ the minimal sample size, the generalized-camera kinds it supports (thesis
 ch. 8.3), its family (linear / minimal / globally optimal / refinement),
 whether it needs a known rotation and whether it recovers the metric scale.
 
+The contract a plugin fulfils is written once, below, as :class:`EstimatorPlugin`
+(a ``typing.Protocol`` that :class:`EstimatorInfo` satisfies) and the
+protocols of its callables: :class:`Estimator` (required), and the optional
+hooks through which :mod:`mcgeom.robust` drives it -- :class:`MinimalSolver`
+with :class:`Sampler` (classic RANSAC: draw ``min_sample`` correspondences,
+solve, score), :class:`Proposer` (a method-specific robust search whose
+motions RANSAC scores and refines) -- and :class:`Objective` (set-valued
+global optima). :func:`register` and :class:`EstimatorInfo` are annotated with
+them; ``tests/test_registry_contract.py`` checks the built-ins against them.
+
 Third-party packages register through the entry-point group
 ``mcgeom.estimators``: each entry point names a module (or a callable) whose
 import registers its estimators with :func:`register`. Entry points are
@@ -16,10 +26,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from importlib import metadata
-from typing import Callable, Iterable, Optional
+from typing import Any, Callable, Iterable, Optional, Protocol, Union
+
+import numpy as np
+
+from .types import RayPairs, RigMotion
 
 __all__ = [
     "CAMERA_KINDS", "FAMILIES", "EstimatorInfo", "register", "get", "names",
+    "Estimator", "MinimalSolver", "Sampler", "Proposer", "Objective", "EstimatorPlugin",
+    "check_distinct",
     "list_estimators", "unregister", "load_plugins", "ENTRY_POINT_GROUP",
     "lp_backends", "set_default_lp_backend", "default_lp_backend", "resolve_lp_backend",
     "glpk_status",
@@ -34,12 +50,123 @@ CAMERA_KINDS = ("most-general", "locally-central", "axial", "locally-central-and
 FAMILIES = ("linear", "minimal", "globally-optimal", "refinement")
 
 
-@dataclass(frozen=True)
-class EstimatorInfo:
-    """A registered estimator and its metadata."""
+# ------------------------------------------------------------ the contract
+# Frames and units for every callable below (DESIGN.md section 3): rays in the
+# rig frame (origins at the camera centres, metres; unit directions), camera
+# ids in ``rays.cam1``/``rays.cam2`` when known; a motion ``(R, t)`` is
+# rig2_from_rig1, ``X2 = R X1 + t``, ``R`` a (3, 3) rotation, ``t`` (3,) in
+# metres; residuals and thresholds in radians (Sampson angular error of the
+# generalized epipolar constraint, thesis eq. 8.15). The hooks' parameters are
+# positional: the robust layer calls them so.
+
+class Estimator(Protocol):
+    """The estimator: ``fn(rays, **options) -> RigMotion`` (required).
+
+    Must: accept the :class:`RayPairs` positionally and its documented options
+    (``register(options=...)``) as keywords; return a :class:`RigMotion` with
+    ``R``, ``t`` (metric when ``verdict.observable``, else unit length or zero),
+    the scale verdict and ``method``; raise ValueError for bad or too few
+    correspondences and :class:`mcgeom.errors.DegenerateError` when the data do
+    not determine the motion -- never return a motion the data do not support.
+    Equivalent inputs (ray order, rig frame) must give equivalent results.
+    """
+
+    def __call__(self, rays: RayPairs, /, **options: Any) -> RigMotion: ...
+
+
+class MinimalSolver(Protocol):
+    """``solver(sample) -> [(R, t), ...]``: every motion consistent with a minimal sample.
+
+    ``sample`` holds exactly ``min_sample`` correspondences (as the plugin's
+    :class:`Sampler`, or the default sampler, drew them). Returns all
+    solutions (possibly none); each ``(R, t)`` must satisfy the sample's
+    epipolar constraints to rounding. A degenerate sample returns ``[]`` or
+    raises :class:`mcgeom.errors.DegenerateError` (the robust layer skips it).
+    The robust layer scores each solution on all correspondences (cf. PoseLib's
+    ``generate_models``).
+    """
+
+    def __call__(self, sample: RayPairs, /) -> list[tuple[np.ndarray, np.ndarray]]: ...
+
+
+class Sampler(Protocol):
+    """``sampler(rays, rng) -> index array``: one minimal sample.
+
+    Returns ``min_sample`` distinct indices into ``rays`` (an int array),
+    drawn with ``rng`` only (the run is then reproducible from the seed), in
+    the layout the :class:`MinimalSolver` expects. ValueError when ``rays``
+    cannot yield such a sample. Optional: the default spreads the sample across
+    camera pairs (:func:`mcgeom.robust.sample_across_cameras`).
+    """
+
+    def __call__(self, rays: RayPairs, rng: np.random.Generator, /) -> np.ndarray: ...
+
+
+class Proposer(Protocol):
+    """``proposer(rays, threshold, prob, rng)``: hypotheses from a method-specific search.
+
+    ``threshold`` is the inlier threshold in radians, ``prob`` the RANSAC
+    confidence, ``rng`` the only source of randomness. Yields ``(R, t)`` or
+    ``(R, t, expected_inlier_ratio)`` (the fraction of the correspondences the
+    search expects the motion to explain); the robust layer scores and refines
+    each on all correspondences and stops asking once one explains about the
+    expected ratio (e.g. the two-stage RANSAC of thesis ch. 7.4). Yielding
+    nothing makes the robust layer fall back to the minimal solver.
+    """
+
+    def __call__(self, rays: RayPairs, threshold: float, prob: float,
+                 rng: np.random.Generator, /
+                 ) -> Iterable[Union[tuple[np.ndarray, np.ndarray],
+                                     tuple[np.ndarray, np.ndarray, float]]]: ...
+
+
+class Objective(Protocol):
+    """``objective(rays, R) -> float``: the value a set-valued global optimum minimises.
+
+    For a globally optimal estimator whose optimum may be a set of rotations
+    (an L-infinity minimum, radians): the value at rotation ``R``; the
+    estimator's results then carry ``info["linf"]`` and the certified
+    ``info["gap"]``, and equivalent inputs must give values within the gaps.
+    """
+
+    def __call__(self, rays: RayPairs, R: np.ndarray, /) -> float: ...
+
+
+class EstimatorPlugin(Protocol):
+    """What a registered estimator provides (:class:`EstimatorInfo` is one).
+
+    ``func`` (:class:`Estimator`) and ``min_sample`` (the fewest
+    correspondences that determine the motion: the size of a minimal sample)
+    are required; ``camera_kinds`` (of :data:`CAMERA_KINDS`), ``family`` (of
+    :data:`FAMILIES`), ``needs_rotation`` and ``recovers_scale`` describe it.
+    RANSAC (:mod:`mcgeom.robust`) can drive the estimator when it has a
+    ``minimal_solver`` (optionally with its ``sampler``) or a ``proposer``:
+    sample size ``min_sample``, generate models with the minimal solver or
+    the proposer, score them (MSAC on the Sampson residual), refine the best
+    on its inliers (the centred refinement, not a hook) -- the split of
+    PoseLib's ``robust/ransac_impl.h`` (sample_sz, generate_models,
+    score_model, refine_model).
+    """
 
     name: str
-    func: Callable
+    func: Estimator
+    min_sample: int
+    camera_kinds: tuple[str, ...]
+    family: str
+    needs_rotation: bool
+    recovers_scale: bool
+    minimal_solver: Optional[MinimalSolver]
+    sampler: Optional[Sampler]
+    proposer: Optional[Proposer]
+    objective: Optional[Objective]
+
+
+@dataclass(frozen=True)
+class EstimatorInfo:
+    """A registered estimator and its metadata (fulfils :class:`EstimatorPlugin`)."""
+
+    name: str
+    func: Estimator
     min_sample: int
     camera_kinds: tuple[str, ...]
     family: str
@@ -47,37 +174,24 @@ class EstimatorInfo:
     recovers_scale: bool = True
     description: str = ""
     options: dict = field(default_factory=dict)
-    #: ``solver(sample: RayPairs) -> list[(R, t)]``: every motion consistent with a
-    #: minimal sample (``min_sample`` rays), for the robust layer; None if the
-    #: estimator cannot be driven by minimal samples
-    minimal_solver: Optional[Callable] = None
-    #: ``sampler(rays: RayPairs, rng) -> index array`` drawing one minimal sample;
+    # the hooks of the contract (see the protocols above); None = not provided
+    minimal_solver: Optional[MinimalSolver] = None
     #: None = the robust layer's default (spread across cameras)
-    sampler: Optional[Callable] = None
-    #: ``proposer(rays, threshold, prob, rng)``: an iterable of ``(R, t)`` or
-    #: ``(R, t, expected_inlier_ratio)`` from a method-specific robust search
-    #: (e.g. the two-stage RANSAC of thesis ch. 7.4); the robust layer scores and
-    #: refines them and stops once one explains the expected inlier ratio
-    proposer: Optional[Callable] = None
-    #: ``objective(rays, R) -> float``: for a globally optimal estimator whose
-    #: optimum may be a set of rotations (an L-infinity minimum), the value it
-    #: minimises; its results carry ``info["linf"]`` and the certified
-    #: ``info["gap"]``. Equivalent inputs must then give equally good results
-    #: (values within the gaps), not necessarily the same rotation.
-    objective: Optional[Callable] = None
+    sampler: Optional[Sampler] = None
+    proposer: Optional[Proposer] = None
+    objective: Optional[Objective] = None
 
-    def __call__(self, rays, **options):
-        _check_distinct(rays, self.min_sample, self.name)
+    def __call__(self, rays: RayPairs, **options: Any) -> RigMotion:
+        check_distinct(rays, self.min_sample, self.name)
         return self.func(rays, **options)
 
 
-def _check_distinct(rays, need: int, name: str) -> None:
+def check_distinct(rays: RayPairs, need: int, name: str) -> None:
     """DegenerateError when repeated correspondences leave fewer distinct ones
     than ``need`` (the minimal sample): copies of one correspondence constrain
     no more than it does, and estimators would otherwise return a motion the
     data do not determine (or search for one at length)."""
     from .errors import DegenerateError
-    from .types import RayPairs
     if not isinstance(rays, RayPairs) or len(rays) < need:
         return  # the estimator's own checks name the problem
     k = rays.n_distinct(at_least=need)
@@ -93,9 +207,9 @@ _plugins_loaded = False
 def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family: str,
              needs_rotation: bool = False, recovers_scale: bool = True,
              description: str = "", options: Optional[dict] = None,
-             minimal_solver: Optional[Callable] = None, sampler: Optional[Callable] = None,
-             proposer: Optional[Callable] = None, objective: Optional[Callable] = None,
-             replace: bool = False) -> Callable[[Callable], Callable]:
+             minimal_solver: Optional[MinimalSolver] = None, sampler: Optional[Sampler] = None,
+             proposer: Optional[Proposer] = None, objective: Optional[Objective] = None,
+             replace: bool = False) -> Callable[[Estimator], Estimator]:
     """Decorator registering ``fn(rays, **options) -> RigMotion`` under ``name``.
 
     ``options`` documents the keyword options (name -> short description).
@@ -115,7 +229,7 @@ def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family:
     if not name or not isinstance(name, str):
         raise ValueError("estimator name must be a non-empty string")
 
-    def deco(fn: Callable) -> Callable:
+    def deco(fn: Estimator) -> Estimator:
         if name in _REGISTRY and not replace:
             raise ValueError(f"estimator {name!r} is already registered")
         _REGISTRY[name] = EstimatorInfo(name, fn, int(min_sample), kinds, family,

@@ -426,6 +426,18 @@ class Rig:
         return self._centres  # type: ignore[attr-defined]
 
     @property
+    def intrinsics(self) -> np.ndarray:
+        """(M, 3, 3) intrinsic matrices ``K`` of the cameras in id order, pixels
+        (read-only; stacked once: the cameras are immutable)."""
+        return self._Ks  # type: ignore[attr-defined]
+
+    @property
+    def rotations(self) -> np.ndarray:
+        """(M, 3, 3) rotations cam_from_rig of the cameras in id order (read-only):
+        row 2 of ``rotations[i]`` is camera i's optical axis in the rig frame."""
+        return self._Rs  # type: ignore[attr-defined]
+
+    @property
     def names(self) -> tuple[str, ...]:
         """Camera names, in id order."""
         return tuple(c.name for c in self.cameras)
@@ -533,13 +545,20 @@ class Rig:
             raise ValueError(f"pixels2 has {px2.shape[0]} rows but pixels1 has {px1.shape[0]}")
         ids1 = self._check_ids("cam1", cam1, px1.shape[0])
         ids2 = ids1 if cam2 is None else self._check_ids("cam2", cam2, px2.shape[0])
-        return self._ray_pairs_checked(px1, px2, ids1, ids2)
+        return self.ray_pairs_prechecked(px1, px2, ids1, ids2)
 
-    def _ray_pairs_checked(self, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
-                           ids2: np.ndarray) -> RayPairs:
-        """:meth:`ray_pairs` of finite float64 (N, 2) pixels and int64 ids of this rig's
-        cameras, already checked by the caller (``mcgeom.cv`` checks its input
-        itself: checking again would cost as much as the bearings)."""
+    def ray_pairs_prechecked(self, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
+                             ids2: np.ndarray) -> RayPairs:
+        """:meth:`ray_pairs` without its argument checks, for callers that checked them.
+
+        Preconditions (the caller's to guarantee; nothing is checked here):
+        ``px1``, ``px2`` finite float64 C-contiguous (N, 2) pixels, ``ids1``,
+        ``ids2`` (N,) int64 ids in ``0 .. len(self) - 1``. A pixel without a
+        finite bearing is still a ValueError. ``mcgeom.cv`` checks its own
+        (OpenCV-style) input: checking again would cost as much as the
+        bearings (measured: 69 of 190 us at 300 Ladybug correspondences,
+        2.3 % of an ``estimateRigMotion``).
+        """
         o1, d1 = self._rays_checked(ids1, px1)
         o2, d2 = self._rays_checked(ids2, px2)
         return RayPairs(o1, d1, o2, d2, ids1, ids2.copy())

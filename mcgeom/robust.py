@@ -15,7 +15,8 @@ constraint (``_core.gec_residuals``), in radians on the unit sphere. With
 ``focal`` given (pixels, one value or one per correspondence) thresholds and
 residuals are in pixels: radians x focal, the usual pinhole approximation;
 per-correspondence values also weight the refinements (variance ~ 1/focal^2),
-e.g. the effective focal length at each pixel that :mod:`mcgeom.cv` computes.
+e.g. the effective focal length at each pixel of
+:func:`mcgeom.pixel_noise.pixels_per_radian` (which :mod:`mcgeom.cv` passes).
 ``motion_focal`` (optional) gives the same per correspondence for a given
 motion: the exact first-order pixel scaling, which depends on the direction of
 the epipolar constraint's gradient; the final refinement uses it.
@@ -31,13 +32,19 @@ import numpy as np
 
 from . import _core, registry
 from .errors import DegenerateError
-from .observability import (refine_centred, rotation_only_fit, rotation_only_residuals,
-                            scale_profile, scale_verdict, travel_direction)
+# travel_direction: the direction an estimator reports when |t| is not
+# observable; the robust layer finishes any estimator's motion and must report
+# the same (see mcgeom.estimators._common: no estimator imports this module)
+from .estimators._common import travel_direction
+from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
+from .observability import scale_profile, scale_verdict
 from .types import RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
 
-#: ``motion_focal(rays, R, t)``: pixels per radian of each residual at motion (R, t)
+#: ``motion_focal(rays, R, t)``: (N,) pixels per radian of each residual at the
+#: motion ``X2 = R X1 + t`` (rig frame, ``t`` in metres); e.g.
+#: :func:`mcgeom.pixel_noise.sampson_pixel_scale`
 MotionFocal = Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]
 
 
@@ -163,6 +170,7 @@ class _Scorer:
         # pixels, so its variance under pixel noise is ~ 1 / f_i^2.
         med = None if focal is None else np.median(focal)   # one median serves both
         self.weights = None if focal is None or np.ptp(focal) == 0 else (focal / med) ** 2
+        # loss scale in radians (the threshold, converted from pixels if needed)
         self.loss_scale = thr if focal is None else thr / float(med)
         self.best: Optional[tuple[np.ndarray, np.ndarray]] = None
         self.best_score = np.inf
@@ -203,7 +211,7 @@ class _Scorer:
                 # the length of the centroid's translation is held: LO is
                 # about the inlier set, and near the critical motion a free
                 # fit slides |t| towards infinity (the final stage frees it)
-                out = _refine(self.rays.take(inl), R, t, self._loss_scale(), "cauchy",
+                out = _refine(self.rays.take(inl), R, t, self.loss_scale, "cauchy",
                               self._w(inl), fix_scale=True)
             except (ValueError, ArithmeticError):
                 return
@@ -219,10 +227,6 @@ class _Scorer:
 
     def _w(self, mask: np.ndarray) -> Optional[np.ndarray]:
         return None if self.weights is None else self.weights[mask]
-
-    def _loss_scale(self) -> float:
-        """Loss scale in radians (the threshold, converted from pixels if needed)."""
-        return self.loss_scale
 
     def scaling_at(self, R: np.ndarray, t: np.ndarray
                    ) -> tuple[Optional[np.ndarray], Optional[np.ndarray], float]:
@@ -291,7 +295,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         raise ValueError(f"too few correspondences: {method} needs at least "
                          f"{info_est.min_sample}, got {n}")
     rays.check_finite()
-    registry._check_distinct(rays, info_est.min_sample, method)
+    registry.check_distinct(rays, info_est.min_sample, method)
     f = _focal_array(focal, n)
     rng = np.random.default_rng(options.seed)
     if motion_focal is not None and f is None:
@@ -344,7 +348,7 @@ def _run_proposer(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOpti
     # per Ladybug problem; a second round changed no result, measured.)
     lo = scorer.lo_rounds
     scorer.lo_rounds = min(1, options.lo_max_rounds)
-    for prop in info_est.proposer(rays, scorer._loss_scale(), options.prob, rng):
+    for prop in info_est.proposer(rays, scorer.loss_scale, options.prob, rng):
         iterations += 1
         scorer.offer(prop[0], prop[1])
         # a proposer may say which inlier ratio to expect (e.g. the one of its
@@ -466,7 +470,7 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         profile = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
                                 (1.0 / k, k), options.loss, scale_used, w_used)
         info["scale_profile"] = profile
-    noise_level = scale_used if options.refine else scorer._loss_scale()
+    noise_level = scale_used if options.refine else scorer.loss_scale
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std,
                             noise_level=noise_level, profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")

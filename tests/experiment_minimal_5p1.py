@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 from mcgeom import synth
-from mcgeom.estimators.five_plus_one import critical_angles, minimal_solutions
+from mcgeom.estimators.five_plus_one_minimal import critical_angles, minimal_solutions
 from mcgeom.types import RayPairs
 
 TOL = 1e-8

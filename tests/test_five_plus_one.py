@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 import mcgeom
 from mcgeom import synth
 from mcgeom.errors import DegenerateError
-from mcgeom.estimators import five_plus_one as fpo
+from mcgeom.estimators import five_plus_one_minimal as minimal
 from problems import rot_err
 
 SETTINGS = settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -40,7 +40,7 @@ def test_eq_7_4_terms_vanish_at_the_true_scale():
     t0 = c - R @ c
     lam = np.linalg.norm(t - t0)
     w = (t - t0) / lam
-    a, b = fpo.scale_terms(p.rays, R, t0, w)
+    a, b = minimal.scale_terms(p.rays, R, t0, w)
     assert np.abs(a + lam * b).max() < 1e-12
     # the 5-point camera's own correspondences carry no scale information (a = 0)
     own = (p.rays.cam1 == a_cam) & (p.rays.cam2 == a_cam)
@@ -49,8 +49,8 @@ def test_eq_7_4_terms_vanish_at_the_true_scale():
 
 def test_minimal_sample_recovers_motion_exactly():
     p = _problem(2)
-    idx = fpo.sample_five_plus_one(p.rays, np.random.default_rng(0))
-    sols = fpo.minimal_solutions(p.rays.take(idx))
+    idx = minimal.sample_five_plus_one(p.rays, np.random.default_rng(0))
+    sols = minimal.minimal_solutions(p.rays.take(idx))
     assert sols
     best = min(sols, key=lambda s: rot_err(s[0], p.R) + np.linalg.norm(s[1] - p.t))
     assert rot_err(best[0], p.R) < 1e-8
@@ -78,10 +78,10 @@ def test_any_camera_can_be_the_five_point_camera():
 
 def test_critical_angle_is_zero_without_rotation():
     rig = synth.generic_rig(4, np.random.default_rng(4))
-    ang = fpo.critical_angles(np.eye(3), np.array([0.3, 0.1, 0.0]), rig.centres, 0)
+    ang = minimal.critical_angles(np.eye(3), np.array([0.3, 0.1, 0.0]), rig.centres, 0)
     assert np.nanmax(ang) < 1e-12
     R = synth.rotation_about([0, 0, 1], 0.2)
-    ang = fpo.critical_angles(R, np.array([0.3, 0.1, 0.0]), rig.centres, 0)
+    ang = minimal.critical_angles(R, np.array([0.3, 0.1, 0.0]), rig.centres, 0)
     assert np.nanmax(ang) > 0.01
 
 
@@ -97,7 +97,7 @@ def test_theorem_3_axis_perpendicular_to_plane_of_centres_is_critical():
     R = synth.rotation_about([0, 0, 1], 0.1)
     d_rel = (R.T - np.eye(3)) @ cb
     t = -R @ (5.0 * d_rel)          # camera a displaces by 5 d_rel
-    ang = fpo.critical_angles(R, t, np.stack([ca, cb]), 0)
+    ang = minimal.critical_angles(R, t, np.stack([ca, cb]), 0)
     assert ang[1] < 1e-9
 
 
@@ -163,7 +163,7 @@ def test_degenerate_sample_raises_or_returns_nothing():
     other = np.flatnonzero(p.rays.cam1 == 1)[:1]
     idx = np.concatenate([np.repeat(own[:1], 5), other])
     try:
-        sols = fpo.minimal_solutions(p.rays.take(idx))
+        sols = minimal.minimal_solutions(p.rays.take(idx))
     except DegenerateError:
         return
     for R, t in sols:   # whatever comes back must not claim the true motion by chance

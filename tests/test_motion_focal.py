@@ -1,4 +1,4 @@
-"""mcgeom.cv._motion_focal: pixels per radian of each correspondence's Sampson
+"""mcgeom.pixel_noise.sampson_pixel_scale: pixels per radian of each correspondence's Sampson
 residual at a motion, so that the final refinement of the robust pipeline
 weighs residuals as the image-plane Sampson error (the first-order maximum
 likelihood residual for isotropic pixel noise). Checked against that error
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from mcgeom import _core, synth
-from mcgeom.cv import _motion_focal
+from mcgeom.pixel_noise import sampson_pixel_scale
 
 
 def _image_sampson(rig, px1, px2, c1, c2, R, t, h=1e-4):
@@ -42,7 +42,7 @@ def test_motion_focal_gives_the_image_plane_sampson_error():
     p = synth.make_problem(rig, R, t, 120, rng, pixel_noise=0.5, cross_fraction=0.3)
     r = rig.ray_pairs(p.pixels1, p.pixels2, p.cam1, p.cam2)
     ang = np.abs(_core.gec_residuals(r.origins1, r.dirs1, r.origins2, r.dirs2, R, t))
-    f = _motion_focal(rig)(r, R, t)
+    f = sampson_pixel_scale(rig)(r, R, t)
     ref = _image_sampson(rig, p.pixels1, p.pixels2, p.cam1, p.cam2, R, t)
     ok = ref > 1e-3  # away from zero residuals, where the ratio is ill-conditioned
     assert ok.sum() > 100

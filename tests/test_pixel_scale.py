@@ -1,5 +1,5 @@
 """``_core.sampson_pixel_scale`` (csrc/pixel_scale.c), the pixels per radian of each
-Sampson residual that ``mcgeom.cv._motion_focal`` returns, against the numpy
+Sampson residual that ``mcgeom.pixel_noise.sampson_pixel_scale`` returns, against the numpy
 implementation it replaced (tests/test_motion_focal.py checks the result against
 the image-plane Sampson error itself)."""
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mcgeom import _core, synth
-from mcgeom.cv import _effective_focal, _motion_focal
+from mcgeom.pixel_noise import pixels_per_radian, sampson_pixel_scale
 
 
 def _rows(a, b):
@@ -17,10 +17,10 @@ def _rows(a, b):
 
 
 def _reference(rig, rays, R, t):
-    """The numpy version of ``_motion_focal(rig)(rays, R, t)`` (unit bearings)."""
-    Ks = rig._Ks
+    """The numpy version of ``sampson_pixel_scale(rig)(rays, R, t)`` (unit bearings)."""
+    Ks = rig.intrinsics
     focal = 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])
-    axes = rig._Rs[:, 2, :]
+    axes = rig.rotations[:, 2, :]
     a = rays.dirs1 @ R.T
     c = t + rays.origins1 @ R.T - rays.origins2
     d2 = rays.dirs2
@@ -34,7 +34,7 @@ def _reference(rig, rays, R, t):
            (_rows(d2, ax2) / focal[rays.cam2]) ** 2 * (n2 - _rows(g2, ax2) ** 2))
     ok = var > 1e-12 * (n1 + n2) / np.square(focal).max()
     f = np.sqrt((n1 + n2) / np.where(ok, var, 1.0))
-    f[~ok] = _effective_focal(rig, rays)[~ok]
+    f[~ok] = pixels_per_radian(rig, rays)[~ok]
     return f
 
 
@@ -46,7 +46,7 @@ def test_matches_numpy_reference(seed):
     t = rng.normal(size=3)
     p = synth.make_problem(rig, R, t, 200, rng, pixel_noise=1.0, outlier_fraction=0.2)
     rays = rig.ray_pairs(p.pixels1, p.pixels2, p.cam1, p.cam2)
-    got = _motion_focal(rig)(rays, R, t)
+    got = sampson_pixel_scale(rig)(rays, R, t)
     np.testing.assert_allclose(got, _reference(rig, rays, R, t), rtol=1e-10)
 
 
@@ -57,8 +57,8 @@ def test_static_camera_falls_back_to_the_effective_focal():
     p = synth.make_problem(rig, np.eye(3), np.array([0.0, 0.0, 1.0]), 60, rng)
     rays = rig.ray_pairs(p.pixels1, p.pixels2, p.cam1, p.cam2)
     intra = rays.take(rays.cam1 == rays.cam2)
-    got = _motion_focal(rig)(intra, np.eye(3), np.zeros(3))
-    np.testing.assert_array_equal(got, _effective_focal(rig, intra))
+    got = sampson_pixel_scale(rig)(intra, np.eye(3), np.zeros(3))
+    np.testing.assert_array_equal(got, pixels_per_radian(rig, intra))
 
 
 def test_bad_input_names_the_problem():

@@ -506,3 +506,22 @@ def test_bad_rig_files(tmp_path, content, message):
 def test_missing_rig_file_is_an_os_error(tmp_path):
     with pytest.raises(FileNotFoundError):
         Rig.load_json(tmp_path / "nope.json")
+
+
+def test_public_accessors_of_the_pixel_noise_model_and_the_prechecked_fast_path():
+    """``intrinsics``/``rotations`` stack the cameras' K and R (read-only), and
+    ``ray_pairs_prechecked`` gives what ``ray_pairs`` gives for checked input."""
+    from mcgeom import synth
+    rng = np.random.default_rng(5)
+    rig = synth.generic_rig(3, rng)
+    np.testing.assert_array_equal(rig.intrinsics, np.stack([c.K for c in rig.cameras]))
+    np.testing.assert_array_equal(rig.rotations, np.stack([c.R for c in rig.cameras]))
+    assert not rig.intrinsics.flags.writeable and not rig.rotations.flags.writeable
+    p = synth.make_problem(rig, synth.random_rotation(rng, 0.2), np.array([0.2, 0.0, 0.1]),
+                           40, rng, cross_fraction=0.3)
+    px1, px2 = np.asarray(p.pixels1, np.float64), np.asarray(p.pixels2, np.float64)
+    c1, c2 = np.asarray(p.cam1, np.int64), np.asarray(p.cam2, np.int64)
+    a = rig.ray_pairs(px1, px2, c1, c2)
+    b = rig.ray_pairs_prechecked(px1, px2, c1, c2)
+    for f in ("origins1", "dirs1", "origins2", "dirs2", "cam1", "cam2"):
+        np.testing.assert_array_equal(getattr(a, f), getattr(b, f))

@@ -44,9 +44,11 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError, NumericalError
-from ..observability import central_travel, refine_centred, scale_verdict, travel_direction
+from ..geometry import refine_centred
+from ..observability import scale_verdict
 from ..registry import get, register, resolve_lp_backend
 from ..types import RayPairs, RigMotion
+from ._common import central_travel, travel_direction
 
 __all__ = ["bnb_lp", "linf_error", "apex_groups"]
 

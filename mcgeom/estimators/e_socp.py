@@ -29,10 +29,12 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..observability import refine_centred, scale_verdict
+from ..geometry import refine_centred
+from ..observability import scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
-from .five_plus_one import LEAST_SQUARES, essential_motions, intra_counts
+from ._common import intra_counts
+from .essential import LEAST_SQUARES, essential_motions
 
 __all__ = ["e_socp", "average_rotations"]
 
