@@ -1,10 +1,15 @@
-"""Built-in estimator plugins; importing this package registers them all."""
+"""Built-in estimator plugins; importing this package registers them all.
 
-from . import linear17  # noqa: F401  (registers "linear17")
-from . import refine  # noqa: F401  (registers "refine")
-from . import five_plus_one  # noqa: F401  (registers "five_plus_one")
-from . import e_socp  # noqa: F401  (registers "e_socp")
-from . import bnb_lp  # noqa: F401  (registers "bnb_lp")
-from . import known_rotation_translation  # noqa: F401  (registers "known_rotation_translation")
+Every public module of this folder is imported here, in name order, and
+registers its estimators with :func:`mcgeom.registry.register` when imported:
+adding an estimator is adding its module (no list to keep here). Modules
+whose name starts with an underscore are shared helpers, imported by the
+estimators that need them.
+"""
 
-__all__ = ["linear17", "refine", "five_plus_one", "e_socp", "bnb_lp", "known_rotation_translation"]
+import importlib
+import pkgutil
+
+__all__ = sorted(m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_"))
+for _name in __all__:
+    importlib.import_module(f"{__name__}.{_name}")
