@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 import pytest
 
-from mcgeom import calibration as C
+from mcgeom import io as C
 from mcgeom.rig import Camera, Rig
 
 DATA = Path(__file__).parent / "data" / "calibration"
@@ -182,7 +182,7 @@ def test_kalibr_subset_parser_agrees_with_pyyaml():
                "a: [it's, 'b''c', \"d]\"]  # comment\nb:\n- - 1\n  - 2\n- [3,\n   4]\nc: ~\n",
                "---\n- k: v\n  w: [1.0e-05, -.inf]\n- - x\n...\n"]
     for text in samples:
-        assert C._parse_yaml_subset(text, "sample") == yaml.safe_load(text)
+        assert C.opencv_yaml._parse_yaml_subset(text, "sample") == yaml.safe_load(text)
 
 
 def test_kalibr_missing_T_cn_cnm1_derived_from_T_cam_imu(tmp_path):
