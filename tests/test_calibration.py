@@ -1,4 +1,4 @@
-"""Tests of mcgeom.calibration: rig loaders for mcgeom JSON, OpenCV FileStorage, Kalibr, COLMAP.
+"""Tests of mcgeom.io: rig loaders for mcgeom JSON, OpenCV FileStorage, Kalibr, COLMAP.
 
 The sample files under tests/data/calibration/ describe two physical rigs:
 
@@ -182,7 +182,7 @@ def test_kalibr_subset_parser_agrees_with_pyyaml():
                "a: [it's, 'b''c', \"d]\"]  # comment\nb:\n- - 1\n  - 2\n- [3,\n   4]\nc: ~\n",
                "---\n- k: v\n  w: [1.0e-05, -.inf]\n- - x\n...\n"]
     for text in samples:
-        assert C.opencv_yaml._parse_yaml_subset(text, "sample") == yaml.safe_load(text)
+        assert C.kalibr._parse_yaml_subset(text, "sample") == yaml.safe_load(text)
 
 
 def test_kalibr_missing_T_cn_cnm1_derived_from_T_cam_imu(tmp_path):
@@ -417,8 +417,13 @@ def test_detect_format_and_dispatch(path, fmt):
     assert C.load_rig(path) == C.load_rig(path, format=fmt)
 
 
-def test_mcgeom_json_dispatches_to_rig_load_json():
-    assert C.load_rig(RIG4_JSON) == Rig.load_json(RIG4_JSON) == C.load_mcgeom_json(RIG4_JSON)
+def test_mcgeom_json_dispatches_to_load_mcgeom_json(tmp_path):
+    rig = C.load_mcgeom_json(RIG4_JSON)
+    assert C.load_rig(RIG4_JSON) == rig
+    C.save_mcgeom_json(rig, tmp_path / "rig.json")
+    assert C.load_rig(tmp_path / "rig.json") == rig
+    with pytest.raises(ValueError, match="Rig"):
+        C.save_mcgeom_json("not a rig", tmp_path / "rig.json")
 
 
 def test_undetectable_file_lists_every_format_tried(tmp_path):
