@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 from mcgeom import io as C
+from mcgeom.io._safe_yaml import MAX_DEPTH, load_yaml
 from mcgeom.rig import Camera, Rig
 
 DATA = Path(__file__).parent / "data" / "calibration"
@@ -176,13 +177,49 @@ def test_kalibr_equidistant_chain_of_three():
     np.testing.assert_allclose(d, T_c1_c0[0, :3], atol=1e-12)  # cam1's x axis in cam0 frame
 
 
-def test_kalibr_subset_parser_agrees_with_pyyaml():
-    yaml = pytest.importorskip("yaml")  # a cross-check only: PyYAML is not a dependency
+def test_kalibr_yaml_is_pyyaml_safe_load():
+    # the restricted loader gives the same data as PyYAML's (Kalibr's own reader)
+    import yaml
     samples = [RADTAN.read_text(), EQUI.read_text(),
                "a: [it's, 'b''c', \"d]\"]  # comment\nb:\n- - 1\n  - 2\n- [3,\n   4]\nc: ~\n",
                "---\n- k: v\n  w: [1.0e-05, -.inf]\n- - x\n...\n"]
     for text in samples:
-        assert C.kalibr._parse_yaml_subset(text, "sample") == yaml.safe_load(text)
+        assert load_yaml(text, "sample") == yaml.safe_load(text)
+    # ... but for numbers with an exponent and no '.', which YAML 1.1 reads as strings
+    assert load_yaml("a: [1e-05, -2E+3, .5e1]\n", "sample") == {"a": [1e-05, -2000.0, 5.0]}
+
+
+@pytest.mark.parametrize("text,line,message", [
+    ("cam0: &a [1, 2]\ncam1: *a\n", 1, "anchors (&a) are not allowed"),
+    ("cam0: [1, 2]\ncam1: *a\n", 2, "aliases (*a) are not allowed"),
+    # billion laughs: refused at the first anchor, before anything is expanded
+    ("a: &a [x, x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
+     "c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b]\ncam0: [*c, *c, *c, *c, *c, *c, *c, *c, *c]\n",
+     1, "anchors (&a) are not allowed"),
+    ("cam0: !!python/object/apply:os.system ['echo pwned']\n", 1,
+     "tags are not allowed (tag:yaml.org,2002:python/object/apply:os.system)"),
+    ("cam0:\n  camera_model: !!python/name:builtins.print ''\n", 2, "tags are not allowed"),
+    ("cam0: !!str pinhole\n", 1, "tags are not allowed"),
+    ("cam0: " + "[" * (MAX_DEPTH + 1) + "]" * (MAX_DEPTH + 1) + "\n", 1,
+     f"nesting deeper than {MAX_DEPTH} levels"),
+    ("cam0:\n" + "  " + "- " * (MAX_DEPTH + 1) + "1\n", 2, f"nesting deeper than {MAX_DEPTH} levels"),
+    ("cam0: {a: 1, a: 2}\n", 1, "duplicate key 'a'"),
+    ("cam0: 1\n---\ncam0: 2\n", 2, "expected a single document"),
+    ("cam0: [1, 2\n", 2, "(while parsing a flow sequence at line 1; truncated file?)"),
+    ("cam0: 1\ncam1: \x07\n", 2, "character U+0007 is not allowed in YAML"),
+], ids=["anchor", "alias", "billion-laughs", "python-tag", "python-name", "str-tag", "deep-flow",
+        "deep-block", "duplicate-key", "two-documents", "truncated", "control-character"])
+def test_kalibr_yaml_refusals(tmp_path, text, line, message):
+    path = tmp_path / "camchain.yaml"
+    path.write_text(text)
+    raises(f"{path}: line {line}: |{message}", C.load_kalibr, path)
+    raises(f"{path}: line {line}: |{message}|format 'kalibr' detected from the content", C.load_rig, path)
+
+
+def test_kalibr_yaml_nesting_at_the_limit_is_read(tmp_path):
+    path = tmp_path / "camchain.yaml"
+    path.write_text("cam1: " + "[" * (MAX_DEPTH - 1) + "]" * (MAX_DEPTH - 1) + "\n")
+    raises(f"{path}|no top-level 'cam0'", C.load_kalibr, path)  # parsed: the depth is allowed
 
 
 def test_kalibr_missing_T_cn_cnm1_derived_from_T_cam_imu(tmp_path):
@@ -451,7 +488,9 @@ def test_load_rig_arguments(tmp_path):
 # --------------------------------------------------------------------------- bad files
 
 @pytest.mark.parametrize("src,fmt,marker,keep,expect", [
-    (RADTAN, "kalibr", "0.07451284, -0.00010", True, "line 29: unterminated flow sequence"),
+    (RADTAN, "kalibr", "0.07451284, -0.00010", True,
+     "line 29: expected ',' or ']', but got '<stream end>' (while parsing a flow sequence; "
+     "truncated file?)"),
     (RADTAN, "kalibr", "  resolution: [752, 480]\n  rostopic: /cam1", False,
      "cam1: missing key 'resolution'"),
     (EQUI, "kalibr", "  intrinsics:\n  - 381.5\n  - 381.25\n", True,
@@ -483,7 +522,8 @@ def test_truncated_colmap_cameras_txt(tmp_path):
 def test_malformed_files(tmp_path):
     tab = variant(tmp_path, RADTAN, "  camera_model: pinhole\n  distortion_coeffs: [-0.28368365",
                   "\tcamera_model: pinhole\n  distortion_coeffs: [-0.28368365")
-    raises(f"{tab}|line 28|tab in indentation", C.load_rig, tab, format="kalibr")
+    raises(f"{tab}: line 28: found character '\\t' that cannot start any token", C.load_rig, tab,
+           format="kalibr")
     dup = variant(tmp_path, RADTAN, "  rostopic: /cam1/image_raw\n",
                   "  rostopic: /cam1/image_raw\n  resolution: [752, 480]\n", "dup.yaml")
     raises(f"{dup}|duplicate key 'resolution'", C.load_kalibr, dup)
@@ -509,7 +549,8 @@ def test_malformed_files(tmp_path):
 
 
 def test_wrong_format(tmp_path):
-    raises(f"{STEREO}|line 6|tags", C.load_rig, STEREO, format="kalibr")
+    # OpenCV's "%YAML:1.0" header is no YAML directive
+    raises(f"{STEREO}: line 1: |while scanning a directive", C.load_rig, STEREO, format="kalibr")
     raises(f"{RADTAN}|not an OpenCV FileStorage file", C.load_rig, RADTAN, format="opencv-yaml")
     raises(f"{RADTAN}|not valid JSON", C.load_rig, RADTAN, format="colmap")
     raises(f"{COLMAP_NEW}|must be a JSON object", C.load_rig, COLMAP_NEW, format="mcgeom-json")

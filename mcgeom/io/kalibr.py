@@ -22,22 +22,18 @@ has ``T_cam_imu`` and ``"cam0"`` otherwise. When a file has both ``T_cn_cnm1`` a
 Pixel coordinates are OpenCV's (Kalibr's corner detection is OpenCV's; its intrinsics are
 used unchanged with OpenCV by everyone), so no offset is applied.
 
-Kalibr writes the file with PyYAML's ``yaml.dump``: older PyYAML writes leaf lists in
-flow style (``- [0.99, 0.01, ...]``), PyYAML >= 5.1 in block style (``- - 0.99``), both
-with PyYAML's *indentless* sequences (``T_cn_cnm1:`` followed by ``- ...`` at the key's
-own indentation), and long flow lists wrap over several lines. PyYAML is not a
-dependency of mcgeom, and ``cv2.FileStorage`` -- even with a ``%YAML:1.0`` header
-prepended -- rejects indentless sequences ("Incorrect indentation"), so this module has
-a small strict parser for the YAML subset Kalibr writes: block mappings and sequences
-(indentless and compact ``- - x`` too), flow sequences (nested, multi-line), plain and
-quoted scalars, comments, one document. Anchors, aliases, tags, flow mappings, block
-scalars, duplicate keys and tabs in indentation are refused with the line number.
+Kalibr writes the file with PyYAML's ``yaml.dump`` and reads it back with PyYAML: older
+PyYAML writes leaf lists in flow style (``- [0.99, 0.01, ...]``), PyYAML >= 5.1 in block
+style (``- - 0.99``), both with PyYAML's *indentless* sequences (``T_cn_cnm1:`` followed by
+``- ...`` at the key's own indentation), and long flow lists wrap over several lines.
+``cv2.FileStorage`` -- even with a ``%YAML:1.0`` header prepended -- rejects indentless
+sequences ("Incorrect indentation"), so the file is read with PyYAML's safe loader,
+restricted to plain data (:mod:`mcgeom.io._safe_yaml`): one document; anchors, aliases,
+tags, duplicate keys and nesting deeper than 64 levels are refused with the line number.
 """
 
 from __future__ import annotations
 
-import json
-import math
 import re
 from typing import Any
 
@@ -45,6 +41,7 @@ import numpy as np
 
 from mcgeom.io._common import (_IDENTITY_POSE, _integer, _make_camera, _make_rig, _read_text,
                                _rotation, _vector, _where)
+from mcgeom.io._safe_yaml import load_yaml
 from mcgeom.rig import Rig
 from mcgeom.validation import numeric
 
@@ -78,336 +75,6 @@ def _matrix(where: str, what: str, value: Any, shape: tuple[int, int]) -> np.nda
         raise ValueError(f"{where}: {what} has non-finite entries")
     return arr
 
-
-# --------------------------------------------------------------------------- YAML subset
-
-class _YamlError(ValueError):
-    pass
-
-
-_FLOAT_RE = re.compile(r"[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)([eE][-+]?[0-9]+)?$")
-_INT_RE = re.compile(r"[-+]?[0-9]+$")
-_SPECIAL_FLOATS = {".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": math.nan,
-                   ".Inf": math.inf, "+.Inf": math.inf, "-.Inf": -math.inf, ".NaN": math.nan,
-                   ".INF": math.inf, "+.INF": math.inf, "-.INF": -math.inf, ".NAN": math.nan}
-_UNSUPPORTED = {"&": "anchors", "*": "aliases", "!": "tags", "|": "block scalars",
-                ">": "block scalars", "{": "flow mappings", "?": "complex keys",
-                "@": "reserved indicators", "`": "reserved indicators"}
-
-
-def _strip_comment(s: str) -> str:
-    """``s`` without a trailing ``# comment`` (a '#' after whitespace, outside quotes)."""
-    i, n, quote = 0, len(s), None
-    while i < n:
-        ch = s[i]
-        if quote == '"':
-            if ch == "\\":
-                i += 1
-            elif ch == '"':
-                quote = None
-        elif quote == "'":
-            if ch == "'" and i + 1 < n and s[i + 1] == "'":
-                i += 1  # '' is an escaped quote
-            elif ch == "'":
-                quote = None
-        elif ch in "'\"" and (i == 0 or s[i - 1] in " \t[,:-"):
-            quote = ch
-        elif ch == "#" and (i == 0 or s[i - 1] in " \t"):
-            return s[:i]
-        i += 1
-    return s
-
-
-class _YamlSubset:
-    """Strict parser for the YAML subset Kalibr (PyYAML ``yaml.dump``) writes."""
-
-    MAX_DEPTH = 64  # nesting limit: a Kalibr file nests 3 deep; no RecursionError on junk
-
-    def __init__(self, text: str, where: str):
-        self.where = where
-        self.depth = 0
-        self.lines: list[list] = []  # [lineno, indent, content]
-        started = ended = False
-        for lineno, raw in enumerate(text.splitlines(), 1):
-            body = _strip_comment(raw).rstrip()
-            if not body.strip():
-                continue
-            stripped = body.lstrip(" ")
-            if stripped.startswith("\t") or "\t" in body[: len(body) - len(stripped)]:
-                self.fail(lineno, "tab in indentation (YAML allows spaces only)")
-            indent = len(body) - len(stripped)
-            if ended:
-                self.fail(lineno, "content after the end-of-document marker '...'")
-            if indent == 0 and re.match(r"---(\s|$)", stripped):
-                if started:
-                    self.fail(lineno, "a second YAML document ('---'): one document expected")
-                started = True
-                stripped = stripped[3:].strip()
-                if not stripped:
-                    continue
-            elif indent == 0 and stripped.startswith("%"):
-                if started or self.lines:
-                    self.fail(lineno, "directive after the start of the document")
-                continue
-            elif indent == 0 and re.match(r"\.\.\.(\s|$)", stripped):
-                ended = True
-                continue
-            started = True
-            self.lines.append([lineno, indent, stripped])
-
-    def fail(self, lineno: int, msg: str) -> None:
-        raise _YamlError(f"{self.where}: line {lineno}: {msg}")
-
-    def parse(self) -> Any:
-        if not self.lines:
-            raise _YamlError(f"{self.where}: empty YAML document")
-        value, i = self.block(0, self.lines[0][1])
-        if i < len(self.lines):
-            lineno, indent, _ = self.lines[i]
-            self.fail(lineno, f"content that does not fit the document's top-level "
-                              f"{'sequence' if isinstance(value, list) else 'structure'} "
-                              f"(indentation {indent})")
-        return value
-
-    # -- block structure
-    @staticmethod
-    def is_item(content: str) -> bool:
-        return content == "-" or content.startswith("- ")
-
-    def split_key(self, lineno: int, content: str) -> tuple[str, str] | None:
-        """``(key, rest)`` if ``content`` is ``key: rest`` / ``key:``, else None."""
-        if content[0] in "\"'":
-            close = content.find(content[0], 1)
-            if close < 0:
-                self.fail(lineno, "unterminated quoted key")
-            key = self.scalar(lineno, content[: close + 1])
-            after = content[close + 1:]
-            if not (after == ":" or after.startswith(": ")):
-                return None
-            return str(key), after[1:].strip()
-        m = re.search(r":(\s|$)", content)
-        if m is None:
-            return None
-        key = content[: m.start()].rstrip()
-        if not key or key[0] in "[]{},#" or key.startswith("- "):
-            return None
-        return key, content[m.end():].strip()
-
-    def nest(self, lineno: int) -> None:
-        self.depth += 1
-        if self.depth > self.MAX_DEPTH:
-            self.fail(lineno, f"nesting deeper than {self.MAX_DEPTH} levels")
-
-    def block(self, i: int, indent: int) -> tuple[Any, int]:
-        self.nest(self.lines[i][0])
-        try:
-            return self._block(i, indent)
-        finally:
-            self.depth -= 1
-
-    def _block(self, i: int, indent: int) -> tuple[Any, int]:
-        lineno, ind, content = self.lines[i]
-        if ind != indent:
-            self.fail(lineno, f"bad indentation ({ind} spaces, expected {indent})")
-        if self.is_item(content):
-            return self.sequence(i, indent)
-        if content[0] in _UNSUPPORTED:
-            self.fail(lineno, f"unsupported YAML feature ({_UNSUPPORTED[content[0]]})")
-        if self.split_key(lineno, content) is not None:
-            return self.mapping(i, indent)
-        value, i = self.inline(i, content, indent)
-        return value, i
-
-    def sequence(self, i: int, indent: int) -> tuple[list, int]:
-        items = []
-        n = len(self.lines)
-        while i < n and self.lines[i][1] == indent and self.is_item(self.lines[i][2]):
-            lineno, _, content = self.lines[i]
-            rest = content[1:].lstrip(" ")
-            if not rest:  # "-" alone: the item is the following, more indented block
-                if i + 1 >= n or self.lines[i + 1][1] <= indent:
-                    items.append(None)
-                    i += 1
-                    continue
-                value, i = self.block(i + 1, self.lines[i + 1][1])
-            elif self.is_item(rest) or (rest[0] not in "[\"'" and self.split_key(lineno, rest)):
-                # compact nested sequence "- - x" or mapping "- key: v": re-read the rest of
-                # the line as a block starting at its own column
-                column = indent + len(content) - len(rest)
-                self.lines[i] = [lineno, column, rest]
-                value, i = self.block(i, column)
-            else:
-                value, i = self.inline(i, rest, indent)
-            items.append(value)
-        if i < n and self.lines[i][1] > indent:
-            self.fail(self.lines[i][0], "unexpected indentation inside a sequence")
-        return items, i
-
-    def mapping(self, i: int, indent: int) -> tuple[dict, int]:
-        out: dict = {}
-        n = len(self.lines)
-        while i < n and self.lines[i][1] == indent:
-            lineno, _, content = self.lines[i]
-            if self.is_item(content):
-                self.fail(lineno, "a sequence item where a 'key: value' was expected")
-            kv = self.split_key(lineno, content)
-            if kv is None:
-                self.fail(lineno, f"expected 'key: value', got {content[:40]!r}")
-            key, rest = kv
-            if key in out:
-                self.fail(lineno, f"duplicate key {key!r}")
-            if rest:
-                out[key], i = self.inline(i, rest, indent)
-            elif i + 1 < n and self.lines[i + 1][1] > indent:
-                out[key], i = self.block(i + 1, self.lines[i + 1][1])
-            elif i + 1 < n and self.lines[i + 1][1] == indent and self.is_item(self.lines[i + 1][2]):
-                out[key], i = self.sequence(i + 1, indent)  # PyYAML's indentless sequence
-            else:
-                out[key], i = None, i + 1
-        if i < n and self.lines[i][1] > indent:
-            self.fail(self.lines[i][0], "unexpected indentation (multi-line plain scalars are "
-                                        "not supported)")
-        return out, i
-
-    # -- inline values: scalars and (possibly multi-line) flow sequences
-    def inline(self, i: int, text: str, parent_indent: int) -> tuple[Any, int]:
-        lineno = self.lines[i][0]
-        if text[0] in _UNSUPPORTED:
-            self.fail(lineno, f"unsupported YAML feature ({_UNSUPPORTED[text[0]]})")
-        if text[0] != "[":
-            if re.search(r":(\s|$)", text) and text[0] not in "\"'":
-                self.fail(lineno, f"unexpected ': ' in a plain value {text[:40]!r} (quote it)")
-            return self.scalar(lineno, text), i + 1
-        j = i + 1
-        while not self.flow_closed(text):
-            if j >= len(self.lines) or self.lines[j][1] <= parent_indent:
-                self.fail(lineno, "unterminated flow sequence '[' (truncated file?)")
-            text += " " + self.lines[j][2]
-            j += 1
-        value, pos = self.flow(lineno, text, 0)
-        if text[pos:].strip():
-            self.fail(lineno, f"unexpected text after a flow sequence: {text[pos:].strip()[:40]!r}")
-        return value, j
-
-    @staticmethod
-    def flow_closed(text: str) -> bool:
-        depth, quote = 0, None
-        k = 0
-        while k < len(text):
-            ch = text[k]
-            if quote == '"':
-                if ch == "\\":
-                    k += 1
-                elif ch == '"':
-                    quote = None
-            elif quote == "'":
-                if ch == "'" and k + 1 < len(text) and text[k + 1] == "'":
-                    k += 1
-                elif ch == "'":
-                    quote = None
-            elif ch in "'\"" and text[:k].rstrip()[-1:] in ("[", ","):
-                quote = ch  # quotes open a scalar only at the start of an item
-            elif ch == "[":
-                depth += 1
-            elif ch == "]":
-                depth -= 1
-                if depth == 0:
-                    return True
-            k += 1
-        return False
-
-    def flow(self, lineno: int, text: str, pos: int) -> tuple[list, int]:
-        """Parse the flow sequence starting at ``text[pos] == '['``; return (list, end)."""
-        self.nest(lineno)
-        try:
-            return self._flow(lineno, text, pos)
-        finally:
-            self.depth -= 1
-
-    def _flow(self, lineno: int, text: str, pos: int) -> tuple[list, int]:
-        assert text[pos] == "["
-        pos += 1
-        items: list = []
-        expect_item = True
-        while True:
-            while pos < len(text) and text[pos] == " ":
-                pos += 1
-            if pos >= len(text):
-                self.fail(lineno, "unterminated flow sequence '['")
-            ch = text[pos]
-            if ch == "]":
-                if expect_item and items:
-                    self.fail(lineno, "empty item in a flow sequence (',]')")
-                return items, pos + 1
-            if not expect_item:
-                if ch != ",":
-                    self.fail(lineno, f"expected ',' or ']' in a flow sequence, got {text[pos:pos + 20]!r}")
-                pos += 1
-                expect_item = True
-                continue
-            if ch == ",":
-                self.fail(lineno, "empty item in a flow sequence (',,')")
-            if ch == "[":
-                value, pos = self.flow(lineno, text, pos)
-            elif ch in "\"'":
-                end = pos + 1
-                while True:
-                    end = text.find(ch, end)
-                    if end < 0:
-                        self.fail(lineno, "unterminated quoted string")
-                    if ch == '"' and text[end - 1] == "\\" and text[end - 2] != "\\":
-                        end += 1
-                        continue
-                    if ch == "'" and end + 1 < len(text) and text[end + 1] == "'":
-                        end += 2
-                        continue
-                    break
-                value, pos = self.scalar(lineno, text[pos:end + 1]), end + 1
-            else:
-                m = re.compile(r"[^,\[\]]*").match(text, pos)
-                token = m.group(0).strip()
-                if token and token[0] in _UNSUPPORTED:
-                    self.fail(lineno, f"unsupported YAML feature ({_UNSUPPORTED[token[0]]})")
-                if re.search(r":(\s|$)", token):
-                    self.fail(lineno, "flow mappings inside sequences are not supported")
-                value, pos = self.scalar(lineno, token), m.end()
-            items.append(value)
-            expect_item = False
-
-    def scalar(self, lineno: int, tok: str) -> Any:
-        if tok[0] == '"':
-            if len(tok) < 2 or tok[-1] != '"':
-                self.fail(lineno, f"unterminated quoted string {tok[:40]!r}")
-            try:
-                return json.loads(tok)
-            except json.JSONDecodeError:
-                self.fail(lineno, f"unsupported escape in {tok[:40]!r}")
-        if tok[0] == "'":
-            if len(tok) < 2 or tok[-1] != "'":
-                self.fail(lineno, f"unterminated quoted string {tok[:40]!r}")
-            return tok[1:-1].replace("''", "'")
-        if tok[0] in _UNSUPPORTED:
-            self.fail(lineno, f"unsupported YAML feature ({_UNSUPPORTED[tok[0]]})")
-        if tok in ("null", "Null", "NULL", "~"):
-            return None
-        if tok in ("true", "True", "TRUE"):
-            return True
-        if tok in ("false", "False", "FALSE"):
-            return False
-        if _INT_RE.match(tok):
-            return int(tok)
-        if _FLOAT_RE.match(tok):
-            return float(tok)
-        if tok in _SPECIAL_FLOATS:
-            return _SPECIAL_FLOATS[tok]
-        return tok
-
-
-def _parse_yaml_subset(text: str, where: str) -> Any:
-    return _YamlSubset(text, where).parse()
-
-
-# --------------------------------------------------------------------------- Kalibr
 
 _KALIBR_OTHER_MODELS = {"omni": "omnidirectional (Mei)", "ds": "double sphere",
                         "eucm": "extended unified"}
@@ -491,7 +158,7 @@ def load_kalibr(path: Any, *, rig_frame: str | None = None) -> Rig:
     where = _where(path)
     if rig_frame not in (None, "cam0", "imu"):
         raise ValueError(f"rig_frame must be 'cam0' or 'imu', got {rig_frame!r}")
-    doc = _parse_yaml_subset(_read_text(path), where)
+    doc = load_yaml(_read_text(path), where)
     if not isinstance(doc, dict):
         raise ValueError(f"{where}: not a Kalibr camchain: the top level must be a mapping "
                          f"cam0, cam1, ..., got {type(doc).__name__}")
