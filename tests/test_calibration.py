@@ -672,6 +672,19 @@ def test_unsupported_lens_models(tmp_path):
            tmp_path / "rig.json", rig_index=1)
 
 
+def test_kalibr_model_names_must_be_strings(tmp_path):
+    # a list or mapping (YAML flow collections) where a name belongs: ValueError, not TypeError
+    lst = variant(tmp_path, EQUI, "camera_model: pinhole\n  distortion_coeffs:\n  - 0.012",
+                  "camera_model: [pinhole]\n  distortion_coeffs:\n  - 0.012", "lst.yaml")
+    raises(f"{lst}|cam2: camera_model must be a string, got ['pinhole']", C.load_kalibr, lst)
+    text = EQUI.read_text()
+    i = text.index("distortion_model: equidistant")
+    mapping = tmp_path / "map.yaml"
+    mapping.write_text(text[:i] + "distortion_model: {equidistant: 1}"
+                       + text[i + len("distortion_model: equidistant"):])
+    raises(f"{mapping}|cam0: distortion_model must be a string", C.load_kalibr, mapping)
+
+
 def test_rig_frame_imu_needs_T_cam_imu():
     raises(f"{EQUI}|cam0: missing key 'T_cam_imu'|rig_frame='imu'", C.load_kalibr, EQUI, rig_frame="imu")
 

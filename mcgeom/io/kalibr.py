@@ -111,6 +111,8 @@ def _kalibr_camera(where: str, key: str, cam: Any) -> dict:
     cm = cam.get("camera_model")
     if cm is None:
         raise ValueError(f"{where}: {key}: missing key 'camera_model'")
+    if not isinstance(cm, str):  # a list or mapping would not even be a dict key below
+        raise ValueError(f"{where}: {key}: camera_model must be a string, got {cm!r}"[:300])
     if cm in _KALIBR_OTHER_MODELS:
         raise ValueError(f"{where}: {key}: camera_model {cm!r} ({_KALIBR_OTHER_MODELS[cm]}) is not "
                          f"supported: mcgeom handles OpenCV pinhole and fisheye lenses only")
@@ -120,6 +122,8 @@ def _kalibr_camera(where: str, key: str, cam: Any) -> dict:
     dm = cam.get("distortion_model")
     if dm is None:
         raise ValueError(f"{where}: {key}: missing key 'distortion_model'")
+    if not isinstance(dm, str):
+        raise ValueError(f"{where}: {key}: distortion_model must be a string, got {dm!r}"[:300])
     if dm not in _KALIBR_DIST:
         extra = " (the FOV model has no OpenCV equivalent)" if dm == "fov" else ""
         raise ValueError(f"{where}: {key}: distortion_model {dm!r} is not supported{extra}; "
