@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 import shutil
+import sys
 from pathlib import Path
 
 import cv2
@@ -207,8 +208,12 @@ def test_kalibr_yaml_is_pyyaml_safe_load():
     ("cam0: 1\n---\ncam0: 2\n", 2, "expected a single document"),
     ("cam0: [1, 2\n", 2, "(while parsing a flow sequence at line 1; truncated file?)"),
     ("cam0: 1\ncam1: \x07\n", 2, "character U+0007 is not allowed in YAML"),
+    pytest.param("cam0:\n  resolution: [" + "9" * 5000 + ", 1]\n", 2, "Exceeds the limit (4300 digits)",
+                 marks=pytest.mark.skipif(not hasattr(sys, "get_int_max_str_digits"),
+                                          reason="Python without the int digit limit")),
 ], ids=["anchor", "alias", "billion-laughs", "python-tag", "python-name", "str-tag", "deep-flow",
-        "deep-block", "duplicate-key", "two-documents", "truncated", "control-character"])
+        "deep-block", "duplicate-key", "two-documents", "truncated", "control-character",
+        "huge-integer"])
 def test_kalibr_yaml_refusals(tmp_path, text, line, message):
     path = tmp_path / "camchain.yaml"
     path.write_text(text)

@@ -60,6 +60,12 @@ class _PlainDataLoader(yaml.SafeLoader):
         finally:
             self._depth -= 1
 
+    def construct_object(self, node: Any, deep: bool = False) -> Any:
+        try:
+            return super().construct_object(node, deep=deep)
+        except ValueError as exc:  # a scalar Python will not convert (an int of 5000 digits)
+            raise ConstructorError(None, None, str(exc), node.start_mark) from None
+
     def construct_mapping(self, node: Any, deep: bool = False) -> dict:
         self.flatten_mapping(node)  # merge keys ("<<") first, as SafeConstructor does
         seen: set = set()
