@@ -459,6 +459,27 @@ def test_detect_format_and_dispatch(path, fmt):
     assert C.load_rig(path) == C.load_rig(path, format=fmt)
 
 
+#: every file under tests/data/calibration: how it is loaded, or which file reads it
+EVERY_FILE = {
+    "kalibr/camchain-imucam-radtan.yaml": {}, "kalibr/camchain-equidistant.yaml": {},
+    "opencv/rig4.yml": {}, "opencv/stereo_calib.yml": {},
+    "opencv/stereo_calib/intrinsics.yml": {"image_size": (752, 480)},
+    "opencv/stereo_calib/extrinsics.yml": "opencv/stereo_calib/intrinsics.yml",
+    "mcgeom/rig4.json": {}, "colmap/rig_config.json": {},
+    "colmap/rig_config_legacy.json": {"rig_index": 0},
+    "colmap/cameras.txt": "colmap/rig_config.json", "colmap/images.txt": "colmap/rig_config.json",
+}
+
+
+def test_every_calibration_sample_loads():
+    found = {p.relative_to(DATA).as_posix() for p in DATA.rglob("*") if p.is_file()}
+    assert found == set(EVERY_FILE)
+    for rel, how in EVERY_FILE.items():
+        if isinstance(how, dict):
+            rig = C.load_rig(DATA / rel, **how)
+            assert len(rig) >= 2, rel
+
+
 def test_mcgeom_json_dispatches_to_load_mcgeom_json(tmp_path):
     rig = C.load_mcgeom_json(RIG4_JSON)
     assert C.load_rig(RIG4_JSON) == rig
