@@ -12,7 +12,7 @@ from .errors import DegenerateError, InfeasibleError, McgeomError, NumericalErro
 from .types import RayPairs, RigMotion, ScaleVerdict
 from . import estimators as _estimators  # noqa: F401  (registers the built-ins)
 from . import robust
-from .calibration import load_rig
+from .io import load_rig
 from .cv import (RIG_5P1_DIRECT, RIG_5P1_RANSAC, RIG_LINEAR17, RIG_LINEAR17_RANSAC,
                  estimateRigMotion)
 

@@ -18,35 +18,15 @@ coefficients). The intrinsic matrix ``K`` may have a skew term ``K[0, 1]``: Open
 functions ignore skew, so they are called on normalized coordinates with an identity
 camera matrix and ``K`` is applied here, exactly.
 
-Rig file format (JSON, ``Rig.save_json`` / ``Rig.load_json``)::
-
-    {
-      "format": "mcgeom-rig",
-      "version": 1,
-      "cameras": [
-        {
-          "name": "front",                 # unique within the rig
-          "model": "pinhole",              # or "fisheye"
-          "width": 1024, "height": 768,    # pixels
-          "K": [[fx, s, cx], [0, fy, cy], [0, 0, 1]],
-          "dist": [k1, k2, p1, p2, k3],    # OpenCV order; fisheye: [k1, k2, k3, k4]
-          "R_cam_from_rig": [[...], [...], [...]],
-          "t_cam_from_rig": [tx, ty, tz]   # metres
-        }
-      ]
-    }
-
-Keys other than these are ignored (room for comments and metadata); a missing key, a
-wrong ``format``/``version`` or a malformed value is a ``ValueError`` that names it.
+Rig files (mcgeom's JSON, OpenCV, Kalibr, COLMAP) are read and written by
+:mod:`mcgeom.io`; this module knows nothing of files.
 """
 
 from __future__ import annotations
 
-import json
 import operator
-import os
 from dataclasses import dataclass, replace
-from typing import Any, Literal, Sequence, Union
+from typing import Any, Literal, Sequence
 
 import cv2
 import numpy as np
@@ -55,13 +35,9 @@ from mcgeom.types import RayPairs
 from mcgeom.validation import (check_int, check_pixels, check_points, check_rotation,
                                check_vector3, numeric)
 
-__all__ = ["Camera", "Rig", "RIG_FORMAT", "RIG_FORMAT_VERSION"]
-
-RIG_FORMAT = "mcgeom-rig"
-RIG_FORMAT_VERSION = 1
+__all__ = ["Camera", "Rig"]
 
 CameraModel = Literal["pinhole", "fisheye"]
-PathLike = Union[str, "os.PathLike[str]"]
 
 _DIST_LENGTHS = {"pinhole": (0, 4, 5, 8, 12, 14), "fisheye": (4,)}
 # OpenCV's default undistortion stops after 5 (pinhole) / 10 (fisheye) iterations, far
@@ -344,7 +320,7 @@ class Camera:
         cos = np.sum(_normalize_rows(rays) * _normalize_rows(X_cam), axis=1)
         return cos > np.cos(_ROUND_TRIP_TOL)  # NaN rows compare False
 
-    # -- frames and serialisation
+    # -- frames
     def in_frame(self, R: np.ndarray, t: np.ndarray) -> "Camera":
         """The same camera with extrinsics w.r.t. a new rig frame ``X_new = R X_old + t``.
 
@@ -355,32 +331,6 @@ class Camera:
         tv = check_vector3("in_frame: t", t)
         R_new = self.R @ Rm.T
         return replace(self, R=R_new, t=self.t - R_new @ tv)
-
-    def to_dict(self) -> dict:
-        """JSON-ready dict of this camera (one entry of the rig file's ``cameras``)."""
-        return {
-            "name": self.name, "model": self.model,
-            "width": self.width, "height": self.height,
-            "K": self.K.tolist(), "dist": self.dist.tolist(),
-            "R_cam_from_rig": self.R.tolist(), "t_cam_from_rig": self.t.tolist(),
-        }
-
-    @classmethod
-    def from_dict(cls, d: Any, where: str = "camera") -> "Camera":
-        """Camera from a rig-file entry; ValueError naming ``where`` and the problem."""
-        if not isinstance(d, dict):
-            raise ValueError(f"{where} must be a JSON object, got {type(d).__name__}")
-        required = ("name", "model", "width", "height", "K", "dist",
-                    "R_cam_from_rig", "t_cam_from_rig")
-        missing = [k for k in required if k not in d]
-        if missing:
-            raise ValueError(f"{where}: missing key(s) {', '.join(map(repr, missing))}")
-        try:
-            return cls(name=d["name"], K=d["K"], dist=d["dist"], model=d["model"],
-                       R=d["R_cam_from_rig"], t=d["t_cam_from_rig"],
-                       width=d["width"], height=d["height"])
-        except ValueError as exc:
-            raise ValueError(f"{where}: {exc}") from None
 
 
 # --------------------------------------------------------------------------- Rig
@@ -576,56 +526,3 @@ class Rig:
         Rm = check_rotation("in_frame: R", R)  # checked once, not once per camera
         tv = check_vector3("in_frame: t", t)
         return Rig(tuple(c.in_frame(Rm, tv) for c in self.cameras))
-
-    # -- serialisation (format in the module docstring)
-    def to_dict(self) -> dict:
-        """JSON-ready dict in the ``mcgeom-rig`` version 1 format."""
-        return {"format": RIG_FORMAT, "version": RIG_FORMAT_VERSION,
-                "cameras": [c.to_dict() for c in self.cameras]}
-
-    @classmethod
-    def from_dict(cls, d: Any) -> "Rig":
-        """Rig from an ``mcgeom-rig`` dict; ValueError naming what is wrong."""
-        if not isinstance(d, dict):
-            raise ValueError(f"a rig description must be a JSON object, got {type(d).__name__}")
-        for key in ("format", "version", "cameras"):
-            if key not in d:
-                raise ValueError(f"rig description: missing key {key!r}")
-        if d["format"] != RIG_FORMAT:
-            raise ValueError(f"rig description: format is {d['format']!r}, expected {RIG_FORMAT!r}")
-        if d["version"] != RIG_FORMAT_VERSION or isinstance(d["version"], bool):
-            raise ValueError(f"rig description: unsupported version {d['version']!r} "
-                             f"(this mcgeom reads version {RIG_FORMAT_VERSION})")
-        cams = d["cameras"]
-        if not isinstance(cams, list):
-            raise ValueError(f"rig description: 'cameras' must be a list, got {type(cams).__name__}")
-        return cls(tuple(Camera.from_dict(c, f"cameras[{i}]") for i, c in enumerate(cams)))
-
-    def save_json(self, path: PathLike) -> None:
-        """Write the rig to ``path`` as ``mcgeom-rig`` JSON (floats round-trip exactly)."""
-        with open(path, "w", encoding="utf-8") as fh:
-            json.dump(self.to_dict(), fh, indent=2)
-            fh.write("\n")
-
-    @classmethod
-    def load_json(cls, path: PathLike) -> "Rig":
-        """Read an ``mcgeom-rig`` JSON file.
-
-        Raises:
-            OSError: the file cannot be read.
-            ValueError: not JSON (truncated, malformed), or not a valid rig description;
-                the message names the file and the problem.
-        """
-        with open(path, "rb") as fh:
-            raw = fh.read()
-        try:
-            d = json.loads(raw.decode("utf-8"))
-        except UnicodeDecodeError as exc:
-            raise ValueError(f"{os.fspath(path)}: not UTF-8 text ({exc.reason})") from None
-        except json.JSONDecodeError as exc:
-            raise ValueError(f"{os.fspath(path)}: not valid JSON ({exc.msg} at line "
-                             f"{exc.lineno} column {exc.colno})") from None
-        try:
-            return cls.from_dict(d)
-        except ValueError as exc:
-            raise ValueError(f"{os.fspath(path)}: {exc}") from None

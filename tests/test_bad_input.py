@@ -742,12 +742,16 @@ FILE_MESSAGES = {
                     (r"not an OpenCV FileStorage file \(it must start with a '%YAML:1.0'",
                      "not an OpenCV FileStorage file (it must start with a '%YAML:1.0' or "
                      "'%YAML 1.2' header, or '<?xml'; got ...)")),
-    "kalibr": ((r"line \d+: unterminated flow sequence '\[' \(truncated file\?\)",
-                "line n: unterminated flow sequence '[' (truncated file?)"),
-               (r"line 2: content that does not fit the document's top-level structure",
-                "line 2: content that does not fit the document's top-level structure"),
-               (r"line 1: unsupported YAML feature \(flow mappings\)",
-                "line 1: unsupported YAML feature (flow mappings)")),
+    "kalibr": ((r"line \d+: expected ',' or '\]', but got '<stream end>' \(while parsing a flow "
+                r"sequence; truncated file\?\)",
+                "line n: expected ',' or ']', but got '<stream end>' (while parsing a flow "
+                "sequence; truncated file?)"),
+               (r"line \d+: mapping values are not allowed here",
+                "line n: mapping values are not allowed here"),
+               # JSON is YAML: the file parses, and is no camchain
+               (r"not a Kalibr camchain: no top-level 'cam0' \(top-level keys: format, version",
+                "not a Kalibr camchain: no top-level 'cam0' (top-level keys: format, version, "
+                "cameras)")),
     "colmap": ((r"not valid JSON \(.*; truncated\?\)", "not valid JSON (... ; truncated?)"),
                (r"not valid JSON \(Expecting ',' delimiter", "not valid JSON (Expecting ',' "
                                                                "delimiter at line n ...)"),

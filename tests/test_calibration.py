@@ -1,4 +1,4 @@
-"""Tests of mcgeom.calibration: rig loaders for mcgeom JSON, OpenCV FileStorage, Kalibr, COLMAP.
+"""Tests of mcgeom.io: rig loaders for mcgeom JSON, OpenCV FileStorage, Kalibr, COLMAP.
 
 The sample files under tests/data/calibration/ describe two physical rigs:
 
@@ -19,13 +19,15 @@ from __future__ import annotations
 import json
 import math
 import shutil
+import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-from mcgeom import calibration as C
+from mcgeom import io as C
+from mcgeom.io._safe_yaml import MAX_DEPTH, load_yaml
 from mcgeom.rig import Camera, Rig
 
 DATA = Path(__file__).parent / "data" / "calibration"
@@ -176,13 +178,53 @@ def test_kalibr_equidistant_chain_of_three():
     np.testing.assert_allclose(d, T_c1_c0[0, :3], atol=1e-12)  # cam1's x axis in cam0 frame
 
 
-def test_kalibr_subset_parser_agrees_with_pyyaml():
-    yaml = pytest.importorskip("yaml")  # a cross-check only: PyYAML is not a dependency
+def test_kalibr_yaml_is_pyyaml_safe_load():
+    # the restricted loader gives the same data as PyYAML's (Kalibr's own reader)
+    import yaml
     samples = [RADTAN.read_text(), EQUI.read_text(),
                "a: [it's, 'b''c', \"d]\"]  # comment\nb:\n- - 1\n  - 2\n- [3,\n   4]\nc: ~\n",
                "---\n- k: v\n  w: [1.0e-05, -.inf]\n- - x\n...\n"]
     for text in samples:
-        assert C._parse_yaml_subset(text, "sample") == yaml.safe_load(text)
+        assert load_yaml(text, "sample") == yaml.safe_load(text)
+    # ... but for numbers with an exponent and no '.', which YAML 1.1 reads as strings
+    assert load_yaml("a: [1e-05, -2E+3, .5e1]\n", "sample") == {"a": [1e-05, -2000.0, 5.0]}
+
+
+@pytest.mark.parametrize("text,line,message", [
+    ("cam0: &a [1, 2]\ncam1: *a\n", 1, "anchors (&a) are not allowed"),
+    ("cam0: [1, 2]\ncam1: *a\n", 2, "aliases (*a) are not allowed"),
+    # billion laughs: refused at the first anchor, before anything is expanded
+    ("a: &a [x, x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
+     "c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b]\ncam0: [*c, *c, *c, *c, *c, *c, *c, *c, *c]\n",
+     1, "anchors (&a) are not allowed"),
+    ("cam0: !!python/object/apply:os.system ['echo pwned']\n", 1,
+     "tags are not allowed (tag:yaml.org,2002:python/object/apply:os.system)"),
+    ("cam0:\n  camera_model: !!python/name:builtins.print ''\n", 2, "tags are not allowed"),
+    ("cam0: !!str pinhole\n", 1, "tags are not allowed"),
+    ("cam0: " + "[" * (MAX_DEPTH + 1) + "]" * (MAX_DEPTH + 1) + "\n", 1,
+     f"nesting deeper than {MAX_DEPTH} levels"),
+    ("cam0:\n" + "  " + "- " * (MAX_DEPTH + 1) + "1\n", 2, f"nesting deeper than {MAX_DEPTH} levels"),
+    ("cam0: {a: 1, a: 2}\n", 1, "duplicate key 'a'"),
+    ("cam0: 1\n---\ncam0: 2\n", 2, "expected a single document"),
+    ("cam0: [1, 2\n", 2, "(while parsing a flow sequence at line 1; truncated file?)"),
+    ("cam0: 1\ncam1: \x07\n", 2, "character U+0007 is not allowed in YAML"),
+    pytest.param("cam0:\n  resolution: [" + "9" * 5000 + ", 1]\n", 2, "Exceeds the limit (4300 digits)",
+                 marks=pytest.mark.skipif(not hasattr(sys, "get_int_max_str_digits"),
+                                          reason="Python without the int digit limit")),
+], ids=["anchor", "alias", "billion-laughs", "python-tag", "python-name", "str-tag", "deep-flow",
+        "deep-block", "duplicate-key", "two-documents", "truncated", "control-character",
+        "huge-integer"])
+def test_kalibr_yaml_refusals(tmp_path, text, line, message):
+    path = tmp_path / "camchain.yaml"
+    path.write_text(text)
+    raises(f"{path}: line {line}: |{message}", C.load_kalibr, path)
+    raises(f"{path}: line {line}: |{message}|format 'kalibr' detected from the content", C.load_rig, path)
+
+
+def test_kalibr_yaml_nesting_at_the_limit_is_read(tmp_path):
+    path = tmp_path / "camchain.yaml"
+    path.write_text("cam1: " + "[" * (MAX_DEPTH - 1) + "]" * (MAX_DEPTH - 1) + "\n")
+    raises(f"{path}|no top-level 'cam0'", C.load_kalibr, path)  # parsed: the depth is allowed
 
 
 def test_kalibr_missing_T_cn_cnm1_derived_from_T_cam_imu(tmp_path):
@@ -417,8 +459,34 @@ def test_detect_format_and_dispatch(path, fmt):
     assert C.load_rig(path) == C.load_rig(path, format=fmt)
 
 
-def test_mcgeom_json_dispatches_to_rig_load_json():
-    assert C.load_rig(RIG4_JSON) == Rig.load_json(RIG4_JSON) == C.load_mcgeom_json(RIG4_JSON)
+#: every file under tests/data/calibration: how it is loaded, or which file reads it
+EVERY_FILE = {
+    "kalibr/camchain-imucam-radtan.yaml": {}, "kalibr/camchain-equidistant.yaml": {},
+    "opencv/rig4.yml": {}, "opencv/stereo_calib.yml": {},
+    "opencv/stereo_calib/intrinsics.yml": {"image_size": (752, 480)},
+    "opencv/stereo_calib/extrinsics.yml": "opencv/stereo_calib/intrinsics.yml",
+    "mcgeom/rig4.json": {}, "colmap/rig_config.json": {},
+    "colmap/rig_config_legacy.json": {"rig_index": 0},
+    "colmap/cameras.txt": "colmap/rig_config.json", "colmap/images.txt": "colmap/rig_config.json",
+}
+
+
+def test_every_calibration_sample_loads():
+    found = {p.relative_to(DATA).as_posix() for p in DATA.rglob("*") if p.is_file()}
+    assert found == set(EVERY_FILE)
+    for rel, how in EVERY_FILE.items():
+        if isinstance(how, dict):
+            rig = C.load_rig(DATA / rel, **how)
+            assert len(rig) >= 2, rel
+
+
+def test_mcgeom_json_dispatches_to_load_mcgeom_json(tmp_path):
+    rig = C.load_mcgeom_json(RIG4_JSON)
+    assert C.load_rig(RIG4_JSON) == rig
+    C.save_mcgeom_json(rig, tmp_path / "rig.json")
+    assert C.load_rig(tmp_path / "rig.json") == rig
+    with pytest.raises(ValueError, match="Rig"):
+        C.save_mcgeom_json("not a rig", tmp_path / "rig.json")
 
 
 def test_undetectable_file_lists_every_format_tried(tmp_path):
@@ -446,7 +514,9 @@ def test_load_rig_arguments(tmp_path):
 # --------------------------------------------------------------------------- bad files
 
 @pytest.mark.parametrize("src,fmt,marker,keep,expect", [
-    (RADTAN, "kalibr", "0.07451284, -0.00010", True, "line 29: unterminated flow sequence"),
+    (RADTAN, "kalibr", "0.07451284, -0.00010", True,
+     "line 29: expected ',' or ']', but got '<stream end>' (while parsing a flow sequence; "
+     "truncated file?)"),
     (RADTAN, "kalibr", "  resolution: [752, 480]\n  rostopic: /cam1", False,
      "cam1: missing key 'resolution'"),
     (EQUI, "kalibr", "  intrinsics:\n  - 381.5\n  - 381.25\n", True,
@@ -478,7 +548,8 @@ def test_truncated_colmap_cameras_txt(tmp_path):
 def test_malformed_files(tmp_path):
     tab = variant(tmp_path, RADTAN, "  camera_model: pinhole\n  distortion_coeffs: [-0.28368365",
                   "\tcamera_model: pinhole\n  distortion_coeffs: [-0.28368365")
-    raises(f"{tab}|line 28|tab in indentation", C.load_rig, tab, format="kalibr")
+    raises(f"{tab}: line 28: found character '\\t' that cannot start any token", C.load_rig, tab,
+           format="kalibr")
     dup = variant(tmp_path, RADTAN, "  rostopic: /cam1/image_raw\n",
                   "  rostopic: /cam1/image_raw\n  resolution: [752, 480]\n", "dup.yaml")
     raises(f"{dup}|duplicate key 'resolution'", C.load_kalibr, dup)
@@ -504,7 +575,8 @@ def test_malformed_files(tmp_path):
 
 
 def test_wrong_format(tmp_path):
-    raises(f"{STEREO}|line 6|tags", C.load_rig, STEREO, format="kalibr")
+    # OpenCV's "%YAML:1.0" header is no YAML directive
+    raises(f"{STEREO}: line 1: |while scanning a directive", C.load_rig, STEREO, format="kalibr")
     raises(f"{RADTAN}|not an OpenCV FileStorage file", C.load_rig, RADTAN, format="opencv-yaml")
     raises(f"{RADTAN}|not valid JSON", C.load_rig, RADTAN, format="colmap")
     raises(f"{COLMAP_NEW}|must be a JSON object", C.load_rig, COLMAP_NEW, format="mcgeom-json")
@@ -624,6 +696,19 @@ def test_unsupported_lens_models(tmp_path):
             "6 FOV 640 480 498.0 498.0 319.5 241.0 0.9", "cameras.txt")
     raises(f"{tmp_path / 'cameras.txt'}|camera 6|'FOV' is not supported", C.load_colmap,
            tmp_path / "rig.json", rig_index=1)
+
+
+def test_kalibr_model_names_must_be_strings(tmp_path):
+    # a list or mapping (YAML flow collections) where a name belongs: ValueError, not TypeError
+    lst = variant(tmp_path, EQUI, "camera_model: pinhole\n  distortion_coeffs:\n  - 0.012",
+                  "camera_model: [pinhole]\n  distortion_coeffs:\n  - 0.012", "lst.yaml")
+    raises(f"{lst}|cam2: camera_model must be a string, got ['pinhole']", C.load_kalibr, lst)
+    text = EQUI.read_text()
+    i = text.index("distortion_model: equidistant")
+    mapping = tmp_path / "map.yaml"
+    mapping.write_text(text[:i] + "distortion_model: {equidistant: 1}"
+                       + text[i + len("distortion_model: equidistant"):])
+    raises(f"{mapping}|cam0: distortion_model must be a string", C.load_kalibr, mapping)
 
 
 def test_rig_frame_imu_needs_T_cam_imu():

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""atheris harness of the rig calibration loaders (mcgeom/calibration.py).
+"""atheris harness of the rig calibration loaders (mcgeom/io/).
 
 Input: byte 0 picks one of the hand-written calibration files of
 tests/data/calibration (fuzz/make_corpus.py's CALIBRATION_FILES, same
@@ -29,22 +29,22 @@ with atheris.instrument_imports(include=["mcgeom"]):
     import numpy as np
 
     import mcgeom
-    from mcgeom import calibration
+    from mcgeom import io as calibration_io
 
 import _common  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[2] / "tests" / "data" / "calibration"
 # (file, loader, format name, siblings that byte 1 may pick instead)
 FILES = [
-    ("mcgeom/rig4.json", calibration.load_mcgeom_json, "mcgeom-json", []),
-    ("opencv/rig4.yml", calibration.load_opencv_yaml, "opencv-yaml", []),
-    ("opencv/stereo_calib.yml", calibration.load_opencv_yaml, "opencv-yaml",
+    ("mcgeom/rig4.json", calibration_io.load_mcgeom_json, "mcgeom-json", []),
+    ("opencv/rig4.yml", calibration_io.load_opencv_yaml, "opencv-yaml", []),
+    ("opencv/stereo_calib.yml", calibration_io.load_opencv_yaml, "opencv-yaml",
      ["opencv/stereo_calib/intrinsics.yml", "opencv/stereo_calib/extrinsics.yml"]),
-    ("kalibr/camchain-equidistant.yaml", calibration.load_kalibr, "kalibr", []),
-    ("kalibr/camchain-imucam-radtan.yaml", calibration.load_kalibr, "kalibr", []),
-    ("colmap/rig_config.json", calibration.load_colmap, "colmap",
+    ("kalibr/camchain-equidistant.yaml", calibration_io.load_kalibr, "kalibr", []),
+    ("kalibr/camchain-imucam-radtan.yaml", calibration_io.load_kalibr, "kalibr", []),
+    ("colmap/rig_config.json", calibration_io.load_colmap, "colmap",
      ["colmap/cameras.txt", "colmap/images.txt"]),
-    ("colmap/rig_config_legacy.json", calibration.load_colmap, "colmap",
+    ("colmap/rig_config_legacy.json", calibration_io.load_colmap, "colmap",
      ["colmap/cameras.txt", "colmap/images.txt"]),
 ]
 WORK = Path(tempfile.mkdtemp(prefix="mcgeom-fuzz-calib-"))

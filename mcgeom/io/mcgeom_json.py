@@ -1,0 +1,139 @@
+"""mcgeom's own rig file: JSON, format ``"mcgeom-rig"`` version 1.
+
+Layout (written by :func:`save_mcgeom_json`, read by :func:`load_mcgeom_json`)::
+
+    {
+      "format": "mcgeom-rig",
+      "version": 1,
+      "cameras": [
+        {
+          "name": "front",                 # unique within the rig
+          "model": "pinhole",              # or "fisheye"
+          "width": 1024, "height": 768,    # pixels
+          "K": [[fx, s, cx], [0, fy, cy], [0, 0, 1]],
+          "dist": [k1, k2, p1, p2, k3],    # OpenCV order; fisheye: [k1, k2, k3, k4]
+          "R_cam_from_rig": [[...], [...], [...]],
+          "t_cam_from_rig": [tx, ty, tz]   # metres
+        }
+      ]
+    }
+
+The values are a :class:`mcgeom.rig.Camera`'s fields unchanged: cam_from_rig extrinsics
+``X_cam = R X_rig + t`` (metres), OpenCV lens models and OpenCV pixel coordinates (see
+:mod:`mcgeom.rig`). Keys other than these are ignored (room for comments and metadata); a
+missing key, a wrong ``format``/``version`` or a malformed value is a ``ValueError`` that
+names it. Floats are written by ``json`` with ``repr`` precision, so a rig round-trips
+exactly.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Union
+
+from mcgeom.io._common import _where
+from mcgeom.rig import Camera, Rig
+
+__all__ = ["RIG_FORMAT", "RIG_FORMAT_VERSION", "rig_to_dict", "rig_from_dict",
+           "load_mcgeom_json", "save_mcgeom_json"]
+
+RIG_FORMAT = "mcgeom-rig"
+RIG_FORMAT_VERSION = 1
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+_CAMERA_KEYS = ("name", "model", "width", "height", "K", "dist", "R_cam_from_rig",
+                "t_cam_from_rig")
+
+
+def _camera_to_dict(cam: Camera) -> dict:
+    """JSON-ready dict of one camera (one entry of the rig file's ``cameras``)."""
+    return {
+        "name": cam.name, "model": cam.model,
+        "width": cam.width, "height": cam.height,
+        "K": cam.K.tolist(), "dist": cam.dist.tolist(),
+        "R_cam_from_rig": cam.R.tolist(), "t_cam_from_rig": cam.t.tolist(),
+    }
+
+
+def _camera_from_dict(d: Any, where: str) -> Camera:
+    """Camera from a rig-file entry; ValueError naming ``where`` and the problem."""
+    if not isinstance(d, dict):
+        raise ValueError(f"{where} must be a JSON object, got {type(d).__name__}")
+    missing = [k for k in _CAMERA_KEYS if k not in d]
+    if missing:
+        raise ValueError(f"{where}: missing key(s) {', '.join(map(repr, missing))}")
+    try:
+        return Camera(name=d["name"], K=d["K"], dist=d["dist"], model=d["model"],
+                      R=d["R_cam_from_rig"], t=d["t_cam_from_rig"],
+                      width=d["width"], height=d["height"])
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+
+
+def rig_to_dict(rig: Rig) -> dict:
+    """JSON-ready dict of ``rig`` in the ``mcgeom-rig`` version 1 format (module docstring)."""
+    return {"format": RIG_FORMAT, "version": RIG_FORMAT_VERSION,
+            "cameras": [_camera_to_dict(c) for c in rig.cameras]}
+
+
+def rig_from_dict(d: Any) -> Rig:
+    """Rig from an ``mcgeom-rig`` dict (parsed JSON); ValueError naming what is wrong."""
+    if not isinstance(d, dict):
+        raise ValueError(f"a rig description must be a JSON object, got {type(d).__name__}")
+    for key in ("format", "version", "cameras"):
+        if key not in d:
+            raise ValueError(f"rig description: missing key {key!r}")
+    if d["format"] != RIG_FORMAT:
+        raise ValueError(f"rig description: format is {d['format']!r}, expected {RIG_FORMAT!r}")
+    if d["version"] != RIG_FORMAT_VERSION or isinstance(d["version"], bool):
+        raise ValueError(f"rig description: unsupported version {d['version']!r} "
+                         f"(this mcgeom reads version {RIG_FORMAT_VERSION})")
+    cams = d["cameras"]
+    if not isinstance(cams, list):
+        raise ValueError(f"rig description: 'cameras' must be a list, got {type(cams).__name__}")
+    return Rig(tuple(_camera_from_dict(c, f"cameras[{i}]") for i, c in enumerate(cams)))
+
+
+def save_mcgeom_json(rig: Rig, path: PathLike) -> None:
+    """Write ``rig`` to ``path`` as ``mcgeom-rig`` JSON (floats round-trip exactly).
+
+    Raises:
+        ValueError: ``rig`` is not a :class:`mcgeom.rig.Rig`.
+        OSError: the file cannot be written.
+    """
+    if not isinstance(rig, Rig):
+        raise ValueError(f"rig must be a mcgeom.rig.Rig, got {type(rig).__name__}")
+    with open(path, "w", encoding="utf-8") as fh:
+        json.dump(rig_to_dict(rig), fh, indent=2)
+        fh.write("\n")
+
+
+def load_mcgeom_json(path: PathLike) -> Rig:
+    """Read an ``mcgeom-rig`` JSON file (layout in the module docstring).
+
+    Returns:
+        A :class:`mcgeom.rig.Rig` with cam_from_rig extrinsics (metres).
+
+    Raises:
+        OSError: the file cannot be read.
+        ValueError: not JSON (truncated, malformed, nested too deeply), or not a valid rig
+            description; the message names the file and the problem.
+    """
+    where = _where(path)
+    with open(path, "rb") as fh:
+        raw = fh.read()
+    try:
+        d = json.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{where}: not UTF-8 text ({exc.reason})") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{where}: not valid JSON ({exc.msg} at line "
+                         f"{exc.lineno} column {exc.colno})") from None
+    except RecursionError:
+        raise ValueError(f"{where}: JSON nested too deeply") from None
+    try:
+        return rig_from_dict(d)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
