@@ -195,12 +195,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("demo", formatter_class=HelpFormatter,
                        help="Ladybug2-like head on the ∞ path of thesis ch. 8.5.2",
-                       description="A Ladybug2-like head on the closed ∞-shaped path of thesis "
-                                   "ch. 8.5.2 (108 motions), every motion estimated from noisy "
-                                   "pixels, chained, and compared with the truth; writes the "
-                                   "trajectories (CSV) and a plot (PNG).")
-    d.add_argument("--method", default="linear17", choices=registry.names(),
-                   help="registered estimator (see mcgeom methods)")
+                       description=textwrap.fill(
+                           "A Ladybug2-like head on the closed ∞-shaped path of thesis ch. "
+                           "8.5.2 (108 motions), every motion estimated from noisy pixels, "
+                           "chained, and compared with the truth; writes the trajectories "
+                           "(CSV) and a plot (PNG).", 79))
+    d.add_argument("--method", default="linear17", choices=registry.names(), metavar="METHOD",
+                   help="registered estimator: " + ", ".join(registry.names()))
     d.add_argument("--noise", type=non_negative_float, default=0.3,
                    help="pixel noise std (px)")
     d.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
@@ -214,8 +215,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     b = sub.add_parser("bench", formatter_class=HelpFormatter,
                        help="benchmarks with ratios against references",
-                       description="Time an mcgeom kernel against a reference "
-                                   "implementation and print the ratios.",
+                       description=textwrap.fill("Time an mcgeom kernel against a "
+                                                 "reference implementation and print the "
+                                                 "ratios.", 79),
                        epilog=_name_list("benchmarks", BENCHES))
     b.add_argument("what", choices=list(BENCHES), metavar="NAME",
                    help="benchmark: " + ", ".join(BENCHES))

@@ -737,7 +737,7 @@ def print_summary_table(summary: list, out=print) -> None:
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment real_data``."""
     ap.add_argument("--sets", nargs="*", default=list(SET_KEYS), choices=SET_KEYS,
-                    help="data sets to evaluate")
+                    metavar="SET", help="data sets to evaluate, of " + ", ".join(SET_KEYS))
     ap.add_argument("--max-pairs", type=positive_int, default=None,
                     help="evaluate only the first pairs of each set (default: all)")
     ap.add_argument("--threshold", type=positive_float, default=THRESHOLD_PX,
