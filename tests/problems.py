@@ -1,5 +1,5 @@
 """Synthetic problems for each generalized-camera kind (thesis ch. 8.3), shared
-by the property suite, the experiments and the benchmarks in tests/."""
+by the property suite and the other tests."""
 
 from __future__ import annotations
 

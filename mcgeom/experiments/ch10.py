@@ -26,7 +26,7 @@ import mcgeom
 from mcgeom import registry
 
 from . import ch9
-from .common import Progress, no_progress, non_negative_int, positive_int
+from .common import Progress, add_count_and_seed, no_progress
 
 METHODS = ("bnb_lp", "e_socp")
 
@@ -72,9 +72,8 @@ def preemption_table(rows: list[dict]) -> str:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment ch10``."""
-    ap.add_argument("--runs", type=positive_int, default=10,
-                    help="problems per noise level (the preemption table: at most 5)")
-    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
+    add_count_and_seed(ap, "--runs", 10,
+                       "problems per noise level (the preemption table: at most 5)")
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:

@@ -18,7 +18,7 @@ import numpy as np
 from mcgeom import metrics, synth
 from mcgeom.cv import estimate
 
-from .common import Progress, no_progress, non_negative_int, positive_int
+from .common import Progress, add_count_and_seed, no_progress
 
 #: fractions of cross-camera correspondences of the printed tables
 CROSS_FRACTIONS = (0.0, 0.05, 0.1)
@@ -67,9 +67,7 @@ def summary(rows: list[dict]) -> dict:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment ch7``."""
-    ap.add_argument("--trials", type=positive_int, default=200,
-                    help="motions per cross-camera fraction")
-    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
+    add_count_and_seed(ap, "--trials", 200, "motions per cross-camera fraction")
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:

@@ -22,7 +22,7 @@ import numpy as np
 import mcgeom
 from mcgeom import metrics, synth
 
-from .common import Progress, import_peer, no_progress, non_negative_int, positive_int
+from .common import Progress, add_count_and_seed, import_peer, no_progress
 
 RIGS = {
     "non-axial rig": (lambda rng: synth.generic_rig(4, rng)),
@@ -113,8 +113,7 @@ def table(res: dict) -> str:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment ch8``."""
-    ap.add_argument("--trials", type=positive_int, default=1000, help="random trials per rig")
-    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
+    add_count_and_seed(ap, "--trials", 1000, "random trials per rig")
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:

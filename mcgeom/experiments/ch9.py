@@ -19,7 +19,7 @@ import mcgeom
 from mcgeom import metrics, synth
 from mcgeom.rig import Rig
 
-from .common import Progress, no_progress, non_negative_int, positive_int
+from .common import Progress, add_count_and_seed, no_progress
 
 METHODS = ("e_socp", "linear17", "five_plus_one")
 LEVELS = (0.0, 0.1, 0.2, 0.3, 0.4, 0.5)
@@ -93,8 +93,7 @@ def table(res: dict) -> str:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment ch9``."""
-    ap.add_argument("--runs", type=positive_int, default=10, help="problems per noise level")
-    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
+    add_count_and_seed(ap, "--runs", 10, "problems per noise level")
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:

@@ -18,7 +18,7 @@ from typing import Callable, Iterable, Optional, TypeVar
 
 __all__ = ["Progress", "no_progress", "progress_bar", "write_line", "MissingPeerError",
            "import_peer", "positive_int", "non_negative_int", "positive_float", "non_negative_float",
-           "positive_int_list", "HelpFormatter", "plain_text"]
+           "positive_int_list", "add_count_and_seed", "HelpFormatter", "plain_text"]
 
 T = TypeVar("T")
 
@@ -75,46 +75,36 @@ def import_peer(module: str, needed_by: str, pip_name: Optional[str] = None) -> 
 # argparse turns the ValueError / ArgumentTypeError of a type= callable into a
 # usage error (exit code 2) instead of a traceback deep in the computation.
 
-def _number(text: str, kind: type, what: str):
+def _number(text: str, kind: type, lower: float, strict: bool, what: str):
+    """``kind(text)``, finite and above ``lower`` (or equal, unless ``strict``)."""
     try:
         value = kind(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
-    if kind is float and not math.isfinite(value):
+        value = None
+    if (value is None or (kind is float and not math.isfinite(value))
+            or value < lower or (strict and value == lower)):
         raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
     return value
 
 
 def positive_int(text: str) -> int:
     """An integer >= 1 (counts of trials, problems, runs)."""
-    value = _number(text, int, "a positive integer")
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
-    return value
+    return _number(text, int, 1, False, "a positive integer")
 
 
 def non_negative_int(text: str) -> int:
     """An integer >= 0 (random seeds: numpy refuses negative ones)."""
-    value = _number(text, int, "a non-negative integer")
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {text!r}")
-    return value
+    return _number(text, int, 0, False, "a non-negative integer")
 
 
 def positive_float(text: str) -> float:
     """A finite number > 0 (time budgets, thresholds)."""
-    value = _number(text, float, "a positive number")
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return value
+    return _number(text, float, 0.0, True, "a positive number")
 
 
 def non_negative_float(text: str) -> float:
     """A finite number >= 0 (noise levels)."""
-    value = _number(text, float, "a non-negative number")
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a non-negative number, got {text!r}")
-    return value
+    return _number(text, float, 0.0, False, "a non-negative number")
 
 
 def positive_int_list(text: str) -> tuple[int, ...]:
@@ -128,6 +118,14 @@ def positive_int_list(text: str) -> tuple[int, ...]:
         raise argparse.ArgumentTypeError(
             f"expected a comma-separated list of positive integers, got {text!r}")
     return values
+
+
+def add_count_and_seed(ap: argparse.ArgumentParser, option: str, default: int,
+                       what: str) -> None:
+    """The two options of most synthetic experiments: how many (``option``, a
+    positive integer) and the random seed."""
+    ap.add_argument(option, type=positive_int, default=default, help=what)
+    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
 
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter,

@@ -21,7 +21,7 @@ from mcgeom import metrics, synth
 from mcgeom.estimators.five_plus_one import critical_angles, minimal_solutions
 from mcgeom.types import RayPairs
 
-from .common import Progress, import_peer, no_progress, non_negative_int, positive_int
+from .common import Progress, add_count_and_seed, import_peer, no_progress
 
 TOL = 1e-8
 
@@ -92,8 +92,7 @@ def run(trials: int = 1000, seed: int = 0, with_poselib: bool = True,
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment minimal_5p1``."""
-    ap.add_argument("--trials", type=positive_int, default=1000, help="random configurations")
-    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
+    add_count_and_seed(ap, "--trials", 1000, "random configurations")
     ap.add_argument("--no-poselib", action="store_true",
                     help="skip the comparison with PoseLib's gen_relpose_6pt")
 

@@ -31,7 +31,7 @@ from mcgeom import metrics, synth
 from mcgeom.cv import estimate
 from mcgeom.rig import Rig
 
-from .common import Progress, import_peer, no_progress, non_negative_int, positive_int
+from .common import Progress, add_count_and_seed, import_peer, no_progress
 
 
 def ring4(radius: float = 0.25, f: float = 500.0) -> Rig:
@@ -148,8 +148,7 @@ def median_differences(res: dict, boot: int = 2000, seed: int = 1) -> str:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment robust_vs_poselib``."""
-    ap.add_argument("--problems", type=positive_int, default=600, help="problems per case")
-    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
+    add_count_and_seed(ap, "--problems", 600, "problems per case")
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
