@@ -1,18 +1,38 @@
-"""The ``mcgeom`` command: ``demo`` (main job on the embedded default),
-``methods`` (registered estimators) and ``bench`` (timings against references).
-Printing and files only; the work is done by mcgeom.demo and mcgeom.bench."""
+"""The mcgeom command: demo (the main job on the embedded synthetic default),
+methods (the registered estimators), bench (timings against references) and
+experiment (the thesis experiments and the real-data evaluations).
+
+Printing, files and the progress bar only; the work is done by the modules of
+mcgeom.experiments, imported when their command runs so that mcgeom --help
+stays fast.
+"""
 
 from __future__ import annotations
 
 import argparse
 import math
 import sys
+import textwrap
 from pathlib import Path
 from typing import Optional, Sequence
 
-from . import registry
+from . import __version__, registry
+from .experiments import EXPERIMENTS
+from .experiments.common import (HelpFormatter, MissingPeerError, non_negative_float,
+                                 non_negative_int, plain_text, positive_float, positive_int,
+                                 positive_int_list, progress_bar)
 
 __all__ = ["main"]
+
+#: name -> one-line description of ``mcgeom bench NAME``
+BENCHES = {
+    "linear17": "linear 17-point estimator (C) against a numpy implementation, N = 17..10000",
+    "cone": "L-infinity cone bisection (C) against clarabel SOCP steps (needs clarabel)",
+    "bnb": "branch and bound over rotations, 4 cameras x 50 points, and its growth",
+    "known_rotation": "multi-view translations with known rotations against dense numpy",
+}
+#: the default N of ``--sizes`` per benchmark
+BENCH_SIZES = {"linear17": (17, 100, 1000, 10000), "cone": (3, 6, 20, 100, 1000)}
 
 
 def _cmd_methods(args: argparse.Namespace) -> int:
@@ -28,10 +48,11 @@ def _cmd_methods(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from .demo import run_demo
+    from .experiments.demo import run_demo
     from .report import plot_trajectories_png, write_trajectory_csv
 
-    res = run_demo(method=args.method, pixel_noise=args.noise, seed=args.seed)
+    res = run_demo(method=args.method, pixel_noise=args.noise, seed=args.seed,
+                   progress=progress_bar)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"Ladybug2-like head, ∞ path of {len(res.frames)} motions "
@@ -61,20 +82,18 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    if args.what == "cone":
-        return _bench_cone(args)
-    if args.what == "bnb":
-        return _bench_bnb(args)
-    if args.what == "known_rotation":
-        return _bench_known_rotation(args)
-    if args.what != "linear17":
-        print(f"unknown benchmark {args.what!r}; available: linear17, cone, bnb, known_rotation",
-              file=sys.stderr)
-        return 2
-    from .bench.linear17 import bench_linear17
+    return {"linear17": _bench_linear17, "cone": _bench_cone, "bnb": _bench_bnb,
+            "known_rotation": _bench_known_rotation}[args.what](args)
 
-    sizes = tuple(int(s) for s in args.sizes.split(","))
-    rows = bench_linear17(sizes, budget_s=args.budget)
+
+def _sizes(args: argparse.Namespace) -> tuple[int, ...]:
+    return BENCH_SIZES[args.what] if args.sizes is None else args.sizes
+
+
+def _bench_linear17(args: argparse.Namespace) -> int:
+    from .experiments.bench.linear17 import bench_linear17
+
+    rows = bench_linear17(_sizes(args), budget_s=args.budget, progress=progress_bar)
     print("linear17: mcgeom (C kernel via the Python API, RayPairs in, RigMotion out) "
           "vs a straightforward numpy implementation of the same algorithm")
     print(f"{'N':>7} {'mcgeom[us]':>11} {'numpy[us]':>11} {'ratio':>7} {'us/ray':>8} {'iters':>5}")
@@ -86,11 +105,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _bench_cone(args: argparse.Namespace) -> int:
-    from .bench.cone import bench_cone
+    from .experiments.bench.cone import bench_cone
 
-    sizes = ((3, 6, 20, 100, 1000) if args.sizes == "17,100,1000,10000"
-             else tuple(int(s) for s in args.sizes.split(",")))
-    rows = bench_cone(sizes, budget_s=args.budget)
+    rows = bench_cone(_sizes(args), budget_s=args.budget, progress=progress_bar)
     print("cone: mcgeom L-inf cone bisection (C kernel via the Python API) vs "
           "bisection with clarabel solving each SOCP feasibility step")
     print(f"{'N':>6} {'mcgeom[us]':>11} {'clarabel[us]':>13} {'ratio':>7} "
@@ -102,13 +119,13 @@ def _bench_cone(args: argparse.Namespace) -> int:
 
 
 def _bench_known_rotation(args: argparse.Namespace) -> int:
-    from .bench.known_rotation import bench_known_rotation
+    from .experiments.bench.known_rotation import bench_known_rotation
 
     print("known_rotation: centres of a circle sequence (thesis ch. 6.5.1 scaled up, noise "
           "1e-4 rad), constrained solver; mcgeom (C rows + skyline) vs dense numpy, seconds")
     print(f"{'views':>6} {'tracks':>7} {'relation':>10} {'relations':>9} {'mcgeom s':>9} "
           f"{'numpy s':>9} {'ratio':>7} {'max diff':>9}")
-    for r in bench_known_rotation():
+    for r in bench_known_rotation(progress=progress_bar):
         dense = ("" if r.numpy_s is None else
                  f"{r.numpy_s:9.3f} {r.ratio:7.1f} {r.max_diff:9.1e}")
         print(f"{r.views:6d} {r.tracks:7d} {r.relation:>10} {r.relations:9d} "
@@ -117,7 +134,7 @@ def _bench_known_rotation(args: argparse.Namespace) -> int:
 
 
 def _bench_bnb(args: argparse.Namespace) -> int:
-    from .bench.bnb import bench_bnb, growth
+    from .experiments.bench.bnb import bench_bnb, growth
 
     def row(r) -> str:
         g = "" if r.glpk_s is None else f" {r.glpk_s:9.3f} {r.glpk_ratio:7.1f}"
@@ -129,35 +146,113 @@ def _bench_bnb(args: argparse.Namespace) -> int:
     print("bnb: branch and bound over rotations to 1e-4 rad (4 cameras x 50 points, "
           "0.5 px; medians)")
     print(head + f" {'glpk s':>9} {'glpk/nat':>7}")
-    print(row(bench_bnb(problems=args.problems)))
+    print(row(bench_bnb(problems=args.problems, progress=progress_bar)))
     print("published: thesis ch. 10.5.1 about 3.5 s (C++ with GLPK)")
     print("\ngrowth with points (4 cameras) and cameras (50 points each)")
     print(head)
-    for r in growth(problems=max(3, args.problems // 2)):
+    for r in growth(problems=max(3, args.problems // 2), progress=progress_bar):
         print(row(r))
     return 0
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Entry point of the ``mcgeom`` command."""
-    p = argparse.ArgumentParser(prog="mcgeom", description=__doc__.split("\n")[0])
-    sub = p.add_subparsers(dest="cmd", required=True)
-    d = sub.add_parser("demo", help="Ladybug2-like head on the ∞ path of thesis ch. 8.5.2")
-    d.add_argument("--method", default="linear17", choices=registry.names())
-    d.add_argument("--noise", type=float, default=0.3, help="pixel noise std (px)")
-    d.add_argument("--seed", type=int, default=0)
+def _experiment_parser(name: str, module) -> argparse.ArgumentParser:
+    """The parser of ``mcgeom experiment NAME``: the module's options, its
+    docstring as the description."""
+    ep = argparse.ArgumentParser(prog=f"mcgeom experiment {name}",
+                                 description=plain_text(module.__doc__),
+                                 formatter_class=HelpFormatter)
+    module.add_arguments(ep)
+    return ep
+
+
+def _cmd_experiment(args: argparse.Namespace) -> int:
+    from .experiments import load
+
+    module = load(args.name)
+    eargs = _experiment_parser(args.name, module).parse_args(args.options)
+    return module.run_cli(eargs, progress=progress_bar)
+
+
+def _name_list(title: str, items: dict) -> str:
+    """``title:`` and one entry per name, its description wrapped beside it
+    (the epilog is printed as written, so it is wrapped here)."""
+    width = max(len(n) for n in items)
+    lines = [f"{title}:"]
+    for name, desc in items.items():
+        lines += textwrap.wrap(desc, 78, initial_indent=f"  {name:<{width}}  ",
+                               subsequent_indent=" " * (width + 4))
+    return "\n".join(lines)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of the ``mcgeom`` command (without the experiments' own options,
+    which are parsed once the experiment is known)."""
+    p = argparse.ArgumentParser(prog="mcgeom", description=plain_text(__doc__),
+                                formatter_class=HelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}",
+                   help="print the version and exit")
+    sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+
+    d = sub.add_parser("demo", formatter_class=HelpFormatter,
+                       help="Ladybug2-like head on the ∞ path of thesis ch. 8.5.2",
+                       description=textwrap.fill(
+                           "A Ladybug2-like head on the closed ∞-shaped path of thesis ch. "
+                           "8.5.2 (108 motions), every motion estimated from noisy pixels, "
+                           "chained, and compared with the truth; writes the trajectories "
+                           "(CSV) and a plot (PNG).", 79))
+    d.add_argument("--method", default="linear17", choices=registry.names(), metavar="METHOD",
+                   help="registered estimator: " + ", ".join(registry.names()))
+    d.add_argument("--noise", type=non_negative_float, default=0.3,
+                   help="pixel noise std (px)")
+    d.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
     d.add_argument("--out", default="mcgeom_demo", help="output directory")
     d.set_defaults(func=_cmd_demo)
-    m = sub.add_parser("methods", help="list the registered estimators")
+
+    m = sub.add_parser("methods", formatter_class=HelpFormatter,
+                       help="list the registered estimators",
+                       description="List the registered estimators with their options.")
     m.set_defaults(func=_cmd_methods)
-    b = sub.add_parser("bench", help="benchmarks with ratios against references")
-    b.add_argument("what", help="benchmark name (linear17, cone, bnb, known_rotation)")
-    b.add_argument("--problems", type=int, default=10, help="problems per row (bnb)")
-    b.add_argument("--sizes", default="17,100,1000,10000")
-    b.add_argument("--budget", type=float, default=0.5, help="seconds per timing")
+
+    b = sub.add_parser("bench", formatter_class=HelpFormatter,
+                       help="benchmarks with ratios against references",
+                       description=textwrap.fill("Time an mcgeom kernel against a "
+                                                 "reference implementation and print the "
+                                                 "ratios.", 79),
+                       epilog=_name_list("benchmarks", BENCHES))
+    b.add_argument("what", choices=list(BENCHES), metavar="NAME",
+                   help="benchmark: " + ", ".join(BENCHES))
+    b.add_argument("--problems", type=positive_int, default=10,
+                   help="problems per row (bnb)")
+    b.add_argument("--sizes", type=positive_int_list, default=None,
+                   help="comma-separated N (linear17, cone; default: linear17 "
+                        "17,100,1000,10000, cone 3,6,20,100,1000)")
+    b.add_argument("--budget", type=positive_float, default=0.5,
+                   help="seconds per timing (linear17, cone)")
     b.set_defaults(func=_cmd_bench)
-    args = p.parse_args(argv)
-    return int(args.func(args))
+
+    e = sub.add_parser("experiment", formatter_class=HelpFormatter,
+                       help="thesis experiments and real-data evaluations",
+                       description="Run an experiment: mcgeom experiment NAME [its options].\n"
+                                   "mcgeom experiment NAME --help lists its options.",
+                       epilog=_name_list("experiments", {n: desc for n, (_, desc)
+                                                         in EXPERIMENTS.items()}))
+    e.add_argument("name", choices=list(EXPERIMENTS), metavar="NAME",
+                   help="experiment: " + ", ".join(EXPERIMENTS))
+    e.add_argument("options", nargs=argparse.REMAINDER,
+                   help="the experiment's options (see mcgeom experiment NAME --help)")
+    e.set_defaults(func=_cmd_experiment)
+    return p
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Entry point of the ``mcgeom`` command; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except MissingPeerError as exc:
+        # a peer library of a comparison is not installed: say which, no traceback
+        print(f"mcgeom: error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -35,7 +35,7 @@ Solvers (gauge: the first view of the solved component at the origin):
   (sum 5 x the Laplacian; tests/test_ch6_thesis_form.py). Why it helps: the
   expected noise part of E^T E is close to a multiple of G^T G (within a
   factor 6.5-11 over all directions on the ch. 6.5.1 sequence), but spans
-  four orders of magnitude against |c|^2 (``experiment_ch6.py
+  four orders of magnitude against |c|^2 (``mcgeom experiment ch6
   --noise-metric``), so the plain solution is pulled toward small baselines
   far from view 0 -- the spirals of Figs. 6.3 and 6.5.
 
@@ -295,7 +295,7 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
     apart carries the noise of its coefficients times the long baseline, so
     with "all" such relations dominate and the metric solution shrinks. On
     the KITTI-00 stereo tracks (64 views, tracks up to 26 frames) "all" gave
-    a path 2.5-4 % short, the consecutive window 1.1-1.6 % (tests/eval_ch6_kitti.py).
+    a path 2.5-4 % short, the consecutive window 1.1-1.6 % (mcgeom experiment ch6_kitti).
     """
     t_start = time.perf_counter()
     if relation not in RELATIONS:

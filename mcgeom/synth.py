@@ -25,6 +25,7 @@ from typing import Optional, Sequence, Union
 
 import numpy as np
 
+from mcgeom.metrics import rotation_error
 from mcgeom.rig import Camera, Rig
 from mcgeom.types import RayPairs
 
@@ -33,7 +34,6 @@ __all__ = [
     "stereo_head", "axial_rig", "ladybug2", "vehicle8", "generic_rig",
     "rotation_about", "random_rotation", "random_motion", "figure_eight_path",
     "relative_motion", "SyntheticProblem", "make_problem", "perturb_directions",
-    "rotation_error", "translation_errors",
 ]
 
 RngLike = Union[np.random.Generator, int, None]
@@ -645,35 +645,3 @@ def _check_depth_range(depth_range) -> tuple[float, float]:
     if not (np.isfinite(lo) and np.isfinite(hi) and 0.0 < lo <= hi):
         raise ValueError(f"depth_range must satisfy 0 < near <= far (metres), got {depth_range!r}")
     return lo, hi
-
-
-# --------------------------------------------------------------------------- errors
-
-def rotation_error(R_est: np.ndarray, R_true: np.ndarray) -> float:
-    """Angle (radians, in [0, pi]) of the rotation ``R_est R_true^T``.
-
-    Computed with atan2 of the sine and cosine parts, accurate for tiny angles too
-    (arccos of the trace loses half the digits near 0).
-    """
-    D = np.asarray(R_est, dtype=np.float64) @ np.asarray(R_true, dtype=np.float64).T
-    s = 0.5 * np.linalg.norm([D[2, 1] - D[1, 2], D[0, 2] - D[2, 0], D[1, 0] - D[0, 1]])
-    c = 0.5 * (np.trace(D) - 1.0)
-    return float(np.arctan2(s, c))
-
-
-def translation_errors(t_est: np.ndarray, t_true: np.ndarray) -> tuple[float, float]:
-    """``(direction_error, scale_ratio)`` of a translation estimate.
-
-    ``direction_error`` is the angle (radians) between ``t_est`` and ``t_true``;
-    ``scale_ratio`` is ``|t_est| / |t_true|`` (1 = exact metric scale). Both are NaN
-    when ``t_true`` is zero; the angle is NaN when ``t_est`` is zero.
-    """
-    a = np.asarray(t_est, dtype=np.float64).reshape(3)
-    b = np.asarray(t_true, dtype=np.float64).reshape(3)
-    na, nb = np.linalg.norm(a), np.linalg.norm(b)
-    if nb == 0:
-        return float("nan"), float("nan")
-    if na == 0:
-        return float("nan"), 0.0
-    angle = np.arctan2(np.linalg.norm(np.cross(a, b)), a @ b)
-    return float(angle), float(na / nb)

@@ -1,11 +1,11 @@
 """Synthetic problems for each generalized-camera kind (thesis ch. 8.3), shared
-by the property suite, the experiments and the benchmarks in tests/."""
+by the property suite and the other tests."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from mcgeom import synth
+from mcgeom import metrics, synth
 
 #: how to produce data of each kind: (rig factory, cross-camera fraction)
 KIND_SETUPS = {
@@ -60,4 +60,4 @@ def rigid(rng: np.random.Generator):
     return R, rng.normal(size=3)
 
 
-rot_err = synth.rotation_error  # angle (rad) between two rotations, accurate near zero
+rot_err = metrics.rotation_error  # angle (rad) between two rotations, accurate near zero

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import mcgeom
-from mcgeom import _core, registry, synth
+from mcgeom import _core, metrics, registry, synth
 from mcgeom.estimators.bnb_lp import apex_groups, linf_error
 
 # f values agree to the precision of the LPs and of the bisection
@@ -245,7 +245,7 @@ def test_mask_selects_inliers():
     mask = np.ones(n, np.uint8)
     mask[bad] = 0
     m = mcgeom.estimate(rays, "bnb_lp", mask=mask)
-    assert synth.rotation_error(m.R, p.R) < np.radians(0.5)
+    assert metrics.rotation_error(m.R, p.R) < np.radians(0.5)
     assert m.inliers.sum() == n - len(bad)
 
 
@@ -288,8 +288,8 @@ def test_bad_input():
 
 @pytest.mark.slow
 def test_experiment_ch10_runs():
-    import experiment_ch9
-    import experiment_ch10
+    from mcgeom.experiments import ch9 as experiment_ch9
+    from mcgeom.experiments import ch10 as experiment_ch10
     res = experiment_ch9.run(2, levels=(0.0, 0.5), methods=experiment_ch10.METHODS)
     clean, noisy = res[0.0]["bnb_lp"], res[0.5]["bnb_lp"]
     assert np.all(clean[:, 0] < 1e-5) and np.all(np.abs(clean[:, 2] - 1) < 1e-6)

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from mcgeom import multiview, synth
-from mcgeom.bench.known_rotation_numpy import dense_rows
+from mcgeom.experiments.bench.known_rotation_numpy import dense_rows
 
 EPS = np.zeros((3, 3, 3))
 for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):

@@ -1,9 +1,9 @@
-"""Thesis ch. 6 on the real KITTI-00 stereo tracks (tests/eval_ch6_kitti.py runs
-frames 13-76): a shorter stretch here. Skipped without the recordings.
+"""Thesis ch. 6 on the real KITTI-00 stereo tracks (mcgeom experiment ch6_kitti
+runs frames 13-76): a shorter stretch here. Skipped without the recordings.
 
 With known rotations and the stereo rig's offsets the translation must come
 out metric, and close to the ground truth without any alignment. Measured on
-frames 13-40 (28 views, 25.3 m; ``python -P tests/eval_ch6_kitti.py --last
+frames 13-40 (28 views, 25.3 m; ``mcgeom experiment ch6_kitti --last
 40``): with the consecutive window, RMS centre error 0.24-0.25 m and path
 length ratio 0.990-0.993; with every relation of the tracks (up to 26 frames
 apart) RMS 0.48-0.58 m and ratio 0.962-0.965 (the algebraic residuals of the
@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import eval_ch6_kitti as ev
-import eval_real_data as erd
+import mcgeom.experiments.ch6_kitti as ev
+import mcgeom.experiments.real_data as erd
 
 if not erd.data_available():
     pytest.skip(f"real recordings not found under {erd.DATA_ROOT}", allow_module_level=True)

@@ -1,4 +1,4 @@
-"""A reduced run of tests/experiment_ch6.py (thesis ch. 6.5.1) so that it cannot
+"""A reduced run of mcgeom.experiments.ch6 (thesis ch. 6.5.1) so that it cannot
 rot: the full 101-view open sequence on the circle, fewer trials and noise
 levels."""
 
@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-import experiment_ch6 as ex
+import mcgeom.experiments.ch6 as ex
 
 
 def test_reduced_ch6_experiment(tmp_path):
@@ -17,7 +17,7 @@ def test_reduced_ch6_experiment(tmp_path):
     # near noise-free: every variant on the circle (radius 100) to 1e-2
     for rel, sol in ex.VARIANTS:
         assert med[(rel, sol, 1e-7)]["rms"] < 1e-2
-    # measured (python tests/experiment_ch6.py, 10 trials), constrained / plain
+    # measured (mcgeom experiment ch6, 10 trials), constrained / plain
     # median RMS: trilinear 0.41 at 1e-4, 0.10 at 5e-4, 0.04 at 1e-3 (the
     # plain SVD spirals, Fig. 6.5); bilinear 0.26 at 1e-4 (plain folds back,
     # Fig. 6.3). Bilinear relations of <= 3-view tracks fail with both solvers

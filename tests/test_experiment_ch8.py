@@ -1,6 +1,6 @@
 """Reproduction of the thesis ch. 8.5.1 experiment (1,000 trials per rig),
 linear17 next to PoseLib on the same problems. The table is printed (run
-pytest with -s, or `python tests/experiment_ch8.py`); only what must hold is
+pytest with -s, or `mcgeom experiment ch8`); only what must hold is
 asserted: bounded errors, and rotations as good as the peer's to within 2x."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("poselib")
-import experiment_ch8  # noqa: E402
+from mcgeom.experiments import ch8 as experiment_ch8  # noqa: E402
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 """Issue-3 targets, checked on small runs of the experiment scripts (the full
-runs print the tables: ``python tests/experiment_ch7.py 200``,
-``python tests/experiment_minimal_5p1.py 10000``,
-``python -P tests/bench_robust_vs_poselib.py``). Only what must hold is
+runs print the tables: ``mcgeom experiment ch7 --trials 200``,
+``mcgeom experiment minimal_5p1 --trials 10000``,
+``mcgeom experiment robust_vs_poselib``). Only what must hold is
 asserted, never a timing."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import experiment_ch7
-import experiment_minimal_5p1
+from mcgeom.experiments import ch7 as experiment_ch7
+from mcgeom.experiments import minimal_5p1 as experiment_minimal_5p1
 
 
 @pytest.mark.parametrize("cross", [0.0, 0.1])
@@ -38,7 +38,7 @@ def test_minimal_5p1_recovers_noise_free_motion():
 
 def test_robust_pipeline_matches_poselib_accuracy():
     pytest.importorskip("poselib")
-    import bench_robust_vs_poselib as b
+    from mcgeom.experiments import robust_vs_poselib as b
     res = b.run(trials=8, seed=2, cases={k: b.CASES[k] for k in list(b.CASES)[:2]})
     print("\n" + b.table(res))
     for case, methods in res.items():

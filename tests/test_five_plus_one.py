@@ -8,7 +8,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 import mcgeom
-from mcgeom import synth
+from mcgeom import metrics, synth
 from mcgeom.errors import DegenerateError
 from mcgeom.estimators import five_plus_one_minimal as minimal
 from problems import rot_err
@@ -19,7 +19,7 @@ seeds = st.integers(min_value=0, max_value=2**31 - 1)
 
 def _motion(rng, min_angle=0.05, max_angle=0.4, t_norm=1.0):
     R = synth.random_rotation(rng, max_angle)
-    while synth.rotation_error(R, np.eye(3)) < min_angle:
+    while metrics.rotation_error(R, np.eye(3)) < min_angle:
         R = synth.random_rotation(rng, max_angle)
     t = rng.normal(size=3)
     return R, t * t_norm / np.linalg.norm(t)

@@ -8,7 +8,7 @@ import pytest
 
 import mcgeom
 from mcgeom import _core
-from mcgeom.bench.linear17_numpy import linear17_numpy
+from mcgeom.experiments.bench.linear17_numpy import linear17_numpy
 from mcgeom.errors import DegenerateError
 from problems import KIND_SETUPS, make, rot_err
 

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from mcgeom import _core, multiview, synth
-from mcgeom.bench.known_rotation_numpy import dense_rows, dense_solve
+from mcgeom.experiments.bench.known_rotation_numpy import dense_rows, dense_solve
 from mcgeom.synth_views import circle_sequence
 
 VARIANTS = [(r, s) for r in multiview.RELATIONS for s in multiview.SOLVERS]

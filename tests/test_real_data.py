@@ -1,7 +1,7 @@
-"""The robust pipeline on a few real frame pairs (tests/eval_real_data.py does them all).
+"""The robust pipeline on a few real frame pairs (mcgeom experiment real_data does them all).
 
 Skipped when the recordings (../shared/data relative to the repository) are absent.
-The pairs, features and threshold are those of the evaluation script, so every case here
+The pairs, features and threshold are those of the evaluation, so every case here
 is a row of its table. Only what must hold is asserted:
 
 * rotations within 1 deg of the ground truth on KITTI (raw stereo and the GTSAM tracks)
@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import eval_real_data as ev
+import mcgeom.experiments.real_data as ev
 
 if not ev.data_available():
     pytest.skip(f"real recordings not found under {ev.DATA_ROOT}", allow_module_level=True)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from mcgeom import synth
+from mcgeom import metrics, synth
 from mcgeom.rig import Rig
 from mcgeom.types import RayPairs
 
@@ -131,13 +131,13 @@ def test_random_rotation(seed, max_angle):
     R = synth.random_rotation(seed, max_angle)
     np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-12)
     assert np.linalg.det(R) > 0
-    assert synth.rotation_error(R, np.eye(3)) <= max_angle + 1e-9
+    assert metrics.rotation_error(R, np.eye(3)) <= max_angle + 1e-9
 
 
 def test_random_motion():
     R, t = synth.random_motion(3, max_angle=0.2, t_norm=2.5)
     np.testing.assert_allclose(np.linalg.norm(t), 2.5)
-    assert synth.rotation_error(R, np.eye(3)) <= 0.2
+    assert metrics.rotation_error(R, np.eye(3)) <= 0.2
     R2, t2 = synth.random_motion(np.random.default_rng(3), max_angle=0.2, t_norm=2.5)
     np.testing.assert_array_equal(R, R2)
     np.testing.assert_array_equal(t, t2)
@@ -145,16 +145,16 @@ def test_random_motion():
 
 def test_error_helpers():
     R = synth.rotation_about((1, 2, 3), 0.3)
-    assert synth.rotation_error(R, np.eye(3)) == pytest.approx(0.3, abs=1e-14)
-    assert synth.rotation_error(R, R) == 0.0
+    assert metrics.rotation_error(R, np.eye(3)) == pytest.approx(0.3, abs=1e-14)
+    assert metrics.rotation_error(R, R) == 0.0
     tiny = synth.rotation_about((0, 0, 1), 1e-9)
-    assert synth.rotation_error(tiny, np.eye(3)) == pytest.approx(1e-9, rel=1e-6)
-    assert synth.rotation_error(synth.rotation_about((0, 1, 0), np.pi), np.eye(3)) == pytest.approx(np.pi)
-    ang, ratio = synth.translation_errors([2.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    assert metrics.rotation_error(tiny, np.eye(3)) == pytest.approx(1e-9, rel=1e-6)
+    assert metrics.rotation_error(synth.rotation_about((0, 1, 0), np.pi), np.eye(3)) == pytest.approx(np.pi)
+    ang, ratio = metrics.translation_errors([2.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     assert ang == pytest.approx(np.pi / 2) and ratio == pytest.approx(2.0)
-    ang, ratio = synth.translation_errors([0.0, 0.5, 0.0], [0.0, 1.0, 0.0])
+    ang, ratio = metrics.translation_errors([0.0, 0.5, 0.0], [0.0, 1.0, 0.0])
     assert ang == 0.0 and ratio == 0.5
-    assert all(np.isnan(synth.translation_errors([1.0, 0, 0], [0.0, 0, 0])))
+    assert all(np.isnan(metrics.translation_errors([1.0, 0, 0], [0.0, 0, 0])))
 
 
 def test_figure_eight_path():

@@ -1,7 +1,7 @@
 """Thesis ch. 10.5.1 (Figs. 10.4-10.5): B&B+LP against E+SOCP, and the effect
 of the preemptive per-camera test.
 
-Set-up of ch. 10.5.1 (the same as tests/experiment_ch9.py): four cameras, 50
+Set-up of ch. 10.5.1 (the same as mcgeom.experiments.ch9): four cameras, 50
 points each, a random rigid motion, Gaussian pixel noise sigma from 0 to
 0.5 px, ``runs`` problems per level (the thesis used 10). Printed per level
 and method: mean rotation error (deg), translation-direction error (deg),
@@ -13,30 +13,33 @@ Preemption (ch. 10.3, "Feasibility test"; the thesis: 90x): on the 0.5 px
 problems, the search time with and without the per-camera tests, in one run,
 for the thesis's set-up (GLPK, every LP on all its rows) and for ours (native
 backend, working sets), with the number of LPs of each kind.
-``python tests/experiment_ch10.py 10``
+``mcgeom experiment ch10 --runs 10``
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 
 import numpy as np
 
 import mcgeom
 from mcgeom import registry
 
-import experiment_ch9
+from . import ch9
+from .common import Progress, add_count_and_seed, no_progress
 
 METHODS = ("bnb_lp", "e_socp")
 
 
-def preemption(runs: int = 5, sigma: float = 0.5, seed: int = 0, glpk: bool = True) -> list[dict]:
-    """Search times with and without the preemptive test, same problems, same start."""
+def preemption(runs: int = 5, sigma: float = 0.5, seed: int = 0, glpk: bool = True,
+               progress: Progress = no_progress) -> list[dict]:
+    """Search times (s) with and without the preemptive test, same problems,
+    same start, per LP backend: one row per problem and backend."""
     configs = [("native", True), ("native", False)]
     if glpk and "glpk" in registry.lp_backends():
         configs += [("glpk", False)]
     rows = []
-    for R, t, p in experiment_ch9.problems(runs, sigma, seed):
+    for R, t, p in progress(ch9.problems(runs, sigma, seed), total=runs, desc="preemption"):
         start = mcgeom.estimate(p.rays, "refine")
         for backend, ws in configs:
             out = {}
@@ -51,6 +54,7 @@ def preemption(runs: int = 5, sigma: float = 0.5, seed: int = 0, glpk: bool = Tr
 
 
 def preemption_table(rows: list[dict]) -> str:
+    """Medians of :func:`preemption`'s rows per backend: seconds and LP counts."""
     lines = [f"{'backend':<8} {'LPs':<12} {'with s':>8} {'without s':>9} {'ratio':>6} "
              f"{'2-var/3-var LPs with':>22} {'without':>16}"]
     keys = sorted({(r["backend"], r["working_sets"]) for r in rows})
@@ -66,9 +70,17 @@ def preemption_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    runs = int(sys.argv[1]) if len(sys.argv) > 1 else 10
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment ch10``."""
+    add_count_and_seed(ap, "--runs", 10,
+                       "problems per noise level (the preemption table: at most 5)")
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Print the Fig. 10.4-10.5 table and the preemption table."""
+    runs = args.runs
     print("Fig. 10.4-10.5: mean errors over", runs, "problems per level")
-    print(experiment_ch9.table(experiment_ch9.run(runs, methods=METHODS)))
+    print(ch9.table(ch9.run(runs, args.seed, methods=METHODS, progress=progress)))
     print("\npreemptive per-camera test (median over", min(runs, 5), "problems at 0.5 px)")
-    print(preemption_table(preemption(min(runs, 5))))
+    print(preemption_table(preemption(min(runs, 5), seed=args.seed, progress=progress)))
+    return 0

@@ -8,19 +8,21 @@ and the scale error |1 - |t_est| / |t_true|| (thesis Figs. 8.6-8.9).
 
 PoseLib's ``estimate_generalized_relative_pose`` (RANSAC over its minimal
 6-point solver + non-linear refinement) receives the same rays as pixels of a
-virtual pinhole camera (f = 500 px) per rig camera. Run directly for the table:
-``python tests/experiment_ch8.py [trials]``.
+virtual pinhole camera (f = 500 px) per rig camera. The table:
+``mcgeom experiment ch8 [--trials 1000]`` (needs poselib).
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 import time
 
 import numpy as np
 
 import mcgeom
-from mcgeom import synth
+from mcgeom import metrics, synth
+
+from .common import Progress, add_count_and_seed, import_peer, no_progress
 
 RIGS = {
     "non-axial rig": (lambda rng: synth.generic_rig(4, rng)),
@@ -32,13 +34,12 @@ F_VIRTUAL = 500.0
 
 def _errors(R, t, R_true, t_true):
     """(rotation error deg, direction error deg, |1 - scale ratio|)"""
-    d, ratio = synth.translation_errors(t, t_true)
-    return np.degrees(synth.rotation_error(R, R_true)), np.degrees(d), abs(1 - ratio)
+    d, ratio = metrics.translation_errors(t, t_true)
+    return np.degrees(metrics.rotation_error(R, R_true)), np.degrees(d), abs(1 - ratio)
 
 
 def _poselib(prob):
-    import poselib
-
+    poselib = import_peer("poselib", "the ch8 experiment")
     rig, rays = prob.rig, prob.rays
     exts, cams = [], []
     for c in rig.cameras:
@@ -67,14 +68,17 @@ def _poselib(prob):
     return pose.R, pose.t
 
 
-def run(trials: int = 1000, seed: int = 0, noise_deg: float = 0.05, n_rays: int = 100):
-    """{rig: {method: (trials x 3 errors array, seconds)}}"""
+def run(trials: int = 1000, seed: int = 0, noise_deg: float = 0.05, n_rays: int = 100,
+        progress: Progress = no_progress) -> dict:
+    """{rig: {method: (trials x 3 errors array, seconds)}}: per trial the rotation
+    error (deg), translation-direction error (deg) and |1 - scale ratio|; the
+    total time of the method's calls (s)."""
     out = {}
     for name, factory in RIGS.items():
         rng = np.random.default_rng(seed)
         errs = {"linear17": [], "poselib": []}
         secs = {"linear17": 0.0, "poselib": 0.0}
-        for _ in range(trials):
+        for _ in progress(range(trials), total=trials, desc=f"ch8 {name}"):
             rig = factory(rng)
             R, t = synth.random_motion(rng, max_angle=0.5, t_norm=1.0)
             while np.linalg.norm(R - np.eye(3)) < 0.1:   # keep the scale observable
@@ -94,7 +98,8 @@ def run(trials: int = 1000, seed: int = 0, noise_deg: float = 0.05, n_rays: int 
     return out
 
 
-def table(res) -> str:
+def table(res: dict) -> str:
+    """The table of :func:`run`: medians and 90th percentiles, ms per call."""
     lines = [f"{'rig':<14} {'method':<9} {'rot med/p90 [deg]':>19} {'dir med/p90 [deg]':>19} "
              f"{'scale err med/p90':>19} {'ms/call':>8}"]
     for rig, methods in res.items():
@@ -106,6 +111,13 @@ def table(res) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
-    print(table(run(n)))
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment ch8``."""
+    add_count_and_seed(ap, "--trials", 1000, "random trials per rig")
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Print the ch. 8.5.1 table (PoseLib checked before the long run)."""
+    import_peer("poselib", "the ch8 experiment")
+    print(table(run(args.trials, args.seed, progress=progress)))
+    return 0

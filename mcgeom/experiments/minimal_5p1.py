@@ -7,19 +7,21 @@ A configuration counts as solved when one returned motion has rotation error
 and relative translation error below 1e-8. The issue's target is 99.9 %
 (poselib's 5+1 solver: ~97 %); poselib's general 6-point solver
 ``gen_relpose_6pt`` runs on the same rays for comparison.
-``python tests/experiment_minimal_5p1.py 10000``
+``mcgeom experiment minimal_5p1 --trials 10000`` (``--no-poselib`` without it)
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 import time
 
 import numpy as np
 
-from mcgeom import synth
+from mcgeom import metrics, synth
 from mcgeom.estimators.five_plus_one_minimal import critical_angles, minimal_solutions
 from mcgeom.types import RayPairs
+
+from .common import Progress, add_count_and_seed, import_peer, no_progress
 
 TOL = 1e-8
 
@@ -30,7 +32,7 @@ def configuration(rng: np.random.Generator):
         centres = np.vstack([np.zeros(3), rng.uniform(-0.5, 0.5, 3)])
         Rc = [synth.random_rotation(rng, np.pi) for _ in range(2)]   # cam_from_rig
         R = synth.random_rotation(rng, np.radians(30))
-        if synth.rotation_error(R, np.eye(3)) < np.radians(2):
+        if metrics.rotation_error(R, np.eye(3)) < np.radians(2):
             continue
         t = rng.normal(size=3)
         t *= rng.uniform(0.2, 2.0) / np.linalg.norm(t)
@@ -50,12 +52,15 @@ def configuration(rng: np.random.Generator):
 
 
 def solved(sols, R, t) -> bool:
-    return any(synth.rotation_error(Rs, R) < TOL and np.linalg.norm(ts - t) < TOL * np.linalg.norm(t)
+    """True if one (R, t) of ``sols`` is the true motion to :data:`TOL` (rotation
+    in radians, translation relative)."""
+    return any(metrics.rotation_error(Rs, R) < TOL and np.linalg.norm(ts - t) < TOL * np.linalg.norm(t)
                for Rs, ts in sols)
 
 
-def poselib_6pt(rays: RayPairs):
-    import poselib
+def poselib_6pt(rays: RayPairs) -> list:
+    """PoseLib's general 6-point solutions [(R, t), ...] on the same rays."""
+    poselib = import_peer("poselib", "the minimal_5p1 comparison (or --no-poselib)")
     p1, p2 = rays.origins1, rays.origins2
     x1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
     x2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
@@ -65,11 +70,13 @@ def poselib_6pt(rays: RayPairs):
     return out
 
 
-def run(trials: int = 1000, seed: int = 0, with_poselib: bool = True) -> dict:
+def run(trials: int = 1000, seed: int = 0, with_poselib: bool = True,
+        progress: Progress = no_progress) -> dict:
+    """Success rates and mean time per configuration (microseconds)."""
     rng = np.random.default_rng(seed)
     ok = okp = 0
     t_ours = t_pl = 0.0
-    for _ in range(trials):
+    for _ in progress(range(trials), total=trials, desc="minimal_5p1"):
         rays, R, t = configuration(rng)
         t0 = time.perf_counter()
         ok += solved(minimal_solutions(rays), R, t)
@@ -83,7 +90,17 @@ def run(trials: int = 1000, seed: int = 0, with_poselib: bool = True) -> dict:
             "poselib_6pt_us": 1e6 * t_pl / trials if with_poselib else float("nan")}
 
 
-if __name__ == "__main__":
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
-    for k, v in run(n).items():
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment minimal_5p1``."""
+    add_count_and_seed(ap, "--trials", 1000, "random configurations")
+    ap.add_argument("--no-poselib", action="store_true",
+                    help="skip the comparison with PoseLib's gen_relpose_6pt")
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Print the success rates and times."""
+    if not args.no_poselib:
+        import_peer("poselib", "the minimal_5p1 comparison (or --no-poselib)")
+    for k, v in run(args.trials, args.seed, not args.no_poselib, progress=progress).items():
         print(f"{k:>20}: {v}")
+    return 0

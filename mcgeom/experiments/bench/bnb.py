@@ -20,7 +20,9 @@ from typing import Optional
 
 import numpy as np
 
-from .. import estimate, registry, synth
+from mcgeom import estimate, registry, synth
+
+from ..common import Progress, no_progress
 
 __all__ = ["BnbTiming", "bench_bnb", "growth"]
 
@@ -51,11 +53,14 @@ def _problems(cams: int, pts: int, noise: float, n: int, seed: int):
 
 
 def bench_bnb(cams: int = 4, pts: int = 50, noise: float = 0.5, problems: int = 10,
-              resolution: float = 1e-4, glpk: bool = True, seed: int = 0) -> BnbTiming:
-    """Medians over ``problems`` problems (see the module docstring)."""
+              resolution: float = 1e-4, glpk: bool = True, seed: int = 0,
+              progress: Progress = no_progress) -> BnbTiming:
+    """Medians over ``problems`` problems (see the module docstring); ``noise`` in
+    pixels, ``resolution`` in radians, times in seconds."""
     rows = []
     use_glpk = glpk and "glpk" in registry.lp_backends()
-    for p in _problems(cams, pts, noise, problems, seed):
+    for p in progress(_problems(cams, pts, noise, problems, seed), total=problems,
+                      desc=f"bnb {cams} cams x {pts} pts"):
         start = estimate(p.rays, "refine")
         kw = dict(initial=start, resolution=resolution)
         a = estimate(p.rays, "bnb_lp", polish=False, lp_backend="native", **kw).info
@@ -74,9 +79,11 @@ def bench_bnb(cams: int = 4, pts: int = 50, noise: float = 0.5, problems: int = 
 
 
 def growth(points=(25, 50, 100, 200), cameras=(2, 4, 6, 8), problems: int = 5,
-           noise: float = 0.5, resolution: float = 1e-4) -> list[BnbTiming]:
+           noise: float = 0.5, resolution: float = 1e-4,
+           progress: Progress = no_progress) -> list[BnbTiming]:
     """Search times for 4 cameras x ``points`` and for ``cameras`` x 50 points."""
-    out = [bench_bnb(4, n, noise, problems, resolution, glpk=False) for n in points]
-    out += [bench_bnb(m, 50, noise, problems, resolution, glpk=False)
+    out = [bench_bnb(4, n, noise, problems, resolution, glpk=False, progress=progress)
+           for n in points]
+    out += [bench_bnb(m, 50, noise, problems, resolution, glpk=False, progress=progress)
             for m in cameras if m != 4]
     return out

@@ -6,18 +6,20 @@ used 10). Printed per noise level and method: mean rotation error (deg),
 translation-direction error (deg), scale ratio |t_est| / |t_true| and the
 distance between the estimated and the true final centre of the first camera
 (the quantities of Figs. 10.4-10.5). All methods see the same correspondences
-(no outliers) and run without RANSAC. ``python tests/experiment_ch9.py 10``
+(no outliers) and run without RANSAC. ``mcgeom experiment ch9 --runs 10``
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 
 import numpy as np
 
 import mcgeom
-from mcgeom import synth
+from mcgeom import metrics, synth
 from mcgeom.rig import Rig
+
+from .common import Progress, add_count_and_seed, no_progress
 
 METHODS = ("e_socp", "linear17", "five_plus_one")
 LEVELS = (0.0, 0.1, 0.2, 0.3, 0.4, 0.5)
@@ -34,6 +36,7 @@ def rig4(f: float = 800.0) -> Rig:
 
 
 def _metric(m) -> np.ndarray:
+    # the metric translation also when the scale was reported unobservable
     return np.asarray(m.info.get("t_metric", m.t) if m.info.get("t_metric") is not None
                       else m.t)
 
@@ -47,14 +50,17 @@ def problems(runs: int, sigma: float, seed: int = 0):
         yield R, t, synth.make_problem(rig, R, t, 200, rng, pixel_noise=sigma)
 
 
-def run(runs: int = 10, seed: int = 0, levels=LEVELS, methods=METHODS) -> dict:
-    """Mean errors per noise level and method (see :func:`table`)."""
+def run(runs: int = 10, seed: int = 0, levels=LEVELS, methods=METHODS,
+        progress: Progress = no_progress) -> dict:
+    """{sigma: {method: runs x 4 array}}: rotation error (deg), direction error
+    (deg), scale ratio and final-centre distance (m) per problem (see :func:`table`)."""
     rig = rig4()
     c1 = rig.centres[0]
     out = {}
     for sigma in levels:
         rows = {m: [] for m in methods}
-        for R, t, p in problems(runs, sigma, seed):
+        for R, t, p in progress(problems(runs, sigma, seed), total=runs,
+                                desc=f"{sigma:.2f} px"):
             for name in methods:
                 try:
                     m = mcgeom.estimate(p.rays, name)
@@ -62,7 +68,7 @@ def run(runs: int = 10, seed: int = 0, levels=LEVELS, methods=METHODS) -> dict:
                     rows[name].append((np.nan,) * 4)
                     continue
                 tm = _metric(m)
-                rot = np.degrees(synth.rotation_error(m.R, R))
+                rot = np.degrees(metrics.rotation_error(m.R, R))
                 cosd = np.clip(tm @ t / (np.linalg.norm(tm) * np.linalg.norm(t)), -1, 1)
                 ratio = np.linalg.norm(tm) / np.linalg.norm(t)
                 # the first camera's final centre in the rig1 frame: R^T (c1 - t)
@@ -73,6 +79,7 @@ def run(runs: int = 10, seed: int = 0, levels=LEVELS, methods=METHODS) -> dict:
 
 
 def table(res: dict) -> str:
+    """Means over the problems of :func:`run` that did not fail, per level and method."""
     lines = [f"{'sigma px':>8} {'method':<14} {'rot deg':>9} {'dir deg':>9} {'scale':>8} "
              f"{'centre m':>9} {'failed':>6}"]
     for sigma, methods in res.items():
@@ -84,5 +91,12 @@ def table(res: dict) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    print(table(run(int(sys.argv[1]) if len(sys.argv) > 1 else 10)))
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment ch9``."""
+    add_count_and_seed(ap, "--runs", 10, "problems per noise level")
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Print the table of mean errors per noise level and method."""
+    print(table(run(args.runs, args.seed, progress=progress)))
+    return 0

@@ -25,12 +25,13 @@ the real tracks and with the tracks cut to at most three consecutive frames
 as in ch. 6.5.1: plain SVD against the constrained minimisation on real
 noise (about 2e-4 rad here).
 
-    python -P tests/eval_ch6_kitti.py [--first 13] [--last 76] [--window N]
+    mcgeom experiment ch6_kitti [--first 13] [--last 76] [--window N] [--data DIR]
 
 Each variant runs twice: with every relation of every track (tracks here
 are up to 26 frames long) and with the consecutive window of ch. 6.2.3.
 
-The data are read in place from ../shared/data (MCGEOM_REAL_DATA overrides).
+The data are read in place from ../shared/data (--data or MCGEOM_REAL_DATA
+overrides it; see mcgeom.experiments.real_data).
 """
 
 from __future__ import annotations
@@ -40,23 +41,25 @@ import functools
 import sys
 import time
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import eval_real_data as erd  # noqa: E402  (the shared loaders of the real recordings)
+from mcgeom import multiview
+from mcgeom.estimators.known_rotation_translation import known_rotation_translation
+from mcgeom.synth_views import similarity_align, spiral_measure
+from mcgeom.types import RayPairs
 
-from mcgeom import multiview  # noqa: E402
-from mcgeom.estimators.known_rotation_translation import known_rotation_translation  # noqa: E402
-from mcgeom.synth_views import similarity_align, spiral_measure  # noqa: E402
-from mcgeom.types import RayPairs  # noqa: E402
+from . import real_data as erd  # the shared loaders of the real recordings
+from .common import Progress, no_progress, non_negative_int, write_line
 
 #: the KITTI GT of frames 0..12 disagrees with the tracks (data README)
 FIRST_GOOD_FRAME = 13
 
 
 @functools.lru_cache(maxsize=4)
-def load_tracks(first: int = FIRST_GOOD_FRAME, last: int = 76, root: Path = erd.DATA_ROOT):
+def load_tracks(first: int = FIRST_GOOD_FRAME, last: int = 76,
+                root: Optional[Path] = None) -> tuple:
     """Observations of frames ``first..last`` as tracks.
 
     Returns (track, view, bearings, origins, rotations, centres_gt): one row per
@@ -111,6 +114,7 @@ def cut_tracks(track: np.ndarray, view: np.ndarray, max_len: int) -> np.ndarray:
 
 
 def path_length(c: np.ndarray) -> float:
+    """Length of the polyline through the centres ``c`` (m, 3), their unit."""
     return float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum())
 
 
@@ -143,13 +147,16 @@ def chained_two_view(track, view, bearings, origins, rotations) -> np.ndarray:
 
 
 def evaluate(first: int = FIRST_GOOD_FRAME, last: int = 76, windows=(None, 0),
-             out=print) -> dict:
+             out=print, root: Optional[Path] = None,
+             progress: Progress = no_progress) -> dict:
     """Run the four variants with all relations of every track (window None)
     and with the consecutive window of ch. 6.2.3 (0: the smallest, 1 frame
     for bilinear and 2 for trilinear relations; or that many frames), then the
     chained two-view reference; print a table and return {name: dict(rms,
-    end, scale, rms_sim, observable, seconds, views)}."""
-    track, view, bearings, origins, rotations, gt = load_tracks(first, last)
+    end, scale, rms_sim, observable, seconds, views)}: errors in metres, the
+    scale as the ratio of path lengths. ``root``: the data root (default
+    real_data.DATA_ROOT); ``progress`` wraps the loop over the variants."""
+    track, view, bearings, origins, rotations, gt = load_tracks(first, last, root)
     track, view, bearings, origins = keep_multi_view_tracks(track, view, bearings, origins)
     lengths = np.bincount(np.unique(np.c_[track, view], axis=0)[:, 0])
     lengths = lengths[lengths > 0]
@@ -160,18 +167,18 @@ def evaluate(first: int = FIRST_GOOD_FRAME, last: int = 76, windows=(None, 0),
     out(f"{'variant':>50} {'RMS [m]':>9} {'end [m]':>9} {'path ratio':>11} "
         f"{'RMS sim [m]':>12} {'spiral':>7} {'scale':>14} {'s':>7}")
     res = {}
-    for window in windows:
-        for rel in multiview.RELATIONS:
-            q = 2 if rel == "bilinear" else 3
-            win = None if window is None else (window or q - 1)
-            for sol in multiview.SOLVERS:
-                t0 = time.perf_counter()
-                r = multiview.translations_from_tracks(
-                    track, view, bearings, rotations, origins=origins, relation=rel,
-                    solver=sol, pairs="all" if win is None else "window", window=win)
-                dt = time.perf_counter() - t0
-                where = "all" if win is None else f"window {win}"
-                res[f"{rel} + {sol}, {where}"] = _row(r.centres, gt, r.scale.observable, dt)
+    variants = [(w, rel, sol) for w in windows for rel in multiview.RELATIONS
+                for sol in multiview.SOLVERS]
+    for window, rel, sol in progress(variants, total=len(variants), desc="ch6_kitti stereo"):
+        q = 2 if rel == "bilinear" else 3
+        win = None if window is None else (window or q - 1)
+        t0 = time.perf_counter()
+        r = multiview.translations_from_tracks(
+            track, view, bearings, rotations, origins=origins, relation=rel,
+            solver=sol, pairs="all" if win is None else "window", window=win)
+        dt = time.perf_counter() - t0
+        where = "all" if win is None else f"window {win}"
+        res[f"{rel} + {sol}, {where}"] = _row(r.centres, gt, r.scale.observable, dt)
     t0 = time.perf_counter()
     chained = chained_two_view(track, view, bearings, origins, rotations)
     res["chained two-view"] = _row(chained, gt, True, time.perf_counter() - t0)
@@ -180,17 +187,18 @@ def evaluate(first: int = FIRST_GOOD_FRAME, last: int = 76, windows=(None, 0),
 
 
 def evaluate_monocular(first: int = FIRST_GOOD_FRAME, last: int = 76, max_lens=(None, 3),
-                       out=print) -> dict:
+                       out=print, root: Optional[Path] = None,
+                       progress: Progress = no_progress) -> dict:
     """cam0 alone, as the single camera of thesis ch. 6 (no offsets: no metric
     scale, compared after a similarity alignment), with the real tracks and
     with the tracks cut to at most 3 consecutive frames (the short tracks of
     ch. 6.5.1): plain SVD against the constrained minimisation on real noise.
     Returns {name: row} as :func:`evaluate`."""
-    track, view, bearings, origins, rotations, gt = load_tracks(first, last)
+    track, view, bearings, origins, rotations, gt = load_tracks(first, last, root)
     cam0 = np.all(origins == 0.0, axis=1)
     track, view, bearings = track[cam0], view[cam0], bearings[cam0]
     res = {}
-    for max_len in max_lens:
+    for max_len in progress(max_lens, total=len(max_lens), desc="ch6_kitti cam0"):
         tr = track if max_len is None else cut_tracks(track, view, max_len)
         tr, vw, b = keep_multi_view_tracks(tr, view, bearings)
         where = "real tracks" if max_len is None else f"tracks <= {max_len} frames"
@@ -201,8 +209,8 @@ def evaluate_monocular(first: int = FIRST_GOOD_FRAME, last: int = 76, max_lens=(
                                                        solver=sol)
                 res[f"cam0 {rel} + {sol}, {where}"] = _row(
                     r.centres, gt, r.scale.observable, time.perf_counter() - t0)
-    out(f"cam0 alone (no scale: compare 'RMS sim', the error after a similarity; spiral = "
-        f"largest step-direction error):")
+    out("cam0 alone (no scale: compare 'RMS sim', the error after a similarity; spiral = "
+        "largest step-direction error):")
     _print_rows(res, out)
     return res
 
@@ -225,21 +233,28 @@ def _row(c: np.ndarray, gt: np.ndarray, observable: bool, seconds: float) -> dic
             "observable": bool(observable), "seconds": seconds, "views": int(ok.sum())}
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--first", type=int, default=FIRST_GOOD_FRAME)
-    ap.add_argument("--last", type=int, default=76)
-    ap.add_argument("--window", type=int, default=0,
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment ch6_kitti``."""
+    ap.add_argument("--first", type=non_negative_int, default=FIRST_GOOD_FRAME,
+                    help="first frame (the ground truth of frames 0-12 is suspect)")
+    ap.add_argument("--last", type=non_negative_int, default=76, help="last frame")
+    ap.add_argument("--window", type=non_negative_int, default=0,
                     help="the window of the windowed runs (ch. 6.2.3): frames at most this "
                          "far apart; 0 = the smallest (1 bilinear, 2 trilinear)")
-    args = ap.parse_args(argv)
-    if not erd.data_available():
-        print(f"no data at {erd.DATA_ROOT}")
+    erd.add_data_argument(ap)
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Print the stereo table and the cam0 table; 2 if the data are missing."""
+    out = write_line   # the first lines are printed while the bar runs
+    root = erd.data_root_or_none(args, "ch6_kitti")
+    if root is None:
         return 2
-    evaluate(args.first, args.last, (None, args.window))
-    evaluate_monocular(args.first, args.last)
+    if args.last <= args.first:
+        print(f"mcgeom experiment ch6_kitti: error: --last ({args.last}) must be after "
+              f"--first ({args.first})", file=sys.stderr)
+        return 2
+    evaluate(args.first, args.last, (None, args.window), out=out, root=root,
+             progress=progress)
+    evaluate_monocular(args.first, args.last, out=out, root=root, progress=progress)
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -15,7 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import _core
+from mcgeom import _core
+
+from ..common import Progress, import_peer, no_progress
 from .timing import best_of
 
 __all__ = ["ConeTiming", "bench_cone", "clarabel_cone_linf"]
@@ -36,13 +38,9 @@ class ConeTiming:
 
 
 def _import_clarabel():
-    try:
-        import clarabel
-        from scipy import sparse
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise SystemExit(
-            "mcgeom bench cone needs clarabel and scipy (benchmark-only "
-            "dependencies): pip install clarabel scipy") from exc
+    # benchmark-only dependencies: a clear MissingPeerError (exit 2 from the CLI)
+    clarabel = import_peer("clarabel", "mcgeom bench cone")
+    sparse = import_peer("scipy.sparse", "mcgeom bench cone", "scipy")
     return clarabel, sparse
 
 
@@ -118,13 +116,14 @@ def _instance(rng, n):
     return C, V
 
 
-def bench_cone(sizes=(3, 6, 20, 100, 1000), seed: int = 0,
-               budget_s: float = 0.5) -> list[ConeTiming]:
-    """Time cone_linf (C via the Python API) and the clarabel bisection."""
+def bench_cone(sizes=(3, 6, 20, 100, 1000), seed: int = 0, budget_s: float = 0.5,
+               progress: Progress = no_progress) -> list[ConeTiming]:
+    """Time cone_linf (C via the Python API) and the clarabel bisection
+    (microseconds per call; ``budget_s`` seconds per timing)."""
     _import_clarabel()
     rng = np.random.default_rng(seed)
     out = []
-    for n in sizes:
+    for n in progress(sizes, total=len(sizes), desc="cone"):
         C, V = _instance(rng, n)
         r = _core.cone_linf(C, V)
         once = best_of(lambda: _core.cone_linf(C, V), 1, 3)

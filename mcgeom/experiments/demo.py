@@ -13,14 +13,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import estimate, synth
-from .odometry import chain, loop_closure_error, motion_errors, to_matrix
+from mcgeom import estimate, synth
+from mcgeom.metrics import loop_closure_error, motion_errors
+from mcgeom.odometry import chain, to_matrix
+
+from .common import Progress, no_progress
 
 __all__ = ["DemoFrame", "DemoResult", "run_demo"]
 
 
 @dataclass(frozen=True)
 class DemoFrame:
+    """Errors of one frame-to-frame motion: angles in degrees, ``t_err_m`` in
+    metres, ``scale_ratio`` = |t_est| / |t_true|."""
+
     index: int
     n_rays: int
     rot_err_deg: float
@@ -34,6 +40,9 @@ class DemoFrame:
 
 @dataclass(frozen=True)
 class DemoResult:
+    """Per-frame errors, the true and the chained world_from_rig 4x4 poses
+    (metres), the loop-closure gap (metres, radians) and the path length (metres)."""
+
     frames: list
     true_poses: list
     est_poses: list
@@ -53,18 +62,20 @@ class DemoResult:
 
 
 def run_demo(method: str = "linear17", pixel_noise: float = 0.3, points_per_camera: int = 60,
-             n_positions: int = 108, seed: int = 0) -> DemoResult:
+             n_positions: int = 108, seed: int = 0,
+             progress: Progress = no_progress) -> DemoResult:
     """Simulate the ∞ path and estimate every frame-to-frame motion with ``method``.
 
-    When an estimate reports its scale unobservable, the chain uses the
-    method's metric least-squares estimate if it has one (``info['t_metric']``)
-    and the frame is flagged; errors are computed on what was chained.
+    ``pixel_noise``: Gaussian std in pixels. When an estimate reports its scale
+    unobservable, the chain uses the method's metric least-squares estimate if
+    it has one (``info['t_metric']``) and the frame is flagged; errors are
+    computed on what was chained. ``progress`` wraps the loop over the frames.
     """
     rng = np.random.default_rng(seed)
     rig = synth.ladybug2()
     poses = synth.figure_eight_path(n_positions)
     frames, motions = [], []
-    for k in range(len(poses)):
+    for k in progress(range(len(poses)), total=len(poses), desc=f"demo {method}"):
         T1, T2 = poses[k], poses[(k + 1) % len(poses)]
         R_true, t_true = synth.relative_motion(T1, T2)
         M_true = to_matrix(R_true, t_true)

@@ -1,7 +1,7 @@
 """``mcgeom bench known_rotation``: the multi-view translation solver of thesis
 ch. 6 (:mod:`mcgeom.multiview`: C rows and Grams, skyline inverse iteration)
 against the dense numpy implementation of the same math
-(:mod:`mcgeom.bench.known_rotation_numpy`: E row by row, N = E^T E, dense
+(:mod:`mcgeom.experiments.bench.known_rotation_numpy`: E row by row, N = E^T E, dense
 eigh), on the circle sequence of ch. 6.5.1 scaled up (same density of views
 and points). Times are the best of a few calls, seconds."""
 
@@ -12,8 +12,9 @@ from typing import Optional
 
 import numpy as np
 
-from .. import multiview
-from ..synth_views import circle_sequence
+from mcgeom import multiview
+from mcgeom.synth_views import circle_sequence
+from ..common import Progress, no_progress
 from .known_rotation_numpy import dense_solve
 from .timing import best_of
 
@@ -36,11 +37,11 @@ class KnownRotationTiming:
 
 
 def bench_known_rotation(view_counts=(101, 201), dense_up_to: int = 101,
-                         repeat: int = 3) -> list:
-    """One row per (views, relation), constrained solver; the dense reference
-    only up to ``dense_up_to`` views (its memory grows as views^2)."""
+                         repeat: int = 3, progress: Progress = no_progress) -> list:
+    """One row per (views, relation), constrained solver, times in seconds; the
+    dense reference only up to ``dense_up_to`` views (its memory grows as views^2)."""
     rows = []
-    for m in view_counts:
+    for m in progress(view_counts, total=len(view_counts), desc="known_rotation"):
         f = m / 101.0
         seq = circle_sequence(n_views=m, n_points=int(round(1000 * f ** 3)),
                               radius=100.0 * f, sigma=1e-4, rng=7)

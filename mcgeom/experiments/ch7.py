@@ -5,22 +5,30 @@ motion of ch. 7.3.2) and 1 px noise; every frame is estimated with the default
 robust 5+1 pipeline of ``mcgeom.estimateRigMotion``. The issue's targets: among
 estimates reported scale-observable the median scale error is at most 5 %, and
 at least 90 % of the estimates whose scale error exceeds 30 % are reported
-unobservable. Run as a script to print the table for 0, 5 and 10 % cross-camera
-correspondences: ``python tests/experiment_ch7.py 200``.
+unobservable. The tables for 0, 5 and 10 % cross-camera
+correspondences: ``mcgeom experiment ch7 --trials 200``.
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 
 import numpy as np
 
-from mcgeom import synth
+from mcgeom import metrics, synth
 from mcgeom.cv import estimate
+
+from .common import Progress, add_count_and_seed, no_progress
+
+#: fractions of cross-camera correspondences of the printed tables
+CROSS_FRACTIONS = (0.0, 0.05, 0.1)
 
 
 def trial(rng: np.random.Generator, noise_px: float = 1.0, n: int = 400,
           outliers: float = 0.1, max_yaw_deg: float = 2.0, cross: float = 0.0) -> dict:
+    """One forward motion of 0.5-2 m with a yaw below ``max_yaw_deg``, estimated
+    from ``n`` pixel correspondences: scale error (relative), verdict, relative
+    std of the scale, critical angle and rotation error (degrees)."""
     rig = synth.vehicle8()
     yaw = np.radians(rng.uniform(-max_yaw_deg, max_yaw_deg))
     dist = rng.uniform(0.5, 2.0)
@@ -34,15 +42,19 @@ def trial(rng: np.random.Generator, noise_px: float = 1.0, n: int = 400,
     return {"yaw_deg": np.degrees(yaw), "scale_err": abs(np.linalg.norm(t_metric) / dist - 1.0),
             "observable": m.scale.observable, "rel_std": m.scale.rel_std,
             "critical_deg": np.degrees(m.scale.critical_angle),
-            "rot_err_deg": np.degrees(synth.rotation_error(m.R, R))}
+            "rot_err_deg": np.degrees(metrics.rotation_error(m.R, R))}
 
 
-def run(trials: int = 200, seed: int = 0, **kw) -> list[dict]:
+def run(trials: int = 200, seed: int = 0, progress: Progress = no_progress,
+        **kw) -> list[dict]:
+    """``trials`` results of :func:`trial` (keyword options ``kw``), seeded."""
     rng = np.random.default_rng(seed)
-    return [trial(rng, **kw) for _ in range(trials)]
+    return [trial(rng, **kw) for _ in progress(range(trials), total=trials,
+                                                desc=f"ch7 cross {kw.get('cross', 0.0)}")]
 
 
 def summary(rows: list[dict]) -> dict:
+    """Counts and medians of :func:`run`'s rows (scale errors relative, angles in degrees)."""
     err = np.array([r["scale_err"] for r in rows])
     obs = np.array([r["observable"] for r in rows])
     bad = err > 0.30
@@ -53,9 +65,15 @@ def summary(rows: list[dict]) -> dict:
             "median_rot_err_deg": float(np.median([r["rot_err_deg"] for r in rows]))}
 
 
-if __name__ == "__main__":
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 200
-    for cross in (0.0, 0.05, 0.1):   # fraction of cross-camera correspondences
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment ch7``."""
+    add_count_and_seed(ap, "--trials", 200, "motions per cross-camera fraction")
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Print the summary for each fraction of cross-camera correspondences."""
+    for cross in CROSS_FRACTIONS:
         print(f"cross-camera fraction {cross}:")
-        for k, v in summary(run(n, cross=cross)).items():
+        for k, v in summary(run(args.trials, args.seed, progress=progress, cross=cross)).items():
             print(f"{k:>24}: {v}")
+    return 0

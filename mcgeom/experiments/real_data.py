@@ -1,12 +1,14 @@
 """Evaluation of the robust rig-motion pipeline on the real recordings in ../shared/data.
 
-Run from the repository root (the data are read in place, never copied)::
+The data are read in place, never copied (root: ``--data``, else the environment
+variable MCGEOM_REAL_DATA, else ../shared/data beside the working directory or
+beside the source checkout)::
 
-    python -P tests/eval_real_data.py                 # every data set, every pair
-    python -P tests/eval_real_data.py --sets kitti_raw euroc --max-pairs 3
+    mcgeom experiment real_data                 # every data set, every pair
+    mcgeom experiment real_data --sets kitti_raw euroc --max-pairs 3
 
-For every data set (``/work/shared/data/<dir>/load.py``, imported from its path) the
-script builds an :class:`mcgeom.rig.Rig` from the calibration, detects and matches
+For every data set (``<data>/<dir>/load.py``, imported from its path) the
+evaluation builds an :class:`mcgeom.rig.Rig` from the calibration, detects and matches
 features with OpenCV (SIFT, else ORB; Lowe ratio test; mutual check) -- or takes the
 tracked correspondences of the tracks-only set --, forms pixel correspondences between
 consecutive frames
@@ -28,7 +30,7 @@ constraint (:func:`gec_sampson`), and compared with the error under the opposite
 convention (which must be clearly larger on the moving sets).
 
 Importable: :func:`load_sequences`, :func:`correspondences`, :func:`evaluate_pair`,
-:func:`run` are used by ``tests/test_real_data.py``.
+:func:`run` are used by the tests (tests/test_real_data.py).
 """
 
 from __future__ import annotations
@@ -44,14 +46,15 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
+from .common import Progress, no_progress, positive_float, positive_int, write_line
+
 try:
     import cv2
 except ImportError:  # pragma: no cover - opencv is a runtime dependency of mcgeom
     cv2 = None
 
-#: ../shared/data relative to the repository (MCGEOM_REAL_DATA overrides it)
-DATA_ROOT = Path(os.environ.get("MCGEOM_REAL_DATA",
-                                Path(__file__).resolve().parents[1].parent / "shared" / "data"))
+#: the environment variable that names the data root
+DATA_ENV = "MCGEOM_REAL_DATA"
 
 #: default inlier threshold of the robust pipeline, pixels
 THRESHOLD_PX = 1.5
@@ -61,9 +64,52 @@ STATIC_T = 0.02
 MIN_OVERLAP = 0.05
 
 
-def data_available(root: Path = DATA_ROOT) -> bool:
-    """True if the real data sets are present (the evaluation skips cleanly otherwise)."""
-    return (root / "README.md").is_file()
+def data_available(root: Optional[Path] = None) -> bool:
+    """True if the real data sets are present under ``root`` (default
+    :data:`DATA_ROOT`): the tests skip cleanly otherwise."""
+    return (Path(DATA_ROOT if root is None else root) / "README.md").is_file()
+
+
+def default_data_root() -> Path:
+    """The data root when ``--data`` is not given.
+
+    $MCGEOM_REAL_DATA if set; else ../shared/data beside the working directory
+    (a run from the root of a checkout); else ../shared/data beside the source
+    checkout of this module, if it is there (from an install, ``__file__`` is in
+    site-packages, so this guess only helps a source tree); else the first.
+    """
+    env = os.environ.get(DATA_ENV)
+    if env:
+        return Path(env)
+    beside_cwd = Path.cwd().parent / "shared" / "data"
+    # mcgeom/experiments/real_data.py: parents[2] is the checkout, [3] beside it
+    beside_checkout = Path(__file__).resolve().parents[3] / "shared" / "data"
+    for root in (beside_cwd, beside_checkout):
+        if data_available(root):
+            return root
+    return beside_cwd
+
+
+#: the data root of the tests and of the defaults below
+DATA_ROOT = default_data_root()
+
+
+def add_data_argument(ap: argparse.ArgumentParser) -> None:
+    """The ``--data`` option of the experiments on the real recordings."""
+    ap.add_argument("--data", type=Path, default=None,
+                    help=f"root of the real recordings (default: ${DATA_ENV}, else "
+                         f"../shared/data beside the working directory; now {DATA_ROOT})")
+
+
+def data_root_or_none(args: argparse.Namespace, name: str) -> Optional[Path]:
+    """The data root of the parsed options, or None after printing a one-line
+    error that names the path and how to set it (the caller exits with 2)."""
+    root = DATA_ROOT if args.data is None else args.data
+    if data_available(root):
+        return root
+    print(f"mcgeom experiment {name}: error: no real recordings at {root} (no README.md "
+          f"there); pass --data DIR or set {DATA_ENV}", file=sys.stderr)
+    return None
 
 
 # ------------------------------------------------------------------ geometry helpers
@@ -138,7 +184,7 @@ def front_fraction(o1: np.ndarray, d1: np.ndarray, o2: np.ndarray, d2: np.ndarra
 
 # ------------------------------------------------------------------ data sets
 
-def _import_loader(dirname: str, root: Path = DATA_ROOT):
+def _import_loader(dirname: str, root: Path):
     """Import ``<root>/<dirname>/load.py`` under a private module name."""
     path = root / dirname / "load.py"
     spec = importlib.util.spec_from_file_location(f"_mcgeom_realdata_{dirname}", path)
@@ -226,13 +272,15 @@ class Sequence:
 SET_KEYS = ("dgp_scene_02", "dgp_scene_01", "kitti_raw", "euroc", "kitti00_tracks")
 
 
-def load_sequences(keys=SET_KEYS, root: Path = DATA_ROOT, max_pairs: Optional[int] = None,
+def load_sequences(keys=SET_KEYS, root: Optional[Path] = None, max_pairs: Optional[int] = None,
                    pairs: Optional[dict] = None) -> list[Sequence]:
-    """Load the requested data sets (keys of :data:`SET_KEYS`).
+    """Load the requested data sets (keys of :data:`SET_KEYS`) from ``root``
+    (default :data:`DATA_ROOT`).
 
     ``pairs`` may map a key to an explicit list of frame pairs; ``max_pairs`` keeps the
     first pairs of each set.
     """
+    root = DATA_ROOT if root is None else Path(root)
     seqs = []
     for key in keys:
         if key not in SET_KEYS:
@@ -610,8 +658,10 @@ def summarize(seq: Sequence, results: list, out=print) -> list[dict]:
 
 
 def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
-        detector: str = "auto", nfeatures: Optional[int] = None, **options: Any) -> dict:
-    """Evaluate every pair of every sequence in both modes; print rows and summaries."""
+        detector: str = "auto", nfeatures: Optional[int] = None,
+        progress: Progress = no_progress, **options: Any) -> dict:
+    """Evaluate every pair of every sequence in both modes; print rows and summaries
+    with ``out``; ``progress`` wraps the loop over the pairs of each sequence."""
     all_results: dict = {}
     summary = []
     for seq in seqs:
@@ -636,7 +686,7 @@ def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
             out("  correspondences: tracked landmarks; threshold %.2f px" % threshold)
         out(HEADER)
         results = []
-        for k1, k2 in seq.pairs:
+        for k1, k2 in progress(seq.pairs, total=len(seq.pairs), desc=seq.key):
             corr = correspondences(seq, k1, k2, feats)
             g = gt_check(seq, corr, k1, k2)
             R_gt, t_gt = seq.gt_motion(k1, k2)
@@ -684,31 +734,37 @@ def print_summary_table(summary: list, out=print) -> None:
             ("  (%d failed)" % r["failed"]) if r["failed"] else ""))
 
 
-def main(argv: Optional[list] = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--sets", nargs="*", default=list(SET_KEYS), choices=SET_KEYS)
-    ap.add_argument("--max-pairs", type=int, default=None)
-    ap.add_argument("--threshold", type=float, default=THRESHOLD_PX, help="pixels")
-    ap.add_argument("--detector", choices=("auto", "sift", "orb"), default="auto")
-    ap.add_argument("--nfeatures", type=int, default=None)
-    ap.add_argument("--data", type=Path, default=DATA_ROOT)
-    args = ap.parse_args(argv)
-    if not data_available(args.data):
-        print(f"real data not found under {args.data}: nothing to evaluate (skipped)")
-        return 0
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment real_data``."""
+    ap.add_argument("--sets", nargs="*", default=list(SET_KEYS), choices=SET_KEYS,
+                    metavar="SET", help="data sets to evaluate, of " + ", ".join(SET_KEYS))
+    ap.add_argument("--max-pairs", type=positive_int, default=None,
+                    help="evaluate only the first pairs of each set (default: all)")
+    ap.add_argument("--threshold", type=positive_float, default=THRESHOLD_PX,
+                    help="inlier threshold, pixels")
+    ap.add_argument("--detector", choices=("auto", "sift", "orb"), default="auto",
+                    help="feature detector (auto: SIFT if OpenCV has it, else ORB)")
+    ap.add_argument("--nfeatures", type=positive_int, default=None,
+                    help="features per image (default: per data set, 2000-4000)")
+    add_data_argument(ap)
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Evaluate, print the rows and the summary table; 2 if the data are missing."""
+    out = write_line   # rows are printed while the bar runs
+    root = data_root_or_none(args, "real_data")
+    if root is None:
+        return 2
     if cv2 is not None:
         cv2.setNumThreads(2)
     import mcgeom
-    print("mcgeom %s from %s; OpenCV %s; data %s" % (
+    out("mcgeom %s from %s; OpenCV %s; data %s" % (
         mcgeom.__version__, os.path.dirname(mcgeom.__file__),
-        getattr(cv2, "__version__", "-"), args.data))
+        getattr(cv2, "__version__", "-"), root))
     t0 = time.perf_counter()
-    seqs = load_sequences(args.sets, args.data, args.max_pairs)
-    res = run(seqs, args.threshold, detector=args.detector, nfeatures=args.nfeatures)
-    print_summary_table(res["_summary"])
-    print("total %.1f s" % (time.perf_counter() - t0))
+    seqs = load_sequences(args.sets, root, args.max_pairs)
+    res = run(seqs, args.threshold, out=out, detector=args.detector,
+              nfeatures=args.nfeatures, progress=progress)
+    print_summary_table(res["_summary"], out)
+    out("total %.1f s" % (time.perf_counter() - t0))
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -19,22 +19,24 @@ pair's baseline direction on its own (smallest eigenvector of the pair's
 epipolar rows, eq. 6.13), then the centres that best fit those directions
 (min sum |(I - d d^T)(c_j - c_i)|^2 subject to sum |c_j - c_i|^2 = 1).
 
-    python tests/experiment_ch6.py [--trials 10] [--out ch6_out] [--range 50] [--closed-loop]
-                                   [--tracks consecutive|any] [--noise-metric]
-                                   [--pairwise-reference]
+    mcgeom experiment ch6 [--trials 10] [--out ch6_out] [--range 50] [--closed-loop]
+                          [--tracks consecutive|any] [--noise-metric]
+                          [--pairwise-reference]
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 
 from mcgeom import multiview
 from mcgeom.synth_views import circle_sequence, similarity_align, spiral_measure
+
+from .common import Progress, no_progress, non_negative_int, positive_float, positive_int
 
 SIGMAS = (1e-7, 1.2e-5, 1e-4, 5e-4, 1e-3, 1e-2)
 VARIANTS = [(r, s) for r in multiview.RELATIONS for s in multiview.SOLVERS]
@@ -57,38 +59,42 @@ def step_angles(aligned: np.ndarray, true: np.ndarray) -> np.ndarray:
 
 def run(trials: int = 10, sigmas=SIGMAS, n_views: int = 101, n_points: int = 1000,
         seed: int = 0, visible_range: float = 50.0, closed_loop: bool = False,
-        track_views: str = "consecutive") -> dict:
+        track_views: str = "consecutive", progress: Progress = no_progress) -> dict:
     """{(relation, solver, sigma): dict(rms=[...], spiral=[...], folds=[...],
     worst=[...], worst_links=[...], links=[...], seconds=[...], rigidity=[...])}
-    plus the aligned trajectories of the first trial under key "paths"."""
+    plus the aligned trajectories of the first trial under key "paths".
+    rms: centre error after a similarity (units of the scene, circle radius
+    100); spiral: radians; seconds: solver time. ``progress`` wraps the loop
+    over (sigma, trial)."""
     out, paths = {}, {}
-    for sigma in sigmas:
-        for trial in range(trials):
-            seq = circle_sequence(n_views=n_views, n_points=n_points, sigma=sigma,
-                                  rng=seed + 1000 * trial, visible_range=visible_range,
-                                  closed_loop=closed_loop, track_views=track_views)
-            links = step_links(seq.track, seq.view, n_views)
-            for rel, sol in VARIANTS:
-                r = multiview.translations_from_tracks(seq.track, seq.view, seq.bearings,
-                                                       seq.rotations, relation=rel, solver=sol)
-                ok = r.connected
-                aligned, rms = similarity_align(r.centres[ok], seq.centres[ok])
-                ang = step_angles(aligned, seq.centres[ok])
-                worst = int(np.flatnonzero(ok)[np.argmax(ang)])
-                rec = out.setdefault((rel, sol, sigma), {k: [] for k in (
-                    "rms", "spiral", "folds", "worst", "worst_links", "links", "seconds",
-                    "rigidity")})
-                rec["rms"].append(rms)
-                rec["spiral"].append(spiral_measure(aligned, seq.centres[ok]))
-                rec["folds"].append(int(np.count_nonzero(ang > np.pi / 2)))
-                rec["worst"].append(worst)
-                rec["worst_links"].append(int(links[min(worst, n_views - 2)]))
-                rec["links"].append(float(np.median(links)))
-                rec["seconds"].append(r.timing["total"])
-                rec["rigidity"].append(r.rigidity)
-                if trial == 0:
-                    paths[(rel, sol, sigma)] = aligned
-                    paths[("truth", sigma)] = seq.centres[ok]
+    # one flat loop (same order as sigma-major nested loops) so that one bar covers it
+    for sigma, trial in progress(itertools.product(sigmas, range(trials)),
+                                 total=len(sigmas) * trials, desc="ch6"):
+        seq = circle_sequence(n_views=n_views, n_points=n_points, sigma=sigma,
+                              rng=seed + 1000 * trial, visible_range=visible_range,
+                              closed_loop=closed_loop, track_views=track_views)
+        links = step_links(seq.track, seq.view, n_views)
+        for rel, sol in VARIANTS:
+            r = multiview.translations_from_tracks(seq.track, seq.view, seq.bearings,
+                                                   seq.rotations, relation=rel, solver=sol)
+            ok = r.connected
+            aligned, rms = similarity_align(r.centres[ok], seq.centres[ok])
+            ang = step_angles(aligned, seq.centres[ok])
+            worst = int(np.flatnonzero(ok)[np.argmax(ang)])
+            rec = out.setdefault((rel, sol, sigma), {k: [] for k in (
+                "rms", "spiral", "folds", "worst", "worst_links", "links", "seconds",
+                "rigidity")})
+            rec["rms"].append(rms)
+            rec["spiral"].append(spiral_measure(aligned, seq.centres[ok]))
+            rec["folds"].append(int(np.count_nonzero(ang > np.pi / 2)))
+            rec["worst"].append(worst)
+            rec["worst_links"].append(int(links[min(worst, n_views - 2)]))
+            rec["links"].append(float(np.median(links)))
+            rec["seconds"].append(r.timing["total"])
+            rec["rigidity"].append(r.rigidity)
+            if trial == 0:
+                paths[(rel, sol, sigma)] = aligned
+                paths[("truth", sigma)] = seq.centres[ok]
     out["paths"] = paths
     return out
 
@@ -132,19 +138,20 @@ def pairwise_direction_centres(seq) -> np.ndarray:
 
 def pairwise_reference(trials: int = 10, sigmas=SIGMAS, seed: int = 0,
                        visible_range: float = 50.0, closed_loop: bool = False,
-                       track_views: str = "consecutive") -> dict:
+                       track_views: str = "consecutive",
+                       progress: Progress = no_progress) -> dict:
     """{sigma: dict(rms=[...], spiral=[...])} of ``pairwise_direction_centres``
     on the sequences of ``run`` (same seeds)."""
     out = {}
-    for sigma in sigmas:
+    for sigma, trial in progress(itertools.product(sigmas, range(trials)),
+                                 total=len(sigmas) * trials, desc="pairwise reference"):
         rec = out.setdefault(sigma, {"rms": [], "spiral": []})
-        for trial in range(trials):
-            seq = circle_sequence(sigma=sigma, rng=seed + 1000 * trial,
-                                  visible_range=visible_range, closed_loop=closed_loop,
-                                  track_views=track_views)
-            aligned, rms = similarity_align(pairwise_direction_centres(seq), seq.centres)
-            rec["rms"].append(rms)
-            rec["spiral"].append(spiral_measure(aligned, seq.centres))
+        seq = circle_sequence(sigma=sigma, rng=seed + 1000 * trial,
+                              visible_range=visible_range, closed_loop=closed_loop,
+                              track_views=track_views)
+        aligned, rms = similarity_align(pairwise_direction_centres(seq), seq.centres)
+        rec["rms"].append(rms)
+        rec["spiral"].append(spiral_measure(aligned, seq.centres))
     return out
 
 
@@ -157,7 +164,7 @@ def noise_metric_spread(relation: str, sigma: float = 1e-3, draws: int = 20, see
     of (D, L) and of (D, I): 1 would mean the noise adds the same cost to
     every configuration of unit norm, i.e. no bias."""
     from mcgeom import synth
-    from mcgeom.bench.known_rotation_numpy import dense_rows
+    from .bench.known_rotation_numpy import dense_rows
     seq = circle_sequence(sigma=0.0, rng=seed, visible_range=visible_range)
     q = 2 if relation == "bilinear" else 3
     idx = multiview._relations(seq.track, seq.view, q, "all", 1)
@@ -198,16 +205,17 @@ def write_pngs(res: dict, outdir: Path, sigmas=SIGMAS) -> list:
     return files
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--trials", type=int, default=10)
-    ap.add_argument("--out", default="ch6_out")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--range", type=float, default=50.0, help="visible range of a view")
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment ch6``."""
+    ap.add_argument("--trials", type=positive_int, default=10, help="trials per noise level")
+    ap.add_argument("--out", default="ch6_out", help="directory of the PNGs")
+    ap.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
+    ap.add_argument("--range", type=positive_float, default=50.0,
+                    help="visible range of a view (units of the scene, circle radius 100)")
     ap.add_argument("--closed-loop", action="store_true",
                     help="tracks also link the last view to the first (a ring)")
     ap.add_argument("--tracks", choices=("consecutive", "any"), default="consecutive",
-                    help="a track's <= 3 views: consecutive along the sequence (default), or "
+                    help="a track's <= 3 views: consecutive along the sequence, or "
                          "drawn among all views that see the point (wide triangles: rigid, "
                          "no spirals for either solver)")
     ap.add_argument("--noise-metric", action="store_true",
@@ -216,9 +224,12 @@ def main(argv=None) -> int:
     ap.add_argument("--pairwise-reference", action="store_true",
                     help="also run pairwise directions + centres, a reference for how far "
                          "the bilinear data go (dense, about a second per trial)")
-    args = ap.parse_args(argv)
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Run the experiment with parsed options; print the tables, write the PNGs."""
     res = run(args.trials, seed=args.seed, visible_range=args.range,
-              closed_loop=args.closed_loop, track_views=args.tracks)
+              closed_loop=args.closed_loop, track_views=args.tracks, progress=progress)
     print(f"thesis ch. 6.5.1: 101 views, circle radius 100, 1000 points, range {args.range:g}, "
           f"tracks <= 3 {args.tracks} views, {'closed loop' if args.closed_loop else 'open sequence'}; "
           f"medians over {args.trials} trials; folds = steps reversed by > 90 deg; worst = "
@@ -251,7 +262,8 @@ def main(argv=None) -> int:
             print(f"  {rel:9s} {sigma:8.1e}  " + "   ".join(cells))
     if args.pairwise_reference:
         ref = pairwise_reference(args.trials, seed=args.seed, visible_range=args.range,
-                                 closed_loop=args.closed_loop, track_views=args.tracks)
+                                 closed_loop=args.closed_loop, track_views=args.tracks,
+                                 progress=progress)
         print("reference, not a thesis variant: pairwise baseline directions, then centres "
               "(median RMS / spiral[deg]):")
         for sigma in SIGMAS:
@@ -268,6 +280,3 @@ def main(argv=None) -> int:
     print("wrote " + ", ".join(str(f) for f in files))
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import estimate, synth
+from mcgeom import estimate, synth
+from ..common import Progress, no_progress
 from .linear17_numpy import linear17_numpy
 from .timing import best_of
 
@@ -30,13 +31,14 @@ class Linear17Timing:
         return self.numpy_us / self.mcgeom_us
 
 
-def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0,
-                   budget_s: float = 0.5) -> list[Linear17Timing]:
-    """Time linear17 (C, via the Python API) and the numpy reference for each N."""
+def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float = 0.5,
+                   progress: Progress = no_progress) -> list[Linear17Timing]:
+    """Time linear17 (C, via the Python API) and the numpy reference for each N
+    (microseconds per call, best of batches; ``budget_s`` seconds per timing)."""
     rng = np.random.default_rng(seed)
     rig = synth.generic_rig(4, rng)
     out = []
-    for n in sizes:
+    for n in progress(sizes, total=len(sizes), desc="linear17"):
         R, t = synth.random_motion(rng, max_angle=0.3, t_norm=0.5)
         prob = synth.make_problem(rig, R, t, n, rng, angular_noise=np.deg2rad(0.05),
                                   require_visible=False)

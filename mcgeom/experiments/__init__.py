@@ -1,0 +1,43 @@
+"""The application layer: the experiments of the thesis chapters, the
+evaluations on real recordings, the benchmarks (:mod:`mcgeom.experiments.bench`)
+and the demo (:mod:`mcgeom.experiments.demo`).
+
+Each experiment runs as ``mcgeom experiment NAME [options]``. Its module
+exposes ``add_arguments(parser)`` (its command-line options) and
+``run_cli(args) -> int`` (the exit code), next to importable functions that
+the tests call with small sizes. The modules are imported only when their
+experiment runs, so that ``mcgeom --help`` does not pay for them.
+
+Unlike the library, these modules may use :mod:`mcgeom.synth` (synthetic
+data) and peer libraries (poselib, clarabel), the latter imported lazily.
+"""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+
+__all__ = ["EXPERIMENTS", "load"]
+
+#: name -> (module under mcgeom.experiments, one-line description)
+EXPERIMENTS: dict[str, tuple[str, str]] = {
+    "ch6": ("ch6", "thesis ch. 6.5.1: known-rotation translations of 101 views on a "
+                   "circle, bilinear/trilinear x plain/constrained"),
+    "ch7": ("ch7", "thesis ch. 7.5.2: scale observability of the 8-camera vehicle rig"),
+    "ch8": ("ch8", "thesis ch. 8.5.1: linear17 next to PoseLib on three rigs (needs poselib)"),
+    "ch9": ("ch9", "thesis ch. 10.5.1 set-up: E+SOCP next to linear17 and five_plus_one"),
+    "ch10": ("ch10", "thesis ch. 10.5.1: B&B+LP against E+SOCP, and the preemptive test"),
+    "minimal_5p1": ("minimal_5p1", "noise-free minimal 5+1 samples: how often the true "
+                                   "motion is among the solutions"),
+    "robust_vs_poselib": ("robust_vs_poselib", "robust rig motion from pixels: mcgeom "
+                                               "against PoseLib (needs poselib)"),
+    "real_data": ("real_data", "the robust pipeline on the real recordings (KITTI, DDAD, "
+                               "EuRoC), against their ground truth"),
+    "ch6_kitti": ("ch6_kitti", "thesis ch. 6 on real data: the KITTI-00 stereo trajectory "
+                               "from tracks with known rotations"),
+}
+
+
+def load(name: str) -> ModuleType:
+    """The module of experiment ``name`` (a key of :data:`EXPERIMENTS`)."""
+    return importlib.import_module(f"{__name__}.{EXPERIMENTS[name][0]}")
