@@ -151,7 +151,7 @@ def _n_choose(n: int, k: int) -> int:
     return 0 if n < k else (n * (n - 1) // 2 if k == 2 else n * (n - 1) * (n - 2) // 6)
 
 
-def _relations(track, view, q, pairs, window):
+def relations(track, view, q, pairs, window):
     """Index tuples (K, q) of the observations of each relation, sorted by view
     inside each relation: every q-subset of a track's observations in q
     distinct views (within ``window`` views of each other for "window")."""
@@ -314,7 +314,7 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
     # de-rotated bearings and offsets (ch. 6.1): x = R_i^T b
     x = np.einsum("kji,kj->ki", R[view], b)
     w = None if origins is None else np.einsum("kji,kj->ki", R[view], origins)
-    idx = _relations(track, view, q, pairs, int(window))
+    idx = relations(track, view, q, pairs, int(window))
     if len(idx) == 0:
         raise ValueError(f"no {relation} relation: every track needs observations in "
                          f"{q} distinct views" + (f" within {window} views" if pairs == "window"

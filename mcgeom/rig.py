@@ -234,7 +234,7 @@ class Camera:
         visible = front.copy()
         visible[front] = self.in_image(pixels[front])
         if self.has_distortion and np.any(visible):
-            visible[visible] = self._round_trip_ok(pixels[visible], X[visible])
+            visible[visible] = self.round_trip_ok(pixels[visible], X[visible])
         return pixels, visible
 
     def in_image(self, pixels: Any) -> np.ndarray:
@@ -311,7 +311,7 @@ class Camera:
         scale = np.divide(np.sin(theta), theta_d, out=np.ones_like(theta), where=theta_d > 0)
         return np.column_stack([xy_d * scale[:, None], np.cos(theta)])
 
-    def _round_trip_ok(self, pixels: np.ndarray, X_cam: np.ndarray) -> np.ndarray:
+    def round_trip_ok(self, pixels: np.ndarray, X_cam: np.ndarray) -> np.ndarray:
         """(N,) bool: each pixel unprojects to the direction of its camera-frame point
         (never raises: a pixel without a ray simply fails). Used by synth too."""
         if pixels.shape[0] == 0:

@@ -407,7 +407,7 @@ def _observe(cam: Camera, points: np.ndarray, raw: bool) -> tuple[np.ndarray, np
         return pixels, visible
     X_cam = points @ cam.R.T + cam.t
     ok = X_cam[:, 2] > np.cos(RAW_HALF_ANGLE) * np.linalg.norm(X_cam, axis=1)
-    ok[ok] = cam._round_trip_ok(pixels[ok], X_cam[ok])  # package-internal, never raises
+    ok[ok] = cam.round_trip_ok(pixels[ok], X_cam[ok])  # never raises
     return pixels, ok
 
 

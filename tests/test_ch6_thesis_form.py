@@ -98,7 +98,7 @@ def test_N_and_L_are_the_thesis_E_and_G(relation):
     track, view, b, rot, _ = _views(11)
     m, q = len(rot), 2 if relation == "bilinear" else 3
     x = np.einsum("kji,kj->ki", rot[view], b)
-    idx = multiview._relations(track, view, q, "all", 1)
+    idx = multiview.relations(track, view, q, "all", 1)
     S_blocks, G_blocks = thesis_AG(x[idx], view[idx], m)
     E = np.vstack([S @ G for S, G in zip(S_blocks, G_blocks)])
     GtG = sum(G.T @ G for G in G_blocks)
@@ -114,7 +114,7 @@ def test_solvers_are_kaucic_svd_and_algorithm_1(relation, seed):
     track, view, b, rot, _ = _views(seed)
     m, q = len(rot), 2 if relation == "bilinear" else 3
     x = np.einsum("kji,kj->ki", rot[view], b)
-    idx = multiview._relations(track, view, q, "all", 1)
+    idx = multiview.relations(track, view, q, "all", 1)
     S_blocks, G_blocks = thesis_AG(x[idx], view[idx], m)
     # gauge: first centre at the origin, i.e. drop its three columns
     E = np.vstack([S @ G for S, G in zip(S_blocks, G_blocks)])[:, 3:]

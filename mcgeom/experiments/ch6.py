@@ -119,7 +119,7 @@ def pairwise_direction_centres(seq) -> np.ndarray:
     sequence fix. Dense (3m unknowns): for experiments only."""
     m = len(seq.rotations)
     x = np.einsum("kji,kj->ki", seq.rotations[seq.view], seq.bearings)
-    idx = multiview._relations(seq.track, seq.view, 2, "all", 1)
+    idx = multiview.relations(seq.track, seq.view, 2, "all", 1)
     keys, block = np.unique(seq.view[idx], axis=0, return_inverse=True)
     rows = np.cross(x[idx[:, 0]], x[idx[:, 1]])       # eq. 6.5 rows in c_j - c_i
     gram = np.zeros((len(keys), 3, 3))
@@ -167,7 +167,7 @@ def noise_metric_spread(relation: str, sigma: float = 1e-3, draws: int = 20, see
     from .bench.known_rotation_numpy import dense_rows
     seq = circle_sequence(sigma=0.0, rng=seed, visible_range=visible_range)
     q = 2 if relation == "bilinear" else 3
-    idx = multiview._relations(seq.track, seq.view, q, "all", 1)
+    idx = multiview.relations(seq.track, seq.view, q, "all", 1)
     m = len(seq.rotations)
 
     def rows(b):

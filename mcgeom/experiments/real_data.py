@@ -356,6 +356,11 @@ class Features:
         self._cache: dict = {}
         self.seconds = 0.0
 
+    @property
+    def n_images(self) -> int:
+        """Number of distinct images detected so far (each is detected once)."""
+        return len(self._cache)
+
     def __call__(self, path: str) -> tuple[np.ndarray, np.ndarray]:
         if path not in self._cache:
             t0 = time.perf_counter()
@@ -700,7 +705,7 @@ def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
                 out(format_row(r))
         if feats is not None:
             out("  feature detection %.1f s in total (%d images)" % (feats.seconds,
-                                                                     len(feats._cache)))
+                                                                     feats.n_images))
         out("-- summary %s" % seq.name)
         summary += summarize(seq, results, out)
         all_results[seq.key] = results

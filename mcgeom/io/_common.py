@@ -16,22 +16,22 @@ from mcgeom.rig import Camera, Rig
 from mcgeom.validation import check_int, check_rotation, numeric
 
 
-def _where(path: Any) -> str:
+def describe_path(path: Any) -> str:
     """The file name as messages show it."""
     return os.fspath(path)
 
 
-def _read_text(path: Any) -> str:
+def read_text(path: Any) -> str:
     """The file's text (UTF-8, optional BOM); ValueError naming the file if not text."""
     with open(path, "rb") as fh:
         raw = fh.read()
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ValueError(f"{_where(path)}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+        raise ValueError(f"{describe_path(path)}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
 
 
-def _make_camera(where: str, entry: str, **fields: Any) -> Camera:
+def make_camera(where: str, entry: str, **fields: Any) -> Camera:
     """A Camera, with Camera's own checks reported as '<file>: <entry>: <problem>'."""
     try:
         return Camera(**fields)
@@ -39,7 +39,7 @@ def _make_camera(where: str, entry: str, **fields: Any) -> Camera:
         raise ValueError(f"{where}: {entry}: {exc}") from None
 
 
-def _make_rig(where: str, cameras: list[Camera]) -> Rig:
+def make_rig(where: str, cameras: list[Camera]) -> Rig:
     """A Rig, with Rig's own checks (unique names, ...) reported as '<file>: <problem>'."""
     try:
         return Rig(tuple(cameras))
@@ -47,7 +47,7 @@ def _make_rig(where: str, cameras: list[Camera]) -> Rig:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def _vector(where: str, what: str, value: Any, n: int | None = None) -> np.ndarray:
+def vector(where: str, what: str, value: Any, n: int | None = None) -> np.ndarray:
     """A finite 1-D float vector (row/column matrices accepted), of length n if given."""
     if value is None:
         raise ValueError(f"{where}: {what} is empty")
@@ -65,7 +65,7 @@ def _vector(where: str, what: str, value: Any, n: int | None = None) -> np.ndarr
     return arr
 
 
-def _rotation(where: str, what: str, value: Any) -> np.ndarray:
+def rotation(where: str, what: str, value: Any) -> np.ndarray:
     """:func:`mcgeom.validation.check_rotation` with the file in the message."""
     try:
         return check_rotation(what, value)
@@ -73,7 +73,7 @@ def _rotation(where: str, what: str, value: Any) -> np.ndarray:
         raise ValueError(f"{where}: {exc}") from None
 
 
-def _integer(where: str, what: str, value: Any) -> int:
+def integer(where: str, what: str, value: Any) -> int:
     """:func:`mcgeom.validation.check_int` with the file in the message."""
     try:
         return check_int(what, value)
@@ -82,4 +82,4 @@ def _integer(where: str, what: str, value: Any) -> int:
 
 
 # The identity rigid transform (R, t): a camera that defines the rig frame.
-_IDENTITY_POSE = (np.eye(3), np.zeros(3))
+IDENTITY_POSE = (np.eye(3), np.zeros(3))

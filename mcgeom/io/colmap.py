@@ -43,7 +43,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from mcgeom.io._common import _IDENTITY_POSE, _make_camera, _make_rig, _read_text, _vector, _where
+from mcgeom.io._common import IDENTITY_POSE, make_camera, make_rig, read_text, vector, describe_path
 from mcgeom.rig import Rig
 
 __all__ = ["load_colmap"]
@@ -53,7 +53,7 @@ _QUAT_NORM_TOL = 1e-3       # |‖q‖ - 1| above this: not a rotation as writte
 
 def _quaternion_to_rotation(where: str, what: str, value: Any) -> np.ndarray:
     """Rotation matrix of a (w, x, y, z) Hamilton quaternion (COLMAP's and Eigen's order)."""
-    q = _vector(where, what, value, 4)
+    q = vector(where, what, value, 4)
     norm = float(np.linalg.norm(q))
     if abs(norm - 1.0) > _QUAT_NORM_TOL:
         raise ValueError(f"{where}: {what} is not a rotation: quaternion (w, x, y, z) = "
@@ -85,7 +85,7 @@ def _colmap_intrinsics(where: str, entry: str, model: str,
         raise ValueError(f"{where}: {entry}: COLMAP camera model {model!r} is not supported "
                          f"(supported: {', '.join(_COLMAP_MODELS)})")
     n, build = _COLMAP_MODELS[model]
-    p = _vector(where, f"{entry}: {model} parameters", params)
+    p = vector(where, f"{entry}: {model} parameters", params)
     if p.size != n:
         raise ValueError(f"{where}: {entry}: COLMAP model {model} has {n} parameters, got {p.size}")
     fx, fy, cx, cy, dist, lens = build(p)
@@ -96,9 +96,9 @@ def _colmap_intrinsics(where: str, entry: str, model: str,
 
 def _parse_colmap_cameras(path: Any) -> dict[int, tuple[str, int, int, list[float], int]]:
     """cameras.txt: {camera_id: (model, width, height, params, lineno)}."""
-    where = _where(path)
+    where = describe_path(path)
     cams: dict[int, tuple[str, int, int, list[float], int]] = {}
-    for lineno, raw in enumerate(_read_text(path).splitlines(), 1):
+    for lineno, raw in enumerate(read_text(path).splitlines(), 1):
         line = raw.strip()
         if not line or line.startswith("#"):
             continue
@@ -127,9 +127,9 @@ def _parse_colmap_cameras(path: Any) -> dict[int, tuple[str, int, int, list[floa
 
 def _parse_colmap_images(path: Any) -> list[tuple[str, int]]:
     """images.txt: [(image name, camera_id)] (every other data line is a POINTS2D line)."""
-    where = _where(path)
+    where = describe_path(path)
     out = []
-    lines = [(n, ln) for n, ln in enumerate(_read_text(path).splitlines(), 1)
+    lines = [(n, ln) for n, ln in enumerate(read_text(path).splitlines(), 1)
              if not ln.startswith("#")]
     k = 0
     while k < len(lines):
@@ -152,9 +152,9 @@ def _parse_colmap_images(path: Any) -> list[tuple[str, int]]:
 
 
 def _json_file(path: Any) -> Any:
-    where = _where(path)
+    where = describe_path(path)
     try:
-        return json.loads(_read_text(path))
+        return json.loads(read_text(path))
     except RecursionError:
         raise ValueError(f"{where}: JSON nested too deeply") from None
     except json.JSONDecodeError as exc:
@@ -184,7 +184,7 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
 
     Conventions: module docstring.
     """
-    where = _where(path)
+    where = describe_path(path)
     data = _json_file(path)
     if not isinstance(data, list) or not data:
         raise ValueError(f"{where}: not a COLMAP rig config: expected a non-empty JSON list of "
@@ -218,7 +218,7 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
     cams_path = cameras_txt if cameras_txt is not None else os.path.join(
         os.path.dirname(os.fspath(path)), "cameras.txt")
     colmap_cams = _parse_colmap_cameras(cams_path)
-    cwhere = _where(cams_path)
+    cwhere = describe_path(cams_path)
 
     poses: list[tuple[np.ndarray, np.ndarray]] = []
     ids: list[int] = []
@@ -233,9 +233,9 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
             has = [key for key in ("rel_qvec", "rel_tvec") if key in e]
             if len(has) == 2:
                 poses.append((_quaternion_to_rotation(where, f"{entry}: rel_qvec", e["rel_qvec"]),
-                              _vector(where, f"{entry}: rel_tvec", e["rel_tvec"], 3)))
+                              vector(where, f"{entry}: rel_tvec", e["rel_tvec"], 3)))
             elif cid == ref and not has:
-                poses.append(_IDENTITY_POSE)
+                poses.append(IDENTITY_POSE)
             else:
                 lacking = [key for key in ("rel_qvec", "rel_tvec") if key not in e]
                 raise ValueError(f"{where}: {entry}: missing key {lacking[0]!r} (COLMAP would "
@@ -261,11 +261,11 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
                 if has:
                     raise ValueError(f"{where}: {entry}: the reference sensor must not have "
                                      f"{has[0]} (its pose is the identity)")
-                poses.append(_IDENTITY_POSE)
+                poses.append(IDENTITY_POSE)
             elif len(has) == 2:
                 poses.append((_quaternion_to_rotation(where, f"{entry}: cam_from_rig_rotation",
                                                       e["cam_from_rig_rotation"]),
-                              _vector(where, f"{entry}: cam_from_rig_translation",
+                              vector(where, f"{entry}: cam_from_rig_translation",
                                       e["cam_from_rig_translation"], 3)))
             else:
                 lacking = [key for key in ("cam_from_rig_rotation", "cam_from_rig_translation")
@@ -278,7 +278,7 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
                 if image_list is None:
                     img_path = images_txt if images_txt is not None else os.path.join(
                         os.path.dirname(os.fspath(cams_path)), "images.txt")
-                    image_list = (_where(img_path), _parse_colmap_images(img_path))
+                    image_list = (describe_path(img_path), _parse_colmap_images(img_path))
                 iwhere, images = image_list
                 found = {cid for name, cid in images if name.startswith(e["image_prefix"])}
                 if not found:
@@ -313,6 +313,6 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
             K, dist, lens = _colmap_intrinsics(where, f"{entry}: camera_params", override[0], override[1])
         else:
             K, dist, lens = _colmap_intrinsics(cwhere, f"line {lineno} (camera {cid})", model, params)
-        out.append(_make_camera(where, entry, name=name, K=K, dist=dist, model=lens,
+        out.append(make_camera(where, entry, name=name, K=K, dist=dist, model=lens,
                                 R=pose[0], t=pose[1], width=width, height=height))
-    return _make_rig(where, out)
+    return make_rig(where, out)

@@ -13,7 +13,7 @@ import json
 import re
 from typing import Any, Callable
 
-from mcgeom.io._common import _read_text, _where
+from mcgeom.io._common import read_text, describe_path
 from mcgeom.io.colmap import load_colmap
 from mcgeom.io.kalibr import load_kalibr
 from mcgeom.io.mcgeom_json import RIG_FORMAT, load_mcgeom_json
@@ -31,7 +31,7 @@ def _sniff(path: Any) -> tuple[str | None, str, dict[str, str]]:
     Detection is by signature, not by a full parse, so that a damaged file of a
     recognisable format gets that format's precise error message.
     """
-    text = _read_text(path)
+    text = read_text(path)
     head = text.lstrip()
     reasons: dict[str, str] = {}
     if head.startswith("{"):
@@ -80,7 +80,7 @@ def detect_format(path: Any) -> str:
     fmt, _, reasons = _sniff(path)
     if fmt is None:
         tried = "; ".join(f"{f}: {reasons.get(f, 'rejected')}" for f in FORMATS)
-        raise ValueError(f"{_where(path)}: cannot tell the calibration format. Tried {tried}. "
+        raise ValueError(f"{describe_path(path)}: cannot tell the calibration format. Tried {tried}. "
                          f"Pass format= one of {', '.join(FORMATS)}")
     return fmt
 

@@ -39,8 +39,8 @@ from typing import Any
 
 import numpy as np
 
-from mcgeom.io._common import (_IDENTITY_POSE, _integer, _make_camera, _make_rig, _read_text,
-                               _rotation, _vector, _where)
+from mcgeom.io._common import (IDENTITY_POSE, integer, make_camera, make_rig, read_text,
+                               rotation, vector, describe_path)
 from mcgeom.io._safe_yaml import load_yaml
 from mcgeom.rig import Rig
 from mcgeom.validation import numeric
@@ -90,7 +90,7 @@ def _kalibr_numbers(where: str, entry: str, cam: dict, key: str, n: int | None) 
     for v in value:
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise ValueError(f"{where}: {entry}: {key} must hold numbers, got {v!r}")
-    return _vector(where, f"{entry}: {key}", value if value else np.zeros(0), n)
+    return vector(where, f"{entry}: {key}", value if value else np.zeros(0), n)
 
 
 def _kalibr_transform(where: str, entry: str, key: str, value: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -102,7 +102,7 @@ def _kalibr_transform(where: str, entry: str, key: str, value: Any) -> tuple[np.
     if np.max(np.abs(T[3] - [0, 0, 0, 1])) > _BOTTOM_ROW_TOL:
         raise ValueError(f"{where}: {what} is not a rigid transform: last row is {T[3].tolist()}, "
                          f"expected [0, 0, 0, 1]")
-    return _rotation(where, what, T[:3, :3]), T[:3, 3].copy()
+    return rotation(where, what, T[:3, :3]), T[:3, 3].copy()
 
 
 def _kalibr_camera(where: str, key: str, cam: Any) -> dict:
@@ -138,8 +138,8 @@ def _kalibr_camera(where: str, key: str, cam: Any) -> dict:
         raise ValueError(f"{where}: {key}: missing key 'resolution'")
     if not isinstance(res, list) or len(res) != 2:
         raise ValueError(f"{where}: {key}: resolution must be [width, height], got {res!r}")
-    width = _integer(where, f"{key}: resolution width", res[0])
-    height = _integer(where, f"{key}: resolution height", res[1])
+    width = integer(where, f"{key}: resolution width", res[0])
+    height = integer(where, f"{key}: resolution height", res[1])
     K = np.array([[fu, 0.0, pu], [0.0, fv, pv], [0.0, 0.0, 1.0]])
     out = {"name": key, "K": K, "dist": dist, "model": model, "width": width, "height": height}
     for tkey in ("T_cn_cnm1", "T_cam_imu"):
@@ -159,10 +159,10 @@ def load_kalibr(path: Any, *, rig_frame: str | None = None) -> Rig:
 
     Cameras are named ``cam0, cam1, ...`` as in the file. Conventions: module docstring.
     """
-    where = _where(path)
+    where = describe_path(path)
     if rig_frame not in (None, "cam0", "imu"):
         raise ValueError(f"rig_frame must be 'cam0' or 'imu', got {rig_frame!r}")
-    doc = load_yaml(_read_text(path), where)
+    doc = load_yaml(read_text(path), where)
     if not isinstance(doc, dict):
         raise ValueError(f"{where}: not a Kalibr camchain: the top level must be a mapping "
                          f"cam0, cam1, ..., got {type(doc).__name__}")
@@ -200,7 +200,7 @@ def load_kalibr(path: Any, *, rig_frame: str | None = None) -> Rig:
         if frame == "imu":
             poses.append(c["T_cam_imu"])                  # X_cam = T_cam_imu X_imu
         elif n == 0:
-            poses.append(_IDENTITY_POSE)                  # rig frame = cam0
+            poses.append(IDENTITY_POSE)                  # rig frame = cam0
         else:
             if "T_cn_cnm1" in c:
                 step = c["T_cn_cnm1"]                     # X_cn = T_cn_cnm1 X_cnm1
@@ -212,6 +212,6 @@ def load_kalibr(path: Any, *, rig_frame: str | None = None) -> Rig:
             poses.append(_compose(step, poses[n - 1]))    # T_cn_c0 = T_cn_cnm1 T_cnm1_c0
     out = []
     for c, (R, t) in zip(cams, poses):
-        out.append(_make_camera(where, c["name"], name=c["name"], K=c["K"], dist=c["dist"],
+        out.append(make_camera(where, c["name"], name=c["name"], K=c["K"], dist=c["dist"],
                                 model=c["model"], R=R, t=t, width=c["width"], height=c["height"]))
-    return _make_rig(where, out)
+    return make_rig(where, out)

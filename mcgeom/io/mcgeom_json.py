@@ -32,7 +32,7 @@ import json
 import os
 from typing import Any, Union
 
-from mcgeom.io._common import _where
+from mcgeom.io._common import describe_path
 from mcgeom.rig import Camera, Rig
 
 __all__ = ["RIG_FORMAT", "RIG_FORMAT_VERSION", "rig_to_dict", "rig_from_dict",
@@ -121,7 +121,7 @@ def load_mcgeom_json(path: PathLike) -> Rig:
         ValueError: not JSON (truncated, malformed, nested too deeply), or not a valid rig
             description; the message names the file and the problem.
     """
-    where = _where(path)
+    where = describe_path(path)
     with open(path, "rb") as fh:
         raw = fh.read()
     try:

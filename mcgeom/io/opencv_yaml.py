@@ -61,8 +61,8 @@ from typing import Any
 import cv2
 import numpy as np
 
-from mcgeom.io._common import (_IDENTITY_POSE, _integer, _make_camera, _make_rig, _read_text,
-                               _rotation, _vector, _where)
+from mcgeom.io._common import (IDENTITY_POSE, integer, make_camera, make_rig, read_text,
+                               rotation, vector, describe_path)
 from mcgeom.rig import Camera, Rig
 from mcgeom.validation import check_int
 
@@ -135,8 +135,8 @@ def _max_nesting(text: str) -> int:
 
 
 def _read_filestorage(path: Any) -> dict:
-    where = _where(path)
-    text = _read_text(path)
+    where = describe_path(path)
+    text = read_text(path)
     if _max_nesting(text) > _MAX_NESTING:
         raise ValueError(f"{where}: nested more than {_MAX_NESTING} levels deep: not a calibration "
                          f"file (refused before OpenCV's parser, which does not limit its recursion)")
@@ -215,8 +215,8 @@ def _size_from(where: str, entry: str, d: dict, default: tuple[int, int] | None,
         missing = "image_height" if has[0] == "image_width" else "image_width"
         raise ValueError(f"{where}: {entry}: {has[0]} is given but {missing} is missing")
     if has:
-        size = (_integer(where, f"{entry}: image_width", d["image_width"]),
-                _integer(where, f"{entry}: image_height", d["image_height"]))
+        size = (integer(where, f"{entry}: image_width", d["image_width"]),
+                integer(where, f"{entry}: image_height", d["image_height"]))
         if default is not None and tuple(default) != size:
             raise ValueError(f"{where}: {entry}: the file's image size {size} differs from "
                              f"image_size={tuple(default)}")
@@ -252,10 +252,10 @@ def _opencv_camera(where: str, entry: str, name: str, d: dict, model_arg: str | 
     D = _one_of(where, entry, d, D_keys)
     if not isinstance(K, np.ndarray) and not isinstance(K, list):
         raise ValueError(f"{where}: {entry}: {K_keys[0]} must be a matrix, got {K!r}")
-    dist = _vector(where, f"{entry}: distortion coefficients", D)
+    dist = vector(where, f"{entry}: distortion coefficients", D)
     model = _opencv_model(where, entry, d, dist.size, model_arg)
     width, height = _size_from(where, entry, d, size_arg, size_hint)
-    return _make_camera(where, entry, name=name, K=K, dist=dist, model=model,
+    return make_camera(where, entry, name=name, K=K, dist=dist, model=model,
                         R=pose[0], t=pose[1], width=width, height=height)
 
 
@@ -263,7 +263,7 @@ def _opencv_pose(where: str, entry: str, R: Any, T: Any) -> tuple[np.ndarray, np
     if isinstance(R, np.ndarray) and R.shape in ((3, 1), (1, 3)):
         raise ValueError(f"{where}: {entry}: R must be a 3x3 rotation matrix, got a 3-vector "
                          f"(a rotation vector? convert it with cv2.Rodrigues)")
-    return (_rotation(where, f"{entry}: R", R), _vector(where, f"{entry}: T", T, 3))
+    return (rotation(where, f"{entry}: R", R), vector(where, f"{entry}: T", T, 3))
 
 
 def _opencv_multi(where: str, tree: dict, model: str | None,
@@ -294,7 +294,7 @@ def _opencv_multi(where: str, tree: dict, model: str | None,
         out.append(_opencv_camera(where, entry, name, d, model, size,
                                   "add image_width and image_height",
                                   ("camera_matrix", "K"), ("distortion_coefficients", "D"), pose))
-    return _make_rig(where, out)
+    return make_rig(where, out)
 
 
 def _sibling_extrinsics(path: Any) -> str | None:
@@ -309,7 +309,7 @@ def _sibling_extrinsics(path: Any) -> str | None:
 
 def _opencv_stereo(path: Any, tree: dict, model: str | None, size: tuple[int, int] | None,
                    extrinsics_path: Any) -> Rig:
-    where = _where(path)
+    where = describe_path(path)
     missing = [k for k in ("M1", "D1", "M2", "D2") if k not in tree]
     if missing:
         hint = (" (this looks like stereo_calib's extrinsics.yml: load intrinsics.yml with "
@@ -321,7 +321,7 @@ def _opencv_stereo(path: Any, tree: dict, model: str | None, size: tuple[int, in
         if has_pose:
             raise ValueError(f"{where}: has {' and '.join(has_pose)} itself, but extrinsics_path= "
                              f"was also given")
-        ext_tree, ext_where = _read_filestorage(extrinsics_path), _where(extrinsics_path)
+        ext_tree, ext_where = _read_filestorage(extrinsics_path), describe_path(extrinsics_path)
     elif not has_pose:
         sibling = _sibling_extrinsics(path)
         if sibling is None:
@@ -338,14 +338,14 @@ def _opencv_stereo(path: Any, tree: dict, model: str | None, size: tuple[int, in
             "or pass image_size=(width, height)")
     size = _size_from(where, "stereo layout", tree, size, hint)
     cams = []
-    for k, pose in ((1, _IDENTITY_POSE), (2, pose2)):
+    for k, pose in ((1, IDENTITY_POSE), (2, pose2)):
         d = {"K": tree[f"M{k}"], "D": tree[f"D{k}"], "image_width": size[0], "image_height": size[1]}
         for key in ("model", "distortion_model", "fisheye_model"):
             if key in tree:
                 d[key] = tree[key]
         cams.append(_opencv_camera(where, f"camera {k} (M{k}, D{k})", f"cam{k}", d, model, None, "",
                                    ("K",), ("D",), pose))
-    return _make_rig(where, cams)
+    return make_rig(where, cams)
 
 
 def load_opencv_yaml(path: Any, *, image_size: Any = None, model: str | None = None,
@@ -363,7 +363,7 @@ def load_opencv_yaml(path: Any, *, image_size: Any = None, model: str | None = N
 
     Layouts and conventions: see the module docstring.
     """
-    where = _where(path)
+    where = describe_path(path)
     size = _check_image_size_arg(image_size)
     model = _check_model_arg(model)
     tree = _read_filestorage(path)

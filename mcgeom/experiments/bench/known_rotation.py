@@ -55,7 +55,7 @@ def bench_known_rotation(view_counts=(101, 201), dense_up_to: int = 101,
             if m <= dense_up_to:
                 q = 2 if rel == "bilinear" else 3
                 x = np.einsum("kji,kj->ki", seq.rotations[seq.view], seq.bearings)
-                idx = multiview._relations(seq.track, seq.view, q, "all", 1)
+                idx = multiview.relations(seq.track, seq.view, q, "all", 1)
 
                 def dense():
                     return dense_solve(x[idx], seq.view[idx], m, "constrained")
