@@ -1,6 +1,6 @@
 """mcgeom: relative motion, with metric scale, of calibrated multi-camera rigs.
 
-Conventions (DESIGN.md section 3): rays and camera centres in the rig frame
+Conventions (docs/architecture.md §3): rays and camera centres in the rig frame
 (metres); a motion is rig2_from_rig1, ``X_rig2 = R @ X_rig1 + t`` as in
 ``cv2.recoverPose``; angles in radians.
 """

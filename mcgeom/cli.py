@@ -44,6 +44,14 @@ def _cmd_methods(args: argparse.Namespace) -> int:
         print(f"    camera kinds: {', '.join(e.camera_kinds)}")
         for k, v in e.options.items():
             print(f"    option {k}: {v}")
+    # the LP backends of bnb_lp: the available ones, and why GLPK is not (with
+    # the command that brings it) when it is not
+    print(f"\nLP backends (bnb_lp, default {registry.default_lp_backend()}):")
+    backends = registry.lp_backends()
+    for name, what in backends.items():
+        print(f"    {name}: {what}")
+    if "glpk" not in backends:
+        print(f"    glpk: {registry.glpk_status()}")
     return 0
 
 

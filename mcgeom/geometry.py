@@ -7,7 +7,7 @@ cheirality count and the centred refinement (its profile statistic) that the
 estimators and the robust layer use too, and the estimators import the
 verdict, so these helpers cannot live in either without an import cycle.
 
-Frames and units (DESIGN.md section 3): rays in the rig frame (origins in
+Frames and units (docs/architecture.md §3): rays in the rig frame (origins in
 metres, unit directions), a motion ``(R, t)`` is rig2_from_rig1, ``X2 = R X1
 + t`` with ``t`` in metres; angles in radians.
 """

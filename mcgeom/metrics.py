@@ -1,6 +1,6 @@
 """Error metrics of motion estimates and trajectories.
 
-A motion is rig2_from_rig1 (DESIGN.md section 3): ``X_rig2 = R X_rig1 + t``,
+A motion is rig2_from_rig1 (docs/architecture.md §3): ``X_rig2 = R X_rig1 + t``,
 ``t`` in metres in the rig2 frame; as a 4x4 matrix ``M = [[R, t], [0, 1]]``.
 Poses are world_from_rig 4x4 matrices (metres). Angles are in radians.
 

@@ -151,10 +151,16 @@ def _n_choose(n: int, k: int) -> int:
     return 0 if n < k else (n * (n - 1) // 2 if k == 2 else n * (n - 1) * (n - 2) // 6)
 
 
-def relations(track, view, q, pairs, window):
+def relations(track: np.ndarray, view: np.ndarray, q: int, pairs: str,
+              window: int) -> np.ndarray:
     """Index tuples (K, q) of the observations of each relation, sorted by view
     inside each relation: every q-subset of a track's observations in q
-    distinct views (within ``window`` views of each other for "window")."""
+    distinct views (within ``window`` views of each other for "window").
+
+    ``track`` and ``view`` (N,) give each observation's track and view index;
+    ``q`` is 2 (bilinear, eq. 6.5) or 3 (trilinear, eq. 6.11); ``pairs`` is
+    one of :data:`PAIRS`. The returned int array indexes the observations.
+    """
     order = np.lexsort((view, track))
     t_sorted = track[order]
     starts = np.flatnonzero(np.r_[True, t_sorted[1:] != t_sorted[:-1]])

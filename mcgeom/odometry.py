@@ -1,7 +1,7 @@
 """Chaining frame-to-frame rig motions into a trajectory (its errors: mcgeom.metrics).
 
 Poses are world_from_rig 4x4 matrices (metres); a motion is rig2_from_rig1
-(DESIGN.md section 3), so the next pose is ``T_world_rig2 = T_world_rig1 @
+(docs/architecture.md §3), so the next pose is ``T_world_rig2 = T_world_rig1 @
 inv(M)``.
 """
 

@@ -51,7 +51,7 @@ FAMILIES = ("linear", "minimal", "globally-optimal", "refinement")
 
 
 # ------------------------------------------------------------ the contract
-# Frames and units for every callable below (DESIGN.md section 3): rays in the
+# Frames and units for every callable below (docs/architecture.md §3): rays in the
 # rig frame (origins at the camera centres, metres; unit directions), camera
 # ids in ``rays.cam1``/``rays.cam2`` when known; a motion ``(R, t)`` is
 # rig2_from_rig1, ``X2 = R X1 + t``, ``R`` a (3, 3) rotation, ``t`` (3,) in

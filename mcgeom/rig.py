@@ -1,6 +1,6 @@
 """Calibrated multi-camera rigs: pixels -> bearings -> Plücker rays, and rig files.
 
-Frames and units (DESIGN.md section 3):
+Frames and units (docs/architecture.md §3):
 
 * Camera frame: OpenCV's (x right, y down, z forward), metres.
 * Rig frame: whatever frame the extrinsics are expressed in, metres.

@@ -4,7 +4,7 @@ Shared by the tests, the benchmarks and the demo, so that all of them speak abou
 same rigs. Every random function takes ``rng``: a ``numpy.random.Generator``, an int
 seed, or None (fresh entropy); the same seed always gives the same output.
 
-Frames: rigs follow DESIGN.md section 3 (cam_from_rig extrinsics, metres). The rig
+Frames: rigs follow docs/architecture.md §3 (cam_from_rig extrinsics, metres). The rig
 frame of the vehicle, Ladybug and stereo rigs is **x forward, y left, z up**; camera
 frames are OpenCV's (x right, y down, z forward). A motion ``(R, t)`` is rig2_from_rig1:
 ``X_rig2 = R X_rig1 + t``.

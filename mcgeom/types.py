@@ -1,6 +1,6 @@
 """Data types shared by every layer: ray correspondences and rig motions.
 
-Frames and units follow DESIGN.md section 3: rays are expressed in the rig frame
+Frames and units follow docs/architecture.md §3: rays are expressed in the rig frame
 (metres), a motion is rig2_from_rig1, ``X_rig2 = R @ X_rig1 + t``.
 """
 

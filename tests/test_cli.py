@@ -162,3 +162,15 @@ def test_no_progress_bar_when_stderr_is_not_a_terminal(monkeypatch):
     monkeypatch.setattr(sys, "stderr", fake)
     assert list(common.progress_bar(range(3), total=3, desc="x")) == [0, 1, 2]
     assert fake.getvalue() == ""
+
+
+def test_methods_lists_the_lp_backends_and_how_to_get_glpk(tmp_path):
+    """Without libglpk (a library path that does not exist) ``mcgeom methods``
+    still lists the native backend and says how to install GLPK."""
+    import os
+    env = dict(os.environ, MCG_GLPK_LIBRARY=str(tmp_path / "no-libglpk.so"))
+    r = subprocess.run([sys.executable, "-m", "mcgeom", "methods"], capture_output=True,
+                       text=True, check=True, cwd=tmp_path, env=env)
+    backends = r.stdout[r.stdout.index("LP backends"):]
+    assert "native:" in backends
+    assert "glpk: unavailable" in backends and "pip install 'mcgeom[glpk]'" in backends

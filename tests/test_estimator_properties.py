@@ -1,5 +1,5 @@
 """The shared property suite: every registered estimator, every generalized
-camera kind it declares (DESIGN.md section 6). A third-party plugin registered
+camera kind it declares (docs/architecture.md §6). A third-party plugin registered
 through the ``mcgeom.estimators`` entry points is picked up automatically."""
 
 from __future__ import annotations

@@ -83,7 +83,7 @@ def test_grams_match_dense_rows(q):
     """Block Grams scattered = E^T E of the dense numpy rows (central views)."""
     track, view, b, rot, c, _ = random_views(3, m=5)
     x = np.einsum("kji,kj->ki", rot[view], b)
-    idx = multiview._relations(track, view, q, "all", 1)
+    idx = multiview.relations(track, view, q, "all", 1)
     keys, block = np.unique(view[idx], axis=0, return_inverse=True)
     block = block.reshape(-1)
     grams = _core.relation_grams(x[idx], None, block, len(keys))
@@ -100,7 +100,7 @@ def test_structured_solver_matches_dense_numpy(relation, solver):
     track, view, b, rot, c, _ = random_views(5, m=7, sigma=1e-3)
     r = multiview.translations_from_tracks(track, view, b, rot, relation=relation, solver=solver)
     x = np.einsum("kji,kj->ki", rot[view], b)
-    idx = multiview._relations(track, view, 2 if relation == "bilinear" else 3, "all", 1)
+    idx = multiview.relations(track, view, 2 if relation == "bilinear" else 3, "all", 1)
     ref = dense_solve(x[idx], view[idx], 7, solver)
     ref *= np.sign(np.sum(ref * r.centres))
     assert r.converged

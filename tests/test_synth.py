@@ -12,7 +12,7 @@ from mcgeom.types import RayPairs
 
 
 def epipolar_residuals(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Generalized epipolar residual (DESIGN.md section 3) of each correspondence:
+    """Generalized epipolar residual (docs/architecture.md §3) of each correspondence:
     d2^T [t]x R d1 + d2^T R m1 + m2^T R d1 with unit d and m = origin x d."""
     d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
     d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)

@@ -4,7 +4,7 @@
  * Relative motion of a calibrated multi-camera rig (a generalized camera)
  * from ray correspondences, after J.-H. Kim's thesis (chapters cited below).
  *
- * Conventions (shared with the Python package, see DESIGN.md section 3):
+ * Conventions (shared with the Python package, see docs/architecture.md §3):
  *   - All matrices are dense, row-major, double precision.
  *     A "m x n" array a has element (i, j) at a[i * n + j].
  *   - A ray is given either by an origin point o and a direction d (both in the

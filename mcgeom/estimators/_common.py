@@ -14,7 +14,7 @@ so the import stays one-way. The row-wise geometry that the scale verdict
 needs too (cheirality counts, rotation fit, centred refinement) is in
 :mod:`mcgeom.geometry`, below both.
 
-Frames and units (DESIGN.md section 3): rays in the rig frame (origins in
+Frames and units (docs/architecture.md §3): rays in the rig frame (origins in
 metres), ``X2 = R X1 + t`` with ``t`` in metres.
 """
 

@@ -3,7 +3,7 @@
 Each camera ``i`` with enough intra-camera correspondences gives, through its
 essential matrix (OpenCV's 5-point solver with RANSAC, the same code as the 5+1
 method), the rig rotation ``R_i`` and a half-line of possible rig translations.
-In our convention (DESIGN.md section 3, ``X2 = R X1 + t``) camera ``i``'s centre
+In our convention (docs/architecture.md §3, ``X2 = R X1 + t``) camera ``i``'s centre
 ``c_i`` moves to ``R^T (c_i - t)`` and its own translation direction is ``w_i``:
 
     t = t0_i + lam_i w_i,   t0_i = c_i - R c_i,   lam_i >= 0,

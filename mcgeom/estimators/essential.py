@@ -6,7 +6,7 @@ cheirality check of ``cv2.recoverPose``), the rig rotation and a line of rig
 translations. Let ``Q`` rotate rig axes into a local frame of camera ``a``
 (origin at its centre ``c_a``, mean viewing direction along +z, so that its
 rays project to normalised image points). The 5-point solver returns ``(R_a,
-u)`` with ``Y2 = R_a Y1 + lam u`` in that frame, hence (DESIGN.md section 3,
+u)`` with ``Y2 = R_a Y1 + lam u`` in that frame, hence (docs/architecture.md §3,
 ``X2 = R X1 + t``)
 
     R = Q^T R_a Q,        t(lam) = t0 + lam w,   t0 = c_a - R c_a,  w = Q^T u,

@@ -4,7 +4,7 @@ A 5+1 sample is five intra-camera correspondences of one camera ``a`` and one
 correspondence of another camera (or a cross-camera one). The five give the
 rotation and the line of translations ``t(lam) = t0 + lam w`` through the
 5-point solver (:func:`mcgeom.estimators.essential.essential_motions`); the
-sixth fixes ``lam`` by eq. 7.4. In our convention (DESIGN.md section 3,
+sixth fixes ``lam`` by eq. 7.4. In our convention (docs/architecture.md §3,
 ``X2 = R X1 + t``), substituting ``t(lam)`` into the generalized epipolar
 constraint of a correspondence ``(d1, m1) <-> (d2, m2)`` gives ``e(lam) = a +
 lam b`` with

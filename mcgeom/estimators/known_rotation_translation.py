@@ -1,7 +1,7 @@
 """``known_rotation_translation``: the translation of a rig motion whose
 rotation is known (thesis ch. 6 with the de-rotated rig of ch. 4.2, Fig. 4.2).
 
-With R known, the generalized epipolar constraint (DESIGN.md section 3)
+With R known, the generalized epipolar constraint (docs/architecture.md §3)
 ``d2^T [t]x R d1 + d2^T R m1 + m2^T R d1 = 0`` is linear in t:
 ``(R d1 x d2) . t = -(d2^T R m1 + m2^T R d1)``. It is solved as the two-view
 case of :func:`mcgeom.multiview.translations_from_tracks` (view 0 = rig 1 at

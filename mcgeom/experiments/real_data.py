@@ -23,7 +23,7 @@ with the ground truth.
 
 Ground truth convention. The loaders give ``relative_pose(d, i, j)`` = pose of rig j in
 rig i, ``X_rig_i = T X_rig_j``. mcgeom's motion is rig2_from_rig1, ``X_rig2 = R X_rig1 +
-t`` (DESIGN.md section 3), i.e. ``inv(relative_pose(d, k, k+1))``. This is checked on
+t`` (docs/architecture.md §3), i.e. ``inv(relative_pose(d, k, k+1))``. This is checked on
 every pair by the Sampson error of the correspondences under the ground-truth motion,
 computed here with an independent numpy implementation of the generalized epipolar
 constraint (:func:`gec_sampson`), and compared with the error under the opposite
@@ -132,7 +132,7 @@ def gec_sampson(o1: np.ndarray, d1: np.ndarray, o2: np.ndarray, d2: np.ndarray,
                 R: np.ndarray, t: np.ndarray) -> np.ndarray:
     """First-order (Sampson) angular error, radians, of the generalized epipolar constraint.
 
-    Own numpy implementation (independent of the C kernels) of DESIGN.md section 3:
+    Own numpy implementation (independent of the C kernels) of docs/architecture.md §3:
     ``e = d2^T [t]x R d1 + d2^T R m1 + m2^T R d1`` with ``m = c x d``, divided by the
     norm of its gradient with respect to tangent perturbations of the unit bearings
     ``d1`` and ``d2`` (camera centres fixed). For one pinhole camera this is the usual

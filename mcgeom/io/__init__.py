@@ -1,7 +1,7 @@
 """Rig calibration files in the formats users have (I/O only: parsing and conventions).
 
 Every loader returns a :class:`mcgeom.rig.Rig` whose cameras carry **cam_from_rig**
-extrinsics, ``X_cam = R X_rig + t`` (DESIGN.md section 3), OpenCV lens models
+extrinsics, ``X_cam = R X_rig + t`` (docs/architecture.md §3), OpenCV lens models
 (``"pinhole"``: ``cv2.projectPoints`` coefficients, ``"fisheye"``: ``cv2.fisheye``) and
 OpenCV pixel coordinates (centre of the top-left pixel at ``(0, 0)``). Data flows from
 here to :mod:`mcgeom.rig`, never back: ``rig`` knows nothing of files.
