@@ -26,8 +26,7 @@ import numpy as np
 
 from . import _core
 from .rig import Rig
-from .robust import MotionFocal   # the callback type robust.ransac calls
-from .types import RayPairs
+from .types import MotionFocal, RayPairs
 
 __all__ = ["pixels_per_radian", "sampson_pixel_scale"]
 

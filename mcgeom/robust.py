@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any, Callable, Optional, Union
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -38,14 +38,10 @@ from .errors import DegenerateError
 from .estimators._common import travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import scale_profile, scale_verdict
-from .types import RayPairs, RigMotion, ScaleVerdict
+from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
 
-#: ``motion_focal(rays, R, t)``: (N,) pixels per radian of each residual at the
-#: motion ``X2 = R X1 + t`` (rig frame, ``t`` in metres); e.g.
-#: :func:`mcgeom.pixel_noise.sampson_pixel_scale`
-MotionFocal = Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)

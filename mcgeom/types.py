@@ -7,13 +7,13 @@ Frames and units follow docs/architecture.md §3: rays are expressed in the rig 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
 from .validation import as_camera_ids, as_vectors, check_rotation, check_vector3
 
-__all__ = ["RayPairs", "ScaleVerdict", "RigMotion"]
+__all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "MotionFocal"]
 
 
 @dataclass(frozen=True)
@@ -196,3 +196,10 @@ class RigMotion:
         """rig1_from_rig2 with the same verdict and diagnostics."""
         return RigMotion(self.R.T.copy(), -self.R.T @ self.t, self.scale, self.method,
                          self.residual_rms, self.inliers, dict(self.info))
+
+
+#: ``motion_focal(rays, R, t)``: (N,) pixels per radian of each residual at the
+#: motion ``X2 = R X1 + t`` (rig frame, ``t`` in metres); made by the rig's
+#: pixel-noise model (:func:`mcgeom.pixel_noise.sampson_pixel_scale`), called by
+#: :func:`mcgeom.robust.ransac`: a type both layers share, so it lives here
+MotionFocal = Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]
