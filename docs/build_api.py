@@ -12,8 +12,10 @@ is an error: CI runs this and fails on it.
 from __future__ import annotations
 
 import argparse
+import os
 import pkgutil
 import sys
+import tempfile
 import warnings
 from pathlib import Path
 
@@ -43,8 +45,13 @@ def main(argv: list[str] | None = None) -> int:
 
     pdoc.render.configure(docformat="restructuredtext", show_source=False)
     modules = public_modules()
-    pdoc.pdoc(*modules, output_directory=args.out)
-    print(f"API reference of {len(modules)} modules in {args.out}/index.html")
+    out = args.out.resolve()
+    # document the installed package: from a checkout's root, the spec "mcgeom"
+    # would also name the source folder (a pdoc warning, hence an error here)
+    with tempfile.TemporaryDirectory() as neutral:
+        os.chdir(neutral)
+        pdoc.pdoc(*modules, output_directory=out)
+    print(f"API reference of {len(modules)} modules in {out}/index.html")
     return 0
 
 
