@@ -108,7 +108,8 @@ def test_layers():
     model, the verdict and the shared geometry below the estimators and the
     robust layer."""
     g = _graph()
-    apps = ("mcgeom.cli", "mcgeom.__main__", "mcgeom.experiments")
+    # the sequence pipeline runs the façade's robust two-frame pipeline per step
+    apps = ("mcgeom.cli", "mcgeom.__main__", "mcgeom.experiments", "mcgeom.sequence")
     users_of_cv = {m for m in g if "mcgeom.cv" in g[m]}
     assert all(m.startswith(apps) for m in users_of_cv), users_of_cv
     io = [m for m in g if m.startswith("mcgeom.io")]

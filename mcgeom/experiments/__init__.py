@@ -35,6 +35,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
                                "EuRoC), against their ground truth"),
     "ch6_kitti": ("ch6_kitti", "thesis ch. 6 on real data: the KITTI-00 stereo trajectory "
                                "from tracks with known rotations"),
+    "odometry_kitti00": ("odometry_kitti00", "the sequence back end on the KITTI-00 stereo "
+                                             "tracks: ATE and scale drift, next to naive "
+                                             "chaining and PoseLib"),
 }
 
 
