@@ -60,6 +60,10 @@ def write_atomically(path: Union[str, os.PathLike], data: Union[str, bytes]) -> 
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix="-" + os.path.basename(target),
                                dir=folder)
     try:
+        # mkstemp creates the file 0600; give it the mode a plain open() would
+        mask = os.umask(0)
+        os.umask(mask)
+        os.fchmod(fd, 0o666 & ~mask)
         with os.fdopen(fd, "wb") as fh:
             fh.write(raw)
             fh.flush()
