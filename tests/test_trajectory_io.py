@@ -102,33 +102,26 @@ def test_comments_and_blank_lines_are_skipped(tmp_path):
     np.testing.assert_allclose(T[1, :3, :3], np.eye(3))   # q and -q: the same rotation
 
 
-@pytest.mark.parametrize("text, message", [
-    ("0 1 2 3 0 0 0 1\n1 1 2 3 0 0 1\n", r"t\.txt:2: a TUM line has 8 numbers .* got 7"),
-    ("0 1 2 3 0 0 0 1\n1 1 2 x 0 0 0 1\n", r"t\.txt:2: 'x' is not a number"),
-    ("# c\n0 1 2 3 0 0 0 2\n", r"t\.txt:2: the quaternion .* has norm 2, not 1"),
-    ("0 1 2 3 0 0 0 0\n", r"t\.txt:1: the quaternion .* has norm 0"),
-    ("0 1 2 nan 0 0 0 1\n", r"t\.txt:1: non-finite number"),
-    ("1 1 2 3 0 0 0 1\n1 1 2 3 0 0 0 1\n", r"t\.txt:2: timestamp 1\.0 does not follow"),
-    ("# only a comment\n", r"t\.txt: no poses"),
+@pytest.mark.parametrize("name, text, message", [
+    ("t.txt", "0 1 2 3 0 0 0 1\n1 1 2 3 0 0 1\n", r"t\.txt:2: a TUM line has 8 numbers .* got 7"),
+    ("t.txt", "0 1 2 3 0 0 0 1\n1 1 2 x 0 0 0 1\n", r"t\.txt:2: 'x' is not a number"),
+    ("t.txt", "# c\n0 1 2 3 0 0 0 2\n", r"t\.txt:2: the quaternion .* has norm 2, not 1"),
+    ("t.txt", "0 1 2 3 0 0 0 0\n", r"t\.txt:1: the quaternion .* has norm 0"),
+    ("t.txt", "0 1 2 nan 0 0 0 1\n", r"t\.txt:1: non-finite number"),
+    ("t.txt", "1 1 2 3 0 0 0 1\n1 1 2 3 0 0 0 1\n", r"t\.txt:2: timestamp 1\.0 does not follow"),
+    ("t.txt", "# only a comment\n", r"t\.txt: no poses"),
+    ("k.kitti", "1 0 0 0 0 1 0 0 0 0 1\n", r"k\.kitti:1: a KITTI line has 12 numbers .* got 11"),
+    ("k.kitti", "0 1 0 0 0 0 0 1 0 0 0 0 1\n", r"k\.kitti:1: .* got 13 \(a leading timestamp"),
+    ("k.kitti", "1 0 0 0 0 1 0 0 0 0 1 0\n2 0 0 0 0 1 0 0 0 0 1 0\n",
+     r"k\.kitti:2: its 3x3 part is not a rotation"),
+    ("k.kitti", "1 0 0 0 0 1 0 0 0 0 -1 0\n", r"k\.kitti:1: .*not a rotation .*det = -1"),
 ])
-def test_malformed_tum_names_file_and_line(tmp_path, text, message):
-    p = tmp_path / "t.txt"
+def test_malformed_files_name_file_and_line(tmp_path, name, text, message):
+    p = tmp_path / name
     p.write_text(text)
+    reader = tio.read_kitti if name.endswith(".kitti") else tio.read_tum
     with pytest.raises(ValueError, match=message):
-        tio.read_tum(p)
-
-
-@pytest.mark.parametrize("text, message", [
-    ("1 0 0 0 0 1 0 0 0 0 1\n", r"k\.txt:1: a KITTI line has 12 numbers .* got 11"),
-    ("0 1 0 0 0 0 0 1 0 0 0 0 1\n", r"k\.txt:1: .* got 13 \(a leading timestamp column"),
-    ("1 0 0 0 0 1 0 0 0 0 1 0\n2 0 0 0 0 1 0 0 0 0 1 0\n", r"k\.txt:2: its 3x3 part is not a rotation"),
-    ("1 0 0 0 0 1 0 0 0 0 -1 0\n", r"k\.txt:1: .*not a rotation .*det = -1"),
-])
-def test_malformed_kitti_names_file_and_line(tmp_path, text, message):
-    p = tmp_path / "k.txt"
-    p.write_text(text)
-    with pytest.raises(ValueError, match=message):
-        tio.read_kitti(p)
+        reader(p)
 
 
 def test_kitti_benchmark_precision_is_accepted(tmp_path):
