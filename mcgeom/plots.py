@@ -29,7 +29,7 @@ from matplotlib.patches import Patch
 
 from .io.trajectory import write_atomically
 from .metrics import path_length, relative_pose_error
-from .validation import check_poses
+from .validation import check_int, check_poses
 
 __all__ = ["STATUS_COLOURS", "DIRECTION_ONLY_COLOUR", "PlotSegment", "plot_trajectory"]
 
@@ -161,7 +161,8 @@ def plot_trajectory(path: Union[str, os.PathLike], segments: Any,
                     gt_poses: Optional[np.ndarray] = None,
                     step_status: Optional[Sequence[str]] = None,
                     step_errors: Optional[np.ndarray] = None, title: str = "", *,
-                    plane: Optional[str] = None, ate: Optional[Mapping[str, Any]] = None) -> None:
+                    plane: Optional[str] = None, ate: Optional[Mapping[str, Any]] = None,
+                    frame_offset: int = 0) -> None:
     """Write a PNG: the estimated trajectory from above, with its scale status.
 
     ``path``: the PNG (written atomically; its folder must exist).
@@ -180,11 +181,14 @@ def plot_trajectory(path: Union[str, os.PathLike], segments: Any,
     is added, and its per-frame errors (``ate["frames"]`` if present, else 0..)
     are drawn in the second panel. ``plane``: the top-view axes, e.g. ``"xz"`` for
     camera-like frames (y down); default: the two of largest extent.
+    ``frame_offset``: added to the frame numbers shown on the error panel's axis
+    (e.g. the ``--start`` frame of the images, so that the axis names the files' frames).
 
     F is the number of frames: ``len(gt_poses)`` if given, else one past the
     last segment frame. Size: 1500 x 700 px with the error panel, 900 x 800 without.
     """
     segs = _as_segments(segments)
+    offset = check_int("frame_offset", frame_offset)
     n_frames = int(max(s.frames[-1] for s in segs)) + 1
     gt = None
     if gt_poses is not None:
@@ -229,7 +233,7 @@ def plot_trajectory(path: Union[str, os.PathLike], segments: Any,
     ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
               fontsize=10, frameon=False)
     if ax_err is not None:
-        _draw_errors(ax_err, errors, status, ate)
+        _draw_errors(ax_err, errors, status, ate, offset)
 
     headline = title
     if ate is not None:
@@ -311,11 +315,12 @@ def _draw_top_view(ax: Any, segs: list[PlotSegment], placed: list[np.ndarray],
 
 
 def _draw_errors(ax: Any, errors: Optional[np.ndarray], status: Optional[list[str]],
-                 ate: Optional[Mapping[str, Any]]) -> None:
-    """Per-step translation error (bars, coloured by status) and ATE per frame."""
+                 ate: Optional[Mapping[str, Any]], offset: int) -> None:
+    """Per-step translation error (bars, coloured by status) and ATE per frame;
+    frame numbers shifted by ``offset``."""
     handles = []
     if errors is not None and errors.size:
-        k = np.arange(errors.size)
+        k = np.arange(errors.size) + offset
         ok = np.isfinite(errors)
         colours = ([STATUS_COLOURS[s] for s in status] if status is not None
                    else [_ESTIMATE_COLOUR] * errors.size)
@@ -333,7 +338,7 @@ def _draw_errors(ax: Any, errors: Optional[np.ndarray], status: Optional[list[st
                                                     "steps (no error in metres)"))
     if ate is not None:
         e = np.asarray(ate["errors"], dtype=np.float64)
-        frames = np.asarray(ate.get("frames", np.arange(e.size)))
+        frames = np.asarray(ate.get("frames", np.arange(e.size))) + offset
         ax.plot(frames, e, color="black", linewidth=1.8, marker=".", label="ATE per frame")
         handles.append(Line2D([], [], color="black", marker=".", label="ATE per frame "
                               "(after SE(3) alignment)"))

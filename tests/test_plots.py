@@ -53,7 +53,7 @@ def test_with_ground_truth_statuses_and_ate(tmp_path):
     status = ["carried"] * 10 + ["metric"] * 10
     ate = metrics.absolute_trajectory_error(est, gt)
     out = tmp_path / "t.png"
-    plots.plot_trajectory(out, est, gt, status, title="loop", ate=ate)
+    plots.plot_trajectory(out, est, gt, status, title="loop", ate=ate, frame_offset=13)
     assert _png_size(out) == (1500, 700)
     assert os.listdir(tmp_path) == ["t.png"]       # no temporary file left
 
@@ -96,6 +96,7 @@ def test_the_default_plane_is_the_one_of_largest_extent():
     ({"step_status": ["observed"] * 20}, r"unknown value\(s\) \['observed'\]"),
     ({"step_errors": np.zeros(5)}, r"step_errors must have shape \(20,\)"),
     ({"plane": "xx"}, r"plane must be None"),
+    ({"gt_poses": _loop(), "frame_offset": 1.5}, r"frame_offset must be an integer"),
     ({"gt_poses": np.tile(np.eye(4), (3, 1, 1))}, r"gt_poses has 3 poses but the segments"),
 ])
 def test_bad_arguments_are_refused_and_nothing_is_written(tmp_path, kwargs, message):
