@@ -16,7 +16,7 @@ import numpy as np
 
 __all__ = ["MAX_CAMERA_ID", "ROTATION_TOL", "numeric", "rotation_problem", "check_rotation",
            "check_vector3", "check_pixels", "check_points", "check_int", "as_vectors",
-           "as_camera_ids"]
+           "as_camera_ids", "check_poses"]
 
 #: tolerance of max |R^T R - I| for a matrix to count as a rotation
 ROTATION_TOL = 1e-6
@@ -90,6 +90,41 @@ def check_points(what: str, points: Any) -> np.ndarray:
     if not np.all(np.isfinite(P)):
         raise ValueError(f"{what} has non-finite entries")
     return np.ascontiguousarray(P)
+
+
+def check_poses(what: str, poses: Any, n: int | None = None,
+                rotation_tol: float = ROTATION_TOL) -> np.ndarray:
+    """``poses`` as a finite (N, 4, 4) float64 array of rigid transforms (e.g.
+    world_from_rig, metres), N >= 1 (or exactly ``n``), or ValueError naming the
+    first bad pose: each top-left 3x3 a rotation to ``rotation_tol`` (max
+    |R^T R - I|, det > 0), bottom row (0, 0, 0, 1) exactly."""
+    T = numeric(what, poses)
+    if T.ndim == 2 and T.shape == (4, 4):
+        raise ValueError(f"{what} must have shape (N, 4, 4), got one (4, 4) matrix "
+                         "(wrap it as poses[None])")
+    if T.ndim != 3 or T.shape[1:] != (4, 4) or T.shape[0] == 0:
+        raise ValueError(f"{what} must have shape (N, 4, 4) with N >= 1, got {T.shape}")
+    if n is not None and T.shape[0] != n:
+        raise ValueError(f"{what} has {T.shape[0]} poses, expected {n}")
+    finite = np.all(np.isfinite(T), axis=(1, 2))
+    if not np.all(finite):
+        k = int(np.flatnonzero(~finite)[0])
+        raise ValueError(f"{what} has {int((~finite).sum())} pose(s) with non-finite "
+                         f"entries (first: pose {k})")
+    bottom = np.all(T[:, 3, :] == (0.0, 0.0, 0.0, 1.0), axis=1)
+    if not np.all(bottom):
+        k = int(np.flatnonzero(~bottom)[0])
+        raise ValueError(f"{what}: pose {k} has bottom row {T[k, 3].tolist()}, "
+                         "not (0, 0, 0, 1)")
+    R = T[:, :3, :3]
+    ortho = np.max(np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)), axis=(1, 2))
+    bad = (ortho >= rotation_tol) | (np.linalg.det(R) <= 0)
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{what}: pose {k} is not rigid: its 3x3 part is not a rotation "
+                         f"(max |R^T R - I| = {ortho[k]:.3g}, det = "
+                         f"{float(np.linalg.det(R[k])):.6g})")
+    return np.ascontiguousarray(T)
 
 
 def check_int(what: str, value: Any) -> int:

@@ -27,6 +27,10 @@ represent, pathological nesting -- is a ``ValueError`` whose message names the f
 entry and the problem (``OSError`` if the file cannot be opened at all). Camera-level
 checks (``K``, distortion length, rotation within 1e-6 of orthonormal, image size) are
 :class:`mcgeom.rig.Camera`'s own.
+
+Trajectories (world_from_rig poses) are read and written in the TUM and KITTI formats by
+:mod:`.trajectory` (:func:`read_tum`, :func:`write_tum`, :func:`read_kitti`,
+:func:`write_kitti`), with the same "<file>:<line>: <problem>" errors and atomic writes.
 """
 
 from mcgeom.io.colmap import load_colmap
@@ -35,6 +39,7 @@ from mcgeom.io.kalibr import load_kalibr
 from mcgeom.io.mcgeom_json import (RIG_FORMAT, RIG_FORMAT_VERSION, load_mcgeom_json,
                                    rig_from_dict, rig_to_dict, save_mcgeom_json)
 from mcgeom.io.opencv_yaml import OPENCV_RIG_FORMAT, load_opencv_yaml, save_opencv_yaml
+from mcgeom.io.trajectory import read_kitti, read_tum, write_kitti, write_tum
 
 __all__ = [
     "load_rig", "detect_format", "FORMATS",
@@ -42,4 +47,5 @@ __all__ = [
     "RIG_FORMAT", "RIG_FORMAT_VERSION",
     "load_opencv_yaml", "save_opencv_yaml", "OPENCV_RIG_FORMAT",
     "load_kalibr", "load_colmap",
+    "read_tum", "write_tum", "read_kitti", "write_kitti",
 ]
