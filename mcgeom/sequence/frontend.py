@@ -308,7 +308,12 @@ class FrontEnd:
         ratio: Lowe's ratio test threshold, in (0, 1].
         cross_camera: match across the overlapping cameras (:func:`overlapping_pairs`).
         geometric_check: reject temporal matches inconsistent with a RANSAC essential
-            matrix of their camera (:func:`essential_inliers`).
+            matrix of their camera (:func:`essential_inliers`). On by default because
+            it measurably helps the two-frame estimator downstream (SIFT, 4000 per
+            image): on DDAD scene_02 the share of step correspondences within 1 px of
+            the ground-truth epipolar geometry rises from 92 / 90 % to 96 / 95 % and
+            the |t| error of ``mcgeom.cv.estimate`` drops from 2.3 / 8.9 % to 1.3 /
+            5.1 %; on KITTI raw 0023 the share rises by about 1 point (94-97 %).
         threshold_px: the epipolar threshold of both checks, pixels.
         min_overlap: the overlap fraction from which a camera pair is matched.
     """
