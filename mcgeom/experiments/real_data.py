@@ -46,6 +46,9 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
+from mcgeom.sequence.features import FeatureDetector, match_descriptors
+from mcgeom.sequence.frontend import overlapping_pairs
+
 from .common import Progress, no_progress, positive_float, positive_int, write_line
 
 try:
@@ -60,8 +63,6 @@ DATA_ENV = "MCGEOM_REAL_DATA"
 THRESHOLD_PX = 1.5
 #: below this GT translation (metres) a pair is "static": the direction of t is noise
 STATIC_T = 0.02
-#: camera pairs whose views overlap by at least this fraction get cross-camera matches
-MIN_OVERLAP = 0.05
 
 
 def data_available(root: Optional[Path] = None) -> bool:
@@ -209,36 +210,6 @@ def rig_from_calib(d: dict):
     return Rig(tuple(cams))
 
 
-def overlapping_pairs(rig, min_frac: float = MIN_OVERLAP,
-                      depths: tuple = (5.0, 15.0, 40.0)) -> list[tuple[int, int, float]]:
-    """Camera pairs (i, j), i < j, whose fields of view overlap (from the calibration only).
-
-    A grid of pixels of camera i is back-projected to a few depths and projected into
-    camera j; the overlap is the larger of the two visible fractions (i in j, j in i).
-    """
-    def frac(i: int, j: int) -> float:
-        ci = rig.cameras[i]
-        u, v = np.meshgrid(np.linspace(0, ci.width - 1, 24), np.linspace(0, ci.height - 1, 16))
-        px = np.c_[u.ravel(), v.ravel()]
-        o, dirs = rig.rays(np.full(len(px), i), px)
-        vis = []
-        for z in depths:
-            # depth along the optical axis of camera i: scale the bearing accordingly
-            cos = dirs @ ci.R[2]
-            _, ok = rig.project(j, o + dirs * (z / cos)[:, None])
-            vis.append(ok.mean())
-        return float(np.mean(vis))
-
-    out = []
-    n = len(rig.cameras)
-    for i in range(n):
-        for j in range(i + 1, n):
-            f = max(frac(i, j), frac(j, i))
-            if f >= min_frac:
-                out.append((i, j, f))
-    return out
-
-
 @dataclass
 class Sequence:
     """One evaluated recording: loaded data, rig, ground truth and the pairs to evaluate."""
@@ -342,7 +313,9 @@ def _load_one(key: str, root: Path) -> Sequence:
 # ------------------------------------------------------------------ features
 
 class Features:
-    """Keypoints + descriptors per image path, computed once (SIFT, else ORB)."""
+    """Keypoints + descriptors per image path, computed once (SIFT, else ORB) with
+    :class:`mcgeom.sequence.features.FeatureDetector`; the cache keeps every image's
+    features (a few frames per data set here)."""
 
     def __init__(self, nfeatures: int = 3000, detector: str = "auto"):
         if cv2 is None:
@@ -350,9 +323,8 @@ class Features:
         use_sift = detector == "sift" or (detector == "auto" and hasattr(cv2, "SIFT_create"))
         self.name = "SIFT" if use_sift else "ORB"
         self.nfeatures = nfeatures
-        self._det = cv2.SIFT_create(nfeatures=nfeatures) if use_sift else \
-            cv2.ORB_create(nfeatures=nfeatures)
-        self.norm = cv2.NORM_L2 if use_sift else cv2.NORM_HAMMING
+        self._det = FeatureDetector("sift" if use_sift else "orb", nfeatures)
+        self.norm = self._det.norm
         self._cache: dict = {}
         self.seconds = 0.0
 
@@ -367,36 +339,10 @@ class Features:
             img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
             if img is None:
                 raise OSError(f"cannot read image {path}")
-            kps, desc = self._det.detectAndCompute(img, None)
-            pts = np.array([k.pt for k in kps], dtype=np.float64).reshape(-1, 2)
-            if desc is None:
-                desc = np.zeros((0, 128), np.float32)
-            self._cache[path] = (pts, desc)
+            kp = self._det.detect(img, what=path)
+            self._cache[path] = (kp.pixels, kp.descriptors)
             self.seconds += time.perf_counter() - t0
         return self._cache[path]
-
-
-def match_descriptors(desc1: np.ndarray, desc2: np.ndarray, norm: int,
-                      ratio: float = 0.8) -> tuple[np.ndarray, np.ndarray]:
-    """Indices (i1, i2) of mutual nearest neighbours that pass Lowe's ratio test both ways."""
-    if len(desc1) < 2 or len(desc2) < 2:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    bf = cv2.BFMatcher(norm, crossCheck=False)
-
-    def best(a, b):
-        nn = bf.knnMatch(a, b, k=2)
-        idx = np.full(len(a), -1, np.int64)
-        for q, m in enumerate(nn):
-            if len(m) == 2 and m[0].distance < ratio * m[1].distance:
-                idx[q] = m[0].trainIdx
-        return idx
-
-    f = best(desc1, desc2)
-    b = best(desc2, desc1)
-    i1 = np.flatnonzero(f >= 0)
-    i2 = f[i1]
-    keep = b[i2] == i1
-    return i1[keep], i2[keep]
 
 
 # ------------------------------------------------------------------ correspondences
@@ -447,7 +393,7 @@ def correspondences(seq: Sequence, k1: int, k2: int, feats: Optional[Features] =
         for i, j in combos:
             pts1, de1 = feats(f1["images"][names[i]])
             pts2, de2 = feats(f2["images"][names[j]])
-            a, b = match_descriptors(de1, de2, feats.norm)
+            a, b, _ = match_descriptors(de1, de2, feats.norm)
             parts.append((pts1[a], pts2[b], i, j))
         out = _concat(parts)
     out.seconds = time.perf_counter() - t0
