@@ -16,6 +16,8 @@ import textwrap
 from pathlib import Path
 from typing import Optional, Sequence
 
+import numpy as np
+
 from . import __version__, registry
 from .experiments import EXPERIMENTS
 from .experiments.common import (HelpFormatter, MissingPeerError, non_negative_float,
@@ -86,6 +88,51 @@ def _cmd_demo(args: argparse.Namespace) -> int:
                           title=f"loop gap {1000 * res.loop_gap_m:.1f} mm")
     print(f"wrote {out / 'trajectory_true.csv'}, {out / 'trajectory_estimated.csv'}, "
           f"{out / 'trajectory.png'}")
+    return 0
+
+
+def _print_run(run) -> None:
+    """The summary of a sequence run: steps by scale status, segments, errors."""
+    traj = run.trajectory
+    status = traj.status
+    counts = {k: status.count(k) for k in ("metric", "carried", "unknown")}
+    seq = run.sequence
+    print(f"{seq.n_frames} frames of {seq.n_cameras} cameras ({seq.layout} layout, "
+          f"{seq.root}); {len(run.tracks)} observations in "
+          f"{len(np.unique(run.tracks.track))} tracks")
+    print(f"steps: {counts['metric']} metric, {counts['carried']} carried, "
+          f"{counts['unknown']} unknown (scale not observable, never chained as metric); "
+          f"{len(traj.segments)} segment(s), "
+          f"{sum(not sg.metric for sg in traj.segments)} direction-only")
+    known = traj.known
+    if known.sum() > 1:
+        c = traj.centres[known]
+        print(f"metric trajectory: {int(known.sum())} frames, path "
+              f"{float(np.sum(np.linalg.norm(np.diff(c, axis=0), axis=1))):.3f} m")
+    else:
+        print("metric trajectory: none (no step with an observable scale)")
+    if run.errors is not None:
+        print("against the ground truth: " + run.errors.summary())
+    secs = ", ".join(f"{k} {v:.1f} s" for k, v in run.seconds.items())
+    print(f"wrote {run.out}/ (trajectory_tum.txt, trajectory_kitti.txt, steps.csv, "
+          f"trajectory.png{', errors.txt' if run.errors is not None else ''}); {secs}")
+
+
+def _cmd_odometry(args: argparse.Namespace) -> int:
+    from .sequence.run import run_odometry
+
+    try:
+        run = run_odometry(args.rig, args.images, args.out, start=args.start, end=args.end,
+                           step=args.step, features=args.features,
+                           n_features=args.n_features, cross_camera=not args.no_cross_camera,
+                           threshold=args.threshold, gt=args.gt, progress=progress_bar,
+                           title=Path(args.images).name)
+    except (ValueError, OSError) as exc:
+        # bad input (rig file, image layout, unreadable image, ground truth):
+        # the message names it; nothing was written
+        print(f"mcgeom odometry: error: {exc}", file=sys.stderr)
+        return 2
+    _print_run(run)
     return 0
 
 
@@ -215,6 +262,42 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--seed", type=non_negative_int, default=0, help="random seed")
     d.add_argument("--out", default="mcgeom_demo", help="output directory")
     d.set_defaults(func=_cmd_demo)
+
+    o = sub.add_parser("odometry", formatter_class=HelpFormatter,
+                       help="a rig's image sequence to a metric trajectory",
+                       description=textwrap.fill(
+                           "Feature tracks (OpenCV) of a rig's image sequence, every step's "
+                           "motion with its scale verdict, and the metric trajectory: scale "
+                           "observed on a step (metric), carried along the tracks "
+                           "(carried), or not known (unknown: such a stretch is reported "
+                           "as direction-only, never chained with a guessed length). "
+                           "Writes OUT/trajectory_tum.txt, trajectory_kitti.txt, steps.csv "
+                           "and trajectory.png; with --gt also errors.txt (ATE after an "
+                           "SE(3) alignment, no scale; RPE; scale drift).", 79),
+                       epilog=textwrap.fill(
+                           "Image layouts: IMAGES/<camera name or camN>/ with the same "
+                           "number of images each (sorted names give the frame order); "
+                           "EuRoC/ASL (camN/data.csv + camN/data/); KITTI raw "
+                           "(image_02/data, image_03/data).", 79))
+    o.add_argument("--rig", required=True, help="rig calibration file (mcgeom JSON, OpenCV "
+                   "FileStorage, Kalibr camchain, COLMAP rig config)")
+    o.add_argument("--images", required=True, help="folder of the images")
+    o.add_argument("--out", default="mcgeom_odometry", help="output folder")
+    o.add_argument("--start", type=non_negative_int, default=0, help="first frame")
+    o.add_argument("--end", type=positive_int, default=None,
+                   help="frame to stop before (default: all)")
+    o.add_argument("--step", type=positive_int, default=1, help="use every STEP-th frame")
+    o.add_argument("--features", choices=("sift", "orb"), default="sift",
+                   help="feature detector and descriptor")
+    o.add_argument("--n-features", type=positive_int, default=4000,
+                   help="features per image")
+    o.add_argument("--threshold", type=positive_float, default=1.0,
+                   help="inlier threshold of the two-frame estimates (pixels)")
+    o.add_argument("--no-cross-camera", action="store_true",
+                   help="do not match across cameras whose views overlap")
+    o.add_argument("--gt", default=None, help="ground truth, TUM file of world_from_rig "
+                   "(time stamps as the images', or frame numbers)")
+    o.set_defaults(func=_cmd_odometry)
 
     m = sub.add_parser("methods", formatter_class=HelpFormatter,
                        help="list the registered estimators",

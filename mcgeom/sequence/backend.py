@@ -48,6 +48,7 @@ Why ``metric_from="steps"`` and ``window=2`` by default (measured):
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Callable, Iterable, Optional
 
 import numpy as np
@@ -67,6 +68,9 @@ METRIC_FROM = ("tracks", "steps")
 #: a step with fewer two-frame correspondences is not estimated (the 5+1 and
 #: 17-point samples need 6 and 17; below a dozen RANSAC has nothing to vote)
 MIN_STEP_CORRESPONDENCES = 12
+#: cross-camera inliers that make a "no translation detected" step metric
+#: (t = 0 m, see _static_verdict)
+MIN_CROSS_FOR_STATIC = 20
 
 
 def _check_int(name: str, value: Any, lower: int) -> int:
@@ -115,6 +119,22 @@ def _observation_index(tracks: Tracks, n_cams: int) -> Callable:
     return index
 
 
+def _static_verdict(m: RigMotion, cross_inliers: np.ndarray) -> RigMotion:
+    """A step with "no translation detected" (``t = 0``: a pure rotation
+    explains every inlier) is metric -- zero metres -- when cross-camera
+    inliers took part: they see the scene at a finite depth through the rig's
+    known baselines, so a translation would have shown as parallax there
+    (thesis ch. 7.3.2: cross-camera correspondences fix the scale). Without
+    them a scene at infinity cannot be told from a static rig: the step keeps
+    its "not observable" verdict."""
+    if m.scale.observable or np.any(m.t != 0) \
+            or int(cross_inliers.sum()) < MIN_CROSS_FOR_STATIC:
+        return m
+    reason = (f"{m.scale.reason}; {int(cross_inliers.sum())} cross-camera inliers at the "
+              f"rig's baselines bound it: t = 0 m")
+    return replace(m, scale=replace(m.scale, observable=True, reason=reason))
+
+
 def _step_estimates(rig: Rig, tracks: Tracks, method: str, threshold: float,
                     progress: Optional[Callable], options: dict):
     """Two-frame motions (None where a step cannot be estimated), reasons,
@@ -146,8 +166,9 @@ def _step_estimates(rig: Rig, tracks: Tracks, method: str, threshold: float,
             n_inl.append(0)
             reasons.append(f"no motion between frames {k} and {k + 1}: {exc}")
             continue
-        motions.append(m)
         mask = np.asarray(m.inliers, bool)
+        m = _static_verdict(m, mask & (c1 != c2))
+        motions.append(m)
         n_inl.append(int(mask.sum()))
         reasons.append(m.scale.reason)
         for f, c in ((k, c1), (k + 1, c2)):
@@ -262,6 +283,10 @@ def _segment_centres(rig: Rig, tracks: Tracks, keep: np.ndarray, motions: list,
     obs = np.flatnonzero(observed)
     lengths = np.array([np.linalg.norm(motions[a + k].t) for k in obs])
     den = float(d[obs] @ d[obs])
+    if not np.any(lengths > 0):
+        # every observed step is static (t = 0 m): the segment does not move
+        info["steps_scale"] = 0.0
+        return np.zeros_like(c), True, "steps", info
     if not den > 0:
         raise NumericalError(f"frames {a}..{b + 1}: the tracks give no translation on the "
                              "observed steps")
