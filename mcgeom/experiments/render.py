@@ -250,26 +250,29 @@ class Renderer:
                 g = np.flatnonzero(base == lv)
                 if g.size == 0:
                     continue
-                lo = self._sample(plane.mips[lv], ak[g], bk[g], plane.texel * 2.0 ** lv)
+                lo = self._sample(plane.mips[lv], ak[g], bk[g], plane.texel, lv)
                 if lv + 1 <= last:
-                    hi = self._sample(plane.mips[lv + 1], ak[g], bk[g],
-                                      plane.texel * 2.0 ** (lv + 1))
+                    hi = self._sample(plane.mips[lv + 1], ak[g], bk[g], plane.texel, lv + 1)
                     lo = lo + frac[g] * (hi - lo)
                 vals[g] = lo
             out[sel] = plane.gain * vals
         return np.clip(np.rint(out), 0, 255).astype(np.uint8).reshape(rays.shape)
 
     @staticmethod
-    def _sample(tex: np.ndarray, a: np.ndarray, b: np.ndarray, texel: float) -> np.ndarray:
-        """Bilinear texture values at plane coordinates (metres) for a level whose
-        texels are ``texel`` metres (texel centres at (k + 0.5) texel)."""
+    def _sample(tex: np.ndarray, a: np.ndarray, b: np.ndarray, texel: float,
+                level: int) -> np.ndarray:
+        """Bilinear values of mip ``level`` at plane coordinates ``(a, b)`` (metres) of a
+        texture of ``texel`` metres (level 0: texel centres at (k + 0.5) texel)."""
+        # cv2.pyrDown centres pixel k of a level on pixel 2k of the level below, so
+        # level-l coordinates are the level-0 ones divided by 2^l
+        scale = 1.0 / 2.0 ** level
         # cv2.remap wants maps of fewer than 32767 rows and columns: lay the points
         # out as rows of 1024 (the padding is sampled and dropped)
         n = a.shape[0]
         rows = -(-n // 1024)
         maps = np.zeros((2, rows * 1024), np.float32)
-        maps[0, :n] = a / texel - 0.5
-        maps[1, :n] = b / texel - 0.5
+        maps[0, :n] = (a / texel - 0.5) * scale
+        maps[1, :n] = (b / texel - 0.5) * scale
         return cv2.remap(tex, maps[0].reshape(rows, 1024), maps[1].reshape(rows, 1024),
                          cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE).reshape(-1)[:n]
 
