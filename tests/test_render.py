@@ -100,7 +100,7 @@ def test_rendered_dot_at_projected_pixel(T):
     assert np.linalg.norm(px_plain[0] - px[0]) > 2.0      # distortion matters here
     img = render.Renderer(scene, rig).render(T, "cam")
     found = _blob_centre(img, px[0])
-    assert np.linalg.norm(found - px[0]) < 0.25, (found, px[0])
+    assert np.linalg.norm(found - px[0]) < 0.1, (found, px[0])
 
 
 def test_distortion_is_the_camera_model(scene):

@@ -33,7 +33,8 @@ import numpy as np
 
 from mcgeom.validation import check_int, check_vector3
 
-__all__ = ["Plane", "Scene", "CourtyardLayout", "courtyard", "loop_path", "procedural_texture"]
+__all__ = ["Plane", "Scene", "CourtyardLayout", "courtyard", "loop_path", "procedural_texture",
+           "check_n_frames", "layout_or_default"]
 
 # below this size (texels) a mip level carries no useful detail
 _MIN_MIP_SIZE = 4
@@ -254,6 +255,23 @@ class CourtyardLayout:
         return np.array([0.0, self.straight_y / 2 + self.turn_radius])
 
 
+def check_n_frames(n_frames: Any) -> int:
+    """``n_frames`` as an int of at least 2 (a sequence needs two frames), else ValueError."""
+    n = check_int("n_frames", n_frames)
+    if n < 2:
+        raise ValueError(f"n_frames must be at least 2, got {n}")
+    return n
+
+
+def layout_or_default(layout: Any) -> "CourtyardLayout":
+    """``layout`` if it is a :class:`CourtyardLayout`, the default one for None,
+    else ValueError."""
+    lay = CourtyardLayout() if layout is None else layout
+    if not isinstance(lay, CourtyardLayout):
+        raise ValueError(f"layout must be a CourtyardLayout, got {type(lay).__name__}")
+    return lay
+
+
 def _wall(name: str, a: np.ndarray, b: np.ndarray, bottom: float, top: float,
           texel: float, gen: np.random.Generator, gain: float) -> Plane:
     """Vertical wall from ``a`` to ``b`` (world x, y) between heights ``bottom`` and
@@ -278,9 +296,7 @@ def courtyard(seed: int = 0, layout: CourtyardLayout | None = None) -> Scene:
     seed = check_int("seed", seed)
     if seed < 0:
         raise ValueError(f"seed must be non-negative, got {seed}")
-    lay = CourtyardLayout() if layout is None else layout
-    if not isinstance(lay, CourtyardLayout):
-        raise ValueError(f"layout must be a CourtyardLayout, got {type(lay).__name__}")
+    lay = layout_or_default(layout)
     gen = np.random.default_rng(seed)
     cx, cy = lay.block_centre
     hx = lay.straight_x / 2 + lay.turn_radius        # half extents of the path
@@ -331,12 +347,8 @@ def loop_path(n_frames: int, step: float | None = None, start: float = 0.0,
     Returns:
         (n_frames, 4, 4) world_from_rig poses.
     """
-    n = check_int("n_frames", n_frames)
-    if n < 2:
-        raise ValueError(f"n_frames must be at least 2, got {n}")
-    lay = CourtyardLayout() if layout is None else layout
-    if not isinstance(lay, CourtyardLayout):
-        raise ValueError(f"layout must be a CourtyardLayout, got {type(lay).__name__}")
+    n = check_n_frames(n_frames)
+    lay = layout_or_default(layout)
     L = lay.length
     step = L / n if step is None else _finite_positive("step", step)
     try:
