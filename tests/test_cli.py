@@ -64,11 +64,14 @@ def test_unknown_experiment_is_an_argparse_error(capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["demo", "--noise", "-1"], "argument --noise: expected a non-negative number"),
-    (["demo", "--noise", "nan"], "argument --noise: expected a non-negative number"),
+    (["demo", "--frames", "1"], "argument --frames: expected at least 2 frames"),
+    (["demo", "--frames", "-4"], "argument --frames: expected a positive integer"),
     (["demo", "--seed", "-3"], "argument --seed: expected a non-negative integer"),
     (["demo", "--seed", "1.5"], "argument --seed: expected a non-negative integer"),
-    (["demo", "--method", "nope"], "argument --method: invalid choice"),
+    (["demo", "--features", "surf"], "argument --features: invalid choice"),
+    (["odometry", "--rig", "r.json", "--images", "d", "--step", "0"],
+     "argument --step: expected a positive integer"),
+    (["odometry", "--images", "d"], "the following arguments are required: --rig"),
     (["bench", "linear17", "--budget", "0"], "argument --budget: expected a positive number"),
     (["bench", "bnb", "--problems", "0"], "argument --problems: expected a positive integer"),
     (["bench", "linear17", "--sizes", "5,abc"], "argument --sizes: expected a comma-separated"),
@@ -100,7 +103,7 @@ def test_validators():
             fn(bad)
 
 
-@pytest.mark.parametrize("argv", [["demo"], ["bench"], ["experiment"]] +
+@pytest.mark.parametrize("argv", [["demo"], ["odometry"], ["bench"], ["experiment"]] +
                          [["experiment", name] for name in EXPERIMENTS])
 def test_every_option_shows_its_default(argv, capsys):
     assert _exit_code(argv + ["--help"]) == 0
@@ -110,7 +113,8 @@ def test_every_option_shows_its_default(argv, capsys):
     entries = re.split(r"\n(?=  -)", section)
     for entry in entries:
         if not entry.startswith("  -h, --help"):
-            assert "default" in " ".join(entry.split()), (argv, entry)
+            text = " ".join(entry.split())
+            assert "default" in text or text.endswith("; required"), (argv, entry)
     assert all(len(line) <= 100 for line in out.splitlines()), argv   # wrapped, not cut
 
 

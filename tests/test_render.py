@@ -227,16 +227,6 @@ def test_written_layout(tmp_path):
     assert np.loadtxt(tmp_path / "out" / "groundtruth_tum.txt").shape == (2, 8)
 
 
-def test_tum_quaternions_match_rodrigues():
-    for yaw in (0.0, 90.0, 179.0, -135.0):
-        R = rotation_about((0.3, -0.2, 1.0), math.radians(yaw))
-        q = render._quaternion_xyzw(R)   # noqa: SLF001  (the private writer, tested here)
-        rvec = cv2.Rodrigues(R)[0].ravel()
-        angle = np.linalg.norm(rvec)
-        expect = np.append(np.sin(angle / 2) * rvec / max(angle, 1e-300), np.cos(angle / 2))
-        assert np.allclose(q, expect, atol=1e-12) and np.allclose(_quat_to_R(q), R, atol=1e-12)
-
-
 def test_progress_wraps_the_frames(tmp_path):
     seen = []
 

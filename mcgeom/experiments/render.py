@@ -40,6 +40,7 @@ import cv2
 import numpy as np
 
 from mcgeom.io import save_mcgeom_json
+from mcgeom.io.trajectory import write_tum
 from mcgeom.rig import Camera, Rig
 from mcgeom.synth import look_at_camera
 from mcgeom.validation import check_int
@@ -322,35 +323,6 @@ class RenderedSequence:
         return int(self.poses.shape[0])
 
 
-def _quaternion_xyzw(R: np.ndarray) -> np.ndarray:
-    """Unit quaternion (x, y, z, w), w >= 0, of a rotation matrix (Shepperd's method:
-    the largest of the four squared components is taken first, for stability)."""
-    tr = np.trace(R)
-    cand = np.array([1 + 2 * R[0, 0] - tr, 1 + 2 * R[1, 1] - tr, 1 + 2 * R[2, 2] - tr, 1 + tr])
-    k = int(np.argmax(cand))
-    q = np.empty(4)
-    q[k] = 0.5 * math.sqrt(max(cand[k], 0.0))
-    d = 4 * q[k]
-    if k == 3:
-        q[:3] = ((R[2, 1] - R[1, 2]) / d, (R[0, 2] - R[2, 0]) / d, (R[1, 0] - R[0, 1]) / d)
-    else:
-        i, j, m = k, (k + 1) % 3, (k + 2) % 3
-        q[j] = (R[j, i] + R[i, j]) / d
-        q[m] = (R[m, i] + R[i, m]) / d
-        q[3] = (R[m, j] - R[j, m]) / d
-    q /= np.linalg.norm(q)
-    return -q if q[3] < 0 else q
-
-
-def _write_tum(path: Path, poses: np.ndarray) -> None:
-    """TUM trajectory: ``timestamp tx ty tz qx qy qz qw`` a line, timestamp = index."""
-    lines = []
-    for k, T in enumerate(poses):
-        vals = np.concatenate([T[:3, 3], _quaternion_xyzw(T[:3, :3])])
-        lines.append(f"{k} " + " ".join(f"{x:.9f}" for x in vals))
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-
-
 def _prepare_out_dir(out_dir: Any, rig: Rig, n_frames: int) -> tuple[Path, dict[str, Path]]:
     """Create the folders; refuse a folder holding what is not ours; remove frames
     of an earlier, longer run (they would be read as frames of this one)."""
@@ -445,7 +417,7 @@ def render_sequence(out_dir: Union[str, PathLike], n_frames: int = 90, seed: int
     rig_path = root / "rig.json"
     save_mcgeom_json(rig, rig_path)
     gt_path = root / "groundtruth_tum.txt"
-    _write_tum(gt_path, poses)
+    write_tum(gt_path, poses)   # timestamps: the frame indices
     used_step = lay.length / n if step is None else float(step)
     return RenderedSequence(root, rig, poses, {k: tuple(v) for k, v in paths.items()},
                             rig_path, gt_path, used_step, lay.length)
