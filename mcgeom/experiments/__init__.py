@@ -38,6 +38,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
     "odometry_kitti00": ("odometry_kitti00", "the sequence back end on the KITTI-00 stereo "
                                              "tracks: ATE and scale drift, next to naive "
                                              "chaining and PoseLib"),
+    "odometry_real": ("odometry_real", "the whole sequence pipeline on the real image "
+                                       "recordings (KITTI raw, DDAD, EuRoC) against their "
+                                       "ground truth"),
 }
 
 

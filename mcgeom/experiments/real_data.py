@@ -185,7 +185,7 @@ def front_fraction(o1: np.ndarray, d1: np.ndarray, o2: np.ndarray, d2: np.ndarra
 
 # ------------------------------------------------------------------ data sets
 
-def _import_loader(dirname: str, root: Path):
+def import_loader(dirname: str, root: Path):
     """Import ``<root>/<dirname>/load.py`` under a private module name."""
     path = root / dirname / "load.py"
     spec = importlib.util.spec_from_file_location(f"_mcgeom_realdata_{dirname}", path)
@@ -272,7 +272,7 @@ def _consecutive(frames: list) -> list[tuple[int, int]]:
 
 def _load_one(key: str, root: Path) -> Sequence:
     if key.startswith("dgp_"):
-        mod = _import_loader("dgp_ddad_testscene", root)
+        mod = import_loader("dgp_ddad_testscene", root)
         scene = key[4:]
         d = mod.load(scene)
         s = Sequence(key, d["name"], d, mod, rig_from_calib(d), _consecutive(d["frames"]),
@@ -280,7 +280,7 @@ def _load_one(key: str, root: Path) -> Sequence:
         s.note = ("parked car: GT motion 0, translation direction meaningless"
                   if s.static else "6-camera surround rig, 1.27 m / 0.1 deg per pair")
     elif key == "kitti_raw":
-        mod = _import_loader("kitti_raw_0023_tiny", root)
+        mod = import_loader("kitti_raw_0023_tiny", root)
         d = mod.load()
         s = Sequence(key, d["name"], d, mod, rig_from_calib(d), _consecutive(d["frames"]),
                      nfeatures=3000)
@@ -289,14 +289,14 @@ def _load_one(key: str, root: Path) -> Sequence:
         s.note = ("GT = OXTS poses, ~5 cm per-step position jitter (~5 % of |t|); the scale "
                   "error against the integrated INS velocity is given too")
     elif key == "euroc":
-        mod = _import_loader("euroc_v101_kimera", root)
+        mod = import_loader("euroc_v101_kimera", root)
         d = mod.load("micro")
         s = Sequence(key, d["name"], d, mod, rig_from_calib(d), _consecutive(d["frames"]),
                      nfeatures=2000, static=True)
         s.note = ("MAV standing still (GT |t| ~1 mm per pair): translation direction and "
                   "scale error are meaningless here; what matters is the verdict / |t|")
     elif key == "kitti00_tracks":
-        mod = _import_loader("kitti00_gtsam_stereo_tracks", root)
+        mod = import_loader("kitti00_gtsam_stereo_tracks", root)
         d = mod.load()
         # the KITTI GT of frames 0..12 disagrees with the images (data README): skip them
         allp = _consecutive(d["frames"])
