@@ -51,9 +51,10 @@ def _scene(poses: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
 
 
 def _tracks(rig: Rig, poses: np.ndarray, points: np.ndarray, sigma: float,
-            rng: np.random.Generator) -> Tracks:
+            rng: np.random.Generator, cross: bool = False) -> Tracks:
     """Intra-camera tracks only: a point seen by camera i is track
-    ``point * n_cams + i`` (no cross-camera matches), raw pixels + noise."""
+    ``point * n_cams + i`` (no cross-camera matches), raw pixels + noise;
+    with ``cross`` a point is one track in every camera that sees it."""
     n_cams = len(rig.cameras)
     track, frame, cam, px = [], [], [], []
     for k, T in enumerate(poses):
@@ -61,7 +62,7 @@ def _tracks(rig: Rig, poses: np.ndarray, points: np.ndarray, sigma: float,
         for i in range(n_cams):
             p, vis = rig.project(i, X_rig)
             idx = np.flatnonzero(vis)
-            track.append(idx * n_cams + i)
+            track.append(idx if cross else idx * n_cams + i)
             frame.append(np.full(len(idx), k))
             cam.append(np.full(len(idx), i))
             px.append(p[idx] + sigma * rng.standard_normal((len(idx), 2)))
@@ -70,10 +71,10 @@ def _tracks(rig: Rig, poses: np.ndarray, points: np.ndarray, sigma: float,
 
 
 def _sequence(yaws: list, seed: int = 1, sigma: float = 0.2, rig: Rig = RING,
-              n_points: int = 3000):
+              n_points: int = 3000, step_length: float = 1.0, cross: bool = False):
     rng = np.random.default_rng(seed)
-    poses = _path(yaws)
-    return poses, _tracks(rig, poses, _scene(poses, n_points, rng), sigma, rng)
+    poses = _path(yaws, step_length)
+    return poses, _tracks(rig, poses, _scene(poses, n_points, rng), sigma, rng, cross)
 
 
 def _true_lengths(poses: np.ndarray) -> np.ndarray:
@@ -182,6 +183,22 @@ def test_outlier_observations_are_rejected():
     assert traj.known.all()
     err = np.linalg.norm(traj.centres - poses[:, :3, 3], axis=1)
     assert err.max() < 0.2
+
+
+def test_static_rig_is_metric_zero_only_with_cross_camera_inliers():
+    """A parked rig: "no translation detected" is metric (0 m) when
+    cross-camera inliers at the rig's baseline bound the translation; without
+    them (a scene at infinity would look the same) it stays unknown."""
+    stereo = Rig([synth.look_at_camera(n, (0.0, y, 0.0), (1.0, 0.0, 0.0), f=600.0)
+                  for n, y in (("left", 0.25), ("right", -0.25))])
+    poses, tracks = _sequence([0.0] * 3, seed=11, rig=stereo, step_length=0.0, cross=True)
+    assert np.any(tracks.correspondences(0, 1)[2] != tracks.correspondences(0, 1)[3])
+    traj = estimate_trajectory(stereo, tracks)
+    assert traj.status == ("metric",) * 3 and traj.known.all()
+    assert np.abs(traj.centres).max() == 0.0
+    poses, tracks = _sequence([0.0] * 3, seed=11, step_length=0.0)
+    traj = estimate_trajectory(RING, tracks)
+    assert traj.status == ("unknown",) * 3 and not traj.known[1:].any()
 
 
 def test_bad_input_is_a_value_error():
