@@ -98,8 +98,9 @@ def _print_run(run) -> None:
     if run.errors is not None:
         print("against the ground truth: " + run.errors.summary())
     secs = ", ".join(f"{k} {v:.1f} s" for k, v in run.seconds.items())
+    gt_files = ", errors.txt, errors.csv, rpe.csv" if run.errors is not None else ""
     print(f"wrote {run.out}/ (trajectory_tum.txt, trajectory_kitti.txt, steps.csv, "
-          f"trajectory.png{', errors.txt' if run.errors is not None else ''}); {secs}")
+          f"trajectory.png{gt_files}); {secs}")
 
 
 def _cmd_odometry(args: argparse.Namespace) -> int:

@@ -33,7 +33,7 @@ def test_pipeline_on_rendered_images_is_metric_and_accurate(rendered, tmp_path):
     assert run.errors.ate["rmse"] < 0.05
     assert abs(run.errors.scale_drift_percent) < 3.0
     for name in ("trajectory_tum.txt", "trajectory_kitti.txt", "steps.csv", "trajectory.png",
-                 "errors.txt", "trajectory_frames.txt"):
+                 "errors.txt", "errors.csv", "rpe.csv", "trajectory_frames.txt"):
         assert (tmp_path / "out" / name).stat().st_size > 0, name
     ts, poses = read_tum(tmp_path / "out" / "trajectory_tum.txt")
     assert np.allclose(poses, traj.poses) and np.array_equal(ts, np.arange(6))
@@ -41,6 +41,9 @@ def test_pipeline_on_rendered_images_is_metric_and_accurate(rendered, tmp_path):
         rows = list(csv.DictReader(f))
     assert [r["scale"] for r in rows] == list(traj.status)
     assert all(float(r["translation_m"]) > 0.8 for r in rows)
+    with open(tmp_path / "out" / "rpe.csv") as f:
+        rpe = list(csv.DictReader(f))
+    assert len(rpe) == 5 and all(float(r["translation_error_m"]) < 0.05 for r in rpe)
 
 
 def test_evo_reads_the_trajectory(rendered, tmp_path):

@@ -58,16 +58,13 @@ FIRST_GOOD_FRAME = 13
 
 
 @functools.lru_cache(maxsize=4)
-def load_tracks(first: int = FIRST_GOOD_FRAME, last: int = 76,
-                root: Optional[Path] = None) -> tuple:
-    """Observations of frames ``first..last`` as tracks.
-
-    Returns (track, view, bearings, origins, rotations, centres_gt): one row per
-    ray (both cameras of every stereo observation), view = frame - first,
-    bearings and origins in the rig frame (metres), rotations (m, 3, 3)
-    view_from_world and the true centres (m, 3) in the world frame relative to
-    view 0 (metres). Cached: the stereo and the cam0 evaluations read the
-    recording once (callers select from the arrays, never write to them)."""
+def load_observations(first: int = FIRST_GOOD_FRAME, last: int = 76,
+                      root: Optional[Path] = None) -> tuple:
+    """The stereo observations of frames ``first..last``: ``(rig, track, view,
+    camera, pixels, T_world_rig)``, one row per pixel (both cameras of every
+    landmark's observation; view = frame - first) and the true poses (m, 4, 4).
+    Cached: several evaluations read the recording once (callers select
+    from the arrays, never write to them)."""
     seq = erd.load_sequences(["kitti00_tracks"], root=root)[0]
     frames = seq.d["frames"][first:last + 1]
     names = seq.d["cameras"]
@@ -79,11 +76,24 @@ def load_tracks(first: int = FIRST_GOOD_FRAME, last: int = 76,
                 view.append(v)
                 cam.append(c)
                 px.append(o[name])
-    origins, bearings = seq.rig.rays(np.array(cam), np.array(px, float))
     T = np.array([f["T_world_rig"] for f in frames])
+    return (seq.rig, np.array(track), np.array(view), np.array(cam), np.array(px, float), T)
+
+
+def load_tracks(first: int = FIRST_GOOD_FRAME, last: int = 76,
+                root: Optional[Path] = None) -> tuple:
+    """Observations of frames ``first..last`` as tracks.
+
+    Returns (track, view, bearings, origins, rotations, centres_gt): one row per
+    ray (both cameras of every stereo observation), view = frame - first,
+    bearings and origins in the rig frame (metres), rotations (m, 3, 3)
+    view_from_world and the true centres (m, 3) in the world frame relative to
+    view 0 (metres)."""
+    rig, track, view, cam, px, T = load_observations(first, last, root)
+    origins, bearings = rig.rays(cam, px)
     rotations = np.transpose(T[:, :3, :3], (0, 2, 1))   # view_from_world = R_world_rig^T
     centres = T[:, :3, 3] - T[0, :3, 3]
-    return (np.array(track), np.array(view), bearings, origins, rotations, centres)
+    return (track, view, bearings, origins, rotations, centres)
 
 
 def keep_multi_view_tracks(track, view, *arrays):

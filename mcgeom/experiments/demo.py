@@ -114,8 +114,8 @@ def describe(demo: DemoRun) -> list[str]:
                f"without a metric position")
         lines.append(f"FAILED: {why}")
     lines.append(f"wrote {run.out}/: trajectory_tum.txt, groundtruth_tum.txt, "
-                 f"trajectory_kitti.txt, steps.csv, errors.txt, trajectory.png, rig.json, "
-                 f"images/")
+                 f"trajectory_kitti.txt, steps.csv, errors.txt, rpe.csv, trajectory.png, "
+                 f"rig.json, images/")
     lines.append(f"re-run the pipeline on these images: mcgeom odometry --rig {run.out}/rig.json "
                  f"--images {run.out}/images --gt {run.out}/groundtruth_tum.txt "
                  f"--out {run.out}_odometry")

@@ -35,11 +35,12 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from mcgeom.metrics import absolute_trajectory_error
 from mcgeom.odometry import chain
 from mcgeom.sequence import Tracks, estimate_trajectory
 
 from . import real_data as erd
-from .ch6_kitti import FIRST_GOOD_FRAME, path_length
+from .ch6_kitti import FIRST_GOOD_FRAME, load_observations, path_length
 from .common import Progress, import_peer, no_progress, non_negative_int, write_line
 
 #: (name, options of estimate_trajectory)
@@ -57,39 +58,26 @@ def load(first: int = FIRST_GOOD_FRAME, last: int = 76, root: Optional[Path] = N
     ``first..last`` renumbered from 0 (each landmark one track, seen by cam0
     and cam1) and the true world_from_rig poses (m, 4, 4), the first the
     identity (metres)."""
-    seq = erd.load_sequences(["kitti00_tracks"], root=root)[0]
-    frames = seq.d["frames"][first:last + 1]
-    names = seq.d["cameras"]
-    track, frame, cam, px = [], [], [], []
-    for v, f in enumerate(frames):
-        for lm, o in f["obs"].items():
-            for c, name in enumerate(names):
-                track.append(lm)
-                frame.append(v)
-                cam.append(c)
-                px.append(o[name])
-    tracks = Tracks(np.array(track), np.array(frame), np.array(cam), np.array(px, float),
-                    len(frames))
-    T = np.array([f["T_world_rig"] for f in frames])
-    return seq.rig, tracks, np.linalg.inv(T[0]) @ T
+    rig, track, frame, cam, px, T = load_observations(first, last, root)
+    tracks = Tracks(track, frame, cam, px, len(T))
+    return rig, tracks, np.linalg.inv(T[0]) @ T
 
 
-def _ate(est: np.ndarray, gt: np.ndarray) -> float:
-    """RMS of ``est`` (m, 3) after the rigid motion that best maps it onto
-    ``gt`` (least squares, no scale: the metric scale is what is evaluated;
-    Umeyama 1991 without the scale factor)."""
-    me, mg = est.mean(axis=0), gt.mean(axis=0)
-    U, _, Vt = np.linalg.svd((est - me).T @ (gt - mg))
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    return float(np.sqrt(np.mean(np.sum((((est - me) @ R.T) + mg - gt) ** 2, axis=1))))
+def _at(centres: np.ndarray) -> np.ndarray:
+    """Poses (n, 4, 4) with the given centres (the ATE uses positions only)."""
+    T = np.tile(np.eye(4), (len(centres), 1, 1))
+    T[:, :3, 3] = centres
+    return T
 
 
 def _row(centres: np.ndarray, gt: np.ndarray, seconds: float, note: str) -> dict:
     ok = np.all(np.isfinite(centres), axis=1)
     g = gt[:, :3, 3]
     length = path_length(g)
-    ate = _ate(centres[ok], g[ok]) if ok.sum() >= 3 else float("nan")
+    # RMS after the rigid motion (no scale) that best maps the estimate onto
+    # the truth (Umeyama 1991 without the scale factor), as evo computes it
+    ate = (absolute_trajectory_error(_at(centres[ok]), gt[ok])["rmse"] if ok.sum() >= 3
+           else float("nan"))
     return {"ate": ate, "ate_pct": 100.0 * ate / length,
             "drift_pct": 100.0 * (path_length(centres[ok]) / path_length(g[ok]) - 1.0),
             "end": float(np.linalg.norm(centres[-1] - g[-1])) if ok[-1] else float("nan"),

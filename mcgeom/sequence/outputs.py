@@ -15,8 +15,9 @@ output (an existing ``out`` is replaced only once the new one is complete).
 * ``steps.csv``: one line per step ``frame1, frame2, correspondences,
   inliers, rotation_deg, translation_m, scale, segment, reason``
   (``translation_m`` empty when the step's length is not known in metres);
-* ``errors.txt`` and ``errors.csv`` with ground truth: ATE (after an SE(3)
-  alignment, no scale), RPE per step, scale drift;
+* with ground truth: ``errors.txt`` (ATE after an SE(3) alignment, no scale;
+  RPE; scale drift), ``errors.csv`` (the ATE of each frame) and ``rpe.csv``
+  (the relative pose error of each step);
 * ``trajectory.png``: the top view coloured by scale status (and the errors).
 """
 
@@ -63,6 +64,18 @@ def _errors_files(folder: Path, errors: SequenceErrors, frame_numbers: np.ndarra
         w.writerow(["frame", "ate_m"])
         for k, e in zip(errors.frames, errors.ate["errors"]):
             w.writerow([int(frame_numbers[k]), f"{e:.6f}"])
+    # the relative pose error of each step between frames with a metric
+    # position (Sturm et al. 2012; evo's RPE with delta = 1 frame)
+    rpe = errors.rpe
+    with open(folder / "rpe.csv", "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(["frame1", "frame2", "translation_error_m", "rotation_error_deg",
+                    "length_ratio"])
+        for (i, j), et, er, lr in zip(rpe["pairs"], rpe["translation"], rpe["rotation_deg"],
+                                      rpe["length_ratio"]):
+            w.writerow([int(frame_numbers[errors.frames[i]]),
+                        int(frame_numbers[errors.frames[j]]), f"{et:.6f}", f"{er:.6f}",
+                        f"{lr:.6f}"])
 
 
 def write_outputs(out: Any, trajectory: Trajectory, *, timestamps: Optional[np.ndarray] = None,
