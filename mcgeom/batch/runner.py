@@ -133,7 +133,9 @@ def write_summary(rows: Sequence[dict], out: Any) -> list[Path]:
 
 
 def _results(client: Client, todo: list[ManifestEntry], out: Path) -> Iterator[dict]:
-    futures = {client.submit(run_sequence, e, str(out), pure=False, retries=RETRIES): e
+    # one core per worker process: OpenCV's thread pool limited to one thread
+    # (Dask's nanny already sets OMP/MKL/OpenBLAS threads to 1)
+    futures = {client.submit(run_sequence, e, str(out), 1, pure=False, retries=RETRIES): e
                for e in todo}
     for fut in as_completed(futures):
         entry = futures[fut]

@@ -20,6 +20,7 @@ import time
 from pathlib import Path
 from typing import Any, Optional
 
+import cv2
 import numpy as np
 
 from ..sequence.run import run_odometry
@@ -99,7 +100,8 @@ def done_row(entry: ManifestEntry, out_root: Any) -> Optional[dict]:
     return data["row"]
 
 
-def run_sequence(entry: ManifestEntry, out_root: Any) -> dict:
+def run_sequence(entry: ManifestEntry, out_root: Any,
+                 opencv_threads: Optional[int] = None) -> dict:
     """Run the sequence pipeline on ``entry`` into ``out_root/<name>/`` and
     return its summary row (keys :data:`SUMMARY_COLUMNS`).
 
@@ -110,7 +112,12 @@ def run_sequence(entry: ManifestEntry, out_root: Any) -> dict:
     ``rpe_rotation_rmse_deg`` and ``scale_drift_percent`` (None when not
     measurable); ``error``: the error text of a failed sequence. Never raises
     for a failing sequence; the row is written to ``result.json`` last.
+    ``opencv_threads``: when given, ``cv2.setNumThreads`` of this process (a
+    batch worker takes one core: OpenCV's own thread pool would compete with
+    the other workers).
     """
+    if opencv_threads is not None:
+        cv2.setNumThreads(int(opencv_threads))
     out = Path(out_root) / entry.name
     t0 = time.perf_counter()
     try:
