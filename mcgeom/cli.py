@@ -166,9 +166,9 @@ def _cmd_batch(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         with connect(workers=args.workers, scheduler=args.scheduler) as client:
-            link = getattr(client, "dashboard_link", None)
-            if link:
-                print(f"Dask dashboard: {link}", flush=True)
+            # the link only when the scheduler serves a dashboard (it needs bokeh)
+            if "dashboard" in client.scheduler_info().get("services", {}):
+                print(f"Dask dashboard: {client.dashboard_link}", flush=True)
             rows = run(entries, args.out, client=client, progress=_batch_bar(counts))
     except (ValueError, OSError) as exc:
         print(f"mcgeom batch: error: {exc}", file=sys.stderr)
@@ -184,7 +184,7 @@ def _cmd_batch(args: argparse.Namespace) -> int:
               f"{_fmt(r['seconds'], '.1f'):>6}  {r['error'] or ''}")
     ok = sum(r["status"] == "ok" for r in rows)
     print(f"{ok} ok, {len(rows) - ok} failed of {len(rows)} sequences in {wall:.1f} s "
-          f"({len(rows) - counts['ok'] - counts['failed']} already done); wrote "
+          f"({sum(r['reused'] for r in rows)} already done, not run again); wrote "
           f"{Path(args.out)}/summary.csv")
     return 0 if ok == len(rows) else 1
 
@@ -292,6 +292,15 @@ def _name_list(title: str, items: dict) -> str:
     return "\n".join(lines)
 
 
+def _command(sub, name: str, help: str, description: str,
+             epilog: Optional[str] = None) -> argparse.ArgumentParser:
+    """A sub-command whose description (and epilog) are paragraphs wrapped to
+    79 columns."""
+    return sub.add_parser(name, formatter_class=HelpFormatter, help=help,
+                          description=textwrap.fill(description, 79),
+                          epilog=None if epilog is None else textwrap.fill(epilog, 79))
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The parser of the ``mcgeom`` command (without the experiments' own options,
     which are parsed once the experiment is known)."""
@@ -301,16 +310,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="print the version and exit")
     sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
 
-    d = sub.add_parser("demo", formatter_class=HelpFormatter,
-                       help="the main job: rendered images of a surround rig to a metric "
-                            "trajectory",
-                       description=textwrap.fill(
-                           "Render a 5-camera surround car rig driving a closed 83 m loop "
-                           "through a textured courtyard (deterministic), run mcgeom odometry "
-                           "on the images and compare the trajectory with the rendered path "
-                           "(ATE after an SE(3) alignment, no scale). Writes the trajectories "
-                           "(TUM, KITTI), the ground truth, steps.csv, the plot, the rig file "
-                           "and the images to OUT.", 79))
+    d = _command(sub, "demo",
+                 help="the main job: rendered images of a surround rig to a metric "
+                      "trajectory",
+                 description=(
+                     "Render a 5-camera surround car rig driving a closed 83 m loop "
+                     "through a textured courtyard (deterministic), run mcgeom odometry "
+                     "on the images and compare the trajectory with the rendered path "
+                     "(ATE after an SE(3) alignment, no scale). Writes the trajectories "
+                     "(TUM, KITTI), the ground truth, steps.csv, the plot, the rig file "
+                     "and the images to OUT."))
     d.add_argument("--frames", type=frame_count, default=90, help="frames around the loop")
     d.add_argument("--seed", type=non_negative_int, default=0, help="seed of the textures")
     d.add_argument("--features", choices=("sift", "orb"), default="sift",
@@ -318,22 +327,22 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", default="mcgeom_demo", help="output directory")
     d.set_defaults(func=_cmd_demo)
 
-    o = sub.add_parser("odometry", formatter_class=HelpFormatter,
-                       help="a rig's image sequence to a metric trajectory",
-                       description=textwrap.fill(
-                           "Feature tracks (OpenCV) of a rig's image sequence, every step's "
-                           "motion with its scale verdict, and the metric trajectory: scale "
-                           "observed on a step (metric), carried along the tracks "
-                           "(carried), or not known (unknown: such a stretch is reported "
-                           "as direction-only, never chained with a guessed length). "
-                           "Writes OUT/trajectory_tum.txt, trajectory_kitti.txt, steps.csv "
-                           "and trajectory.png; with --gt also errors.txt (ATE after an "
-                           "SE(3) alignment, no scale; RPE; scale drift).", 79),
-                       epilog=textwrap.fill(
-                           "Image layouts: IMAGES/<camera name or camN>/ with the same "
-                           "number of images each (sorted names give the frame order); "
-                           "EuRoC/ASL (camN/data.csv + camN/data/); KITTI raw "
-                           "(image_02/data, image_03/data).", 79))
+    o = _command(sub, "odometry",
+                 help="a rig's image sequence to a metric trajectory",
+                 description=(
+                     "Feature tracks (OpenCV) of a rig's image sequence, every step's "
+                     "motion with its scale verdict, and the metric trajectory: scale "
+                     "observed on a step (metric), carried along the tracks "
+                     "(carried), or not known (unknown: such a stretch is reported "
+                     "as direction-only, never chained with a guessed length). "
+                     "Writes OUT/trajectory_tum.txt, trajectory_kitti.txt, steps.csv "
+                     "and trajectory.png; with --gt also errors.txt (ATE after an "
+                     "SE(3) alignment, no scale; RPE; scale drift)."),
+                 epilog=(
+                     "Image layouts: IMAGES/<camera name or camN>/ with the same "
+                     "number of images each (sorted names give the frame order); "
+                     "EuRoC/ASL (camN/data.csv + camN/data/); KITTI raw "
+                     "(image_02/data, image_03/data)."))
     o.add_argument("--rig", required=True, help="rig calibration file (mcgeom JSON, OpenCV "
                    "FileStorage, Kalibr camchain, COLMAP rig config); required")
     o.add_argument("--images", required=True, help="folder of the images; required")
@@ -355,24 +364,24 @@ def build_parser() -> argparse.ArgumentParser:
                    "errors computed)")
     o.set_defaults(func=_cmd_odometry)
 
-    bt = sub.add_parser("batch", formatter_class=HelpFormatter,
-                        help="odometry of many sequences on Dask (local or a cluster)",
-                        description=textwrap.fill(
-                            "Run mcgeom odometry on every sequence of MANIFEST, one Dask "
-                            "task per sequence, on a local cluster of worker processes or "
-                            "on an existing Dask cluster. Writes OUT/<name>/ (the odometry "
-                            "outputs) and OUT/summary.csv (and summary.parquet with "
-                            "pyarrow): status, frames, path length, shares of metric / "
-                            "carried / unknown steps, run time, ATE / RPE / scale drift "
-                            "with ground truth, the error of a failed sequence. A re-run "
-                            "with the same OUT skips the sequences already done. Exit "
-                            "code 1 when a sequence failed. Needs pip install "
-                            "'mcgeom[batch]'.", 79),
-                        epilog=textwrap.fill(
-                            "MANIFEST: a CSV file with the header name,rig,images,gt "
-                            "(gt may be empty) and optional columns start, end, step, "
-                            "features, n_features, threshold, cross_camera; paths "
-                            "relative to the manifest's folder.", 79))
+    bt = _command(sub, "batch",
+                  help="odometry of many sequences on Dask (local or a cluster)",
+                  description=(
+                      "Run mcgeom odometry on every sequence of MANIFEST, one Dask "
+                      "task per sequence, on a local cluster of worker processes or "
+                      "on an existing Dask cluster. Writes OUT/<name>/ (the odometry "
+                      "outputs) and OUT/summary.csv (and summary.parquet with "
+                      "pyarrow): status, frames, path length, shares of metric / "
+                      "carried / unknown steps, run time, ATE / RPE / scale drift "
+                      "with ground truth, the error of a failed sequence. A re-run "
+                      "with the same OUT skips the sequences already done. Exit "
+                      "code 1 when a sequence failed. Needs pip install "
+                      "'mcgeom[batch]'."),
+                  epilog=(
+                      "MANIFEST: a CSV file with the header name,rig,images,gt "
+                      "(gt may be empty) and optional columns start, end, step, "
+                      "features, n_features, threshold, cross_camera; paths "
+                      "relative to the manifest's folder."))
     bt.add_argument("manifest", help="the CSV file of sequences")
     bt.add_argument("--out", required=True, help="output folder; required")
     where = bt.add_mutually_exclusive_group()

@@ -128,8 +128,10 @@ def test_a_rerun_skips_finished_work(first_run, rendered, client):
     before = {p: p.stat().st_mtime_ns for p in files}
     broken = (out / "broken" / "result.json").stat().st_mtime_ns
     again = run(rendered / "manifest.csv", out, client=client)
-    assert again[:3] == rows[:3]          # read back from the done-markers
-    assert {**again[3], "seconds": 0} == {**rows[3], "seconds": 0}
+    assert [r["reused"] for r in rows] == [False] * 4
+    assert [r["reused"] for r in again] == [True, True, True, False]
+    assert [{**r, "reused": 0} for r in again[:3]] == [{**r, "reused": 0} for r in rows[:3]]
+    assert {**again[3], "seconds": 0, "reused": 0} == {**rows[3], "seconds": 0, "reused": 0}
     assert {p: p.stat().st_mtime_ns for p in files} == before      # not rewritten
     # a failed sequence is tried again (its input may have been fixed)
     assert (out / "broken" / "result.json").stat().st_mtime_ns > broken
@@ -199,7 +201,10 @@ def test_cli_batch_on_one_sequence(rendered, tmp_path, capsys):
     text = capsys.readouterr().out
     assert code == 0, text
     assert "1 ok, 0 failed of 1 sequences" in text and "summary.csv" in text
+    assert "(0 already done" in text
     assert (tmp_path / "out" / "one" / "trajectory_tum.txt").is_file()
+    code = cli.main(["batch", str(manifest), "--out", str(tmp_path / "out"), "--workers", "1"])
+    assert code == 0 and "(1 already done" in capsys.readouterr().out
 
 
 def test_cli_batch_errors(tmp_path, capsys, monkeypatch):

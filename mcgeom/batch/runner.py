@@ -156,7 +156,9 @@ def run(manifest: Union[str, os.PathLike, Sequence[ManifestEntry]], out: Any, *,
     finished run is already in ``out`` are not run again. ``progress``:
     ``progress(iterable, total=, desc=)`` wrapping the rows as they complete
     (skipped ones first). Returns the rows (keys
-    :data:`mcgeom.batch.task.SUMMARY_COLUMNS`) in manifest order.
+    :data:`mcgeom.batch.task.SUMMARY_COLUMNS`, and ``reused``: True for a
+    sequence whose finished run was found in ``out`` and not run again) in
+    manifest order.
     """
     entries = _entries(manifest)
     out = Path(out).resolve()
@@ -170,9 +172,9 @@ def run(manifest: Union[str, os.PathLike, Sequence[ManifestEntry]], out: Any, *,
     bar = progress or (lambda it, total=None, desc=None: it)
 
     def rows(c: Optional[Client]) -> Iterable[dict]:
-        yield from (r for r in done.values() if r is not None)
+        yield from ({**r, "reused": True} for r in done.values() if r is not None)
         if todo:
-            yield from _results(c, todo, out)
+            yield from ({**r, "reused": False} for r in _results(c, todo, out))
 
     got: dict[str, dict] = {}
     if client is not None or not todo:
