@@ -207,6 +207,20 @@ def test_cli_batch_on_one_sequence(rendered, tmp_path, capsys):
     assert code == 0 and "(1 already done" in capsys.readouterr().out
 
 
+def test_cli_batch_on_an_existing_cluster(rendered, client, tmp_path, capsys):
+    """--scheduler ADDRESS: the workers of a cluster that was already running."""
+    manifest = _manifest(tmp_path, f"name,rig,images,gt,end,features\ntwo,"
+                                   f"{rendered}/beta/rig.json,{rendered}/beta/images,,3,orb\n")
+    code = cli.main(["batch", str(manifest), "--out", str(tmp_path / "out"), "--scheduler",
+                     client.scheduler.address])
+    text = capsys.readouterr().out
+    assert code == 0 and "1 ok, 0 failed of 1 sequences" in text, text
+    assert client.status == "running"          # the batch closed its own client only
+    with open(tmp_path / "out" / "summary.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert row["frames"] == "3" and row["ate_rmse_m"] == ""
+
+
 def test_cli_batch_errors(tmp_path, capsys, monkeypatch):
     manifest = _manifest(tmp_path, "name,rig,images\n")
     assert cli.main(["batch", str(manifest), "--out", str(tmp_path / "o")]) == 2

@@ -22,7 +22,7 @@ import os
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Optional, Sequence, Union
+from typing import Any, Callable, Iterable, Iterator, Optional, Sequence, Union
 
 import dask
 from distributed import Client, LocalCluster, as_completed
@@ -147,7 +147,8 @@ def _results(client: Client, todo: list[ManifestEntry], out: Path) -> Iterator[d
 
 def run(manifest: Union[str, os.PathLike, Sequence[ManifestEntry]], out: Any, *,
         client: Optional[Client] = None, workers: Optional[int] = None,
-        scheduler: Optional[str] = None, progress: Any = None) -> list[dict]:
+        scheduler: Optional[str] = None,
+        progress: Optional[Callable[..., Iterable]] = None) -> list[dict]:
     """Run every sequence of ``manifest`` (a file, :func:`read_manifest`, or
     its entries) on Dask and write ``out/<name>/`` and ``out/summary.csv``.
 
