@@ -232,3 +232,42 @@ def test_cli_batch_errors(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)     # as if not installed
     assert cli.main(["batch", str(manifest), "--out", str(tmp_path / "o")]) == 2
     assert "mcgeom batch needs Dask: pip install 'mcgeom[batch]'" in capsys.readouterr().err
+
+
+def _kill_every_runner(client, stop: threading.Event, killed: list) -> None:
+    """SIGKILL whichever worker runs a sequence, again and again, until stopped."""
+    while not stop.is_set():
+        busy = [a for a, keys in client.processing().items()
+                if any("run_sequence" in str(k) for k in keys)]
+        if busy:
+            try:
+                pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
+            except Exception:         # the worker went away meanwhile: look again
+                continue
+            time.sleep(0.3)
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+            while not stop.is_set() and busy[0] in client.processing():
+                time.sleep(0.05)      # until the scheduler has seen it die
+        time.sleep(0.05)
+
+
+def test_a_sequence_whose_worker_always_dies_fails_after_the_bound(rendered, client,
+                                                                   tmp_path):
+    """Retries of a killed task are bounded: after WORKER_DEATHS + 1 deaths the
+    sequence is recorded as failed (Dask's KilledWorker), the batch ends."""
+    manifest = _manifest(tmp_path, f"name,rig,images,gt,end\ndoomed,"
+                                   f"{rendered}/gamma/rig.json,{rendered}/gamma/images,,3\n")
+    stop, killed = threading.Event(), []
+    killer = threading.Thread(target=_kill_every_runner, args=(client, stop, killed))
+    killer.start()
+    try:
+        (row,) = run(manifest, tmp_path / "out", client=client)
+    finally:
+        stop.set()
+        killer.join()
+    assert row["status"] == "failed" and "KilledWorker" in row["error"], row
+    assert len(killed) == WORKER_DEATHS + 1
+    with open(tmp_path / "out" / "summary.csv") as f:
+        assert "KilledWorker" in next(iter(csv.DictReader(f)))["error"]
+    client.wait_for_workers(2, timeout=60)    # the nannies restarted them
