@@ -37,8 +37,9 @@ SUMMARY_COLUMNS = ("name", "status", "frames", "path_length_m", "metric_share",
 RESULT_FILE = "result.json"
 
 
-def failed_row(name: str, error: str, seconds: float = float("nan")) -> dict:
-    """The summary row of a sequence that failed with ``error`` (text)."""
+def failed_row(name: str, error: str, seconds: Optional[float] = None) -> dict:
+    """The summary row of a sequence that failed with ``error`` (text);
+    ``seconds`` None when not known (a task whose worker died)."""
     row = {k: None for k in SUMMARY_COLUMNS}
     row.update(name=name, status="failed", seconds=seconds, error=error)
     return row
