@@ -1,5 +1,5 @@
 """The mcgeom command: demo (the main job on rendered images), odometry (an
-image sequence to a metric trajectory), methods (the registered estimators),
+image sequence to a metric trajectory), batch (many sequences on Dask), methods (the registered estimators),
 bench (timings against references) and experiment (the thesis experiments
 and the real-data evaluations).
 
@@ -121,6 +121,74 @@ def _cmd_odometry(args: argparse.Namespace) -> int:
     return 0
 
 
+#: what ``mcgeom batch`` says when Dask is not installed (exit code 2)
+NEEDS_DASK = "mcgeom batch needs Dask: pip install 'mcgeom[batch]'"
+
+
+def _batch_bar(counts: dict):
+    """A progress callable for :func:`mcgeom.batch.run`: a tqdm bar on stderr
+    whose postfix counts the sequences done and failed as rows arrive."""
+    from tqdm import tqdm
+
+    def progress(rows, total=None, desc=None):
+        stream = sys.stderr
+        with tqdm(total=total, desc=desc, file=stream, leave=False,
+                  disable=not (hasattr(stream, "isatty") and stream.isatty())) as bar:
+            for row in rows:
+                counts["ok" if row["status"] == "ok" else "failed"] += 1
+                bar.set_postfix(done=counts["ok"], failed=counts["failed"])
+                bar.update()
+                yield row
+    return progress
+
+
+def _fmt(value, spec: str) -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def _cmd_batch(args: argparse.Namespace) -> int:
+    try:
+        import dask  # noqa: F401  (the optional extra: checked before any work)
+        import distributed  # noqa: F401
+    except ImportError:
+        print(f"mcgeom: error: {NEEDS_DASK}", file=sys.stderr)
+        return 2
+    import time
+
+    from .batch import connect, read_manifest, run
+
+    try:
+        entries = read_manifest(args.manifest)
+    except ValueError as exc:
+        print(f"mcgeom batch: error: {exc}", file=sys.stderr)
+        return 2
+    counts = {"ok": 0, "failed": 0}
+    t0 = time.perf_counter()
+    try:
+        with connect(workers=args.workers, scheduler=args.scheduler) as client:
+            # the link only when the scheduler serves a dashboard (it needs bokeh)
+            if "dashboard" in client.scheduler_info().get("services", {}):
+                print(f"Dask dashboard: {client.dashboard_link}", flush=True)
+            rows = run(entries, args.out, client=client, progress=_batch_bar(counts))
+    except (ValueError, OSError) as exc:
+        print(f"mcgeom batch: error: {exc}", file=sys.stderr)
+        return 2
+    wall = time.perf_counter() - t0
+    width = max(len(r["name"]) for r in rows)
+    print(f"{'name':<{width}} {'status':>6} {'frames':>6} {'path m':>8} {'metric':>6} "
+          f"{'ATE m':>7} {'drift %':>8} {'s':>6}  error")
+    for r in rows:
+        print(f"{r['name']:<{width}} {r['status']:>6} {_fmt(r['frames'], 'd'):>6} "
+              f"{_fmt(r['path_length_m'], '.3f'):>8} {_fmt(r['metric_share'], '.0%'):>6} "
+              f"{_fmt(r['ate_rmse_m'], '.3f'):>7} {_fmt(r['scale_drift_percent'], '+.2f'):>8} "
+              f"{_fmt(r['seconds'], '.1f'):>6}  {r['error'] or ''}")
+    ok = sum(r["status"] == "ok" for r in rows)
+    print(f"{ok} ok, {len(rows) - ok} failed of {len(rows)} sequences in {wall:.1f} s "
+          f"({sum(r['reused'] for r in rows)} already done, not run again); wrote "
+          f"{Path(args.out)}/summary.csv")
+    return 0 if ok == len(rows) else 1
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     return {"linear17": _bench_linear17, "cone": _bench_cone, "bnb": _bench_bnb,
             "known_rotation": _bench_known_rotation}[args.what](args)
@@ -224,6 +292,15 @@ def _name_list(title: str, items: dict) -> str:
     return "\n".join(lines)
 
 
+def _command(sub, name: str, help: str, description: str,
+             epilog: Optional[str] = None) -> argparse.ArgumentParser:
+    """A sub-command whose description (and epilog) are paragraphs wrapped to
+    79 columns."""
+    return sub.add_parser(name, formatter_class=HelpFormatter, help=help,
+                          description=textwrap.fill(description, 79),
+                          epilog=None if epilog is None else textwrap.fill(epilog, 79))
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The parser of the ``mcgeom`` command (without the experiments' own options,
     which are parsed once the experiment is known)."""
@@ -233,16 +310,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="print the version and exit")
     sub = p.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
 
-    d = sub.add_parser("demo", formatter_class=HelpFormatter,
-                       help="the main job: rendered images of a surround rig to a metric "
-                            "trajectory",
-                       description=textwrap.fill(
-                           "Render a 5-camera surround car rig driving a closed 83 m loop "
-                           "through a textured courtyard (deterministic), run mcgeom odometry "
-                           "on the images and compare the trajectory with the rendered path "
-                           "(ATE after an SE(3) alignment, no scale). Writes the trajectories "
-                           "(TUM, KITTI), the ground truth, steps.csv, the plot, the rig file "
-                           "and the images to OUT.", 79))
+    d = _command(sub, "demo",
+                 help="the main job: rendered images of a surround rig to a metric "
+                      "trajectory",
+                 description=(
+                     "Render a 5-camera surround car rig driving a closed 83 m loop "
+                     "through a textured courtyard (deterministic), run mcgeom odometry "
+                     "on the images and compare the trajectory with the rendered path "
+                     "(ATE after an SE(3) alignment, no scale). Writes the trajectories "
+                     "(TUM, KITTI), the ground truth, steps.csv, the plot, the rig file "
+                     "and the images to OUT."))
     d.add_argument("--frames", type=frame_count, default=90, help="frames around the loop")
     d.add_argument("--seed", type=non_negative_int, default=0, help="seed of the textures")
     d.add_argument("--features", choices=("sift", "orb"), default="sift",
@@ -250,22 +327,22 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", default="mcgeom_demo", help="output directory")
     d.set_defaults(func=_cmd_demo)
 
-    o = sub.add_parser("odometry", formatter_class=HelpFormatter,
-                       help="a rig's image sequence to a metric trajectory",
-                       description=textwrap.fill(
-                           "Feature tracks (OpenCV) of a rig's image sequence, every step's "
-                           "motion with its scale verdict, and the metric trajectory: scale "
-                           "observed on a step (metric), carried along the tracks "
-                           "(carried), or not known (unknown: such a stretch is reported "
-                           "as direction-only, never chained with a guessed length). "
-                           "Writes OUT/trajectory_tum.txt, trajectory_kitti.txt, steps.csv "
-                           "and trajectory.png; with --gt also errors.txt (ATE after an "
-                           "SE(3) alignment, no scale; RPE; scale drift).", 79),
-                       epilog=textwrap.fill(
-                           "Image layouts: IMAGES/<camera name or camN>/ with the same "
-                           "number of images each (sorted names give the frame order); "
-                           "EuRoC/ASL (camN/data.csv + camN/data/); KITTI raw "
-                           "(image_02/data, image_03/data).", 79))
+    o = _command(sub, "odometry",
+                 help="a rig's image sequence to a metric trajectory",
+                 description=(
+                     "Feature tracks (OpenCV) of a rig's image sequence, every step's "
+                     "motion with its scale verdict, and the metric trajectory: scale "
+                     "observed on a step (metric), carried along the tracks "
+                     "(carried), or not known (unknown: such a stretch is reported "
+                     "as direction-only, never chained with a guessed length). "
+                     "Writes OUT/trajectory_tum.txt, trajectory_kitti.txt, steps.csv "
+                     "and trajectory.png; with --gt also errors.txt (ATE after an "
+                     "SE(3) alignment, no scale; RPE; scale drift)."),
+                 epilog=(
+                     "Image layouts: IMAGES/<camera name or camN>/ with the same "
+                     "number of images each (sorted names give the frame order); "
+                     "EuRoC/ASL (camN/data.csv + camN/data/); KITTI raw "
+                     "(image_02/data, image_03/data)."))
     o.add_argument("--rig", required=True, help="rig calibration file (mcgeom JSON, OpenCV "
                    "FileStorage, Kalibr camchain, COLMAP rig config); required")
     o.add_argument("--images", required=True, help="folder of the images; required")
@@ -286,6 +363,33 @@ def build_parser() -> argparse.ArgumentParser:
                    "(time stamps as the images', or frame numbers) (default: none, no "
                    "errors computed)")
     o.set_defaults(func=_cmd_odometry)
+
+    bt = _command(sub, "batch",
+                  help="odometry of many sequences on Dask (local or a cluster)",
+                  description=(
+                      "Run mcgeom odometry on every sequence of MANIFEST, one Dask "
+                      "task per sequence, on a local cluster of worker processes or "
+                      "on an existing Dask cluster. Writes OUT/<name>/ (the odometry "
+                      "outputs) and OUT/summary.csv (and summary.parquet with "
+                      "pyarrow): status, frames, path length, shares of metric / "
+                      "carried / unknown steps, run time, ATE / RPE / scale drift "
+                      "with ground truth, the error of a failed sequence. A re-run "
+                      "with the same OUT skips the sequences already done. Exit "
+                      "code 1 when a sequence failed. Needs pip install "
+                      "'mcgeom[batch]'."),
+                  epilog=(
+                      "MANIFEST: a CSV file with the header name,rig,images,gt "
+                      "(gt may be empty) and optional columns start, end, step, "
+                      "features, n_features, threshold, cross_camera; paths "
+                      "relative to the manifest's folder."))
+    bt.add_argument("manifest", help="the CSV file of sequences")
+    bt.add_argument("--out", required=True, help="output folder; required")
+    where = bt.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=positive_int, default=None,
+                       help="worker processes of a local cluster (default: the CPU count)")
+    where.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="address of an existing Dask scheduler, e.g. tcp://host:8786")
+    bt.set_defaults(func=_cmd_batch)
 
     m = sub.add_parser("methods", formatter_class=HelpFormatter,
                        help="list the registered estimators",

@@ -174,3 +174,39 @@ def test_no_private_access_across_modules():
                           if a.name.startswith("_") and not a.name.startswith("__")
                           and a.name != "_core"]
     assert found == []
+
+
+DASK = ("dask", "distributed")
+
+
+def _third_party_imports(path: Path) -> set[str]:
+    """Top-level names of the absolute imports of a module, at any depth."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names |= {a.name.split(".")[0] for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_only_the_batch_package_imports_dask():
+    """Dask is an optional extra: only mcgeom.batch (and the CLI's batch
+    command, inside its function, after checking that Dask is there) may
+    import it; the rest of mcgeom must import without it."""
+    users = {m for m, p in _modules().items() if _third_party_imports(p) & set(DASK)}
+    assert "mcgeom.batch.runner" in users
+    assert users <= {"mcgeom.batch", "mcgeom.batch.runner", "mcgeom.cli"}, users
+    # the CLI imports it lazily: not at module level
+    tree = ast.parse((SRC / "cli.py").read_text(encoding="utf-8"))
+    top = {a.name.split(".")[0] for n in tree.body if isinstance(n, ast.Import)
+           for a in n.names}
+    top |= {n.module.split(".")[0] for n in tree.body
+            if isinstance(n, ast.ImportFrom) and not n.level and n.module}
+    assert not top & set(DASK)
+    # and nothing imports mcgeom.batch but the CLI and the experiments
+    g = _graph()
+    importers = {m for m in g if any(d == "mcgeom.batch" or d.startswith("mcgeom.batch.")
+                                     for d in g[m]) and not m.startswith("mcgeom.batch")}
+    assert importers <= {"mcgeom.cli"} | {m for m in g if m.startswith("mcgeom.experiments")}, \
+        importers
