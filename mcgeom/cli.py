@@ -16,8 +16,6 @@ import textwrap
 from pathlib import Path
 from typing import Optional, Sequence
 
-import numpy as np
-
 from . import __version__, registry
 from .experiments import EXPERIMENTS
 from .experiments.common import (HelpFormatter, MissingPeerError,
@@ -78,21 +76,19 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _print_run(run) -> None:
     """The summary of a sequence run: steps by scale status, segments, errors."""
     traj = run.trajectory
-    status = traj.status
-    counts = {k: status.count(k) for k in ("metric", "carried", "unknown")}
+    counts = traj.status_counts
     seq = run.sequence
     print(f"{seq.n_frames} frames of {seq.n_cameras} cameras ({seq.layout} layout, "
           f"{seq.root}); {len(run.tracks)} observations in "
-          f"{len(np.unique(run.tracks.track))} tracks")
+          f"{run.tracks.n_tracks} tracks")
     print(f"steps: {counts['metric']} metric, {counts['carried']} carried, "
           f"{counts['unknown']} unknown (scale not observable, never chained as metric); "
           f"{len(traj.segments)} segment(s), "
           f"{sum(not sg.metric for sg in traj.segments)} direction-only")
     known = traj.known
     if known.sum() > 1:
-        c = traj.centres[known]
         print(f"metric trajectory: {int(known.sum())} frames, path "
-              f"{float(np.sum(np.linalg.norm(np.diff(c, axis=0), axis=1))):.3f} m")
+              f"{traj.metric_path_length:.3f} m")
     else:
         print("metric trajectory: none (no step with an observable scale)")
     if run.errors is not None:

@@ -90,6 +90,8 @@ def test_straight_without_overlap_never_invents_a_scale():
     assert traj.known.tolist() == [True] + [False] * 6
     assert not any(s.metric for s in traj.segments)
     assert all(np.isnan(s.length) for s in traj.steps)
+    assert traj.status_counts == {"metric": 0, "carried": 0, "unknown": 6}
+    assert traj.metric_path_length == 0.0
     # the directions are still right: the rig drives along its x axis
     seg = traj.segments[0]
     d = np.diff(seg.poses[:, :3, 3], axis=0)
@@ -110,6 +112,8 @@ def test_turn_carries_the_scale_through_the_straight_stretches():
     est = np.array([s.length for s in traj.steps])
     np.testing.assert_allclose(est, _true_lengths(poses), rtol=0.04)
     assert traj.known.all() and len(traj.segments) == 1
+    assert traj.status_counts == {"metric": 3, "carried": 8, "unknown": 0}
+    np.testing.assert_allclose(traj.metric_path_length, est.sum())
     err = np.linalg.norm(traj.centres - poses[:, :3, 3], axis=1)
     assert err.max() < 0.04 * 11.0     # 4 % of the 11 m path
 

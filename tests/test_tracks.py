@@ -31,6 +31,10 @@ def test_correspondences_pair_every_camera_combination():
     assert len(tr.correspondences(0, 2)[0]) == 1          # only track 1 spans frames 0..2
 
 
+def test_n_tracks_counts_distinct_tracks():
+    assert _tracks().n_tracks == 3
+
+
 def test_in_frames_renumbers():
     sub = _tracks().in_frames(1, 2)
     assert sub.n_frames == 2 and len(sub) == 5 and sub.frame.min() == 0

@@ -21,7 +21,6 @@ from pathlib import Path
 from typing import Any, Optional
 
 import cv2
-import numpy as np
 
 from ..sequence.run import run_odometry
 from .manifest import ManifestEntry
@@ -53,17 +52,13 @@ def _finite(x: Any) -> Optional[float]:
 
 def _ok_row(name: str, run: Any, seconds: float) -> dict:
     traj = run.trajectory
-    status = list(traj.status)
-    n = max(len(status), 1)
-    known = traj.known
-    c = traj.centres[known]
-    # path of the metric trajectory only: direction-only stretches have no length
-    path = float(np.sum(np.linalg.norm(np.diff(c, axis=0), axis=1))) if len(c) > 1 else 0.0
+    counts = traj.status_counts
+    n = max(len(traj.steps), 1)
     row = failed_row(name, "", seconds)
-    row.update(status="ok", frames=int(traj.n_frames), path_length_m=path,
-               metric_share=status.count("metric") / n,
-               carried_share=status.count("carried") / n,
-               unknown_share=status.count("unknown") / n, error=None)
+    # path of the metric trajectory only: direction-only stretches have no length
+    row.update(status="ok", frames=int(traj.n_frames), path_length_m=traj.metric_path_length,
+               metric_share=counts["metric"] / n, carried_share=counts["carried"] / n,
+               unknown_share=counts["unknown"] / n, error=None)
     if run.errors is not None:
         e = run.errors
         row.update(ate_rmse_m=_finite(e.ate["rmse"]),

@@ -22,8 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
-import numpy as np
-
 from mcgeom.sequence.run import OdometryRun, run_odometry
 
 from .common import Progress, no_progress
@@ -82,21 +80,15 @@ def run_demo(out: Any = "mcgeom_demo", n_frames: int = 90, seed: int = 0,
     return DemoRun(rendered, run, seconds)
 
 
-def status_counts(run: OdometryRun) -> dict:
-    """Number of steps per scale status."""
-    status = run.trajectory.status
-    return {k: status.count(k) for k in ("metric", "carried", "unknown")}
-
-
 def describe(demo: DemoRun) -> list[str]:
     """The lines ``mcgeom demo`` prints (the CLI adds nothing but them)."""
     r, run = demo.rendered, demo.run
     rig = r.rig
-    c = status_counts(run)
+    c = run.trajectory.status_counts
     lines = [f"rendered {r.n_frames} frames of a {len(rig)}-camera surround rig "
              f"({', '.join(rig.names)}; {rig.cameras[0].width}x{rig.cameras[0].height} px) "
              f"around a {r.path_length:.1f} m loop with 4 turns in {demo.render_seconds:.1f} s",
-             f"tracks: {len(np.unique(run.tracks.track))} ({len(run.tracks)} observations)",
+             f"tracks: {run.tracks.n_tracks} ({len(run.tracks)} observations)",
              f"steps: {c['metric']} metric, {c['carried']} carried, {c['unknown']} unknown"]
     e: Optional[Any] = run.errors
     if e is not None:

@@ -63,9 +63,8 @@ def run_set(name: str, root: Path, progress: Progress = no_progress) -> dict:
     traj = estimate_trajectory(rig, tracks)
     err = evaluate(traj, gt)
     known = traj.known
-    status = traj.status
     out = {"name": name, "frames": seq.n_frames, "cameras": len(rig),
-           "status": {k: status.count(k) for k in ("metric", "carried", "unknown")},
+           "status": traj.status_counts,
            "errors": err, "step_errors": None if err is None else err.step_errors}
     if known[-1]:
         out["end_error_m"] = float(np.linalg.norm(traj.poses[-1, :3, 3] - gt[-1, :3, 3]))

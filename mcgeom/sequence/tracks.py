@@ -80,6 +80,11 @@ class Tracks:
     def __len__(self) -> int:
         return int(self.pixels.shape[0])
 
+    @property
+    def n_tracks(self) -> int:
+        """Number of distinct tracks (scene points)."""
+        return int(np.unique(self.track).size)
+
     def in_frames(self, first: int, last: int) -> "Tracks":
         """The observations of frames ``first .. last`` (inclusive), renumbered
         from 0 (tracks keep their ids)."""

@@ -143,6 +143,19 @@ class Trajectory:
         return tuple(s.status for s in self.steps)
 
     @property
+    def status_counts(self) -> dict:
+        """Number of steps per scale status, every key of :data:`SCALE_STATUS`."""
+        status = self.status
+        return {k: status.count(k) for k in SCALE_STATUS}
+
+    @property
+    def metric_path_length(self) -> float:
+        """Length (metres) of the path through the frames located in metres
+        (:attr:`known`); direction-only stretches have no length."""
+        c = self.poses[self.known, :3, 3]
+        return float(np.sum(np.linalg.norm(np.diff(c, axis=0), axis=1))) if len(c) > 1 else 0.0
+
+    @property
     def centres(self) -> np.ndarray:
         """(F, 3) positions of the rig in the world frame (metres; NaN where
         not known)."""
