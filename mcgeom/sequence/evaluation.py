@@ -41,10 +41,11 @@ def associate(timestamps: np.ndarray, gt_timestamps: np.ndarray, gt_poses: np.nd
     gt = check_poses("ground truth", gt_poses, n=gts.shape[0])
     order = np.argsort(gts)
     gts, gt = gts[order], gt[order]
-    j = np.clip(np.searchsorted(gts, ts), 1, max(len(gts) - 1, 1))
-    j = np.where(np.abs(gts[j - 1] - ts) <= np.abs(gts[np.minimum(j, len(gts) - 1)] - ts),
-                 j - 1, j)
-    j = np.minimum(j, len(gts) - 1)
+    # the nearer of the two neighbours in time
+    right = np.searchsorted(gts, ts)
+    lo = np.clip(right - 1, 0, len(gts) - 1)
+    hi = np.clip(right, 0, len(gts) - 1)
+    j = np.where(np.abs(gts[lo] - ts) <= np.abs(gts[hi] - ts), lo, hi)
     dt = np.abs(gts[j] - ts)
     if np.any(dt > max_dt):
         k = int(np.argmax(dt > max_dt))

@@ -54,12 +54,18 @@ class OdometryRun:
     seconds: dict = field(default_factory=dict)
 
 
+def _timestamps(sequence: ImageSequence) -> np.ndarray:
+    """The frames' time stamps: seconds when the layout gives them, else the
+    frame numbers."""
+    return (sequence.timestamps if sequence.timestamps is not None
+            else sequence.indices.astype(float))
+
+
 def _gt_for(sequence: ImageSequence, gt_path: Any) -> np.ndarray:
     """Ground truth (F, 4, 4) of the sequence's frames from a TUM file, by time
-    stamp (seconds when the layout gives them, else the frame numbers)."""
+    stamp (:func:`_timestamps`)."""
     gt_ts, gt_poses = read_tum(gt_path)
-    ts = (sequence.timestamps if sequence.timestamps is not None
-          else sequence.indices.astype(float))
+    ts = _timestamps(sequence)
     # half the frame interval: the nearest ground truth must be this frame's
     dt = float(np.median(np.diff(ts))) if len(ts) > 1 else 1.0
     return associate(ts, gt_ts, gt_poses, max_dt=0.5 * abs(dt))
@@ -98,9 +104,7 @@ def run_odometry(rig: Any, images: Any, out: Any, *, start: int = 0, end: Option
     times["back end"] = time.perf_counter() - t1
     errors = None if gt_poses is None else evaluate(trajectory, gt_poses)
     t2 = time.perf_counter()
-    ts = (sequence.timestamps if sequence.timestamps is not None
-          else sequence.indices.astype(float))
-    out = write_outputs(out, trajectory, timestamps=ts, frame_numbers=sequence.indices,
+    out = write_outputs(out, trajectory, timestamps=_timestamps(sequence), frame_numbers=sequence.indices,
                         gt_poses=gt_poses, errors=errors, title=title, extra=extra_outputs)
     times["outputs"] = time.perf_counter() - t2
     return OdometryRun(rig, sequence, tracks, trajectory, errors, Path(out), times)
