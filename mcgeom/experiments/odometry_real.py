@@ -21,9 +21,9 @@ from typing import Optional
 
 import numpy as np
 
-from mcgeom.io.images import find_image_sequence, read_image
+from mcgeom.io.images import find_image_sequence
 from mcgeom.metrics import rotation_angle
-from mcgeom.sequence import estimate_trajectory, tracks_from_images
+from mcgeom.sequence import build_tracks, estimate_trajectory
 from mcgeom.sequence.evaluation import evaluate
 
 from . import real_data as erd
@@ -58,8 +58,7 @@ def run_set(name: str, root: Path, progress: Progress = no_progress) -> dict:
     if seq.n_frames != len(gt):
         raise ValueError(f"{name}: {seq.n_frames} frames of images but {len(gt)} ground-truth "
                          f"poses")
-    frames = ([read_image(p) for p in paths] for paths in seq.paths)
-    tracks = tracks_from_images(rig, progress(frames, total=seq.n_frames, desc=name))
+    tracks = build_tracks(rig, seq, progress=progress)
     traj = estimate_trajectory(rig, tracks)
     err = evaluate(traj, gt)
     known = traj.known

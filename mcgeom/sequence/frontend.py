@@ -444,13 +444,15 @@ def tracks_from_images(rig: Rig, frames: Iterable[Sequence[Any]], *, features: s
 def build_tracks(rig: Rig, sequence: ImageSequence, *, features: str = "sift",
                  n_features: int = 4000, ratio: float = 0.8, cross_camera: bool = True,
                  geometric_check: bool = True, threshold_px: float = EPIPOLAR_PX,
-                 progress: Optional[Callable[[int], Any]] = None) -> Tracks:
+                 progress: Optional[Callable[..., Iterable]] = None) -> Tracks:
     """Feature tracks of an image sequence on disk
     (:func:`mcgeom.io.images.find_image_sequence`).
 
     Each image is read once, when its frame is processed (grey, ``cv2.imread``);
     only the previous frame's features are kept. Frame k of the tracks is frame k
     of ``sequence`` (after its slicing). Options: see :class:`FrontEnd`.
+    ``progress``: wraps the loop over the frames (``progress(iterable, total=,
+    desc=)``, e.g. a tqdm bar), as the back end's does.
 
     Raises:
         ValueError: the sequence's camera count differs from the rig's; an image
@@ -463,8 +465,9 @@ def build_tracks(rig: Rig, sequence: ImageSequence, *, features: str = "sift",
         raise ValueError(f"{sequence.root}: the sequence has {sequence.n_cameras} cameras "
                          f"({', '.join(sequence.folders)}) but the rig has {len(rig)} "
                          f"({', '.join(rig.names)})")
-    frames = ([read_image(p) for p in paths] for paths in sequence.paths)
+    frames: Iterable = ([read_image(p) for p in paths] for paths in sequence.paths)
+    if progress is not None:
+        frames = progress(frames, total=sequence.n_frames, desc="frames")
     return tracks_from_images(rig, frames, features=features, n_features=n_features,
                               ratio=ratio, cross_camera=cross_camera,
-                              geometric_check=geometric_check, threshold_px=threshold_px,
-                              progress=progress)
+                              geometric_check=geometric_check, threshold_px=threshold_px)

@@ -18,12 +18,12 @@ from typing import Any, Callable, Iterable, Optional
 import numpy as np
 
 from ..io import load_rig
-from ..io.images import ImageSequence, find_image_sequence, read_image
+from ..io.images import ImageSequence, find_image_sequence
 from ..io.trajectory import read_tum
 from ..rig import Rig
 from .backend import estimate_trajectory
 from .evaluation import SequenceErrors, associate, evaluate
-from .frontend import tracks_from_images
+from .frontend import build_tracks
 from .outputs import write_outputs
 from .tracks import Tracks
 from .trajectory import Trajectory
@@ -94,10 +94,8 @@ def run_odometry(rig: Any, images: Any, out: Any, *, start: int = 0, end: Option
     rig = rig if isinstance(rig, Rig) else load_rig(rig)
     sequence = find_image_sequence(images, rig, start=start, end=end, step=step)
     gt_poses = None if gt is None else _gt_for(sequence, gt)
-    frames = ([read_image(p) for p in paths] for paths in sequence.paths)
-    tracks = tracks_from_images(rig, bar(frames, total=sequence.n_frames, desc="frames"),
-                                features=features, n_features=n_features,
-                                cross_camera=cross_camera)
+    tracks = build_tracks(rig, sequence, features=features, n_features=n_features,
+                          cross_camera=cross_camera, progress=bar)
     times["front end"] = time.perf_counter() - t0
     t1 = time.perf_counter()
     trajectory = estimate_trajectory(rig, tracks, threshold=threshold, progress=bar)
