@@ -577,8 +577,40 @@ static void test_cone_undecided_wide_bracket(void)
               1.5707963267948966);
 }
 
+/* fuzz_cls (CI run, 10 s): a harness finding, not a kernel bug. With
+ * rcond = 0.032, mcg_cls_range drops G's second singular direction
+ * (s2 / s1 = 0.0097), as documented; the harness compared x with a y = G z
+ * lying almost wholly along that dropped direction. The kernel's answer is
+ * pinned here: x = +-u1 (G's leading left singular vector), resid = |A u1|. */
+static void test_cls_range_dropped_direction(void)
+{
+    const double a[2] = {0.99859922178988325, 1.0};
+    const double g[4] = {1.0, 1.0, 0.0038910505836575876, 0.023906614785992219};
+    double x[2], resid = -1.0, w[256], ggt[3], lam, u[2], nu, dot;
+    size_t ws = mcg_cls_range_work_size(1, 2, 2);
+    check(ws > 0 && ws <= 256, "cls_range 1x2, r = 2: work size", (double)ws, 256.0);
+    check_status(mcg_cls_range(1, 2, 2, a, g, 0.0319824, x, &resid, w, 256), MCG_OK,
+                 "cls_range with one direction of G below rcond");
+    /* u1: leading eigenvector of G G^T (2 x 2, closed form) */
+    ggt[0] = g[0] * g[0] + g[1] * g[1];
+    ggt[1] = g[0] * g[2] + g[1] * g[3];
+    ggt[2] = g[2] * g[2] + g[3] * g[3];
+    lam = 0.5 * (ggt[0] + ggt[2]) + sqrt(0.25 * (ggt[0] - ggt[2]) * (ggt[0] - ggt[2]) +
+                                         ggt[1] * ggt[1]);
+    u[0] = ggt[1];
+    u[1] = lam - ggt[0];
+    nu = sqrt(u[0] * u[0] + u[1] * u[1]);
+    u[0] /= nu;
+    u[1] /= nu;
+    dot = fabs(x[0] * u[0] + x[1] * u[1]);
+    check(fabs(dot - 1.0) < 1e-12, "cls_range: x = +-u1 of G", dot - 1.0, 1e-12);
+    check(fabs(resid - fabs(a[0] * u[0] + a[1] * u[1])) < 1e-12, "cls_range: resid = |A u1|",
+          resid - fabs(a[0] * u[0] + a[1] * u[1]), 1e-12);
+}
+
 int main(void)
 {
+    test_cls_range_dropped_direction();
     test_cone_undecided_wide_bracket();
     test_cone_gamma_and_rounded_point();
     test_rot_from_quat_denormal();

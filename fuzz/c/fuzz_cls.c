@@ -148,16 +148,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                  n - k);
     /* optimality against decoded feasible directions */
     for (trial = 0; trial < 3; ++trial) {
-        double y[MAXD], z[MAXD], ay[MAXD], cy[MAXD], den, ratio, tol;
+        double y[MAXD], z[MAXD], ay[MAXD], cy[MAXD], den, ratio, tol, trunc;
         for (i = 0; i < MAXD; ++i)
             z[i] = fz_range(&in, -1.0, 1.0);
+        trunc = 0.0;
         if (which == 2) {
+            /* singular directions of G below rcond s_max(G) are dropped
+             * (documented), so y = G z is feasible only up to its part along
+             * them: |y_dropped| <= rcond s_max(G) |z| <= rcond |G|_F |z|.
+             * With e = that bound / |y|, |A y| / |y| >= resid (1 - e) - |A| e,
+             * a rigorous allowance (the old rcond-proportional one was not:
+             * a y almost wholly along a dropped direction broke it) */
+            double rc = rcond > 0.0 ? rcond : 1e-12, e;
             mul(c, n, k, z, y); /* y = G z */
             den = norm(y, n);
-            /* columns of G below rcond s_max(G) are dropped (documented): a
-             * y made of them only is outside the range searched */
             if (!(den > 1e-3 * norm(z, k)))
                 continue;
+            e = rc * norm(c, n * k) * norm(z, k) / den;
+            if (!(e < 0.5))
+                continue; /* y mostly outside the range searched */
+            trunc = e * (resid + norm(a, m * n));
         } else {
             memcpy(y, z, sizeof y);
             if (which == 0) {
@@ -173,8 +183,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         ratio = norm(ay, m) / den;
         /* rank truncations (rcond; partial: the default 1e-10 of A_2) and
          * rounding: relative to |A| |x| */
-        tol = 1e-7 * (double)(m + n) * (1.0 + norm(x, n)) * (1.0 + norm(y, n) / den);
-        if (rcond > 1e-7)
+        tol = trunc + 1e-7 * (double)(m + n) * (1.0 + norm(x, n)) * (1.0 + norm(y, n) / den);
+        if (which == 1 && rcond > 1e-7)
             tol += (rcond > 1.0 ? 1.0 : rcond) * (double)(m + n) * (1.0 + norm(x, n)) *
                    (1.0 + norm(y, n) / den);
         FZ_CHECK(ratio >= resid - tol, "cls %d: a feasible y has |A y|/|C y| %.17g < resid %.17g",
