@@ -127,7 +127,12 @@ def test_a_rerun_skips_finished_work(first_run, rendered, client):
     files = [out / n / f for n, *_ in SEQUENCES for f in ("result.json", "trajectory_tum.txt")]
     before = {p: p.stat().st_mtime_ns for p in files}
     broken = (out / "broken" / "result.json").stat().st_mtime_ns
+    # what a worker killed while writing leaves: removed when the task runs again
+    stale = out / ".broken.partial-killed"
+    stale.mkdir()
+    (stale / "steps.csv").write_text("half a file")
     again = run(rendered / "manifest.csv", out, client=client)
+    assert not stale.exists()
     assert [r["reused"] for r in rows] == [False] * 4
     assert [r["reused"] for r in again] == [True, True, True, False]
     assert [{**r, "reused": 0} for r in again[:3]] == [{**r, "reused": 0} for r in rows[:3]]

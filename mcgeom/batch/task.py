@@ -15,6 +15,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import shutil
 import tempfile
 import time
 from pathlib import Path
@@ -96,6 +97,18 @@ def done_row(entry: ManifestEntry, out_root: Any) -> Optional[dict]:
     return data["row"]
 
 
+def _remove_stale_partials(out: Path) -> None:
+    # a worker killed mid-write (the retry case) leaves the hidden temporary
+    # folders of mcgeom.sequence.outputs' atomic write beside ``out``; the
+    # batch runs one task per sequence at a time, so any such folder of this
+    # sequence is stale when its task starts
+    if out.parent.is_dir():
+        for stale in out.parent.glob(f".{out.name}.partial-*"):
+            shutil.rmtree(stale, ignore_errors=True)
+        for stale in out.parent.glob(f".{out.name}.old-*"):
+            shutil.rmtree(stale, ignore_errors=True)
+
+
 def run_sequence(entry: ManifestEntry, out_root: Any,
                  opencv_threads: Optional[int] = None) -> dict:
     """Run the sequence pipeline on ``entry`` into ``out_root/<name>/`` and
@@ -115,6 +128,7 @@ def run_sequence(entry: ManifestEntry, out_root: Any,
     if opencv_threads is not None:
         cv2.setNumThreads(int(opencv_threads))
     out = Path(out_root) / entry.name
+    _remove_stale_partials(out)
     t0 = time.perf_counter()
     try:
         run = run_odometry(entry.rig, entry.images, out, gt=entry.gt, title=entry.name,
