@@ -33,7 +33,7 @@ import numpy as np
 
 from mcgeom.types import RayPairs
 from mcgeom.validation import (check_int, check_pixels, check_points, check_rotation,
-                               check_vector3, numeric)
+                               check_vector3, integral_camera_ids, numeric)
 
 __all__ = ["Camera", "Rig"]
 
@@ -435,8 +435,7 @@ class Rig:
     def _check_ids(self, what: str, ids: Any, n: int) -> np.ndarray:
         arr = np.asarray(ids)
         if arr.ndim == 0:  # one id for every pixel
-            if arr.dtype.kind not in "iu":
-                raise ValueError(f"{what} must hold integer camera ids, got {ids!r}")
+            arr = integral_camera_ids(what, arr)
             self.camera(int(arr))  # ValueError for an unknown id
             arr = np.full(n, int(arr), dtype=np.int64)
         if arr.ndim != 1:
@@ -445,11 +444,7 @@ class Rig:
             raise ValueError(f"{what} has {arr.shape[0]} ids but there are {n} pixels")
         if arr.size == 0:
             return np.zeros(0, dtype=np.int64)
-        if arr.dtype.kind not in "iu":
-            if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
-                arr = arr.astype(np.int64)
-            else:
-                raise ValueError(f"{what} must hold integer camera ids, got dtype {arr.dtype}")
+        arr = integral_camera_ids(what, arr)   # the one rule (mcgeom.validation)
         bad = (arr < 0) | (arr >= len(self.cameras))
         if np.any(bad):
             raise ValueError(f"{what}: unknown camera id {int(arr[bad][0])}: rig has cameras "

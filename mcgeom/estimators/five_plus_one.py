@@ -35,6 +35,7 @@ from ..geometry import rcross, refine_centred
 from ..observability import scale_profile, scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
+from ..validation import check_int
 from ._common import camera_ids, intra_counts, travel_direction
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
 from .five_plus_one_minimal import (critical_angles, minimal_solutions, sample_five_plus_one,
@@ -165,6 +166,8 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    if five_camera is not None:  # 1.5, "1" or True would otherwise pick a camera silently
+        five_camera = check_int("five_camera", five_camera)
     if len(rays) < 6:
         raise ValueError(f"too few correspondences: five_plus_one needs at least 6, got {len(rays)}")
     rays.check_finite()

@@ -177,8 +177,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--out", type=Path, default=Path("tests/data/real"),
                     help="output folder of the .npz fixtures")
     ap.add_argument("--only", nargs="*", default=None, choices=[s.name for s in FIXTURES],
-                    metavar="NAME", help="write only these fixtures, of "
-                                         + ", ".join(s.name for s in FIXTURES))
+                    metavar="NAME", help="write only these fixtures (default: all of "
+                                         + ", ".join(s.name for s in FIXTURES) + ")")
     ap.add_argument("--max-corr", type=positive_int, default=200,
                     help="correspondences kept per fixture")
     ap.add_argument("--candidates", type=positive_int, default=6,
