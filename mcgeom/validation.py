@@ -175,14 +175,12 @@ def check_seed(seed: Any) -> Optional[int]:
     ``seed`` otherwise (numpy's own messages name nothing)."""
     if seed is None:
         return None
-    if isinstance(seed, (bool, np.bool_)):
-        raise ValueError(f"seed must be None or a non-negative integer, got {seed!r}")
     try:
-        value = operator.index(seed)
-    except TypeError:
-        raise ValueError(f"seed must be None or a non-negative integer, got {seed!r}") from None
+        value = check_int("seed", seed)   # no bool, no float, no string
+    except ValueError:
+        value = -1
     if value < 0:
-        raise ValueError(f"seed must be None or a non-negative integer, got {value}")
+        raise ValueError(f"seed must be None or a non-negative integer, got {seed!r}")
     return value
 
 

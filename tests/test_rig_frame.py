@@ -6,7 +6,6 @@ format, on the sample files of tests/data/calibration (see tests/test_calibratio
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,15 +13,8 @@ import pytest
 import mcgeom
 from mcgeom import io as C
 from mcgeom.rig import Rig
-
-DATA = Path(__file__).parent / "data" / "calibration"
-RADTAN = DATA / "kalibr" / "camchain-imucam-radtan.yaml"
-EQUI = DATA / "kalibr" / "camchain-equidistant.yaml"
-STEREO = DATA / "opencv" / "stereo_calib.yml"
-RIG4_YML = DATA / "opencv" / "rig4.yml"
-RIG4_JSON = DATA / "mcgeom" / "rig4.json"
-COLMAP_NEW = DATA / "colmap" / "rig_config.json"
-COLMAP_OLD = DATA / "colmap" / "rig_config_legacy.json"
+# the sample files of the loaders' own tests (tests/ is on the path: pyproject.toml)
+from test_calibration import COLMAP_NEW, COLMAP_OLD, EQUI, RADTAN, RIG4_JSON, RIG4_YML, STEREO
 
 
 def _pose(c) -> np.ndarray:
