@@ -63,6 +63,23 @@ def frame_count(text: str) -> int:
     return n
 
 
+def rig_frame_arg(text: str):
+    """argparse type of ``--rig-frame``: ``body``, ``camera:NAME``, ``camera:INDEX``, or
+    a text file holding the 4x4 rigid transform rig_from_default (``numpy.loadtxt``)."""
+    if text == "body" or (text.startswith("camera:") and len(text) > len("camera:")):
+        return text
+    if not Path(text).is_file():
+        raise argparse.ArgumentTypeError(
+            f"expected body, camera:NAME, camera:INDEX or a file holding a 4x4 transform, "
+            f"got {text!r}")
+    import numpy as np
+    from .io.frame import check_frame_spec
+    try:
+        return check_frame_spec(np.loadtxt(text, ndmin=2))
+    except ValueError as exc:   # unreadable numbers, wrong shape, not rigid
+        raise argparse.ArgumentTypeError(f"{text}: {exc}") from None
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
     from .experiments.demo import describe, run_demo
 
@@ -107,7 +124,7 @@ def _cmd_odometry(args: argparse.Namespace) -> int:
                            step=args.step, features=args.features,
                            n_features=args.n_features, cross_camera=not args.no_cross_camera,
                            threshold=args.threshold, gt=args.gt, progress=progress_bar,
-                           title=Path(args.images).name)
+                           title=Path(args.images).name, rig_frame=args.rig_frame)
     except (ValueError, OSError) as exc:
         # bad input (rig file, image layout, unreadable image, ground truth):
         # the message names it; nothing was written
@@ -341,6 +358,12 @@ def build_parser() -> argparse.ArgumentParser:
                      "(image_02/data, image_03/data)."))
     o.add_argument("--rig", required=True, help="rig calibration file (mcgeom JSON, OpenCV "
                    "FileStorage, Kalibr camchain, COLMAP rig config); required")
+    o.add_argument("--rig-frame", default=None, metavar="FRAME", type=rig_frame_arg,
+                   help="rig frame of the estimated motions: 'body' (the body/IMU frame, "
+                        "when the file has one), 'camera:NAME' / 'camera:INDEX', or a text "
+                        "file holding the 4x4 transform from the default frame (default: "
+                        "the file's own: Kalibr IMU if every camera has T_cam_imu, else "
+                        "cam0; COLMAP the reference camera; mcgeom JSON the file's frame)")
     o.add_argument("--images", required=True, help="folder of the images; required")
     o.add_argument("--out", default="mcgeom_odometry", help="output folder")
     o.add_argument("--start", type=non_negative_int, default=0, help="first frame")
@@ -376,7 +399,7 @@ def build_parser() -> argparse.ArgumentParser:
                   epilog=(
                       "MANIFEST: a CSV file with the header name,rig,images,gt "
                       "(gt may be empty) and optional columns start, end, step, "
-                      "features, n_features, threshold, cross_camera; paths "
+                      "features, n_features, threshold, cross_camera, rig_frame; paths "
                       "relative to the manifest's folder."))
     bt.add_argument("manifest", help="the CSV file of sequences")
     bt.add_argument("--out", required=True, help="output folder; required")

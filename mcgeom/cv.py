@@ -32,6 +32,7 @@ from . import robust as _robust   # (the name robust is estimate()'s flag)
 from .pixel_noise import pixels_per_radian, sampson_pixel_scale
 from .rig import Rig
 from .types import RigMotion
+from .validation import integral_camera_ids
 
 __all__ = [
     "RIG_5P1_RANSAC", "RIG_LINEAR17", "RIG_LINEAR17_RANSAC", "RIG_5P1_DIRECT",
@@ -73,8 +74,7 @@ def _ids(name: str, ids: Any, n: int, rig: Rig) -> np.ndarray:
         raise ValueError(f"{name} has {a.shape[0]} entries, expected {n} (one per point)")
     if n == 0:                                     # [] is float64 for numpy
         return np.zeros(0, np.int64)
-    if a.dtype.kind not in "iu":
-        raise ValueError(f"{name} must hold integer camera ids, got dtype {a.dtype}")
+    a = integral_camera_ids(name, a)   # the one rule of Rig.ray_pairs and RayPairs
     bad = (a < 0) | (a >= len(rig.cameras))
     if bad.any():
         raise ValueError(f"{name} holds camera id {int(a[bad][0])}, but the rig has cameras "
@@ -97,6 +97,23 @@ def _resolve(method: str, robust_flag: Optional[bool]) -> tuple[str, bool]:
     return method, bool(robust_flag)
 
 
+#: the RANSAC-only options of :func:`estimate` and their defaults
+_RANSAC_DEFAULTS = {"prob": 0.999, "threshold": 1.0, "maxIters": 1000, "seed": 0}
+
+
+def _no_ransac_options(name: str, **given: Any) -> None:
+    """ValueError naming a RANSAC-only option given a non-default value for a method
+    that does not run RANSAC (it would be ignored silently)."""
+    for key, value in given.items():
+        default = _RANSAC_DEFAULTS[key]
+        same = value is default or (type(value) in (int, float) and not isinstance(value, bool)
+                                    and value == default)
+        if not same:
+            raise ValueError(f"{key}={value!r} is a RANSAC option, but method {name!r} runs "
+                             f"without RANSAC (direct) and would ignore it: drop {key}, or "
+                             f"pass method='ransac:{name}' where {name} can drive RANSAC")
+
+
 def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
@@ -109,7 +126,11 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     mean focal length of the two cameras), ``prob`` the RANSAC confidence,
     ``maxIters`` its iteration cap, ``mask`` (N, N x 1, nonzero = use) selects
     the correspondences to consider. The returned ``inliers`` mask has N entries
-    (False for masked-out correspondences).
+    (False for masked-out correspondences). ``prob``, ``threshold``, ``maxIters``
+    and ``seed`` are RANSAC options: with a method that runs without RANSAC
+    (``direct:...``, ``robust=False``, ``RIG_LINEAR17``, estimators without a
+    minimal solver) a non-default value is a ValueError naming the option and
+    the method, not ignored.
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
@@ -130,6 +151,8 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
                                                        else ""))
         use = m != 0
     name, run_robust = _resolve(method, robust)
+    if not run_robust:
+        _no_ransac_options(name, prob=prob, threshold=threshold, maxIters=maxIters, seed=seed)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
     rays_all = rig.ray_pairs_prechecked(p1, p2, ids1, ids2)

@@ -25,7 +25,7 @@ Rig files (mcgeom's JSON, OpenCV, Kalibr, COLMAP) are read and written by
 from __future__ import annotations
 
 import operator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal, Sequence
 
 import cv2
@@ -33,7 +33,7 @@ import numpy as np
 
 from mcgeom.types import RayPairs
 from mcgeom.validation import (check_int, check_pixels, check_points, check_rotation,
-                               check_vector3, numeric)
+                               check_vector3, integral_camera_ids, numeric)
 
 __all__ = ["Camera", "Rig"]
 
@@ -340,11 +340,27 @@ class Rig:
     """A calibrated multi-camera rig: cameras with extrinsics in one rig frame (metres).
 
     Camera ids are the indices into ``cameras``. Names must be unique.
+
+    ``frame`` says which physical frame the extrinsics (and so every ray, and every
+    motion ``rig2_from_rig1`` estimated with this rig) are expressed in:
+
+    * ``"body"``: a frame of the rig body that no camera defines (Kalibr's IMU frame,
+      or the frame of an mcgeom file in which no camera sits at the origin);
+    * ``"camera:<name>"``: the frame of that camera (its extrinsics are the identity);
+    * ``"custom ..."``: a frame chosen with an explicit transform (:meth:`in_frame`,
+      :func:`mcgeom.load_rig` with ``frame=`` a 4x4 matrix);
+    * ``"unspecified"``: a rig built in code without saying (the default).
+
+    The label is metadata: it is not compared by ``==`` (two rigs with equal cameras are
+    equal) and it is never used in the mathematics.
     """
 
     cameras: tuple[Camera, ...]
+    frame: str = field(default="unspecified", compare=False)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.frame, str) or not self.frame:
+            raise ValueError(f"frame must be a non-empty string naming the rig frame, got {self.frame!r}")
         cams = self.cameras
         if isinstance(cams, Camera) or not isinstance(cams, Sequence):
             raise ValueError(f"cameras must be a sequence of Camera, got {type(cams).__name__}")
@@ -369,6 +385,18 @@ class Rig:
 
     def __len__(self) -> int:
         return len(self.cameras)
+
+    def __repr__(self) -> str:
+        return f"Rig(frame={self.frame!r}, cameras={list(self.names)!r})"
+
+    def camera_at_origin(self, tol: float = 1e-12) -> str | None:
+        """Name of the first camera whose extrinsics are the identity (within ``tol``,
+        rotation entries and metres), i.e. whose frame is the rig frame; else None."""
+        for c in self.cameras:
+            if (float(np.max(np.abs(c.R - np.eye(3)))) <= tol
+                    and float(np.max(np.abs(c.t))) <= tol):
+                return c.name
+        return None
 
     @property
     def centres(self) -> np.ndarray:
@@ -407,8 +435,7 @@ class Rig:
     def _check_ids(self, what: str, ids: Any, n: int) -> np.ndarray:
         arr = np.asarray(ids)
         if arr.ndim == 0:  # one id for every pixel
-            if arr.dtype.kind not in "iu":
-                raise ValueError(f"{what} must hold integer camera ids, got {ids!r}")
+            arr = integral_camera_ids(what, arr)
             self.camera(int(arr))  # ValueError for an unknown id
             arr = np.full(n, int(arr), dtype=np.int64)
         if arr.ndim != 1:
@@ -417,11 +444,7 @@ class Rig:
             raise ValueError(f"{what} has {arr.shape[0]} ids but there are {n} pixels")
         if arr.size == 0:
             return np.zeros(0, dtype=np.int64)
-        if arr.dtype.kind not in "iu":
-            if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
-                arr = arr.astype(np.int64)
-            else:
-                raise ValueError(f"{what} must hold integer camera ids, got dtype {arr.dtype}")
+        arr = integral_camera_ids(what, arr)   # the one rule (mcgeom.validation)
         bad = (arr < 0) | (arr >= len(self.cameras))
         if np.any(bad):
             raise ValueError(f"{what}: unknown camera id {int(arr[bad][0])}: rig has cameras "
@@ -517,12 +540,14 @@ class Rig:
         """Project rig-frame points into camera ``cam_id``; see :meth:`Camera.project`."""
         return self.camera(cam_id).project(points_rig)
 
-    def in_frame(self, R: Any, t: Any) -> "Rig":
+    def in_frame(self, R: Any, t: Any, frame: str | None = None) -> "Rig":
         """The same physical rig described in a new rig frame ``X_new = R X_old + t``.
 
         Each camera's extrinsics become ``cam_from_new = cam_from_old o old_from_new``;
-        rays of the new rig are the old rays mapped by ``(R, t)``.
+        rays of the new rig are the old rays mapped by ``(R, t)``. ``frame`` labels the new
+        frame (:attr:`frame`); default ``"custom (X = R X_<old frame> + t)"``.
         """
         Rm = check_rotation("in_frame: R", R)  # checked once, not once per camera
         tv = check_vector3("in_frame: t", t)
-        return Rig(tuple(c.in_frame(Rm, tv) for c in self.cameras))
+        label = f"custom (X = R X_{self.frame} + t)" if frame is None else frame
+        return Rig(tuple(c.in_frame(Rm, tv) for c in self.cameras), frame=label)

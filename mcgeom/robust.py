@@ -39,6 +39,7 @@ from .estimators._common import travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import scale_profile, scale_verdict
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
+from .validation import check_seed
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
 
@@ -75,6 +76,7 @@ class RansacOptions:
             raise ValueError(f"maxIters must be an integer, got {self.max_iters}")
         if int(self.max_iters) < 1:
             raise ValueError(f"maxIters must be >= 1, got {self.max_iters}")
+        object.__setattr__(self, "seed", check_seed(self.seed))
         if self.strategy not in ("auto", "proposer", "minimal"):
             raise ValueError(f"strategy must be 'auto', 'proposer' or 'minimal', got "
                              f"{self.strategy!r}")
@@ -297,6 +299,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     if motion_focal is not None and f is None:
         raise ValueError("motion_focal needs focal (thresholds in pixels)")
     scorer = _Scorer(rays, options.threshold, f, options, motion_focal)
+    _check_threshold_angle(options.threshold, scorer.loss_scale, f)
 
     use_proposer = info_est.proposer is not None and options.strategy in ("auto", "proposer")
     if options.strategy == "proposer" and info_est.proposer is None:
@@ -315,12 +318,65 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         still = _no_translation(rays, scorer, options, method, t_start)
         if still is not None:
             return still
+        _threshold_too_small(rays, scorer, options, method, max(6, info_est.min_sample))
         raise DegenerateError(f"{method}: no motion found that explains at least "
                               f"{max(6, info_est.min_sample)} correspondences "
                               f"({scorer.n_hyp} hypotheses from {iterations} samples): degenerate "
                               f"data (e.g. points collinear or coplanar in every camera, or "
                               f"too few correspondences per camera: {_per_camera(rays)})")
     return _finish(rays, scorer, options, method, iterations, t_start)
+
+
+#: largest inlier threshold as an angle (radians): above it every correspondence is an
+#: inlier, and the Cauchy refinement's loss scale overflows long before 1e200 px
+MAX_THRESHOLD_RAD = 1.0
+#: a hypothesis that explains the minimal number of correspondences within this angle
+#: (radians; 10 px at f = 1000 px, pixel noise and then some) fits the data: none within
+#: the threshold means the threshold, not the data, is at fault
+_FITS_RAD = 1e-2
+
+
+def _unit(focal: Optional[np.ndarray]) -> str:
+    return "px" if focal is not None else "rad"
+
+
+def _check_threshold_angle(threshold: float, angle: float, focal: Optional[np.ndarray]) -> None:
+    """ValueError naming ``threshold`` when it is an angle above :data:`MAX_THRESHOLD_RAD`
+    (rather than "coordinates so large that the computation overflows" from the
+    refinement, or every correspondence an inlier of a pure rotation)."""
+    if angle > MAX_THRESHOLD_RAD:
+        at = (f" at the rig's {float(np.median(focal)):.4g} px per radian"
+              if focal is not None else "")
+        limit = (f"{MAX_THRESHOLD_RAD * float(np.median(focal)):.4g} px" if focal is not None
+                 else f"{MAX_THRESHOLD_RAD:g} rad")
+        raise ValueError(f"threshold {threshold:g} {_unit(focal)} is an angular error of "
+                         f"{angle:.3g} rad{at}: above {MAX_THRESHOLD_RAD:g} rad every "
+                         f"correspondence is an inlier; it must be at most {limit} (of the "
+                         f"order of the pixel noise, e.g. 1 px)")
+
+
+def _threshold_too_small(rays: RayPairs, scorer: "_Scorer", options: RansacOptions,
+                         method: str, need: int) -> None:
+    """DegenerateError naming ``threshold`` when hypotheses were found that fit ``need``
+    correspondences closely, but not within the threshold: the threshold is below what
+    even exact samples reach, the data are not degenerate."""
+    if scorer.best is None:
+        return
+    r = np.sort(scorer.residuals(*scorer.best))
+    if r.size < need:
+        return
+    r_k = float(r[need - 1])
+    angle = r_k if scorer.focal is None else r_k / float(np.median(scorer.focal))
+    if r_k > options.threshold and angle <= _FITS_RAD:
+        unit = _unit(scorer.focal)
+        # a DegenerateError (a ValueError) as before: callers that catch "no motion
+        # found" still do; the message names the threshold, not collinear points
+        raise DegenerateError(f"threshold {options.threshold:g} {unit} is too small: the best of "
+                         f"{scorer.n_hyp} hypotheses of {method} explains {need} "
+                         f"correspondences within {r_k:.3g} {unit} but fewer within the "
+                         f"threshold; pass a threshold of the order of the pixel noise "
+                         f"(e.g. 1 px; if it is that already, the data do not determine the "
+                         f"motion)")
 
 
 def _per_camera(rays: RayPairs) -> str:

@@ -11,7 +11,8 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from .validation import as_camera_ids, as_vectors, check_rotation, check_vector3
+from .validation import (as_camera_ids, as_vectors, check_directions, check_rotation,
+                         check_vector3)
 
 __all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "MotionFocal"]
 
@@ -57,10 +58,7 @@ class RayPairs:
             if not np.all(np.isfinite(getattr(self, name))):
                 raise ValueError(f"rays.{name} contains NaN or inf")
         for name in ("dirs1", "dirs2"):
-            d = getattr(self, name)
-            zero = np.flatnonzero(np.einsum("ij,ij->i", d, d) <= 1e-200)
-            if zero.size:
-                raise ValueError(f"rays.{name} contains a zero-length direction (row {zero[0]})")
+            check_directions(f"rays.{name}", getattr(self, name))
 
     def n_distinct(self, at_least: Optional[int] = None) -> int:
         """Number of distinct correspondences (exact repeats of all six arrays'

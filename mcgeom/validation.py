@@ -14,9 +14,10 @@ from typing import Any, Optional
 
 import numpy as np
 
-__all__ = ["MAX_CAMERA_ID", "ROTATION_TOL", "numeric", "rotation_problem", "check_rotation",
-           "check_vector3", "check_pixels", "check_points", "check_int", "as_vectors",
-           "as_camera_ids", "check_poses"]
+__all__ = ["MAX_CAMERA_ID", "ROTATION_TOL", "MIN_DIRECTION_NORM", "numeric", "rotation_problem",
+           "check_rotation", "check_vector3", "check_pixels", "check_points", "check_int",
+           "as_vectors", "as_camera_ids", "integral_camera_ids", "check_directions",
+           "check_seed", "check_poses"]
 
 #: tolerance of max |R^T R - I| for a matrix to count as a rotation
 ROTATION_TOL = 1e-6
@@ -140,6 +141,48 @@ def check_int(what: str, value: Any) -> int:
 #: largest camera id of a RayPairs (2^20 - 1, the C core's size limit)
 MAX_CAMERA_ID = 2 ** 20 - 1
 
+#: a ray direction shorter than this is a zero-length direction, for every estimator
+#: (the C kernels' bound, csrc/include/mcgeom.h: |d| < 1e-50 is MCG_EINVAL)
+MIN_DIRECTION_NORM = 1e-50
+
+
+def check_directions(what: str, d: np.ndarray) -> None:
+    """ValueError naming ``what`` if a row of the (N, 3) float64 array ``d`` is shorter
+    than :data:`MIN_DIRECTION_NORM` (NaN rows count too; one rule for every estimator:
+    directions scaled by 1e-150 are zero-length everywhere, not accepted by some)."""
+    short = np.flatnonzero(~(np.einsum("ij,ij->i", d, d) >= MIN_DIRECTION_NORM ** 2))
+    if short.size:
+        raise ValueError(f"{what} contains a zero-length direction (row {short[0]}; "
+                         f"|d| < {MIN_DIRECTION_NORM:g})")
+
+
+def integral_camera_ids(what: str, arr: np.ndarray) -> np.ndarray:
+    """Camera ids of an integer dtype: integer arrays as they are (the caller checks the
+    range before any cast: a uint64 2**63 must not wrap), floats as int64 only when every
+    value is a finite whole number (``2.0``: what ``np.loadtxt`` gives); anything else is
+    a ValueError naming ``what``. The one rule of ``Rig.ray_pairs``, ``RayPairs`` and the
+    OpenCV-style façade."""
+    if arr.dtype.kind in "iu":
+        return arr
+    if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
+        return arr.astype(np.int64)
+    raise ValueError(f"{what} must hold integer camera ids, got dtype {arr.dtype}"
+                     + (" with a fractional or non-finite value" if arr.dtype.kind == "f" else ""))
+
+
+def check_seed(seed: Any) -> Optional[int]:
+    """A RANSAC seed: None (fresh entropy) or a non-negative integer; ValueError naming
+    ``seed`` otherwise (numpy's own messages name nothing)."""
+    if seed is None:
+        return None
+    try:
+        value = check_int("seed", seed)   # no bool, no float, no string
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise ValueError(f"seed must be None or a non-negative integer, got {seed!r}")
+    return value
+
 
 def as_vectors(name: str, a: Any, n: Optional[int] = None) -> np.ndarray:
     """Return ``a`` as a C-contiguous float64 (N, 3) array or raise ValueError.
@@ -163,11 +206,7 @@ def as_camera_ids(name: str, a: Any, n: int) -> Optional[np.ndarray]:
     arr = np.asarray(a)
     if arr.ndim != 1 or arr.shape[0] != n:
         raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
-    if arr.dtype.kind not in "iu":
-        if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
-            arr = arr.astype(np.int64)
-        else:
-            raise ValueError(f"{name} must hold integer camera ids, got dtype {arr.dtype}")
+    arr = integral_camera_ids(name, arr)
     if arr.size and arr.min() < 0:
         raise ValueError(f"{name} holds a negative camera id ({int(arr.min())})")
     # ids index per-camera tables (centres, counts) in the estimators: a huge

@@ -820,6 +820,145 @@ def test_file_unknown_format(tmp_path):
         mcgeom.load_rig(tmp_path / "missing.json")
 
 
+# ------------------------------------------------------------------ options named (issue 18)
+
+@row("threshold-too-large", "`threshold` 1e20 or 1e300 px (an angle far above 1 rad), through "
+     "the façade and `robust.ransac`",
+     "`ValueError`: threshold 1e+300 px is an angular error of ... rad at the rig's ... px per "
+     "radian: above 1 rad every correspondence is an inlier; it must be at most ... px")
+def test_threshold_too_large():
+    p1, p2, c1, c2, rig = pixels()
+    for thr in (1e20, 1e200, 1e300):
+        with raises(ValueError, re.escape(f"threshold {thr:g} px") + " is an angular error .* "
+                                "above 1 rad"):
+            cv.estimate(p1, p2, c1, c2, rig, threshold=thr)
+    with raises(ValueError, "threshold 2 rad is an angular error of 2 rad: above 1 rad"):
+        mcgeom.robust.ransac(rays(), "five_plus_one", threshold=2.0)
+    cv.estimate(p1, p2, c1, c2, rig, threshold=800.0)   # below 1 rad: accepted
+
+
+@row("threshold-too-small", "`threshold` 1e-300, 1e-12 or 1e-6 px on data with 0.3 px noise",
+     "`DegenerateError`: threshold 1e-06 px is too small: the best of k hypotheses of "
+     "five_plus_one explains 6 correspondences within ... px but fewer within the threshold "
+     "(not 'degenerate data ... collinear')")
+def test_threshold_too_small():
+    p1, p2, c1, c2, rig = pixels()
+    for thr in (1e-300, 1e-12, 1e-6):
+        with pytest.raises(mcgeom.DegenerateError) as e:
+            cv.estimate(p1, p2, c1, c2, rig, threshold=thr)
+        assert f"threshold {thr:g} px is too small" in str(e.value)
+        assert "collinear" not in str(e.value)
+
+
+@row("five-camera-not-integer", "`five_camera` 1.5, NaN, '1', True or [1] (`five_plus_one`)",
+     "`ValueError`: five_camera must be an integer camera id, got 1.5 (1.0 is camera 1, as "
+     "for camera ids)")
+def test_five_camera_not_integer():
+    for bad in (1.5, np.nan, "1", True, [1]):
+        with raises(ValueError, re.escape(f"five_camera must be an integer camera id, got "
+                                          f"{bad!r}")):
+            est(rays(), "five_plus_one", five_camera=bad)
+    for ok in (np.int64(1), 1.0):
+        assert est(rays(), "five_plus_one", five_camera=ok).info["five_camera"] == 1
+
+
+@row("robust-threshold-e-socp", "`robust_threshold` 0, -1, NaN or '1' (`e_socp`)",
+     "`ValueError`: robust_threshold must be None (least squares) or a finite angle > 0 "
+     "(radians), got 0 (not accepted as the default, not reported as loss_scale)")
+def test_robust_threshold_e_socp():
+    for bad in (0, 0.0, -1, np.nan, "1", True):
+        with raises(ValueError, "robust_threshold must be None .* got"):
+            est(rays(), "e_socp", robust_threshold=bad)
+
+
+@row("ransac-option-direct-method", "`threshold`, `prob`, `maxIters` or `seed` given to a "
+     "method that runs without RANSAC (`direct:...`, `robust=False`, `RIG_LINEAR17`)",
+     "`ValueError`: threshold=3.0 is a RANSAC option, but method 'linear17' runs without "
+     "RANSAC (direct) and would ignore it (the defaults pass)")
+def test_ransac_option_direct_method():
+    p1, p2, c1, c2, rig = pixels()
+    for method, kw in ((cv.RIG_LINEAR17, {"threshold": 3.0}),
+                       (cv.RIG_5P1_DIRECT, {"prob": 0.5}),
+                       ("e_socp", {"maxIters": 50}),
+                       ("refine", {"seed": 3}),
+                       ("bnb_lp", {"seed": None})):
+        (key, value), = kw.items()
+        name = method.split(":")[-1]
+        with raises(ValueError, re.escape(f"{key}={value!r} is a RANSAC option, but method "
+                                          f"'{name}' runs without RANSAC")):
+            cv.estimate(p1, p2, c1, c2, rig, method=method, **kw)
+    with raises(ValueError, "threshold=2.0 is a RANSAC option, but method 'five_plus_one'"):
+        cv.estimate(p1, p2, c1, c2, rig, robust=False, threshold=2.0)
+    cv.estimate(p1, p2, c1, c2, rig, method=cv.RIG_LINEAR17, threshold=1.0)  # the default
+
+
+@row("seed-wrong", "`seed` -1, 1.5, 'a' or True (façade, `robust.ransac`)",
+     "`ValueError`: seed must be None or a non-negative integer, got -1")
+def test_seed_wrong():
+    p1, p2, c1, c2, rig = pixels()
+    for bad in (-1, 1.5, "a", True, [1, 2]):
+        with raises(ValueError, "seed must be None or a non-negative integer, got"):
+            cv.estimate(p1, p2, c1, c2, rig, seed=bad)
+        with raises(ValueError, "seed must be None or a non-negative integer, got"):
+            mcgeom.robust.ransac(rays(), "five_plus_one", seed=bad)
+    cv.estimate(p1, p2, c1, c2, rig, seed=np.uint32(7))
+
+
+@row("directions-tiny", "ray directions scaled by 1e-150 (finite, non-zero, below 1e-50)",
+     "`ValueError`: rays.dirs1 contains a zero-length direction (row 0; |d| < 1e-50): one rule "
+     "for every estimator (`mcgeom.validation.check_directions`), robust too")
+def test_directions_tiny():
+    r = rays()
+    tiny = with_rays(dirs1=r.dirs1 * 1e-150, dirs2=r.dirs2 * 1e-150)
+    every_estimator(tiny, ValueError, r"zero-length direction \(row 0; \|d\| < 1e-50\)")
+    with raises(ValueError, "zero-length direction"):
+        mcgeom.robust.ransac(tiny, "five_plus_one")
+    # 1e-40 is above the bound: every estimator takes it (the same motion as unit rays)
+    scaled = with_rays(dirs1=r.dirs1 * 1e-40, dirs2=r.dirs2 * 1e-40)
+    for name in names():
+        assert rot_err(est(scaled, name).R, MOTION[0]) < R_TOL, name
+
+
+@row("ids-integral-float", "camera ids as floats with whole values (1.0, 2.0: what `np.loadtxt` "
+     "gives), to the façade, `Rig.ray_pairs` and `RayPairs`",
+     "accepted everywhere: the same motion as integer ids (one rule, "
+     "`mcgeom.validation.integral_camera_ids`); a fraction, NaN or inf is refused everywhere")
+def test_ids_integral_float():
+    p1, p2, c1, c2, rig = pixels()
+    ref = cv.estimate(p1, p2, c1, c2, rig)
+    m = cv.estimate(p1, p2, c1.astype(float), c2.astype(np.float32), rig)
+    np.testing.assert_array_equal(m.R, ref.R)
+    np.testing.assert_array_equal(m.t, ref.t)
+    a = rig.ray_pairs(p1, p2, c1.astype(float), c2.astype(float))
+    np.testing.assert_array_equal(a.cam1, c1)
+    np.testing.assert_array_equal(with_rays(cam1=rays().cam1.astype(float)).cam1, rays().cam1)
+    for bad in (c1 + 0.5, np.where(c1 == 0, np.nan, c1)):
+        with raises(ValueError, "cameraIds1 must hold integer camera ids"):
+            cv.estimate(p1, p2, bad, c2, rig)
+        with raises(ValueError, "cam1 must hold integer camera ids"):
+            rig.ray_pairs(p1, p2, bad, c2)
+        with raises(ValueError, "cam1 must hold integer camera ids"):
+            with_rays(cam1=bad)
+
+
+@row("rig-frame-wrong", "`load_rig(frame=)` 'imu', 'camera:nosuch', a 3x3 or non-rigid "
+     "matrix, or 'body' for a file without a body frame (COLMAP, Kalibr without T_cam_imu)",
+     "`ValueError`: frame must be 'body' ... / <file>: frame='camera:nosuch': no camera named "
+     "or numbered 'nosuch'; the rig's cameras are ... / <file>: frame='body': the file ... has "
+     "no body/IMU frame")
+def test_rig_frame_wrong():
+    rig4 = CALIB / "mcgeom" / "rig4.json"
+    for bad, msg in (("imu", "frame must be 'body'"), (np.eye(3), "frame: a transform must be"),
+                     (2.0 * np.eye(4), "frame: the 4x4 transform is not rigid"),
+                     ("camera:nosuch", "frame='camera:nosuch': no camera named or numbered")):
+        with raises(ValueError, msg):
+            mcgeom.load_rig(rig4, frame=bad)
+    for path in (CALIB / "colmap" / "rig_config.json",
+                 CALIB / "kalibr" / "camchain-equidistant.yaml"):
+        with raises(ValueError, "frame='body': the file of format .* has no body/IMU frame"):
+            mcgeom.load_rig(path, frame="body")
+
+
 # ------------------------------------------------------------------ the table
 
 BEGIN, END = "<!-- rows of tests/test_bad_input.py: begin -->", "<!-- rows: end -->"

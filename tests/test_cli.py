@@ -10,6 +10,7 @@ import re
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import mcgeom
@@ -72,6 +73,8 @@ def test_unknown_experiment_is_an_argparse_error(capsys):
     (["odometry", "--rig", "r.json", "--images", "d", "--step", "0"],
      "argument --step: expected a positive integer"),
     (["odometry", "--images", "d"], "the following arguments are required: --rig"),
+    (["odometry", "--rig", "r.json", "--images", "d", "--rig-frame", "imu"],
+     "argument --rig-frame: expected body, camera:NAME, camera:INDEX or a file"),
     (["bench", "linear17", "--budget", "0"], "argument --budget: expected a positive number"),
     (["bench", "bnb", "--problems", "0"], "argument --problems: expected a positive integer"),
     (["bench", "linear17", "--sizes", "5,abc"], "argument --sizes: expected a comma-separated"),
@@ -178,3 +181,20 @@ def test_methods_lists_the_lp_backends_and_how_to_get_glpk(tmp_path):
     backends = r.stdout[r.stdout.index("LP backends"):]
     assert "native:" in backends
     assert "glpk: unavailable" in backends and "pip install 'mcgeom[glpk]'" in backends
+
+
+def test_rig_frame_argument(tmp_path):
+    """--rig-frame: names pass through, a file gives its checked 4x4 transform."""
+    assert cli.rig_frame_arg("body") == "body"
+    assert cli.rig_frame_arg("camera:2") == "camera:2"
+    T = np.eye(4)
+    T[:3, 3] = (0.1, -0.2, 1.5)
+    np.savetxt(tmp_path / "T.txt", T)
+    np.testing.assert_array_equal(cli.rig_frame_arg(str(tmp_path / "T.txt")), T)
+    np.savetxt(tmp_path / "bad.txt", 2 * T)
+    with pytest.raises(argparse.ArgumentTypeError, match="bad.txt: frame: the 4x4 transform "
+                                                         "is not rigid"):
+        cli.rig_frame_arg(str(tmp_path / "bad.txt"))
+    (tmp_path / "text.txt").write_text("not numbers\n")
+    with pytest.raises(argparse.ArgumentTypeError, match="text.txt"):
+        cli.rig_frame_arg(str(tmp_path / "text.txt"))

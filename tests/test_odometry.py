@@ -117,3 +117,25 @@ def test_a_failed_run_keeps_the_previous_outputs(rendered, tmp_path, capsys):
     assert code == 2
     assert (out / "trajectory_tum.txt").read_text() == "# an earlier run\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]   # no partial folder
+
+
+def test_rig_frame_names_the_frame_of_the_trajectory(rendered, tmp_path, capsys):
+    """--rig-frame camera:NAME: the same physical motion, expressed in that camera's
+    frame (each step conjugated by cam_from_body); a frame the rig lacks is a clear
+    error naming frame, and nothing is written."""
+    images = rendered.out_dir / "images"
+    body = run_odometry(rendered.rig_path, images, tmp_path / "body", end=3)
+    name = body.rig.names[0]
+    cam = run_odometry(rendered.rig_path, images, tmp_path / "cam", end=3,
+                       rig_frame=f"camera:{name}")
+    assert cam.rig.frame == f"camera:{name}" and body.rig.frame != cam.rig.frame
+    F = np.eye(4)
+    F[:3, :3], F[:3, 3] = body.rig.cameras[0].R, body.rig.cameras[0].t
+    for Pb, Pc in zip(body.trajectory.poses, cam.trajectory.poses):
+        # world_from_cam = (world_from_body F^-1) re-anchored at the first frame
+        expect = F @ Pb @ np.linalg.inv(F)
+        np.testing.assert_allclose(Pc, expect, atol=1e-4)
+    code, err = _odometry(capsys, "--rig", str(rendered.rig_path), "--images", str(images),
+                          "--rig-frame", "camera:nosuch", "--out", str(tmp_path / "bad"))
+    assert code == 2 and "frame='camera:nosuch'" in err and name in err
+    assert not (tmp_path / "bad").exists()

@@ -4,8 +4,9 @@ The header starts with ``name,rig,images,gt`` (``gt`` may be left empty on a
 row: no ground truth, no errors); further columns carry per-sequence options
 of :func:`mcgeom.sequence.run.run_odometry`, each optional and empty for its
 default: ``start``, ``end``, ``step``, ``features`` (``sift`` / ``orb``),
-``n_features``, ``threshold`` (pixels) and ``cross_camera`` (``true`` /
-``false``). Paths are relative to the manifest's folder (absolute ones are
+``n_features``, ``threshold`` (pixels), ``cross_camera`` (``true`` /
+``false``) and ``rig_frame`` (``body``, ``camera:NAME`` or ``camera:INDEX``: the
+rig frame of the motions, as ``mcgeom odometry --rig-frame``). Paths are relative to the manifest's folder (absolute ones are
 kept); they are resolved here and not opened: a missing images folder is the
 failure of that one sequence, not of the batch.
 
@@ -63,10 +64,18 @@ def _boolean(text: str) -> bool:
     raise ValueError("expected true or false")
 
 
+def _rig_frame(text: str) -> str:
+    """body or camera:NAME or camera:INDEX"""
+    if text == "body" or (text.startswith("camera:") and len(text) > len("camera:")):
+        return text
+    raise ValueError("expected body, camera:NAME or camera:INDEX")
+
+
 #: option column -> parser of its cell (the keyword of run_odometry is the name)
 OPTION_COLUMNS: dict[str, Callable[[str], Any]] = {
     "start": _int(0), "end": _int(1), "step": _int(1), "features": _features,
     "n_features": _int(1), "threshold": _positive_float, "cross_camera": _boolean,
+    "rig_frame": _rig_frame,
 }
 
 

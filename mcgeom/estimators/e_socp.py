@@ -128,6 +128,13 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    if robust_threshold is not None and (
+            isinstance(robust_threshold, (bool, np.bool_))
+            or not isinstance(robust_threshold, (int, float, np.number))
+            or not (np.isfinite(robust_threshold) and robust_threshold > 0)):
+        # 0 would silently mean the 1e-3 default below, -1 fail as "loss_scale"
+        raise ValueError(f"robust_threshold must be None (least squares) or a finite angle "
+                         f"> 0 (radians), got {robust_threshold!r}")
     rays.check_finite()
     # one order for any input order: the per-camera searches and the
     # bisections then give the same answer bit for bit

@@ -35,6 +35,7 @@ from ..geometry import rcross, refine_centred
 from ..observability import scale_profile, scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
+from ..validation import integral_camera_ids
 from ._common import camera_ids, intra_counts, travel_direction
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
 from .five_plus_one_minimal import (critical_angles, minimal_solutions, sample_five_plus_one,
@@ -44,6 +45,19 @@ __all__ = ["five_plus_one", "solve", "propose", "scale_one_point_ransac"]
 
 
 # -------------------------------------------------------------- estimator
+
+def _camera_option(what: str, value: object) -> int:
+    """A camera id option by the one rule of camera ids
+    (:func:`mcgeom.validation.integral_camera_ids`: integers, or floats with a whole
+    value); ValueError naming ``what`` for 1.5, "1", True, a list."""
+    arr = np.asarray(value) if not isinstance(value, (str, bytes)) else None
+    if arr is None or arr.ndim != 0 or arr.dtype.kind == "b":
+        raise ValueError(f"{what} must be an integer camera id, got {value!r}")
+    try:
+        return int(integral_camera_ids(what, arr))
+    except ValueError:
+        raise ValueError(f"{what} must be an integer camera id, got {value!r}") from None
+
 
 def _choose_camera(rays: RayPairs, five_camera: Optional[int]):
     cam1, cam2, centres, intra, counts = intra_counts(rays)
@@ -165,6 +179,8 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    if five_camera is not None:  # 1.5, "1" or True would otherwise pick a camera silently
+        five_camera = _camera_option("five_camera", five_camera)
     if len(rays) < 6:
         raise ValueError(f"too few correspondences: five_plus_one needs at least 6, got {len(rays)}")
     rays.check_finite()

@@ -79,6 +79,10 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     if n < 14:
         raise ValueError(f"too few correspondences: linear17 needs at least 17 "
                          f"(16 locally-central or axial, 14 locally-central-and-axial), got {n}")
+    # NaN/inf, then zero-length directions by the one rule of every estimator
+    # (mcgeom.validation.check_directions: the kernel would normalise a 1e-150
+    # direction that the others refuse)
+    rays.check_finite()
     if options is None and (not refine or max_iterations is not None or tolerance is not None
                             or max_scale_rel_std is not None):
         options = _core.Linear17Options(refine=refine, max_iterations=max_iterations,

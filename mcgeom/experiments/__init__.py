@@ -41,6 +41,10 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
     "odometry_real": ("odometry_real", "the whole sequence pipeline on the real image "
                                        "recordings (KITTI raw, DDAD, EuRoC) against their "
                                        "ground truth"),
+    "make_real_fixtures": ("make_real_fixtures", "the small .npz fixtures of matched pixels "
+                                                 "from the real recordings that "
+                                                 "tests/test_real_data_estimators.py runs "
+                                                 "every estimator on"),
     "batch_scaling": ("batch_scaling", "mcgeom batch on Dask: sequences per minute with 1 "
                                        "and 2 workers, scheduler overhead per task, and the "
                                        "extrapolation to 10,000 sequences (needs dask)"),

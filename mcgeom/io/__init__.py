@@ -20,7 +20,9 @@ format             files                                                        
 
 Each module's docstring gives its format's conventions and where they were checked.
 :func:`load_rig` dispatches on ``format=`` or detects the format from the content
-(:func:`detect_format`, in :mod:`.detect`). Any problem with a file -- unreadable text,
+(:func:`detect_format`, in :mod:`.detect`), and returns the rig in the frame chosen with
+``frame=`` (``"body"``, ``"camera:<name or index>"`` or a 4x4 transform; each format's
+default and choices: :mod:`.frame`); :attr:`mcgeom.rig.Rig.frame` names it. Any problem with a file -- unreadable text,
 truncated or malformed syntax, wrong format, missing key, an extrinsic that is not a
 rotation, a singular ``K``, a non-positive image size, a lens model mcgeom cannot
 represent, pathological nesting -- is a ``ValueError`` whose message names the file, the
@@ -35,6 +37,7 @@ Trajectories (world_from_rig poses) are read and written in the TUM and KITTI fo
 
 from mcgeom.io.colmap import load_colmap
 from mcgeom.io.detect import FORMATS, detect_format, load_rig
+from mcgeom.io.frame import select_frame
 from mcgeom.io.kalibr import load_kalibr
 from mcgeom.io.mcgeom_json import (RIG_FORMAT, RIG_FORMAT_VERSION, load_mcgeom_json,
                                    rig_from_dict, rig_to_dict, save_mcgeom_json)
@@ -42,7 +45,7 @@ from mcgeom.io.opencv_yaml import OPENCV_RIG_FORMAT, load_opencv_yaml, save_open
 from mcgeom.io.trajectory import read_kitti, read_tum, write_kitti, write_tum
 
 __all__ = [
-    "load_rig", "detect_format", "FORMATS",
+    "load_rig", "detect_format", "FORMATS", "select_frame",
     "load_mcgeom_json", "save_mcgeom_json", "rig_to_dict", "rig_from_dict",
     "RIG_FORMAT", "RIG_FORMAT_VERSION",
     "load_opencv_yaml", "save_opencv_yaml", "OPENCV_RIG_FORMAT",

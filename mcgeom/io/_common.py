@@ -8,6 +8,7 @@ and the entry here.
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -39,12 +40,21 @@ def make_camera(where: str, entry: str, **fields: Any) -> Camera:
         raise ValueError(f"{where}: {entry}: {exc}") from None
 
 
-def make_rig(where: str, cameras: list[Camera]) -> Rig:
-    """A Rig, with Rig's own checks (unique names, ...) reported as '<file>: <problem>'."""
+def make_rig(where: str, cameras: list[Camera], frame: str | None = None) -> Rig:
+    """A Rig, with Rig's own checks (unique names, ...) reported as '<file>: <problem>'.
+
+    ``frame``: the rig frame's label (:attr:`mcgeom.rig.Rig.frame`); None when the format
+    does not say: ``"camera:<name>"`` if a camera's extrinsics are the identity (that
+    camera's frame is the rig frame), else ``"body"``.
+    """
     try:
-        return Rig(tuple(cameras))
+        rig = Rig(tuple(cameras))
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
+    if frame is None:
+        at_origin = rig.camera_at_origin()
+        frame = "body" if at_origin is None else f"camera:{at_origin}"
+    return replace(rig, frame=frame)
 
 
 def vector(where: str, what: str, value: Any, n: int | None = None) -> np.ndarray:

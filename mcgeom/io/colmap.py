@@ -33,6 +33,9 @@ A COLMAP rig configuration (JSON, a list of rigs) together with COLMAP's ``camer
   (``doc/database.rst``), OpenCV at ``(0, 0)``: the principal point is shifted by -0.5.
 * Cameras appear in the order of the rig config; names are the image prefixes (or
   ``camera_<id>`` for an empty prefix); translations are in the reconstruction's unit.
+* The rig frame is the reference camera's (``Rig.frame == "camera:<its name>"``); COLMAP
+  has no body frame. :func:`mcgeom.load_rig`'s ``frame=`` chooses another camera or an
+  explicit transform (:mod:`mcgeom.io.frame`).
 """
 
 from __future__ import annotations
@@ -245,12 +248,14 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
         if ref not in ids:
             raise ValueError(f"{where}: {rwhere}: ref_camera_id {ref} is not one of the rig's "
                              f"camera_ids {ids}")
+        ref_k = ids.index(ref)
     else:
         refs = [k for k, e in enumerate(entries) if e.get("ref_sensor") is True]
         if len(refs) != 1:
             raise ValueError(f"{where}: {rwhere}: a rig needs exactly one camera with "
                              f"\"ref_sensor\": true (or, in the older format, ref_camera_id); "
                              f"found {len(refs)}")
+        ref_k = refs[0]
         image_list = None
         for k, e in enumerate(entries):
             entry = f"{rwhere}: cameras[{k}] ({e['image_prefix']!r})"
@@ -315,4 +320,4 @@ def load_colmap(path: Any, *, cameras_txt: Any = None, images_txt: Any = None,
             K, dist, lens = _colmap_intrinsics(cwhere, f"line {lineno} (camera {cid})", model, params)
         out.append(make_camera(where, entry, name=name, K=K, dist=dist, model=lens,
                                 R=pose[0], t=pose[1], width=width, height=height))
-    return make_rig(where, out)
+    return make_rig(where, out, frame=f"camera:{out[ref_k].name}")  # rig frame = reference camera

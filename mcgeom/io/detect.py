@@ -15,6 +15,7 @@ from typing import Any, Callable
 
 from mcgeom.io._common import read_text, describe_path
 from mcgeom.io.colmap import load_colmap
+from mcgeom.io.frame import check_frame_spec, select_frame
 from mcgeom.io.kalibr import load_kalibr
 from mcgeom.io.mcgeom_json import RIG_FORMAT, load_mcgeom_json
 from mcgeom.io.opencv_yaml import load_opencv_yaml
@@ -99,25 +100,37 @@ _OPTIONS = {
 }
 
 
-def load_rig(path: Any, format: str | None = None, **options: Any) -> Rig:
-    """Load a rig calibration in any supported format.
+def load_rig(path: Any, format: str | None = None, *, frame: Any = None, **options: Any) -> Rig:
+    """Load a rig calibration in any supported format, in the rig frame you choose.
 
     Args:
         path: the calibration file.
         format: one of ``"mcgeom-json"``, ``"opencv-yaml"``, ``"kalibr"``, ``"colmap"``;
             None detects it from the content (:func:`detect_format`).
+        frame: the rig frame of the returned rig (and so of every motion estimated with
+            it): None (the format's default, table in :mod:`mcgeom.io.frame`), ``"body"``
+            (the body/IMU frame, when the file has one), ``"camera:<name or index>"``
+            (that camera's frame), or a 4x4 rigid transform ``T`` with ``X_rig = T[:3, :3]
+            X_default + T[:3, 3]`` from the format's default frame. The returned
+            :attr:`Rig.frame <mcgeom.rig.Rig.frame>` names it.
         **options: the chosen loader's keyword options: ``image_size``, ``model``,
             ``extrinsics_path`` (opencv-yaml); ``rig_frame`` (kalibr); ``cameras_txt``,
             ``images_txt``, ``rig_index`` (colmap).
 
     Returns:
-        A :class:`mcgeom.rig.Rig` with cam_from_rig extrinsics.
+        A :class:`mcgeom.rig.Rig` with cam_from_rig extrinsics in the chosen frame.
 
     Raises:
         OSError: the file cannot be opened.
-        ValueError: anything wrong with the file (message names file, entry, problem).
+        ValueError: anything wrong with the file (message names file, entry, problem); a
+            ``frame`` that is malformed, names no camera of the rig, or asks for a body
+            frame the file does not have (message names ``frame``).
         TypeError: an option that the format does not take.
     """
+    spec = check_frame_spec(frame)
+    if spec is not None and "rig_frame" in options:
+        raise ValueError("pass either frame= or the Kalibr option rig_frame=, not both "
+                         "(frame='body' is rig_frame='imu', frame='camera:cam0' is rig_frame='cam0')")
     if format is not None and format not in _LOADERS:
         raise ValueError(f"unknown format {format!r}; expected one of {', '.join(FORMATS)} or None")
     if format is not None:
@@ -131,9 +144,10 @@ def load_rig(path: Any, format: str | None = None, **options: Any) -> Rig:
         takes = ", ".join(_OPTIONS[fmt]) or "no options"
         raise TypeError(f"format {fmt!r} does not take option(s) {', '.join(bad)} (it takes {takes})")
     try:
-        return _LOADERS[fmt](path, **options)
+        rig = _LOADERS[fmt](path, **options)
     except ValueError as exc:
         if not why:
             raise
         raise ValueError(f"{exc} [format {fmt!r} detected from the content: {why}; pass "
                          f"format= to override]") from None
+    return select_frame(rig, spec, describe_path(path), fmt)

@@ -16,7 +16,9 @@ the same Kannala-Brandt polynomial; ``none`` -> no distortion; ``fov`` refused),
 T_cnm1_c0``. ``rig_frame="cam0"`` puts the rig frame on cam0 (a ``T_cn_cnm1`` on cam0,
 which Kalibr never writes, is ignored); ``rig_frame="imu"`` on the IMU, with
 ``T_cam_imu`` as each camera's cam_from_rig; the default is ``"imu"`` when every camera
-has ``T_cam_imu`` and ``"cam0"`` otherwise. When a file has both ``T_cn_cnm1`` and
+has ``T_cam_imu`` and ``"cam0"`` otherwise. The rig reports it as ``frame="body"`` (IMU)
+or ``"camera:cam0"``; :func:`mcgeom.load_rig`'s ``frame=`` chooses any camera or an
+explicit transform as well (:mod:`mcgeom.io.frame`). When a file has both ``T_cn_cnm1`` and
 ``T_cam_imu`` (Kalibr's camchain-imucam computes one from the other) they must agree to
 1e-6 (rotation entries and metres), else the file describes two rigs and is refused.
 Pixel coordinates are OpenCV's (Kalibr's corner detection is OpenCV's; its intrinsics are
@@ -214,4 +216,4 @@ def load_kalibr(path: Any, *, rig_frame: str | None = None) -> Rig:
     for c, (R, t) in zip(cams, poses):
         out.append(make_camera(where, c["name"], name=c["name"], K=c["K"], dist=c["dist"],
                                 model=c["model"], R=R, t=t, width=c["width"], height=c["height"]))
-    return make_rig(where, out)
+    return make_rig(where, out, frame="body" if frame == "imu" else "camera:cam0")

@@ -5,6 +5,7 @@ Layout (written by :func:`save_mcgeom_json`, read by :func:`load_mcgeom_json`)::
     {
       "format": "mcgeom-rig",
       "version": 1,
+      "frame": "body",                     # optional: the rig frame (mcgeom.rig.Rig.frame)
       "cameras": [
         {
           "name": "front",                 # unique within the rig
@@ -30,6 +31,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import replace
 from typing import Any, Union
 
 from mcgeom.io._common import describe_path
@@ -74,7 +76,7 @@ def _camera_from_dict(d: Any, where: str) -> Camera:
 
 def rig_to_dict(rig: Rig) -> dict:
     """JSON-ready dict of ``rig`` in the ``mcgeom-rig`` version 1 format (module docstring)."""
-    return {"format": RIG_FORMAT, "version": RIG_FORMAT_VERSION,
+    return {"format": RIG_FORMAT, "version": RIG_FORMAT_VERSION, "frame": rig.frame,
             "cameras": [_camera_to_dict(c) for c in rig.cameras]}
 
 
@@ -93,7 +95,17 @@ def rig_from_dict(d: Any) -> Rig:
     cams = d["cameras"]
     if not isinstance(cams, list):
         raise ValueError(f"rig description: 'cameras' must be a list, got {type(cams).__name__}")
-    return Rig(tuple(_camera_from_dict(c, f"cameras[{i}]") for i, c in enumerate(cams)))
+    frame = d.get("frame")
+    if frame is not None and (not isinstance(frame, str) or not frame):
+        raise ValueError(f"rig description: 'frame' must be a non-empty string naming the rig "
+                         f"frame, got {frame!r}")
+    rig = Rig(tuple(_camera_from_dict(c, f"cameras[{i}]") for i, c in enumerate(cams)))
+    if frame is None or frame == "unspecified":
+        # a file without the label (or written from a rig built in code): say what
+        # the extrinsics show -- a camera at the origin defines the frame
+        at_origin = rig.camera_at_origin()
+        frame = "body" if at_origin is None else f"camera:{at_origin}"
+    return replace(rig, frame=frame)
 
 
 def save_mcgeom_json(rig: Rig, path: PathLike) -> None:

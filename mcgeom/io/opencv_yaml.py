@@ -345,7 +345,7 @@ def _opencv_stereo(path: Any, tree: dict, model: str | None, size: tuple[int, in
                 d[key] = tree[key]
         cams.append(_opencv_camera(where, f"camera {k} (M{k}, D{k})", f"cam{k}", d, model, None, "",
                                    ("K",), ("D",), pose))
-    return make_rig(where, cams)
+    return make_rig(where, cams, frame="camera:cam1")  # cam2_from_cam1: the rig frame is cam1's
 
 
 def load_opencv_yaml(path: Any, *, image_size: Any = None, model: str | None = None,

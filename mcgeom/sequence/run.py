@@ -17,7 +17,7 @@ from typing import Any, Callable, Iterable, Optional
 
 import numpy as np
 
-from ..io import load_rig
+from ..io import load_rig, select_frame
 from ..io.images import ImageSequence, find_image_sequence
 from ..io.trajectory import read_tum
 from ..rig import Rig
@@ -75,7 +75,7 @@ def run_odometry(rig: Any, images: Any, out: Any, *, start: int = 0, end: Option
                  step: int = 1, features: str = "sift", n_features: int = 4000,
                  cross_camera: bool = True, threshold: float = 1.0, gt: Any = None,
                  title: str = "", extra_outputs: Optional[dict] = None,
-                 progress: Optional[Progress] = None) -> OdometryRun:
+                 progress: Optional[Progress] = None, rig_frame: Any = None) -> OdometryRun:
     """Run the sequence pipeline and write its outputs.
 
     ``rig``: a :class:`mcgeom.rig.Rig` or a rig file (any format of
@@ -86,12 +86,15 @@ def run_odometry(rig: Any, images: Any, out: Any, *, start: int = 0, end: Option
     ``threshold``: the two-frame inlier threshold in pixels; ``gt``: a TUM
     file of world_from_rig ground truth (same clock as the images' time
     stamps, or frame numbers when the layout has none); ``progress``: wraps the
-    loops over frames and steps.
+    loops over frames and steps; ``rig_frame``: the rig frame of the estimated
+    motions (``frame=`` of :func:`mcgeom.load_rig`: None for the file's default,
+    ``"body"``, ``"camera:<name or index>"`` or a 4x4 transform); the ground truth
+    must be world_from_rig of that frame.
     """
     bar = progress or _no_progress
     times = {}
     t0 = time.perf_counter()
-    rig = rig if isinstance(rig, Rig) else load_rig(rig)
+    rig = select_frame(rig, rig_frame) if isinstance(rig, Rig) else load_rig(rig, frame=rig_frame)
     sequence = find_image_sequence(images, rig, start=start, end=end, step=step)
     gt_poses = None if gt is None else _gt_for(sequence, gt)
     tracks = build_tracks(rig, sequence, features=features, n_features=n_features,
