@@ -43,6 +43,7 @@
 #define MAX_POLISH 60     /* bracketed Newton steps per root */
 #define DIR2_MIN 1e-100   /* smallest squared length of a bearing */
 #define RANK_TOL 1e-11    /* relative pivot below which the data is degenerate */
+#define MAX_VIOLATION 1e-6 /* of eqs. 3, 4 by a returned unit-norm E */
 
 /* ----------------------------------------------------- polynomial helpers */
 
@@ -117,8 +118,8 @@ static int null_space(const double *d1, const double *d2, double basis[36])
     int k, i, j, c;
     for (k = 0; k < 5; ++k) {
         double u1[3], u2[3];
-        double n1 = sqrt(dot3(d1 + 3 * k, d1 + 3 * k));
-        double n2 = sqrt(dot3(d2 + 3 * k, d2 + 3 * k));
+        /* lengths without overflow: bearings of any non-zero length */
+        double n1 = norm_scaled(d1 + 3 * k, 3), n2 = norm_scaled(d2 + 3 * k, 3);
         for (i = 0; i < 3; ++i) {
             u1[i] = d1[3 * k + i] / n1;
             u2[i] = d2[3 * k + i] / n2;
@@ -502,12 +503,127 @@ static int real_roots(const double *p, int n, double *roots)
     return nr;
 }
 
+/* ---------------------------------------- step 4: polishing the solutions */
+
+/* The 20 monomials at (x, y, z) in Nister's order and their partial
+ * derivatives */
+static void monomials(double x, double y, double z, double m[20], double mx[20], double my[20],
+                      double mz[20])
+{
+    int i;
+    m[0] = x * x * x; m[1] = y * y * y; m[2] = x * x * y; m[3] = x * y * y;
+    m[4] = x * x * z; m[5] = x * x; m[6] = y * y * z; m[7] = y * y;
+    m[8] = x * y * z; m[9] = x * y; m[10] = x * z * z; m[11] = x * z;
+    m[12] = x; m[13] = y * z * z; m[14] = y * z; m[15] = y;
+    m[16] = z * z * z; m[17] = z * z; m[18] = z; m[19] = 1.0;
+    for (i = 0; i < 20; ++i)
+        mx[i] = my[i] = mz[i] = 0.0;
+    mx[0] = 3 * x * x; mx[2] = 2 * x * y; mx[3] = y * y; mx[4] = 2 * x * z; mx[5] = 2 * x;
+    mx[8] = y * z; mx[9] = y; mx[10] = z * z; mx[11] = z; mx[12] = 1.0;
+    my[1] = 3 * y * y; my[2] = x * x; my[3] = 2 * x * y; my[6] = 2 * y * z; my[7] = 2 * y;
+    my[8] = x * z; my[9] = x; my[13] = z * z; my[14] = z; my[15] = 1.0;
+    mz[4] = x * x; mz[6] = y * y; mz[8] = x * y; mz[10] = 2 * x * z; mz[11] = x;
+    mz[13] = 2 * y * z; mz[14] = y; mz[16] = 3 * z * z; mz[17] = 2 * z; mz[18] = 1.0;
+}
+
+/* Relative residual |M m(x, y, z)| / (max|M| |m|) of the ten cubics and, in
+ * r and jac (10 x 3), the residual and its Jacobian */
+static double cubic_residual(double m0[10][20], double mmax, const double v[3], double r[10],
+                             double jac[10][3])
+{
+    double m[20], mx[20], my[20], mz[20], rr = 0.0, mm = 0.0;
+    int i, k;
+    monomials(v[0], v[1], v[2], m, mx, my, mz);
+    for (i = 0; i < 10; ++i) {
+        double a = 0.0, bx = 0.0, by = 0.0, bz = 0.0;
+        for (k = 0; k < 20; ++k) {
+            a += m0[i][k] * m[k];
+            bx += m0[i][k] * mx[k];
+            by += m0[i][k] * my[k];
+            bz += m0[i][k] * mz[k];
+        }
+        r[i] = a;
+        jac[i][0] = bx;
+        jac[i][1] = by;
+        jac[i][2] = bz;
+        rr += a * a;
+    }
+    for (k = 0; k < 20; ++k)
+        mm += m[k] * m[k];
+    return sqrt(rr) / (mmax * sqrt(mm));
+}
+
+/* Gauss-Newton on the ten cubics (eqs. 3, 4) in (x, y, z) from the root of
+ * the univariate polynomial: the elimination and a root of a clustered
+ * degree-10 polynomial lose digits that the original system gives back.
+ * A step is kept only when it lowers the residual; at most POLISH_STEPS. */
+#define POLISH_STEPS 4
+#define POLISH_TOL 1e-12
+static void polish_xyz(double m0[10][20], double mmax, double v[3])
+{
+    double r[10], jac[10][3], res = cubic_residual(m0, mmax, v, r, jac);
+    int it, i, j, k;
+    for (it = 0; it < POLISH_STEPS && res > POLISH_TOL; ++it) {
+        double a[9], g[3], dv[3], vn[3], rn[10], jn[10][3], resn, det;
+        for (i = 0; i < 3; ++i) {
+            g[i] = 0.0;
+            for (j = 0; j < 3; ++j) {
+                a[3 * i + j] = 0.0;
+                for (k = 0; k < 10; ++k)
+                    a[3 * i + j] += jac[k][i] * jac[k][j];
+            }
+            for (k = 0; k < 10; ++k)
+                g[i] -= jac[k][i] * r[k];
+        }
+        det = det33(a);
+        if (!(fabs(det) > 0.0) || !isfinite(det))
+            return;
+        /* Cramer's rule on the 3 x 3 normal equations */
+        for (i = 0; i < 3; ++i) {
+            double b[9];
+            for (j = 0; j < 9; ++j)
+                b[j] = a[j];
+            for (j = 0; j < 3; ++j)
+                b[3 * j + i] = g[j];
+            dv[i] = det33(b) / det;
+        }
+        for (i = 0; i < 3; ++i)
+            vn[i] = v[i] + dv[i];
+        resn = cubic_residual(m0, mmax, vn, rn, jn);
+        if (!(resn < res))
+            return;
+        res = resn;
+        for (i = 0; i < 3; ++i)
+            v[i] = vn[i];
+        for (k = 0; k < 10; ++k) {
+            r[k] = rn[k];
+            for (j = 0; j < 3; ++j)
+                jac[k][j] = jn[k][j];
+        }
+    }
+}
+
+/* Largest violation of det E = 0 (eq. 3) and 2 E E^T E - tr(E E^T) E = 0
+ * (eq. 4) by a unit-norm E */
+static double essential_violation(const double e[9])
+{
+    double eet[9], m[9], tr, worst = fabs(det33(e));
+    int i;
+    mul33_abt(e, e, eet);
+    tr = eet[0] + eet[4] + eet[8];
+    mul33(eet, e, m);
+    for (i = 0; i < 9; ++i)
+        if (!(fabs(2.0 * m[i] - tr * e[i]) <= worst))
+            worst = fabs(2.0 * m[i] - tr * e[i]);
+    return worst;
+}
+
 /* ------------------------------------------------------------ entry point */
 
 int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *n_solutions)
 {
     double basis[36], m[10][20], bx[3][4], by[3][4], b1[3][5], poly[DEG + 1], roots[DEG];
-    double lead, pmax = 0.0;
+    double m0[10][20], lead, pmax = 0.0, mmax = 0.0;
     int k, i, n, nr, deg, ns = 0;
     if (d1 == NULL || d2 == NULL || E == NULL || n_solutions == NULL)
         return MCG_EINVAL;
@@ -521,6 +637,12 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
     if (!null_space(d1, d2, basis))
         return MCG_OK;
     cubic_constraints(basis, m);
+    for (i = 0; i < 10; ++i)
+        for (k = 0; k < 20; ++k) {
+            m0[i][k] = m[i][k];
+            if (fabs(m[i][k]) > mmax)
+                mmax = fabs(m[i][k]);
+        }
     if (!gauss_jordan(m))
         return MCG_OK;
     /* <k> = <e> - z<f>, <l> = <g> - z<h>, <m> = <i> - z<j>: rows 4..9 */
@@ -546,7 +668,7 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
     nr = real_roots(poly, deg, roots);
     for (n = 0; n < nr; ++n) {
         double z = roots[n], z2 = z * z, z3 = z2 * z, z4 = z3 * z;
-        double row[3][3], v[3], best = -1.0, norm = 0.0;
+        double row[3][3], v[3] = {0.0, 0.0, 0.0}, best = -1.0, norm = 0.0;
         double *e = E + 9 * ns;
         int a, b;
         for (k = 0; k < 3; ++k) {
@@ -571,6 +693,18 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
         }
         if (!(best > 0.0))
             continue;
+        /* polish (x, y, z) when the solution is at a finite (x, y) */
+        if (fabs(v[2]) > 1e-8 * sqrt(best)) {
+            double xyz[3];
+            xyz[0] = v[0] / v[2];
+            xyz[1] = v[1] / v[2];
+            xyz[2] = z;
+            polish_xyz(m0, mmax, xyz);
+            v[0] = xyz[0];
+            v[1] = xyz[1];
+            v[2] = 1.0;
+            z = xyz[2];
+        }
         /* E = v0 X + v1 Y + v2 (z Z + W), unit Frobenius norm */
         for (i = 0; i < 9; ++i) {
             e[i] = v[0] * basis[i] + v[1] * basis[9 + i] + v[2] * (z * basis[18 + i] + basis[27 + i]);
@@ -581,6 +715,10 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
             continue;
         for (i = 0; i < 9; ++i)
             e[i] /= norm;
+        /* a root that rounding made up, or one too ill-conditioned to give
+         * an essential matrix, is not a solution */
+        if (!(essential_violation(e) <= MAX_VIOLATION))
+            continue;
         ++ns;
     }
     *n_solutions = ns;

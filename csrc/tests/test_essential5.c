@@ -177,7 +177,7 @@ static void random_trials(void)
 static void near_degenerate(void)
 {
     int kind;
-    const char *names[3] = {"small baseline (|t| = 1e-3 of depth)", "near-planar scene (1e-3)",
+    const char *names[3] = {"small baseline (|t| = 1e-2, depths 2..10)", "near-planar scene (1e-3)",
                             "forward motion"};
     for (kind = 0; kind < 3; kind++) {
         int trials = scaled(1000), found = 0, tr;
@@ -199,7 +199,7 @@ static void near_degenerate(void)
             normalize(t);
             if (kind == 0)
                 for (i = 0; i < 3; i++)
-                    t[i] *= 1e-3;
+                    t[i] *= 1e-2;
             for (k = 0; k < 5; k++) {
                 double X[3], X2[3];
                 X[0] = 4.0 * (urand() - 0.5);
