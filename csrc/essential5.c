@@ -41,6 +41,7 @@
 #define DEG 10            /* degree of det B(z) */
 #define MAX_BISECT 80     /* bisection levels when isolating roots */
 #define MAX_POLISH 60     /* bracketed Newton steps per root */
+#define NEWTON_DONE 1e-9  /* relative Newton step after which a root is final */
 #define DIR2_MIN 1e-100   /* smallest squared length of a bearing */
 #define RANK_TOL 1e-11    /* relative pivot below which the data is degenerate */
 #define MAX_VIOLATION 1e-6 /* of eqs. 3, 4 by a returned unit-norm E */
@@ -403,7 +404,7 @@ static int sturm_changes(const sturm_chain *sc, double z)
 static double polish_root(const sturm_chain *sc, double lo, double hi)
 {
     double flo = horner(sc->s[0], sc->deg[0], lo), fhi = horner(sc->s[0], sc->deg[0], hi), x, dxold;
-    int it;
+    int it, newton;
     if (flo == 0.0)
         return lo;
     if (fhi == 0.0)
@@ -426,7 +427,8 @@ static double polish_root(const sturm_chain *sc, double lo, double hi)
         else
             hi = x;
         xn = df != 0.0 ? x - f / df : 0.5 * (lo + hi);
-        if (!((xn - lo) * (xn - hi) < 0.0) || fabs(2.0 * (xn - x)) > dxold) {
+        newton = (xn - lo) * (xn - hi) < 0.0 && fabs(2.0 * (xn - x)) <= dxold;
+        if (!newton) {
             xn = 0.5 * (lo + hi);
             dxold = fabs(hi - lo);
         } else {
@@ -434,7 +436,10 @@ static double polish_root(const sturm_chain *sc, double lo, double hi)
         }
         dx = xn - x;
         x = xn;
-        if (fabs(dx) <= 4.0 * DBL_EPSILON * fabs(x) || lo == hi)
+        /* a Newton step of relative size 1e-9 leaves an error of order its
+         * square: converged (further steps only chase rounding noise) */
+        if ((newton && fabs(dx) <= NEWTON_DONE * fabs(x)) || fabs(dx) <= 4.0 * DBL_EPSILON * fabs(x) ||
+            lo == hi)
             break;
     }
     return x;
@@ -452,10 +457,16 @@ static int real_roots(const double *p, int n, double *roots)
     int i, top = 0, nr = 0;
     if (n < 1)
         return 0;
-    for (i = 0; i < n; ++i)
-        if (fabs(p[i]) > bound)
-            bound = fabs(p[i]);
-    bound += 1.0; /* Cauchy: every root satisfies |z| < 1 + max |p_i| */
+    /* Fujiwara's bound: every root satisfies |z| <= 2 max(|p_{n-1}|,
+     * |p_{n-2}|^(1/2), ..., |p_0 / 2|^(1/n)); far tighter than Cauchy's
+     * 1 + max |p_i| when the coefficients are large, so fewer bisections */
+    for (i = 0; i < n; ++i) {
+        double c = fabs(p[i]) * (i == 0 ? 0.5 : 1.0);
+        double r = (n - i == 1) ? c : pow(c, 1.0 / (n - i));
+        if (r > bound)
+            bound = r;
+    }
+    bound = 2.0 * bound * (1.0 + 1e-12) + DBL_MIN; /* strictly outside every root */
     if (!isfinite(bound))
         return 0;
     sturm_build(p, n, &sc);
@@ -526,8 +537,8 @@ static void monomials(double x, double y, double z, double m[20], double mx[20],
     mz[13] = 2 * y * z; mz[14] = y; mz[16] = 3 * z * z; mz[17] = 2 * z; mz[18] = 1.0;
 }
 
-/* Relative residual |M m(x, y, z)| / (max|M| |m|) of the ten cubics and, in
- * r and jac (10 x 3), the residual and its Jacobian */
+/* Relative residual |M m(x, y, z)| / (max|M| |m|) of the ten cubics, their
+ * values in r and, when jac is not NULL, their Jacobian (10 x 3) */
 static double cubic_residual(double m0[10][20], double mmax, const double v[3], double r[10],
                              double jac[10][3])
 {
@@ -535,19 +546,24 @@ static double cubic_residual(double m0[10][20], double mmax, const double v[3], 
     int i, k;
     monomials(v[0], v[1], v[2], m, mx, my, mz);
     for (i = 0; i < 10; ++i) {
-        double a = 0.0, bx = 0.0, by = 0.0, bz = 0.0;
-        for (k = 0; k < 20; ++k) {
+        double a = 0.0;
+        for (k = 0; k < 20; ++k)
             a += m0[i][k] * m[k];
-            bx += m0[i][k] * mx[k];
-            by += m0[i][k] * my[k];
-            bz += m0[i][k] * mz[k];
-        }
         r[i] = a;
-        jac[i][0] = bx;
-        jac[i][1] = by;
-        jac[i][2] = bz;
         rr += a * a;
     }
+    if (jac != NULL)
+        for (i = 0; i < 10; ++i) {
+            double bx = 0.0, by = 0.0, bz = 0.0;
+            for (k = 0; k < 20; ++k) {
+                bx += m0[i][k] * mx[k];
+                by += m0[i][k] * my[k];
+                bz += m0[i][k] * mz[k];
+            }
+            jac[i][0] = bx;
+            jac[i][1] = by;
+            jac[i][2] = bz;
+        }
     for (k = 0; k < 20; ++k)
         mm += m[k] * m[k];
     return sqrt(rr) / (mmax * sqrt(mm));
@@ -561,8 +577,11 @@ static double cubic_residual(double m0[10][20], double mmax, const double v[3], 
 #define POLISH_TOL 1e-12
 static void polish_xyz(double m0[10][20], double mmax, double v[3])
 {
-    double r[10], jac[10][3], res = cubic_residual(m0, mmax, v, r, jac);
+    double r[10], jac[10][3], res = cubic_residual(m0, mmax, v, r, NULL);
     int it, i, j, k;
+    if (res <= POLISH_TOL)
+        return; /* most roots: the elimination kept enough digits */
+    res = cubic_residual(m0, mmax, v, r, jac);
     for (it = 0; it < POLISH_STEPS && res > POLISH_TOL; ++it) {
         double a[9], g[3], dv[3], vn[3], rn[10], jn[10][3], resn, det;
         for (i = 0; i < 3; ++i) {

@@ -1080,12 +1080,17 @@ def skyline_eig(first: Any, ptr: Any, a: Any, b: Any, *, shift: float = 0.0, p: 
 
 # -------------------------------------------------------------- essential5.c
 
-def _bearings5(name: str, d: Any) -> np.ndarray:
-    d = _arr(name, d, (5, 3))
-    bad = _first_zero_row(d)
-    if bad is not None:
-        raise ValueError(f"{name}[{bad}] is a zero-length bearing")
-    return d
+def _bearing_error(status: int, what: str, named: tuple) -> None:
+    """Raise for a failed 5-point kernel, naming the bad bearing array first."""
+    if status == lib.MCG_EINVAL:
+        for name, a in named:
+            if not np.isfinite(a).all():
+                raise ValueError(f"{what}: {name} contains NaN or inf")
+            bad = np.flatnonzero(np.einsum("ij,ij->i", a, a) <= 1e-100)
+            if bad.size:
+                raise ValueError(f"{what}: {name}[{bad[0]}] is a zero-length bearing "
+                                 "(|d| < 1e-50)")
+    _check(status, what)
 
 
 def essential5(d1: Any, d2: Any) -> list[np.ndarray]:
@@ -1100,11 +1105,13 @@ def essential5(d1: Any, d2: Any) -> list[np.ndarray]:
     An empty list when there is no real solution or the data is degenerate
     (e.g. a repeated correspondence).
     """
-    d1 = _bearings5("d1", d1)
-    d2 = _bearings5("d2", d2)
+    a = _f64("d1", d1, (5, 3))
+    b = _f64("d2", d2, (5, 3))
     E = np.empty((10, 3, 3))
     ns = ffi.new("int *")
-    _check(lib.mcg_essential5(_p(d1), _p(d2), _p(E), ns), "essential5")
+    st = lib.mcg_essential5(_p(a), _p(b), _p(E), ns)
+    if st != lib.MCG_OK:
+        _bearing_error(st, "essential5", (("d1", a), ("d2", b)))
     return list(E[: ns[0]])
 
 

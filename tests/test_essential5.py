@@ -164,10 +164,10 @@ def test_degenerate_and_bad_input():
         _core.essential5(d1[:4], d2)
     bad = d2.copy()
     bad[2, 1] = np.nan
-    with pytest.raises(ValueError, match="d2 contains NaN"):
+    with pytest.raises(ValueError, match="essential5: d2 contains NaN"):
         _core.essential5(d1, bad)
     bad[2] = 0.0
-    with pytest.raises(ValueError, match=r"d2\[2\] is a zero-length bearing"):
+    with pytest.raises(ValueError, match=r"essential5: d2\[2\] is a zero-length bearing"):
         _core.essential5(d1, bad)
     with pytest.raises(ValueError, match="E must have shape"):
         _core.essential_decompose(np.eye(2), d1, d2)
