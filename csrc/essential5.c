@@ -45,6 +45,7 @@
 #define DIR2_MIN 1e-100   /* smallest squared length of a bearing */
 #define RANK_TOL 1e-11    /* relative pivot below which the data is degenerate */
 #define MAX_VIOLATION 1e-6 /* of eqs. 3, 4 by a returned unit-norm E */
+#define POLISH_TRIGGER 1e-13 /* violation above which a solution is polished */
 
 /* ----------------------------------------------------- polynomial helpers */
 
@@ -226,9 +227,12 @@ static void cubic_constraints(const double basis[36], double m[10][20])
         quad_mul_add(cof[i], e[i], m[9]);
 }
 
-/* Gauss-Jordan elimination of the first ten columns with partial pivoting:
- * afterwards row r reads monomial_r + sum_k m[r][10 + k] monomial_{10 + k}.
- * Returns 0 on a (relatively) zero pivot. */
+/* Elimination of the first ten columns with partial pivoting, reduced only
+ * as far as step 3 needs: afterwards rows 4..9 (Nister's <e> .. <j>) read
+ * monomial_r + sum_k m[r][10 + k] monomial_{10 + k}. Forward elimination
+ * makes the 10 x 10 block upper triangular; back substitution then only
+ * involves rows 4..9 (rows 0..3 are never used). Returns 0 on a
+ * (relatively) zero pivot. */
 static int gauss_jordan(double m[10][20])
 {
     double scale = 0.0;
@@ -258,14 +262,23 @@ static int gauss_jordan(double m[10][20])
         inv = 1.0 / m[c][c];
         for (k = c; k < 20; ++k)
             m[c][k] *= inv;
-        for (r = 0; r < 10; ++r) {
+        for (r = c + 1; r < 10; ++r) {
             double f = m[r][c];
-            if (r == c || f == 0.0)
+            if (f == 0.0)
                 continue;
             for (k = c; k < 20; ++k)
                 m[r][k] -= f * m[c][k];
         }
     }
+    for (c = 9; c > 4; --c)
+        for (r = 4; r < c; ++r) {
+            double f = m[r][c];
+            if (f == 0.0)
+                continue;
+            for (k = 10; k < 20; ++k)
+                m[r][k] -= f * m[c][k];
+            m[r][c] = 0.0;
+        }
     return 1;
 }
 
@@ -637,6 +650,24 @@ static double essential_violation(const double e[9])
     return worst;
 }
 
+/* e = v0 X + v1 Y + v2 (z Z + W) scaled to unit Frobenius norm; 0 if that
+ * is impossible (zero or not finite) */
+static int unit_e(const double basis[36], const double v[3], double z, double e[9])
+{
+    double norm = 0.0;
+    int i;
+    for (i = 0; i < 9; ++i) {
+        e[i] = v[0] * basis[i] + v[1] * basis[9 + i] + v[2] * (z * basis[18 + i] + basis[27 + i]);
+        norm += e[i] * e[i];
+    }
+    norm = sqrt(norm);
+    if (!(norm > 0.0) || !isfinite(norm))
+        return 0;
+    for (i = 0; i < 9; ++i)
+        e[i] /= norm;
+    return 1;
+}
+
 /* ------------------------------------------------------------ entry point */
 
 int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *n_solutions)
@@ -687,7 +718,7 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
     nr = real_roots(poly, deg, roots);
     for (n = 0; n < nr; ++n) {
         double z = roots[n], z2 = z * z, z3 = z2 * z, z4 = z3 * z;
-        double row[3][3], v[3] = {0.0, 0.0, 0.0}, best = -1.0, norm = 0.0;
+        double row[3][3], v[3] = {0.0, 0.0, 0.0}, best = -1.0;
         double *e = E + 9 * ns;
         int a, b;
         for (k = 0; k < 3; ++k) {
@@ -712,8 +743,12 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
         }
         if (!(best > 0.0))
             continue;
-        /* polish (x, y, z) when the solution is at a finite (x, y) */
-        if (fabs(v[2]) > 1e-8 * sqrt(best)) {
+        if (!unit_e(basis, v, z, e))
+            continue;
+        /* the digits the elimination lost on ill-conditioned roots come
+         * back from Gauss-Newton on the original cubics (when the solution
+         * is at a finite (x, y); most roots skip this) */
+        if (essential_violation(e) > POLISH_TRIGGER && fabs(v[2]) > 1e-8 * sqrt(best)) {
             double xyz[3];
             xyz[0] = v[0] / v[2];
             xyz[1] = v[1] / v[2];
@@ -722,18 +757,9 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
             v[0] = xyz[0];
             v[1] = xyz[1];
             v[2] = 1.0;
-            z = xyz[2];
+            if (!unit_e(basis, v, xyz[2], e))
+                continue;
         }
-        /* E = v0 X + v1 Y + v2 (z Z + W), unit Frobenius norm */
-        for (i = 0; i < 9; ++i) {
-            e[i] = v[0] * basis[i] + v[1] * basis[9 + i] + v[2] * (z * basis[18 + i] + basis[27 + i]);
-            norm += e[i] * e[i];
-        }
-        norm = sqrt(norm);
-        if (!(norm > 0.0) || !isfinite(norm))
-            continue;
-        for (i = 0; i < 9; ++i)
-            e[i] /= norm;
         /* a root that rounding made up, or one too ill-conditioned to give
          * an essential matrix, is not a solution */
         if (!(essential_violation(e) <= MAX_VIOLATION))
