@@ -176,3 +176,21 @@ def test_degenerate_and_bad_input():
     from mcgeom.errors import DegenerateError
     with pytest.raises(DegenerateError):
         _core.essential_decompose(np.diag([1.0, 0.0, 0.0]), d1, d2)
+
+
+def test_bench_essential5_command(capsys, monkeypatch):
+    """``mcgeom bench essential5``: one row per solver with its success rate and
+    mean number of solutions (PoseLib's row or a note saying it is missing)."""
+    import sys
+
+    from mcgeom import cli
+    assert cli.main(["bench", "essential5", "--problems", "40", "--budget", "0.01"]) == 0
+    out = capsys.readouterr().out
+    rows = {line.split()[0]: line.split() for line in out.splitlines()
+            if line.split() and line.split()[0] in ("mcgeom", "opencv", "poselib")}
+    assert float(rows["mcgeom"][1]) == 1.0  # found: all 40 problems
+    assert float(rows["opencv"][2]) == pytest.approx(float(rows["mcgeom"][2]), abs=0.5)
+    assert "C kernel alone" in out
+    monkeypatch.setitem(sys.modules, "poselib", None)
+    assert cli.main(["bench", "essential5", "--problems", "5", "--budget", "0.01"]) == 0
+    assert "poselib not compared: mcgeom bench essential5 needs poselib" in capsys.readouterr().out
