@@ -305,37 +305,34 @@ static void b_row(const double *ra, const double *rb, double bx[4], double by[4]
     b1[4] = -b[6];
 }
 
-/* det of B(z) = [bx by b1] (rows k, l, m): degree 10, 11 coefficients */
+/* p += sign f (a b - c d) for polynomials in z (rising powers) of degrees
+ * nf, na, nb, nc, nd with na + nb = nc + nd and nf + na + nb = DEG: one
+ * term of the cofactor expansion of det B(z) */
+static void add_cofactor_term(const double *f, int nf, const double *a, int na, const double *b,
+                              int nb, const double *c, int nc, const double *d, int nd,
+                              double sign, double p[DEG + 1])
+{
+    double ab[DEG + 1], cd[DEG + 1], s[DEG + 1];
+    int i;
+    zpoly_mul(a, na, b, nb, ab);
+    zpoly_mul(c, nc, d, nd, cd);
+    for (i = 0; i <= na + nb; ++i)
+        ab[i] -= cd[i];
+    zpoly_mul(f, nf, ab, na + nb, s);
+    for (i = 0; i <= DEG; ++i)
+        p[i] += sign * s[i];
+}
+
+/* det of B(z) = [bx by b1] (rows k, l, m): degree 10, 11 coefficients, by
+ * cofactors along the first row */
 static void b_det(double bx[3][4], double by[3][4], double b1[3][5], double p[DEG + 1])
 {
-    double t7[8], u7[8], w6[7], s[11];
     int i;
     for (i = 0; i <= DEG; ++i)
         p[i] = 0.0;
-    /* bx_k (by_l b1_m - b1_l by_m) */
-    zpoly_mul(by[1], 3, b1[2], 4, t7);
-    zpoly_mul(b1[1], 4, by[2], 3, u7);
-    for (i = 0; i < 8; ++i)
-        t7[i] -= u7[i];
-    zpoly_mul(bx[0], 3, t7, 7, s);
-    for (i = 0; i <= DEG; ++i)
-        p[i] += s[i];
-    /* - by_k (bx_l b1_m - b1_l bx_m) */
-    zpoly_mul(bx[1], 3, b1[2], 4, t7);
-    zpoly_mul(b1[1], 4, bx[2], 3, u7);
-    for (i = 0; i < 8; ++i)
-        t7[i] -= u7[i];
-    zpoly_mul(by[0], 3, t7, 7, s);
-    for (i = 0; i <= DEG; ++i)
-        p[i] -= s[i];
-    /* + b1_k (bx_l by_m - by_l bx_m) */
-    zpoly_mul(bx[1], 3, by[2], 3, w6);
-    zpoly_mul(by[1], 3, bx[2], 3, t7);
-    for (i = 0; i < 7; ++i)
-        w6[i] -= t7[i];
-    zpoly_mul(b1[0], 4, w6, 6, s);
-    for (i = 0; i <= DEG; ++i)
-        p[i] += s[i];
+    add_cofactor_term(bx[0], 3, by[1], 3, b1[2], 4, b1[1], 4, by[2], 3, 1.0, p);
+    add_cofactor_term(by[0], 3, bx[1], 3, b1[2], 4, b1[1], 4, bx[2], 3, -1.0, p);
+    add_cofactor_term(b1[0], 4, bx[1], 3, by[2], 3, by[1], 3, bx[2], 3, 1.0, p);
 }
 
 /* --------------------------------------------- real roots: Sturm chains */
@@ -650,6 +647,28 @@ static double essential_violation(const double e[9])
     return worst;
 }
 
+/* The null vector of a 3 x 3 matrix of rank 2 (rows r): the largest of the
+ * cross products of two of its rows, in v; returns its squared length (0
+ * or less: rank <= 1; -1 when no product is finite). */
+static double largest_cross(double r[3][3], double v[3])
+{
+    double best = -1.0;
+    int a;
+    v[0] = v[1] = v[2] = 0.0;
+    for (a = 0; a < 3; ++a) {
+        double c[3], nn;
+        cross3(r[a], r[(a + 1) % 3], c);
+        nn = dot3(c, c);
+        if (nn > best) {
+            best = nn;
+            v[0] = c[0];
+            v[1] = c[1];
+            v[2] = c[2];
+        }
+    }
+    return best;
+}
+
 /* e = v0 X + v1 Y + v2 (z Z + W) scaled to unit Frobenius norm; 0 if that
  * is impossible (zero or not finite) */
 static int unit_e(const double basis[36], const double v[3], double z, double e[9])
@@ -718,29 +737,16 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
     nr = real_roots(poly, deg, roots);
     for (n = 0; n < nr; ++n) {
         double z = roots[n], z2 = z * z, z3 = z2 * z, z4 = z3 * z;
-        double row[3][3], v[3] = {0.0, 0.0, 0.0}, best = -1.0;
+        double row[3][3], v[3], best;
         double *e = E + 9 * ns;
-        int a, b;
         for (k = 0; k < 3; ++k) {
             row[k][0] = bx[k][0] + bx[k][1] * z + bx[k][2] * z2 + bx[k][3] * z3;
             row[k][1] = by[k][0] + by[k][1] * z + by[k][2] * z2 + by[k][3] * z3;
             row[k][2] = b1[k][0] + b1[k][1] * z + b1[k][2] * z2 + b1[k][3] * z3 +
                         b1[k][4] * z4;
         }
-        /* B(z) [x y 1]^T = 0: the null vector is the cross product of two
-         * rows of B(z), the pair with the largest cross product */
-        for (a = 0; a < 3; ++a) {
-            double c[3], nn;
-            b = (a + 1) % 3;
-            cross3(row[a], row[b], c);
-            nn = dot3(c, c);
-            if (nn > best) {
-                best = nn;
-                v[0] = c[0];
-                v[1] = c[1];
-                v[2] = c[2];
-            }
-        }
+        /* B(z) [x y 1]^T = 0: the null vector of B(z) */
+        best = largest_cross(row, v);
         if (!(best > 0.0))
             continue;
         if (!unit_e(basis, v, z, e))
@@ -850,17 +856,7 @@ int mcg_essential_decompose(const double E[9], const double *d1, const double *d
     for (j = 0; j < 3; ++j)
         for (i = 0; i < 3; ++i)
             c[j][i] = e[3 * i + j];
-    for (k = 0; k < 3; ++k) {
-        double v[3], nn;
-        cross3(c[k], c[(k + 1) % 3], v);
-        nn = dot3(v, v);
-        if (nn > best) {
-            best = nn;
-            tt[0] = v[0];
-            tt[1] = v[1];
-            tt[2] = v[2];
-        }
-    }
+    best = largest_cross(c, tt);
     if (!(best > 0.0))
         return MCG_EDEGENERATE; /* rank <= 1: not an essential matrix */
     best = sqrt(best);

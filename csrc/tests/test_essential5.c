@@ -29,11 +29,26 @@ static void normalize(double *v)
     v[2] /= n;
 }
 
+/* E = [t]x R scaled to unit Frobenius norm: the reference solution */
+static void essential_of(const double R[9], const double t[3], double E[9])
+{
+    double s[9], nrm = 0.0;
+    int i;
+    s[0] = 0.0; s[1] = -t[2]; s[2] = t[1];
+    s[3] = t[2]; s[4] = 0.0; s[5] = -t[0];
+    s[6] = -t[1]; s[7] = t[0]; s[8] = 0.0;
+    matmul(3, 3, 3, s, R, E);
+    for (i = 0; i < 9; i++)
+        nrm += E[i] * E[i];
+    for (i = 0; i < 9; i++)
+        E[i] /= sqrt(nrm);
+}
+
 /* a random motion (rotation up to ~1 rad, unit t) and n points in front of
  * both cameras; d1, d2 unit bearings; Etrue = [t]x R with unit norm */
 static void problem(int n, double R[9], double t[3], double *d1, double *d2, double Etrue[9])
 {
-    double aa[3], s[9], nrm = 0.0;
+    double aa[3];
     int k, i, tries;
     for (i = 0; i < 3; i++)
         aa[i] = 0.3 * nrand();
@@ -60,14 +75,7 @@ static void problem(int n, double R[9], double t[3], double *d1, double *d2, dou
         normalize(d2 + 3 * k);
         ++k;
     }
-    s[0] = 0.0; s[1] = -t[2]; s[2] = t[1];
-    s[3] = t[2]; s[4] = 0.0; s[5] = -t[0];
-    s[6] = -t[1]; s[7] = t[0]; s[8] = 0.0;
-    matmul(3, 3, 3, s, R, Etrue);
-    for (i = 0; i < 9; i++)
-        nrm += Etrue[i] * Etrue[i];
-    for (i = 0; i < 9; i++)
-        Etrue[i] /= sqrt(nrm);
+    essential_of(R, t, Etrue);
 }
 
 /* largest violation of the epipolar, determinant and trace constraints by
@@ -187,7 +195,7 @@ static void near_degenerate(void)
     for (kind = 0; kind < 3; kind++) {
         int trials = scaled(1000), found = 0, tr;
         for (tr = 0; tr < trials; tr++) {
-            double R[9], t[3], aa[3], d1[15], d2[15], E[90], s9[9], Et[9], nrm = 0.0, bestd = 1e300;
+            double R[9], t[3], aa[3], d1[15], d2[15], E[90], Et[9], bestd = 1e300;
             int k, i, ns;
             for (i = 0; i < 3; i++)
                 aa[i] = 0.2 * nrand();
@@ -218,14 +226,7 @@ static void near_degenerate(void)
                 normalize(d1 + 3 * k);
                 normalize(d2 + 3 * k);
             }
-            s9[0] = 0.0; s9[1] = -t[2]; s9[2] = t[1];
-            s9[3] = t[2]; s9[4] = 0.0; s9[5] = -t[0];
-            s9[6] = -t[1]; s9[7] = t[0]; s9[8] = 0.0;
-            matmul(3, 3, 3, s9, R, Et);
-            for (i = 0; i < 9; i++)
-                nrm += Et[i] * Et[i];
-            for (i = 0; i < 9; i++)
-                Et[i] /= sqrt(nrm);
+            essential_of(R, t, Et);
             if (mcg_essential5(d1, d2, E, &ns) != MCG_OK)
                 continue;
             for (k = 0; k < ns; k++)
