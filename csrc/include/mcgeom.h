@@ -907,7 +907,8 @@ int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const dou
  * is no solution (*n_solutions = 0: no real root, or degenerate data such as
  * repeated correspondences, for which the constraints have rank < 5).
  * MCG_EINVAL: NULL pointers, NaN/inf, a zero-length bearing (|d| < 1e-50).
- * Fixed stack (about 12 KB), no workspace. */
+ * Fixed stack (about 8 KB, gcc -O2 x86-64), no workspace. Cost: about 40k
+ * instructions per call (gcc -O3), 4-7 us. */
 int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *n_solutions);
 
 /* The motion (R, t), t of unit length, of the essential matrix E (any
