@@ -1080,6 +1080,9 @@ def skyline_eig(first: Any, ptr: Any, a: Any, b: Any, *, shift: float = 0.0, p: 
 
 # -------------------------------------------------------------- essential5.c
 
+_F64 = np.dtype(np.float64)
+
+
 def _bearing_error(status: int, what: str, named: tuple) -> None:
     """Raise for a failed 5-point kernel, naming the bad bearing array first."""
     if status == lib.MCG_EINVAL:
@@ -1105,8 +1108,12 @@ def essential5(d1: Any, d2: Any) -> list[np.ndarray]:
     An empty list when there is no real solution or the data is degenerate
     (e.g. a repeated correspondence).
     """
-    a = _f64("d1", d1, (5, 3))
-    b = _f64("d2", d2, (5, 3))
+    # the hot path of a RANSAC loop in Python: arrays already float64 (5, 3)
+    # C-contiguous are passed as they are (checked in two comparisons each)
+    a = d1 if (type(d1) is np.ndarray and d1.dtype is _F64 and d1.shape == (5, 3)
+               and d1.flags.c_contiguous) else _arr("d1", d1, (5, 3), check_finite=False)
+    b = d2 if (type(d2) is np.ndarray and d2.dtype is _F64 and d2.shape == (5, 3)
+               and d2.flags.c_contiguous) else _arr("d2", d2, (5, 3), check_finite=False)
     E = np.empty((10, 3, 3))
     ns = ffi.new("int *")
     st = lib.mcg_essential5(_p(a), _p(b), _p(E), ns)

@@ -247,7 +247,7 @@ def _bench_essential5(args: argparse.Namespace) -> int:
     rows, c_us, note = bench_essential5(problems=n, budget_s=args.budget,
                                         progress=progress_bar)
     print(f"essential5: {n} random noise-free minimal problems; found = true E among the "
-          "solutions (to 1e-6); times per call through Python")
+          "solutions (to 1e-6); CPU time per call through Python")
     print(f"{'solver':>8} {'found':>8} {'solutions':>9} {'us/call':>8} {'vs mcgeom':>9}")
     for r in rows:
         print(f"{r.name:>8} {r.found:8.4f} {r.mean_solutions:9.3f} {r.us_per_call:8.2f} "
