@@ -21,6 +21,7 @@ strings in the input format the harness decodes.
 """
 from __future__ import annotations
 
+import math
 import random
 import re
 import struct
@@ -116,8 +117,48 @@ def random_seeds(rng: random.Random, n: int = 24) -> list[bytes]:
             for _ in range(n)]
 
 
+def _u16_in(x: float, lo: float, hi: float) -> bytes:
+    """The fz_range(in, lo, hi) encoding of x (a little-endian 16-bit fraction)."""
+    return struct.pack("<H", max(0, min(65535, round((x - lo) / (hi - lo) * 65535))))
+
+
+def essential5_seeds(rng: random.Random) -> list[bytes]:
+    """fuzz_essential5: well-posed 5-point problems as the harness decodes them
+    (mode 0: rotation angles, translation, five points, no replaced entry;
+    mode 2: each degenerate kind of the same; mode 1: the bearings of such a
+    problem as nice doubles, i.e. rounded to 1/4096 like a noisy sample)."""
+    out = []
+    for _ in range(8):
+        w = [rng.uniform(-0.5, 0.5) for _ in range(3)]
+        t = [rng.uniform(-2.0, 2.0) for _ in range(3)]
+        pts = [(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(2.0, 8.0)) for _ in range(5)]
+        body = b"".join(_u16_in(v, -1.5, 1.5) for v in w)
+        body += b"".join(_u16_in(v, -2.0, 2.0) for v in t)
+        for x, y, z in pts:
+            body += _u16_in(x, -4.0, 4.0) + _u16_in(y, -4.0, 4.0) + _u16_in(z, 0.5, 8.0)
+        out.append(bytes([0]) + body + bytes([1]))
+        out += [bytes([2, kind]) + body for kind in range(5)]
+        # the same problem's bearings (rotation by Rodrigues' formula)
+        th = math.sqrt(sum(v * v for v in w)) or 1e-300
+        k = [v / th for v in w]
+        c, s_, v_ = math.cos(th), math.sin(th), 1.0 - math.cos(th)
+        R = [[k[i] * k[j] * v_ + (c if i == j else 0.0) for j in range(3)] for i in range(3)]
+        R[0][1] -= k[2] * s_; R[0][2] += k[1] * s_; R[1][0] += k[2] * s_
+        R[1][2] -= k[0] * s_; R[2][0] -= k[1] * s_; R[2][1] += k[0] * s_
+        d1, d2 = [], []
+        for X in pts:
+            X2 = [sum(R[i][j] * X[j] for j in range(3)) + t[i] for i in range(3)]
+            for P, d in ((X, d1), (X2, d2)):
+                n = math.sqrt(sum(v * v for v in P))
+                d += [4.0 * v / n for v in P]
+        out.append(bytes([1]) + b"".join(nice(v) for v in d1 + d2))
+    return out
+
+
 def seeds_for(name: str) -> list[bytes]:
     rng = random.Random(f"mcgeom-{name}")
+    if name == "fuzz_essential5":
+        return c_seeds(name, rng) + essential5_seeds(rng)
     if name in MODES:
         return c_seeds(name, rng)
     if name == "fuzz_calibration":

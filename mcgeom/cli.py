@@ -30,6 +30,8 @@ BENCHES = {
     "cone": "L-infinity cone bisection (C) against clarabel SOCP steps (needs clarabel)",
     "bnb": "branch and bound over rotations, 4 cameras x 50 points, and its growth",
     "known_rotation": "multi-view translations with known rotations against dense numpy",
+    "essential5": "5-point essential-matrix solver (C) against OpenCV and PoseLib: success, "
+                  "solutions, time",
 }
 #: the default N of ``--sizes`` per benchmark
 BENCH_SIZES = {"linear17": (17, 100, 1000, 10000), "cone": (3, 6, 20, 100, 1000)}
@@ -204,7 +206,8 @@ def _cmd_batch(args: argparse.Namespace) -> int:
 
 def _cmd_bench(args: argparse.Namespace) -> int:
     return {"linear17": _bench_linear17, "cone": _bench_cone, "bnb": _bench_bnb,
-            "known_rotation": _bench_known_rotation}[args.what](args)
+            "known_rotation": _bench_known_rotation,
+            "essential5": _bench_essential5}[args.what](args)
 
 
 def _sizes(args: argparse.Namespace) -> tuple[int, ...]:
@@ -254,6 +257,25 @@ def _bench_known_rotation(args: argparse.Namespace) -> int:
     return 0
 
 
+def _bench_essential5(args: argparse.Namespace) -> int:
+    from .experiments.bench.essential5 import bench_essential5
+
+    n = 10000 if args.problems is None else args.problems
+    rows, c_us, note = bench_essential5(problems=n, budget_s=args.budget,
+                                        progress=progress_bar)
+    print(f"essential5: {n} random noise-free minimal problems; found = true E among the "
+          "solutions (to 1e-6); CPU time per call through Python")
+    print(f"{'solver':>8} {'found':>8} {'solutions':>9} {'us/call':>8} {'vs mcgeom':>9}")
+    for r in rows:
+        print(f"{r.name:>8} {r.found:8.4f} {r.mean_solutions:9.3f} {r.us_per_call:8.2f} "
+              f"{r.us_per_call / rows[0].us_per_call:9.2f}")
+    print(f"C kernel alone (mcg_essential5 through cffi, preallocated buffers): {c_us:.2f} us "
+          "per call")
+    if note:
+        print(f"poselib not compared: {note}")
+    return 0
+
+
 def _bench_bnb(args: argparse.Namespace) -> int:
     from .experiments.bench.bnb import bench_bnb, growth
 
@@ -267,11 +289,12 @@ def _bench_bnb(args: argparse.Namespace) -> int:
     print("bnb: branch and bound over rotations to 1e-4 rad (4 cameras x 50 points, "
           "0.5 px; medians)")
     print(head + f" {'glpk s':>9} {'glpk/nat':>7}")
-    print(row(bench_bnb(problems=args.problems, progress=progress_bar)))
+    problems = 10 if args.problems is None else args.problems
+    print(row(bench_bnb(problems=problems, progress=progress_bar)))
     print("published: thesis ch. 10.5.1 about 3.5 s (C++ with GLPK)")
     print("\ngrowth with points (4 cameras) and cameras (50 points each)")
     print(head)
-    for r in growth(problems=max(3, args.problems // 2), progress=progress_bar):
+    for r in growth(problems=max(3, problems // 2), progress=progress_bar):
         print(row(r))
     return 0
 
@@ -423,13 +446,13 @@ def build_parser() -> argparse.ArgumentParser:
                        epilog=_name_list("benchmarks", BENCHES))
     b.add_argument("what", choices=list(BENCHES), metavar="NAME",
                    help="benchmark: " + ", ".join(BENCHES))
-    b.add_argument("--problems", type=positive_int, default=10,
-                   help="problems per row (bnb)")
+    b.add_argument("--problems", type=positive_int, default=None,
+                   help="problems per row (bnb: default 10; essential5: default 10000)")
     b.add_argument("--sizes", type=positive_int_list, default=None,
                    help="comma-separated N (linear17, cone; default: linear17 "
                         "17,100,1000,10000, cone 3,6,20,100,1000)")
     b.add_argument("--budget", type=positive_float, default=0.5,
-                   help="seconds per timing (linear17, cone)")
+                   help="seconds per timing (linear17, cone, essential5)")
     b.set_defaults(func=_cmd_bench)
 
     e = sub.add_parser("experiment", formatter_class=HelpFormatter,
