@@ -9,8 +9,9 @@ or the registered estimator.
 :class:`mcgeom.rig.Rig`), a ``prob``/``threshold`` (pixels)/``maxIters`` triple
 and an optional input mask, and returns ``retval, R, t, mask`` in the
 ``cv2.recoverPose`` convention: ``X2 = R X1 + t`` maps rig coordinates at time 1
-to time 2, ``t`` is a 3x1 column in metres (the unit of the rig extrinsics; unit
-length when the scale is not observable), ``mask`` an N x 1 ``uint8`` array
+to time 2, ``t`` is a 3x1 column in metres (the unit of the rig extrinsics: the
+maximum-likelihood metric estimate wherever the data define a scale; unit
+length, with a ``ScaleNotObservableWarning``, when they do not), ``mask`` an N x 1 ``uint8`` array
 with 1 for inliers, ``retval`` the number of inliers. :func:`estimate` runs the
 same and returns the full :class:`mcgeom.RigMotion` (scale verdict, residuals,
 diagnostics).
@@ -23,12 +24,14 @@ name may be passed as a string instead. Estimators that can drive RANSAC
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Optional
 
 import numpy as np
 
 from . import registry
-from . import robust as _robust   # (the name robust is estimate()'s flag)
+from . import robust as _robust
+from .errors import ScaleNotObservableWarning   # (the name robust is estimate()'s flag)
 from .pixel_noise import pixels_per_radian, sampson_pixel_scale
 from .rig import Rig
 from .types import RigMotion
@@ -161,10 +164,27 @@ def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     Same arguments as :func:`estimate`. ``R`` (3x3) and ``t`` (3x1, metres) map
     rig coordinates at time 1 to time 2 (``X2 = R X1 + t``, as
     ``cv2.recoverPose``); ``mask`` is N x 1 ``uint8`` (1 = inlier); ``retval``
-    the number of inliers. ``t`` has unit length when the scale is not
-    observable: call :func:`estimate` for the verdict.
+    the number of inliers.
+
+    ``t`` is in metres whenever the data define a metric scale: its
+    maximum-likelihood estimate. When the verdict of :func:`estimate` says
+    the scale is not observable, a :class:`mcgeom.ScaleNotObservableWarning`
+    is emitted: either ``t`` has unit norm (the data do not determine the
+    scale at all: exactly critical motion, e.g. driving straight with
+    intra-camera matches only, or one camera) or it is the metric estimate
+    with a relative standard deviation above the limit (the message gives
+    it). ``t = 0`` (no warning) when no translation was detected. Call
+    :func:`estimate` for the full verdict.
     """
     m = estimate(points1, points2, cameraIds1, cameraIds2, rig, method=method, prob=prob,
                  threshold=threshold, maxIters=maxIters, mask=mask)
+    if not m.scale.observable and np.any(m.t != 0):
+        if m.info.get("scale_determined", False):
+            what = (f"t is the maximum-likelihood metric estimate, but its relative standard "
+                    f"deviation is {m.scale.rel_std:.3g}")
+        else:
+            what = "t has unit norm: only its direction is determined"
+        warnings.warn(f"estimateRigMotion: the metric scale is not observable ({what}); "
+                      f"{m.scale.reason}", ScaleNotObservableWarning, stacklevel=2)
     out_mask = m.inliers.astype(np.uint8).reshape(-1, 1)
     return int(out_mask.sum()), np.array(m.R), np.array(m.t).reshape(3, 1), out_mask

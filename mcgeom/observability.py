@@ -26,7 +26,18 @@ from .geometry import (count_in_front, displacements, rcross, refine_centred, ro
                        same_camera)
 from .types import RayPairs, ScaleVerdict
 
-__all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile"]
+__all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
+           "scale_determined", "UNDETERMINED_REL_STD"]
+
+#: relative std of ``|t|`` above which the data define no metric scale at all:
+#: a one-sigma interval that reaches zero bounds neither the length nor (with
+#: the flat side of a near-critical cost) infinity. Below it ``t`` is reported
+#: as its maximum-likelihood metric estimate, trusted or not by the verdict;
+#: above it (and for an exactly critical motion) ``t`` has unit norm.
+UNDETERMINED_REL_STD = 1.0
+
+#: unknowns of a rig motion (rotation and metric translation)
+_MOTION_DOF = 6
 
 
 def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> float:
@@ -74,6 +85,21 @@ def _centres_with_intra(rays: RayPairs, mask: np.ndarray,
         return rays.origins1[rows[first]].reshape(-1, 3), cross
     centres = np.unique(rays.origins1[intra], axis=0) if intra.any() else np.zeros((0, 3))
     return centres, cross
+
+
+def scale_determined(rel_std: float, direction_only: bool = False) -> bool:
+    """Do the data define a metric scale at all (thesis ch. 7.3.2)?
+
+    False when the refinement had to fix ``|t|`` (``direction_only``: no
+    correspondence can fix it, e.g. an exactly critical motion or one camera),
+    when the information about ``|t|`` is singular (``rel_std`` not finite)
+    or when its relative standard deviation exceeds
+    :data:`UNDETERMINED_REL_STD`. When True, the estimate's ``t`` is its
+    maximum-likelihood metric estimate (the verdict says how far to trust it:
+    observable only within ``max_rel_std``); when False, ``t`` is a unit
+    direction.
+    """
+    return bool(not direction_only and np.isfinite(rel_std) and rel_std <= UNDETERMINED_REL_STD)
 
 
 def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sigma2: float,
@@ -139,6 +165,18 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
                                 0.0, float("inf"), 0.0)
     centres, n_cross = _centres_with_intra(rays, inliers, same)
     crit = rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
+    n_in = int(np.count_nonzero(inliers))
+    if n_in <= _MOTION_DOF:
+        # no redundancy: the motion fits its 6 correspondences exactly whatever
+        # the noise (a zero residual says nothing about |t|), and a minimal
+        # 5+1 problem has up to ten exact solutions of which several can put
+        # every point in front of the cameras (44 % of the noise-free
+        # configurations of ``mcgeom experiment minimal_5p1``): nothing tells
+        # the physical one
+        return ScaleVerdict(False, f"no redundancy: {n_in} correspondences for the "
+                                   f"{_MOTION_DOF} unknowns of the motion; other exact "
+                                   "solutions may exist and no uncertainty can be estimated",
+                            float("nan"), float("inf"), crit)
     evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {np.degrees(crit):.3g} deg "
                 f"over {len(centres)} cameras, {n_cross} cross-camera inliers")
     if np.isfinite(profile):
@@ -156,7 +194,6 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     # last guard against a confident wrong answer: a metric motion must put
     # its inliers in front of the cameras (a flipped or twisted solution that
     # survived the search puts most of them behind)
-    n_in = int(np.count_nonzero(inliers))
     front = count_in_front(rays, R, t, inliers) / n_in if n_in else 0.0
     if front < 0.5:
         return ScaleVerdict(False, f"cheirality fails: only {100 * front:.0f} % of the inliers "

@@ -37,7 +37,7 @@ from .errors import DegenerateError
 # the same (see mcgeom.estimators._common: no estimator imports this module)
 from .estimators._common import travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
-from .observability import scale_profile, scale_verdict
+from .observability import scale_determined, scale_profile, scale_verdict
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
@@ -473,6 +473,8 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     # the metric estimate whatever the verdict (when the scale is unobservable
     # the refinement may have slid |t| far along its flat valley: a guess)
     info["t_metric"] = np.array(t)
+    # t is the metric estimate unless the branches below find it undetermined
+    determined = info["translation_detected"]
     if not info["translation_detected"]:
         # static rig or pure rotation: the verdict says t = 0 (as the search
         # that finds no motion at all does, _no_translation), not a unit
@@ -487,10 +489,22 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         # near the critical motion the 1-point scale search may propose a
         # huge |t|, which the refinement on all inliers brings back
         # (measured on the Ladybug head: 565 -> 1.06, 45 -> 0.97 for |t| = 1).
-        if not nt <= 10.0 * n0:
+        slid = not nt <= 10.0 * n0
+        if slid:
             nt = n0
-        t = travel_direction(rays, inl, R, t)
-        info["t_metric"] = nt * t
+        direction = travel_direction(rays, inl, R, t)
+        info["t_direction"] = direction
+        if slid or not scale_determined(rel_std):
+            # the data define no scale: a unit direction (issue 18: never a
+            # silent unit vector where a metric estimate exists, and never a
+            # metric-looking one where none does)
+            # (info['t_metric'] keeps the refined t, the least-squares guess,
+            # unless it slid out: then the hypothesis' length along the travel)
+            if slid:
+                info["t_metric"] = nt * direction
+            t = direction
+            determined = False
+    info["scale_determined"] = determined
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
                      float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan"),
                      inl, info)

@@ -31,8 +31,8 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..geometry import rcross, refine_centred
-from ..observability import scale_profile, scale_verdict
+from ..geometry import count_in_front, rcross, refine_centred
+from ..observability import scale_determined, scale_profile, scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import camera_ids, intra_counts, travel_direction
@@ -87,7 +87,7 @@ def solve(rays: RayPairs, five_camera: Optional[int] = None,
         raise DegenerateError(f"five_plus_one: the 5-point solver found no motion in camera {a} "
                               "(too few usable points, or degenerate: no translation)")
     others = np.flatnonzero(~((cam1 == a) & (cam2 == a)))
-    best = None
+    cands = []
     for R, t0, w in essential:
         if others.size:
             sa, sb = scale_terms(rays.take(others), R, t0, w)
@@ -101,9 +101,18 @@ def solve(rays: RayPairs, five_camera: Optional[int] = None,
         res = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2,
                                          rays.dirs2, R, t))
         cost = float(np.sum(res ** 2))
-        if best is None or cost < best["cost"]:
-            best = dict(R=R, t=t, t0=t0, w=w, lam=lam, scale_rel_std=rel, cost=cost,
-                        five_camera=a, n_scale=int(others.size), scale_determined=determined)
+        cands.append(dict(R=R, t=t, t0=t0, w=w, lam=lam, scale_rel_std=rel, cost=cost,
+                          five_camera=a, n_scale=int(others.size), scale_determined=determined,
+                          in_front=count_in_front(rays, R, t)))
+    # Cheirality first, then cost: with few correspondences (6: the minimal
+    # problem) several 5-point solutions fit every epipolar constraint to
+    # rounding, and only the physical one puts the points in front of the
+    # cameras (the verdict would otherwise reject the kept one for cheirality).
+    # 5 % of the correspondences of slack: noise may put a few far or
+    # near-parallel points behind under the right motion.
+    top = max(c["in_front"] for c in cands)
+    slack = int(0.05 * len(rays))
+    best = min((c for c in cands if c["in_front"] >= top - slack), key=lambda c: c["cost"])
     best["critical_angles"] = critical_angles(best["R"], best["t"], centres, a)
     return best
 
@@ -209,17 +218,22 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
                 k = 1.0 + 3.0 * max_scale_rel_std
                 info["scale_profile"] = scale_profile(rays, R, t, out["final_cost"],
                                                       out["sigma2"], (1.0 / k, k))
-                if info["scale_profile"] < 9.0:
-                    rel = float("inf")
     sol["critical_angles"] = critical_angles(R, t, camera_ids(rays)[2], sol["five_camera"])
     info["critical_angles"] = sol["critical_angles"]
+    # a profile that does not exclude |t| x/ (1 + 3 max_scale_rel_std) makes
+    # the verdict "not observable" (it sees the non-linear cost); rel keeps
+    # the first-order std, which says whether a metric estimate exists at all
     verdict = scale_verdict(rays, np.ones(len(rays), bool), R, t, rel, max_scale_rel_std,
-                            fixed)
+                            fixed, profile=info.get("scale_profile", float("nan")))
     info["t_metric"] = np.array(t)   # metric estimate, whatever the verdict
+    # t is the maximum-likelihood metric estimate wherever the data define a
+    # scale at all (the verdict says how far to trust it), a unit direction
+    # where they do not (mcgeom.observability.scale_determined)
+    info["scale_determined"] = scale_determined(rel, fixed)
     if not verdict.observable:
-        nt = np.linalg.norm(t)
-        t = travel_direction(rays, np.ones(len(rays), bool), R, t)
-        info["t_metric"] = nt * t
+        info["t_direction"] = travel_direction(rays, np.ones(len(rays), bool), R, t)
+        if not info["scale_determined"]:
+            t = info["t_direction"]
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
     return RigMotion(R, t, verdict, "five_plus_one", float(np.sqrt(np.mean(r ** 2))), None, info)
 
