@@ -103,7 +103,8 @@ def _resolve(method: str, robust_flag: Optional[bool]) -> tuple[str, bool]:
 def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
-             robust: Optional[bool] = None, **options: Any) -> RigMotion:
+             robust: Optional[bool] = None, calibration_std: Any = None,
+             **options: Any) -> RigMotion:
     """Full :class:`RigMotion` rig2_from_rig1 from pixel correspondences of ``rig``.
 
     ``points1[k]`` (pixels, camera ``cameraIds1[k]``, time 1) and ``points2[k]``
@@ -113,6 +114,13 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     ``maxIters`` its iteration cap, ``mask`` (N, N x 1, nonzero = use) selects
     the correspondences to consider. The returned ``inliers`` mask has N entries
     (False for masked-out correspondences).
+
+    ``calibration_std`` overrides the rig's extrinsic calibration error
+    (:attr:`mcgeom.rig.Rig.extrinsic_std`: from the rig file, else
+    :data:`mcgeom.rig.DEFAULT_EXTRINSIC_STD`): one pair (position std in
+    metres, rotation std in radians) for every camera, or one per camera.
+    ``scale.rel_std`` (and ``info['covariance']``) include its effect on the
+    metric scale, and the verdict is decided on that total.
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
@@ -133,6 +141,8 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
                                                        else ""))
         use = m != 0
     name, run_robust = _resolve(method, robust)
+    cal = rig.extrinsic_std if calibration_std is None else \
+        Rig(rig.cameras, calibration_std).extrinsic_std   # (checked: names the option)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
     rays_all = rig.ray_pairs_prechecked(p1, p2, ids1, ids2)
@@ -143,13 +153,16 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         # thresholds in pixels: the pixel-noise model of the rig converts them
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                            seed=seed, focal=pixels_per_radian(rig, rays),
-                           motion_focal=sampson_pixel_scale(rig), **options)
+                           motion_focal=sampson_pixel_scale(rig), calibration_std=cal,
+                           **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:
             inl = np.zeros(n, bool)
             inl[keep] = m.inliers
     else:
+        if "calibration_std" in registry.get(name).options:
+            options = {"calibration_std": cal, **options}
         m = registry.get(name)(rays, **options)
         inl = use.copy()
     return RigMotion(m.R, m.t, m.scale, m.method, m.residual_rms, inl, m.info)

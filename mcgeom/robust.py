@@ -37,7 +37,7 @@ from .errors import DegenerateError
 # the same (see mcgeom.estimators._common: no estimator imports this module)
 from .estimators._common import travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
-from .observability import scale_determined, scale_profile, scale_verdict
+from .observability import scale_determined, scale_profile, scale_verdict, total_scale_std
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
@@ -258,7 +258,8 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
            threshold: Optional[float] = None, prob: float = 0.999, max_iters: int = 1000,
            seed: Optional[int] = 0, focal: Union[None, float, np.ndarray] = None,
            options: Optional[RansacOptions] = None,
-           motion_focal: Optional[MotionFocal] = None, **kw: Any) -> RigMotion:
+           motion_focal: Optional[MotionFocal] = None, calibration_std: Any = None,
+           **kw: Any) -> RigMotion:
     """Robust rig motion rig2_from_rig1 from correspondences with outliers.
 
     ``method`` is a registered estimator with a minimal solver or a proposer.
@@ -268,8 +269,13 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     ``max_iters`` caps the number of samples; ``seed`` makes the run
     deterministic. ``motion_focal(rays, R, t)`` (with ``focal`` only) returns
     the pixels per radian of every residual at motion (R, t), for the final
-    refinement (see :meth:`_Scorer.scaling_at`). Further ``RansacOptions``
-    fields may be passed as keywords.
+    refinement (see :meth:`_Scorer.scaling_at`). ``calibration_std`` is the
+    rig's extrinsic calibration error, one pair (position std in metres,
+    rotation std in radians) for every camera or an (M, 2) array by camera id
+    (:attr:`mcgeom.rig.Rig.extrinsic_std`; :func:`mcgeom.cv.estimate` passes
+    the rig's): the relative std of ``|t|`` and the verdict include its
+    effect (:func:`mcgeom.observability.calibration_scale_std`); None = rays
+    known exactly. Further ``RansacOptions`` fields may be passed as keywords.
 
     Returns a ``RigMotion`` with the boolean ``inliers`` mask, the scale verdict
     (from the covariance of the final refinement, plus the estimator's own
@@ -320,7 +326,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
                               f"({scorer.n_hyp} hypotheses from {iterations} samples): degenerate "
                               f"data (e.g. points collinear or coplanar in every camera, or "
                               f"too few correspondences per camera: {_per_camera(rays)})")
-    return _finish(rays, scorer, options, method, iterations, t_start)
+    return _finish(rays, scorer, options, method, iterations, t_start, calibration_std)
 
 
 def _per_camera(rays: RayPairs) -> str:
@@ -413,7 +419,7 @@ def _no_translation(rays: RayPairs, scorer: _Scorer, options: RansacOptions, met
 
 
 def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str,
-            iterations: int, t_start: float) -> RigMotion:
+            iterations: int, t_start: float, calibration_std: Any = None) -> RigMotion:
     """Final robust refinement on the inliers, verdict and diagnostics."""
     R, t = scorer.best
     inl = scorer.best_inliers
@@ -456,6 +462,9 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         inl = r < options.threshold
         rel_std = float(out["scale_rel_std"])
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
+        rel_std, parts = total_scale_std(rays.take(used), R, t, out, calibration_std, w_used,
+                                         options.loss, scale_used)
+        info.update(parts)
     if r is None:
         r = scorer.best_residuals
     info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start,

@@ -32,7 +32,7 @@ import numpy as np
 from .. import _core
 from ..errors import DegenerateError
 from ..geometry import count_in_front, rcross, refine_centred
-from ..observability import scale_determined, scale_profile, scale_verdict
+from ..observability import scale_determined, scale_profile, scale_verdict, total_scale_std
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import camera_ids, intra_counts, travel_direction
@@ -153,13 +153,16 @@ def _refine_all(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool) -
                             "(default: the one with most intra-camera correspondences)",
              "refine": "joint nonlinear refinement on all correspondences (default True)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
-                                  "unobservable (0.1)"},
+                                  "unobservable (0.1)",
+             "calibration_std": "extrinsic calibration error of the cameras: (position std "
+                                "m, rotation std rad) for all, or one pair per camera id; "
+                                "included in the relative std of |t| (default None: exact)"},
     minimal_solver=minimal_solutions,
     sampler=sample_five_plus_one,
     proposer=lambda rays, thr, prob, rng: propose(rays, thr, prob, rng),
 )
 def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: bool = True,
-                  max_scale_rel_std: float = 0.1) -> RigMotion:
+                  max_scale_rel_std: float = 0.1, calibration_std=None) -> RigMotion:
     """Rig motion rig2_from_rig1 (R, t in metres) by the 5+1 method on all correspondences.
 
     ``rays`` in the rig frame with origins at the camera centres; camera ids
@@ -169,8 +172,14 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     correspondence not of the 5-point camera, then (``refine``) the motion is
     refined jointly on all correspondences (Sampson angular error). ``info``
     holds the 5-point camera, the critical angles (radians) per camera, the
-    linear scale and its relative std. Raises ValueError when no camera has 5
-    intra-camera correspondences, DegenerateError when the 5-point solver fails.
+    linear scale and its relative std. ``calibration_std`` (see
+    :func:`mcgeom.observability.calibration_scale_std`) adds the rig's
+    extrinsic calibration error to the relative std of ``|t|`` (``info``:
+    ``scale_rel_std_noise``, ``scale_rel_std_calibration``, ``covariance``).
+    ``t`` is the metric estimate wherever the data determine a scale
+    (``info['scale_determined']``), a unit direction where not. Raises
+    ValueError when no camera has 5 intra-camera correspondences,
+    DegenerateError when the 5-point solver fails.
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -212,7 +221,10 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     if out is not None:
         R, t = out["R"], out["t"]
         if len(rays) > 6:
-            rel = float(out["scale_rel_std"]) if not fixed else float("inf")
+            rel, parts = total_scale_std(rays, out["R"], out["t"], out, calibration_std)
+            info.update(parts)
+            if fixed:
+                rel = float("inf")
             info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
             if rel <= max_scale_rel_std:
                 k = 1.0 + 3.0 * max_scale_rel_std
