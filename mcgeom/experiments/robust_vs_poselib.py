@@ -1,8 +1,9 @@
 """Robust rig motion from pixels: mcgeom's default pipeline against PoseLib, same problems.
 
-Cases (issues 3, 18): a Ladybug2-like 6-camera head with 300 correspondences, 30 %
-outliers and 0.5 px noise; the 8-camera car rig of ch. 7.5.2 driving forward
-with at most 2 deg of yaw (400 correspondences, 20 % outliers, 0.5 px); a 2-camera non-overlapping head with 200
+Cases (issues 3, 18): a Ladybug2-like 6-camera head with 300 correspondences,
+30 % outliers and 0.5 px noise; the 8-camera car rig of ch. 7.5.2 driving
+forward with at most 2 deg of yaw (400 correspondences, 20 % outliers,
+0.5 px); a 2-camera non-overlapping head with 200
 correspondences and 0.5 px noise; a 4-camera ring with 4 x 50 points at 0.1,
 0.3 and 0.5 px. Both methods get the same pixels, the same calibration and the
 same 1 px epipolar threshold; PoseLib runs ``estimate_generalized_relative_pose``
@@ -173,14 +174,16 @@ def median_differences(res: dict, boot: int = 2000, seed: int = 1) -> str:
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment robust_vs_poselib``."""
     add_count_and_seed(ap, "--problems", 600, "problems per case")
-    ap.add_argument("--cases", nargs="*", default=list(CASES), choices=list(CASES),
-                    metavar="CASE", help="cases to run, of: " + "; ".join(CASES))
+    ap.add_argument("--cases", nargs="*", default=None, choices=list(CASES), metavar="CASE",
+                    help="cases to run (default: all), of: "
+                         + "; ".join(CASES).replace("%", "%%"))
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     """Print the comparison table and the bootstrap intervals."""
     import_peer("poselib", "robust_vs_poselib")
-    res = run(args.problems, args.seed, {k: CASES[k] for k in args.cases}, progress=progress)
+    res = run(args.problems, args.seed, {k: CASES[k] for k in args.cases or CASES},
+              progress=progress)
     print(table(res))
     print()
     print(median_differences(res))
