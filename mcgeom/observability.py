@@ -31,7 +31,7 @@ from .geometry import (count_in_front, displacements, rcross, refine_centred, ro
 from .types import RayPairs, ScaleVerdict
 
 __all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
-           "scale_determined", "UNDETERMINED_REL_STD", "calibration_scale_std",
+           "scale_determined", "UNDETERMINED_REL_STD", "ZERO_FACTOR", "calibration_scale_std",
            "combine_rel_std", "total_scale_std"]
 
 #: relative std of ``|t|`` above which the data define no metric scale at all:
@@ -92,18 +92,30 @@ def _centres_with_intra(rays: RayPairs, mask: np.ndarray,
     return centres, cross
 
 
-def scale_determined(rel_std: float, direction_only: bool = False) -> bool:
+#: the factor of :func:`scale_profile` that asks "could the cameras not have
+#: moved at all?": |t| shrunk to 1 %
+ZERO_FACTOR = 0.01
+
+
+def scale_determined(rel_std: float, direction_only: bool = False,
+                     zero_profile: float = float("nan")) -> bool:
     """Do the data define a metric scale at all (thesis ch. 7.3.2)?
 
     False when the refinement had to fix ``|t|`` (``direction_only``: no
     correspondence can fix it, e.g. an exactly critical motion or one camera),
-    when the information about ``|t|`` is singular (``rel_std`` not finite)
-    or when its relative standard deviation exceeds
-    :data:`UNDETERMINED_REL_STD`. When True, the estimate's ``t`` is its
-    maximum-likelihood metric estimate (the verdict says how far to trust it:
-    observable only within ``max_rel_std``); when False, ``t`` is a unit
-    direction.
+    when the information about ``|t|`` is singular (``rel_std`` not finite),
+    when its relative standard deviation exceeds :data:`UNDETERMINED_REL_STD`,
+    or when ``zero_profile`` (:func:`scale_profile` for the factor
+    :data:`ZERO_FACTOR`, if computed) does not exclude a vanishing
+    translation at 3 sigma: the length of a noise-driven translation of a
+    static rig is no scale (its first-order std is unreliable there: the norm
+    of pure noise has a relative std near 0.5). When True, the estimate's
+    ``t`` is its maximum-likelihood metric estimate (the verdict says how far
+    to trust it: observable only within ``max_rel_std``); when False, ``t``
+    is a unit direction.
     """
+    if np.isfinite(zero_profile) and zero_profile < 9.0:
+        return False
     return bool(not direction_only and np.isfinite(rel_std) and rel_std <= UNDETERMINED_REL_STD)
 
 

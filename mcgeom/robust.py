@@ -37,7 +37,8 @@ from .errors import DegenerateError
 # the same (see mcgeom.estimators._common: no estimator imports this module)
 from .estimators._common import travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
-from .observability import scale_determined, scale_profile, scale_verdict, total_scale_std
+from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
+                            total_scale_std)
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 
 __all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
@@ -503,7 +504,11 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
             nt = n0
         direction = travel_direction(rays, inl, R, t)
         info["t_direction"] = direction
-        if slid or not scale_determined(rel_std):
+        zero = float("nan")
+        if not slid and scale_determined(rel_std):
+            zero = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
+                                 (ZERO_FACTOR,), options.loss, scale_used, w_used)
+        if slid or not scale_determined(rel_std, zero_profile=zero):
             # the data define no scale: a unit direction (issue 18: never a
             # silent unit vector where a metric estimate exists, and never a
             # metric-looking one where none does)

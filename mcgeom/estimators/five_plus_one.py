@@ -32,7 +32,8 @@ import numpy as np
 from .. import _core
 from ..errors import DegenerateError
 from ..geometry import count_in_front, rcross, refine_centred
-from ..observability import scale_determined, scale_profile, scale_verdict, total_scale_std
+from ..observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
+                              total_scale_std)
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import camera_ids, intra_counts, travel_direction
@@ -241,7 +242,11 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     # t is the maximum-likelihood metric estimate wherever the data define a
     # scale at all (the verdict says how far to trust it), a unit direction
     # where they do not (mcgeom.observability.scale_determined)
-    info["scale_determined"] = scale_determined(rel, fixed)
+    zero = float("nan")
+    if not verdict.observable and out is not None and len(rays) > 6 and \
+            scale_determined(rel, fixed):
+        zero = scale_profile(rays, R, t, out["final_cost"], out["sigma2"], (ZERO_FACTOR,))
+    info["scale_determined"] = scale_determined(rel, fixed, zero)
     if not verdict.observable:
         info["t_direction"] = travel_direction(rays, np.ones(len(rays), bool), R, t)
         if not info["scale_determined"]:
