@@ -8,7 +8,8 @@ Conventions (docs/architecture.md §3): rays and camera centres in the rig frame
 from __future__ import annotations
 
 from . import registry
-from .errors import DegenerateError, InfeasibleError, McgeomError, NumericalError
+from .errors import (DegenerateError, InfeasibleError, McgeomError, NumericalError,
+                     ScaleNotObservableWarning)
 from .types import RayPairs, RigMotion, ScaleVerdict
 from . import estimators as _estimators  # noqa: F401  (registers the built-ins)
 from . import robust
@@ -32,5 +33,6 @@ __all__ = [
     "RayPairs", "RigMotion", "ScaleVerdict", "estimate", "registry", "robust",
     "estimateRigMotion", "RIG_5P1_RANSAC", "RIG_5P1_DIRECT", "RIG_LINEAR17",
     "RIG_LINEAR17_RANSAC", "load_rig",
-    "McgeomError", "NumericalError", "InfeasibleError", "DegenerateError", "__version__",
+    "McgeomError", "NumericalError", "InfeasibleError", "DegenerateError",
+    "ScaleNotObservableWarning", "__version__",
 ]

@@ -9,8 +9,9 @@ or the registered estimator.
 :class:`mcgeom.rig.Rig`), a ``prob``/``threshold`` (pixels)/``maxIters`` triple
 and an optional input mask, and returns ``retval, R, t, mask`` in the
 ``cv2.recoverPose`` convention: ``X2 = R X1 + t`` maps rig coordinates at time 1
-to time 2, ``t`` is a 3x1 column in metres (the unit of the rig extrinsics; unit
-length when the scale is not observable), ``mask`` an N x 1 ``uint8`` array
+to time 2, ``t`` is a 3x1 column in metres (the unit of the rig extrinsics: the
+maximum-likelihood metric estimate wherever the data define a scale; unit
+length, with a ``ScaleNotObservableWarning``, when they do not), ``mask`` an N x 1 ``uint8`` array
 with 1 for inliers, ``retval`` the number of inliers. :func:`estimate` runs the
 same and returns the full :class:`mcgeom.RigMotion` (scale verdict, residuals,
 diagnostics).
@@ -23,12 +24,14 @@ name may be passed as a string instead. Estimators that can drive RANSAC
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Optional
 
 import numpy as np
 
 from . import registry
-from . import robust as _robust   # (the name robust is estimate()'s flag)
+from . import robust as _robust
+from .errors import ScaleNotObservableWarning   # (the name robust is estimate()'s flag)
 from .pixel_noise import pixels_per_radian, sampson_pixel_scale
 from .rig import Rig
 from .types import RigMotion
@@ -117,7 +120,8 @@ def _no_ransac_options(name: str, **given: Any) -> None:
 def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
-             robust: Optional[bool] = None, **options: Any) -> RigMotion:
+             robust: Optional[bool] = None, calibration_std: Any = None,
+             **options: Any) -> RigMotion:
     """Full :class:`RigMotion` rig2_from_rig1 from pixel correspondences of ``rig``.
 
     ``points1[k]`` (pixels, camera ``cameraIds1[k]``, time 1) and ``points2[k]``
@@ -131,6 +135,13 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     (``direct:...``, ``robust=False``, ``RIG_LINEAR17``, estimators without a
     minimal solver) a non-default value is a ValueError naming the option and
     the method, not ignored.
+
+    ``calibration_std`` overrides the rig's extrinsic calibration error
+    (:attr:`mcgeom.rig.Rig.extrinsic_std`: from the rig file, else
+    :data:`mcgeom.rig.DEFAULT_EXTRINSIC_STD`): one pair (position std in
+    metres, rotation std in radians) for every camera, or one per camera.
+    ``scale.rel_std`` (and ``info['covariance']``) include its effect on the
+    metric scale, and the verdict is decided on that total.
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
@@ -153,6 +164,8 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     name, run_robust = _resolve(method, robust)
     if not run_robust:
         _no_ransac_options(name, prob=prob, threshold=threshold, maxIters=maxIters, seed=seed)
+    cal = rig.extrinsic_std if calibration_std is None else \
+        Rig(rig.cameras, calibration_std).extrinsic_std   # (checked: names the option)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
     rays_all = rig.ray_pairs_prechecked(p1, p2, ids1, ids2)
@@ -163,13 +176,16 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         # thresholds in pixels: the pixel-noise model of the rig converts them
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                            seed=seed, focal=pixels_per_radian(rig, rays),
-                           motion_focal=sampson_pixel_scale(rig), **options)
+                           motion_focal=sampson_pixel_scale(rig), calibration_std=cal,
+                           **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:
             inl = np.zeros(n, bool)
             inl[keep] = m.inliers
     else:
+        if "calibration_std" in registry.get(name).options:
+            options = {"calibration_std": cal, **options}
         m = registry.get(name)(rays, **options)
         inl = use.copy()
     return RigMotion(m.R, m.t, m.scale, m.method, m.residual_rms, inl, m.info)
@@ -184,10 +200,27 @@ def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     Same arguments as :func:`estimate`. ``R`` (3x3) and ``t`` (3x1, metres) map
     rig coordinates at time 1 to time 2 (``X2 = R X1 + t``, as
     ``cv2.recoverPose``); ``mask`` is N x 1 ``uint8`` (1 = inlier); ``retval``
-    the number of inliers. ``t`` has unit length when the scale is not
-    observable: call :func:`estimate` for the verdict.
+    the number of inliers.
+
+    ``t`` is in metres whenever the data define a metric scale: its
+    maximum-likelihood estimate. When the verdict of :func:`estimate` says
+    the scale is not observable, a :class:`mcgeom.ScaleNotObservableWarning`
+    is emitted: either ``t`` has unit norm (the data do not determine the
+    scale at all: exactly critical motion, e.g. driving straight with
+    intra-camera matches only, or one camera) or it is the metric estimate
+    with a relative standard deviation above the limit (the message gives
+    it). ``t = 0`` (no warning) when no translation was detected. Call
+    :func:`estimate` for the full verdict.
     """
     m = estimate(points1, points2, cameraIds1, cameraIds2, rig, method=method, prob=prob,
                  threshold=threshold, maxIters=maxIters, mask=mask)
+    if not m.scale.observable and np.any(m.t != 0):
+        if m.info.get("scale_determined", False):
+            what = (f"t is the maximum-likelihood metric estimate, but its relative standard "
+                    f"deviation is {m.scale.rel_std:.3g}")
+        else:
+            what = "t has unit norm: only its direction is determined"
+        warnings.warn(f"estimateRigMotion: the metric scale is not observable ({what}); "
+                      f"{m.scale.reason}", ScaleNotObservableWarning, stacklevel=2)
     out_mask = m.inliers.astype(np.uint8).reshape(-1, 1)
     return int(out_mask.sum()), np.array(m.R), np.array(m.t).reshape(3, 1), out_mask

@@ -7,7 +7,8 @@ caller can tell "you passed garbage" from "this geometry cannot be solved".
 
 from __future__ import annotations
 
-__all__ = ["McgeomError", "NumericalError", "InfeasibleError", "DegenerateError"]
+__all__ = ["McgeomError", "NumericalError", "InfeasibleError", "DegenerateError",
+           "ScaleNotObservableWarning"]
 
 
 class McgeomError(Exception):
@@ -28,4 +29,17 @@ class DegenerateError(McgeomError, ValueError):
     Examples: too few independent correspondences for the detected generalized
     camera case, or a motion without translation for which the generalized
     essential matrix E = [t]x R vanishes.
+    """
+
+
+class ScaleNotObservableWarning(UserWarning):
+    """The metric scale of the returned translation is not trustworthy.
+
+    Emitted by the OpenCV-style :func:`mcgeom.estimateRigMotion`, whose
+    ``(retval, R, t, mask)`` carries no verdict: either the data do not
+    determine the scale at all (exactly critical motion, one camera: ``t`` has
+    unit norm, only its direction is meaningful) or they determine it too
+    loosely (``t`` is the maximum-likelihood metric estimate but its relative
+    standard deviation exceeds the limit). The message says which;
+    :func:`mcgeom.cv.estimate` returns the full verdict instead.
     """

@@ -12,7 +12,10 @@ Two pieces of evidence are combined:
 * statistics: the relative standard deviation of ``|t|`` from the covariance of
   the final nonlinear refinement (residual variance times the inverse
   information matrix), which accounts for the noise, the number of inliers and
-  the rotation uncertainty together.
+  the rotation uncertainty together; and the part the rig's calibration error
+  adds (:func:`calibration_scale_std`: the scale is fixed through the camera
+  centres, so an error in them moves it), combined in quadrature
+  (:func:`combine_rel_std`).
 
 The verdict is "observable" when the statistics say so (relative std at most
 ``max_rel_std``); the critical angle and the cross-camera count explain it.
@@ -22,11 +25,24 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import _core
 from .geometry import (count_in_front, displacements, rcross, refine_centred, rotation_fit,
                        same_camera)
 from .types import RayPairs, ScaleVerdict
 
-__all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile"]
+__all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
+           "scale_determined", "UNDETERMINED_REL_STD", "ZERO_FACTOR", "calibration_scale_std",
+           "combine_rel_std", "total_scale_std"]
+
+#: relative std of ``|t|`` above which the data define no metric scale at all:
+#: a one-sigma interval that reaches zero bounds neither the length nor (with
+#: the flat side of a near-critical cost) infinity. Below it ``t`` is reported
+#: as its maximum-likelihood metric estimate, trusted or not by the verdict;
+#: above it (and for an exactly critical motion) ``t`` has unit norm.
+UNDETERMINED_REL_STD = 1.0
+
+#: unknowns of a rig motion (rotation and metric translation)
+_MOTION_DOF = 6
 
 
 def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> float:
@@ -74,6 +90,33 @@ def _centres_with_intra(rays: RayPairs, mask: np.ndarray,
         return rays.origins1[rows[first]].reshape(-1, 3), cross
     centres = np.unique(rays.origins1[intra], axis=0) if intra.any() else np.zeros((0, 3))
     return centres, cross
+
+
+#: the factor of :func:`scale_profile` that asks "could the cameras not have
+#: moved at all?": |t| shrunk to 1 %
+ZERO_FACTOR = 0.01
+
+
+def scale_determined(rel_std: float, direction_only: bool = False,
+                     zero_profile: float = float("nan")) -> bool:
+    """Do the data define a metric scale at all (thesis ch. 7.3.2)?
+
+    False when the refinement had to fix ``|t|`` (``direction_only``: no
+    correspondence can fix it, e.g. an exactly critical motion or one camera),
+    when the information about ``|t|`` is singular (``rel_std`` not finite),
+    when its relative standard deviation exceeds :data:`UNDETERMINED_REL_STD`,
+    or when ``zero_profile`` (:func:`scale_profile` for the factor
+    :data:`ZERO_FACTOR`, if computed) does not exclude a vanishing
+    translation at 3 sigma: the length of a noise-driven translation of a
+    static rig is no scale (its first-order std is unreliable there: the norm
+    of pure noise has a relative std near 0.5). When True, the estimate's
+    ``t`` is its maximum-likelihood metric estimate (the verdict says how far
+    to trust it: observable only within ``max_rel_std``); when False, ``t``
+    is a unit direction.
+    """
+    if np.isfinite(zero_profile) and zero_profile < 9.0:
+        return False
+    return bool(not direction_only and np.isfinite(rel_std) and rel_std <= UNDETERMINED_REL_STD)
 
 
 def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sigma2: float,
@@ -139,6 +182,18 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
                                 0.0, float("inf"), 0.0)
     centres, n_cross = _centres_with_intra(rays, inliers, same)
     crit = rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
+    n_in = int(np.count_nonzero(inliers))
+    if n_in <= _MOTION_DOF:
+        # no redundancy: the motion fits its 6 correspondences exactly whatever
+        # the noise (a zero residual says nothing about |t|), and a minimal
+        # 5+1 problem has up to ten exact solutions of which several can put
+        # every point in front of the cameras (44 % of the noise-free
+        # configurations of ``mcgeom experiment minimal_5p1``): nothing tells
+        # the physical one
+        return ScaleVerdict(False, f"no redundancy: {n_in} correspondences for the "
+                                   f"{_MOTION_DOF} unknowns of the motion; other exact "
+                                   "solutions may exist and no uncertainty can be estimated",
+                            float("nan"), float("inf"), crit)
     evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {np.degrees(crit):.3g} deg "
                 f"over {len(centres)} cameras, {n_cross} cross-camera inliers")
     if np.isfinite(profile):
@@ -156,10 +211,173 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     # last guard against a confident wrong answer: a metric motion must put
     # its inliers in front of the cameras (a flipped or twisted solution that
     # survived the search puts most of them behind)
-    n_in = int(np.count_nonzero(inliers))
     front = count_in_front(rays, R, t, inliers) / n_in if n_in else 0.0
     if front < 0.5:
         return ScaleVerdict(False, f"cheirality fails: only {100 * front:.0f} % of the inliers "
                                    f"triangulate in front of the cameras (a wrong solution?); "
                                    f"{evidence}", float("nan"), float(rel_std), crit)
     return ScaleVerdict(True, f"scale observable: {evidence}", float("nan"), float(rel_std), crit)
+
+
+# ------------------------------------------------ calibration error of the rig
+
+def _rotvec(w: np.ndarray) -> np.ndarray:
+    """Rotation matrix of the rotation vector ``w`` (radians; Rodrigues)."""
+    th = float(np.linalg.norm(w))
+    if th < 1e-300:
+        return np.eye(3)
+    k = w / th
+    Kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + np.sin(th) * Kx + (1.0 - np.cos(th)) * (Kx @ Kx)
+
+
+def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
+                          extrinsic_std, weights: np.ndarray | None = None,
+                          loss: str = "none", loss_scale: float = 1e-3
+                          ) -> tuple[float, np.ndarray]:
+    """Relative std of the distance travelled due to the rig's calibration error.
+
+    First-order propagation through the least-squares estimate (the implicit
+    function theorem on its normal equations): with ``theta = (w, tau)`` the
+    motion (left rotation increment, radians; translation of the cameras'
+    centroid ``tau = t + R c - c``, metres, as
+    :func:`mcgeom.geometry.refine_centred` uses) and ``p`` the extrinsics of
+    every camera (centre, metres, and orientation, radians, in the rig frame;
+    one camera's error moves the origins and turns the bearings of its rays
+    at both times),
+
+        d theta / d p = -(J^T W J)^-1 J^T W (dr / dp),
+
+    ``r`` the Sampson angular residuals (``_core.gec_residuals``), ``W`` the
+    ``weights`` times the robust loss's IRLS weights at the solution (``loss``,
+    ``loss_scale`` radians, as in the final refinement). The variance of
+    ``|tau|`` is ``sum_j (u^T d tau / d p_j)^2 sigma_j^2`` with ``u = tau /
+    |tau|`` and ``sigma_j`` from ``extrinsic_std``: an (M, 2) array (or one
+    pair) of per-camera 1-sigma position (metres per axis) and rotation
+    (radians per axis) errors, independent across cameras and axes. Jacobians
+    by central differences (the residuals are smooth; 6 + 6 M evaluations of
+    one C call each).
+
+    Returns ``(rel_std, cov)``: the relative std of ``|tau|`` (0 when every
+    std is 0, inf when the motion is not determined by the rays: singular
+    ``J^T W J``) and the (6, 6) covariance of ``theta`` that the calibration
+    error induces (order [w, tau]).
+    """
+    sig = np.asarray(extrinsic_std, dtype=np.float64)
+    R = np.asarray(R, dtype=np.float64)
+    t = np.asarray(t, dtype=np.float64)
+    if rays.cam1 is not None and rays.cam2 is not None:
+        cam1, cam2 = rays.cam1, rays.cam2
+    else:   # cameras from equal origins
+        allo = np.concatenate([rays.origins1, rays.origins2])
+        inv = np.unique(allo, axis=0, return_inverse=True)[1].ravel()
+        cam1, cam2 = inv[:len(rays)], inv[len(rays):]
+    m = int(max(cam1.max(initial=-1), cam2.max(initial=-1))) + 1
+    if sig.shape == (2,):
+        sig = np.tile(sig, (m, 1))
+    if sig.ndim != 2 or sig.shape[1] != 2 or sig.shape[0] < m:
+        raise ValueError(f"calibration_std must have shape (2,) or (M, 2) with M >= {m} "
+                         f"(the cameras of the rays), got {sig.shape}")
+    if not np.any(sig[:m] > 0) or len(rays) == 0:
+        return 0.0, np.zeros((6, 6))
+    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    o1, o2 = rays.origins1 - c, rays.origins2 - c
+    d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
+    d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
+    tau = t + R @ c - c
+
+    def res(o1_, d1_, o2_, d2_, w=np.zeros(3), dtau=np.zeros(3)) -> np.ndarray:
+        return _core.gec_residuals(o1_, d1_, o2_, d2_, _rotvec(w) @ R, tau + dtau)
+
+    r0 = res(o1, d1, o2, d2)
+    w = np.ones(len(rays)) if weights is None else np.asarray(weights, dtype=np.float64)
+    if loss == "cauchy":
+        w = w / (1.0 + (r0 / loss_scale) ** 2)
+    elif loss == "huber":
+        w = w * np.minimum(1.0, loss_scale / np.maximum(np.abs(r0), 1e-300))
+    elif loss == "soft_l1":
+        w = w / np.sqrt(1.0 + (r0 / loss_scale) ** 2)
+    h_ang, scale = 1e-6, max(float(np.linalg.norm(tau)), 1e-9)
+    e = np.eye(3)
+    J = np.empty((len(rays), 6))
+    for k in range(3):
+        J[:, k] = (res(o1, d1, o2, d2, w=h_ang * e[k]) - res(o1, d1, o2, d2, w=-h_ang * e[k])) \
+            / (2 * h_ang)
+        h = 1e-6 * scale
+        J[:, 3 + k] = (res(o1, d1, o2, d2, dtau=h * e[k]) - res(o1, d1, o2, d2, dtau=-h * e[k])) \
+            / (2 * h)
+    H = J.T @ (w[:, None] * J)
+    try:
+        Hinv = np.linalg.inv(H)
+    except np.linalg.LinAlgError:
+        return float("inf"), np.full((6, 6), np.inf)
+    if not np.all(np.isfinite(Hinv)):
+        return float("inf"), np.full((6, 6), np.inf)
+    cov = np.zeros((6, 6))
+    h_pos = 1e-6 * max(1.0, float(np.abs(o1).max(initial=0.0)))
+    for cam in range(m):
+        s1, s2 = cam1 == cam, cam2 == cam
+        if not (s1.any() or s2.any()):
+            continue
+        for kind, std in ((0, sig[cam, 0]), (1, sig[cam, 1])):
+            if std == 0:
+                continue
+            for k in range(3):
+                cols = []
+                for sgn in (1.0, -1.0):
+                    a1, b1, a2, b2 = o1.copy(), d1.copy(), o2.copy(), d2.copy()
+                    if kind == 0:   # the camera's centre moves (rig frame)
+                        a1[s1] += sgn * h_pos * e[k]
+                        a2[s2] += sgn * h_pos * e[k]
+                    else:           # the camera turns about its centre (rig frame)
+                        Q = _rotvec(sgn * h_ang * e[k])
+                        b1[s1] = b1[s1] @ Q.T
+                        b2[s2] = b2[s2] @ Q.T
+                    cols.append(res(a1, b1, a2, b2))
+                step = h_pos if kind == 0 else h_ang
+                dr = (cols[0] - cols[1]) / (2 * step)
+                g = -Hinv @ (J.T @ (w * dr))      # d theta / d p_j
+                cov += std * std * np.outer(g, g)
+    u = tau / scale
+    var = float(u @ cov[3:, 3:] @ u)
+    return float(np.sqrt(max(var, 0.0)) / scale), cov
+
+
+def combine_rel_std(noise: float, calibration: float) -> float:
+    """Total relative std of ``|t|``: the noise part (from the refinement's
+    residuals) and the calibration part (:func:`calibration_scale_std`),
+    independent, in quadrature; inf if either is."""
+    if not (np.isfinite(noise) and np.isfinite(calibration)):
+        return float("inf")
+    return float(np.hypot(noise, calibration))
+
+
+def total_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray, refined: dict,
+                    calibration_std, weights: np.ndarray | None = None, loss: str = "none",
+                    loss_scale: float = 1e-3) -> tuple[float, dict]:
+    """Relative std of ``|t|`` of a refined motion, noise and calibration error together.
+
+    ``refined`` is the result of :func:`mcgeom.geometry.refine_centred` on
+    ``rays`` (its ``scale_rel_std``, ``sigma2`` and ``information``: the
+    noise part); ``calibration_std`` the rig's extrinsic error (see
+    :func:`calibration_scale_std`; None = known exactly); ``weights``,
+    ``loss``, ``loss_scale`` those of the refinement. Returns the total (in
+    quadrature, :func:`combine_rel_std`) and a dict for ``info``:
+    ``scale_rel_std_noise``, ``scale_rel_std_calibration`` and
+    ``covariance`` (6 x 6, order [w rad, tau m], tau the translation of the
+    cameras' centroid: residual variance times the inverse information plus
+    the calibration part).
+    """
+    rel_noise = float(refined["scale_rel_std"])
+    try:
+        cov = refined["sigma2"] * np.linalg.inv(refined["information"])
+    except (np.linalg.LinAlgError, KeyError, ValueError):
+        cov = np.full((6, 6), np.inf)
+    rel_cal = 0.0
+    if calibration_std is not None:
+        rel_cal, cov_cal = calibration_scale_std(rays, R, t, calibration_std, weights, loss,
+                                                 loss_scale)
+        cov = cov + cov_cal
+    return combine_rel_std(rel_noise, rel_cal), {
+        "scale_rel_std_noise": rel_noise, "scale_rel_std_calibration": rel_cal,
+        "covariance": cov}

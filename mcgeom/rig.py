@@ -35,7 +35,7 @@ from mcgeom.types import RayPairs
 from mcgeom.validation import (check_int, check_pixels, check_points, check_rotation,
                                check_vector3, integral_camera_ids, numeric)
 
-__all__ = ["Camera", "Rig"]
+__all__ = ["Camera", "Rig", "DEFAULT_EXTRINSIC_STD"]
 
 CameraModel = Literal["pinhole", "fisheye"]
 
@@ -335,11 +335,47 @@ class Camera:
 
 # --------------------------------------------------------------------------- Rig
 
+#: Default per-camera extrinsic calibration error (1 sigma) used when a rig
+#: states none: 2 mm of camera-centre position per axis and 0.1 degree of
+#: orientation per axis. A target-based multi-camera calibration (Kalibr,
+#: OpenCV stereo) typically reaches 0.5-2 mm and 0.02-0.1 deg; a factory or
+#: CAD calibration is rarely better. Errors of this size set the floor of the
+#: relative uncertainty of a metric scale fixed by short baselines
+#: (:func:`mcgeom.observability.calibration_scale_std`).
+DEFAULT_EXTRINSIC_STD = (2e-3, float(np.radians(0.1)))
+
+
+def _calibration_std(value: Any, m: int) -> tuple[tuple[float, float], ...] | None:
+    """``Rig.calibration_std`` checked: None, or M pairs (metres, radians) >= 0."""
+    if value is None:
+        return None
+    try:
+        a = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError("calibration_std must be a pair (position std in metres, rotation "
+                         f"std in radians) or one pair per camera, got {value!r}") from None
+    if a.shape == (2,):
+        a = np.tile(a, (m, 1))
+    if a.shape != (m, 2):
+        raise ValueError(f"calibration_std must have shape (2,) or ({m}, 2) (metres, radians "
+                         f"per camera), got {a.shape}")
+    if not (np.all(np.isfinite(a)) and np.all(a >= 0)):
+        raise ValueError(f"calibration_std must hold finite values >= 0, got {value!r}")
+    return tuple((float(p), float(r)) for p, r in a)
+
+
 @dataclass(frozen=True)
 class Rig:
     """A calibrated multi-camera rig: cameras with extrinsics in one rig frame (metres).
 
     Camera ids are the indices into ``cameras``. Names must be unique.
+
+    ``calibration_std`` is the 1-sigma error of each camera's extrinsics: one
+    pair ``(position std in metres per axis, rotation std in radians per
+    axis)`` for every camera, or one pair per camera (id order); None (the
+    default) when the calibration does not say, and then
+    :data:`DEFAULT_EXTRINSIC_STD` applies (see :attr:`extrinsic_std`). The
+    scale uncertainty of every estimate from this rig includes it.
 
     ``frame`` says which physical frame the extrinsics (and so every ray, and every
     motion ``rig2_from_rig1`` estimated with this rig) are expressed in:
@@ -356,6 +392,7 @@ class Rig:
     """
 
     cameras: tuple[Camera, ...]
+    calibration_std: Any = None
     frame: str = field(default="unspecified", compare=False)
 
     def __post_init__(self) -> None:
@@ -375,6 +412,8 @@ class Rig:
         if dupes:
             raise ValueError(f"camera names must be unique; repeated: {', '.join(map(repr, dupes))}")
         object.__setattr__(self, "cameras", cams)
+        object.__setattr__(self, "calibration_std", _calibration_std(self.calibration_std,
+                                                                     len(cams)))
         object.__setattr__(self, "_centres", _frozen(np.array([c.centre for c in cams])))
         # Stacked intrinsics/extrinsics for the vectorised bearings of
         # :meth:`_pinhole_rays` (cameras are immutable: stacked once, not per call)
@@ -414,6 +453,15 @@ class Rig:
         """(M, 3, 3) rotations cam_from_rig of the cameras in id order (read-only):
         row 2 of ``rotations[i]`` is camera i's optical axis in the rig frame."""
         return self._Rs  # type: ignore[attr-defined]
+
+    @property
+    def extrinsic_std(self) -> np.ndarray:
+        """(M, 2) 1-sigma extrinsic error of each camera: position (metres, per
+        axis), rotation (radians, per axis); :data:`DEFAULT_EXTRINSIC_STD` for
+        every camera when ``calibration_std`` is None."""
+        if self.calibration_std is None:
+            return np.tile(DEFAULT_EXTRINSIC_STD, (len(self.cameras), 1))
+        return np.array(self.calibration_std, dtype=np.float64)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -550,4 +598,5 @@ class Rig:
         Rm = check_rotation("in_frame: R", R)  # checked once, not once per camera
         tv = check_vector3("in_frame: t", t)
         label = f"custom (X = R X_{self.frame} + t)" if frame is None else frame
-        return Rig(tuple(c.in_frame(Rm, tv) for c in self.cameras), frame=label)
+        return Rig(tuple(c.in_frame(Rm, tv) for c in self.cameras), self.calibration_std,
+                   frame=label)

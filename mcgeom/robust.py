@@ -37,7 +37,8 @@ from .errors import DegenerateError
 # the same (see mcgeom.estimators._common: no estimator imports this module)
 from .estimators._common import travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
-from .observability import scale_profile, scale_verdict
+from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
+                            total_scale_std)
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 from .validation import check_seed
 
@@ -260,7 +261,8 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
            threshold: Optional[float] = None, prob: float = 0.999, max_iters: int = 1000,
            seed: Optional[int] = 0, focal: Union[None, float, np.ndarray] = None,
            options: Optional[RansacOptions] = None,
-           motion_focal: Optional[MotionFocal] = None, **kw: Any) -> RigMotion:
+           motion_focal: Optional[MotionFocal] = None, calibration_std: Any = None,
+           **kw: Any) -> RigMotion:
     """Robust rig motion rig2_from_rig1 from correspondences with outliers.
 
     ``method`` is a registered estimator with a minimal solver or a proposer.
@@ -270,8 +272,13 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     ``max_iters`` caps the number of samples; ``seed`` makes the run
     deterministic. ``motion_focal(rays, R, t)`` (with ``focal`` only) returns
     the pixels per radian of every residual at motion (R, t), for the final
-    refinement (see :meth:`_Scorer.scaling_at`). Further ``RansacOptions``
-    fields may be passed as keywords.
+    refinement (see :meth:`_Scorer.scaling_at`). ``calibration_std`` is the
+    rig's extrinsic calibration error, one pair (position std in metres,
+    rotation std in radians) for every camera or an (M, 2) array by camera id
+    (:attr:`mcgeom.rig.Rig.extrinsic_std`; :func:`mcgeom.cv.estimate` passes
+    the rig's): the relative std of ``|t|`` and the verdict include its
+    effect (:func:`mcgeom.observability.calibration_scale_std`); None = rays
+    known exactly. Further ``RansacOptions`` fields may be passed as keywords.
 
     Returns a ``RigMotion`` with the boolean ``inliers`` mask, the scale verdict
     (from the covariance of the final refinement, plus the estimator's own
@@ -324,7 +331,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
                               f"({scorer.n_hyp} hypotheses from {iterations} samples): degenerate "
                               f"data (e.g. points collinear or coplanar in every camera, or "
                               f"too few correspondences per camera: {_per_camera(rays)})")
-    return _finish(rays, scorer, options, method, iterations, t_start)
+    return _finish(rays, scorer, options, method, iterations, t_start, calibration_std)
 
 
 #: largest inlier threshold as an angle (radians): above it every correspondence is an
@@ -469,7 +476,7 @@ def _no_translation(rays: RayPairs, scorer: _Scorer, options: RansacOptions, met
 
 
 def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str,
-            iterations: int, t_start: float) -> RigMotion:
+            iterations: int, t_start: float, calibration_std: Any = None) -> RigMotion:
     """Final robust refinement on the inliers, verdict and diagnostics."""
     R, t = scorer.best
     inl = scorer.best_inliers
@@ -512,6 +519,9 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         inl = r < options.threshold
         rel_std = float(out["scale_rel_std"])
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
+        rel_std, parts = total_scale_std(rays.take(used), R, t, out, calibration_std, w_used,
+                                         options.loss, scale_used)
+        info.update(parts)
     if r is None:
         r = scorer.best_residuals
     info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start,
@@ -529,6 +539,8 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     # the metric estimate whatever the verdict (when the scale is unobservable
     # the refinement may have slid |t| far along its flat valley: a guess)
     info["t_metric"] = np.array(t)
+    # t is the metric estimate unless the branches below find it undetermined
+    determined = info["translation_detected"]
     if not info["translation_detected"]:
         # static rig or pure rotation: the verdict says t = 0 (as the search
         # that finds no motion at all does, _no_translation), not a unit
@@ -543,10 +555,26 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         # near the critical motion the 1-point scale search may propose a
         # huge |t|, which the refinement on all inliers brings back
         # (measured on the Ladybug head: 565 -> 1.06, 45 -> 0.97 for |t| = 1).
-        if not nt <= 10.0 * n0:
+        slid = not nt <= 10.0 * n0
+        if slid:
             nt = n0
-        t = travel_direction(rays, inl, R, t)
-        info["t_metric"] = nt * t
+        direction = travel_direction(rays, inl, R, t)
+        info["t_direction"] = direction
+        zero = float("nan")
+        if not slid and scale_determined(rel_std):
+            zero = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
+                                 (ZERO_FACTOR,), options.loss, scale_used, w_used)
+        if slid or not scale_determined(rel_std, zero_profile=zero):
+            # the data define no scale: a unit direction (issue 18: never a
+            # silent unit vector where a metric estimate exists, and never a
+            # metric-looking one where none does)
+            # (info['t_metric'] keeps the refined t, the least-squares guess,
+            # unless it slid out: then the hypothesis' length along the travel)
+            if slid:
+                info["t_metric"] = nt * direction
+            t = direction
+            determined = False
+    info["scale_determined"] = determined
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
                      float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan"),
                      inl, info)

@@ -167,8 +167,12 @@ class RigMotion:
     """A relative rig motion rig2_from_rig1: ``X_rig2 = R @ X_rig1 + t``.
 
     ``R`` is a 3x3 rotation, ``t`` the translation in metres (the unit of the
-    rig extrinsics); when ``scale.observable`` is False, ``t`` has unit norm and
-    only its direction is meaningful. ``residual_rms`` is the RMS residual of
+    rig extrinsics). When ``scale.observable`` is False, ``t`` is still the
+    maximum-likelihood metric estimate where the data define a scale at all
+    (``scale.rel_std`` says how loosely; the 5+1 pipeline sets
+    ``info['scale_determined']``), and has unit norm, only its direction
+    meaningful, where they do not (exactly critical motion, one camera). ``t``
+    is zero when no translation was detected. ``residual_rms`` is the RMS residual of
     the method's own cost (documented by each estimator in ``info``),
     ``inliers`` a boolean mask where the method is robust, ``info`` holds
     method-specific diagnostics (detected camera case, ranks, iterations...).

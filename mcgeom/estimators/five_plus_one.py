@@ -31,8 +31,9 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..geometry import rcross, refine_centred
-from ..observability import scale_profile, scale_verdict
+from ..geometry import count_in_front, rcross, refine_centred
+from ..observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
+                              total_scale_std)
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ..validation import integral_camera_ids
@@ -101,7 +102,7 @@ def solve(rays: RayPairs, five_camera: Optional[int] = None,
         raise DegenerateError(f"five_plus_one: the 5-point solver found no motion in camera {a} "
                               "(too few usable points, or degenerate: no translation)")
     others = np.flatnonzero(~((cam1 == a) & (cam2 == a)))
-    best = None
+    cands = []
     for R, t0, w in essential:
         if others.size:
             sa, sb = scale_terms(rays.take(others), R, t0, w)
@@ -115,9 +116,18 @@ def solve(rays: RayPairs, five_camera: Optional[int] = None,
         res = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2,
                                          rays.dirs2, R, t))
         cost = float(np.sum(res ** 2))
-        if best is None or cost < best["cost"]:
-            best = dict(R=R, t=t, t0=t0, w=w, lam=lam, scale_rel_std=rel, cost=cost,
-                        five_camera=a, n_scale=int(others.size), scale_determined=determined)
+        cands.append(dict(R=R, t=t, t0=t0, w=w, lam=lam, scale_rel_std=rel, cost=cost,
+                          five_camera=a, n_scale=int(others.size), scale_determined=determined,
+                          in_front=count_in_front(rays, R, t)))
+    # Cheirality first, then cost: with few correspondences (6: the minimal
+    # problem) several 5-point solutions fit every epipolar constraint to
+    # rounding, and only the physical one puts the points in front of the
+    # cameras (the verdict would otherwise reject the kept one for cheirality).
+    # 5 % of the correspondences of slack: noise may put a few far or
+    # near-parallel points behind under the right motion.
+    top = max(c["in_front"] for c in cands)
+    slack = int(0.05 * len(rays))
+    best = min((c for c in cands if c["in_front"] >= top - slack), key=lambda c: c["cost"])
     best["critical_angles"] = critical_angles(best["R"], best["t"], centres, a)
     return best
 
@@ -158,13 +168,16 @@ def _refine_all(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool) -
                             "(default: the one with most intra-camera correspondences)",
              "refine": "joint nonlinear refinement on all correspondences (default True)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
-                                  "unobservable (0.1)"},
+                                  "unobservable (0.1)",
+             "calibration_std": "extrinsic calibration error of the cameras: (position std "
+                                "m, rotation std rad) for all, or one pair per camera id; "
+                                "included in the relative std of |t| (default None: exact)"},
     minimal_solver=minimal_solutions,
     sampler=sample_five_plus_one,
     proposer=lambda rays, thr, prob, rng: propose(rays, thr, prob, rng),
 )
 def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: bool = True,
-                  max_scale_rel_std: float = 0.1) -> RigMotion:
+                  max_scale_rel_std: float = 0.1, calibration_std=None) -> RigMotion:
     """Rig motion rig2_from_rig1 (R, t in metres) by the 5+1 method on all correspondences.
 
     ``rays`` in the rig frame with origins at the camera centres; camera ids
@@ -174,8 +187,14 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     correspondence not of the 5-point camera, then (``refine``) the motion is
     refined jointly on all correspondences (Sampson angular error). ``info``
     holds the 5-point camera, the critical angles (radians) per camera, the
-    linear scale and its relative std. Raises ValueError when no camera has 5
-    intra-camera correspondences, DegenerateError when the 5-point solver fails.
+    linear scale and its relative std. ``calibration_std`` (see
+    :func:`mcgeom.observability.calibration_scale_std`) adds the rig's
+    extrinsic calibration error to the relative std of ``|t|`` (``info``:
+    ``scale_rel_std_noise``, ``scale_rel_std_calibration``, ``covariance``).
+    ``t`` is the metric estimate wherever the data determine a scale
+    (``info['scale_determined']``), a unit direction where not. Raises
+    ValueError when no camera has 5 intra-camera correspondences,
+    DegenerateError when the 5-point solver fails.
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -219,23 +238,35 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     if out is not None:
         R, t = out["R"], out["t"]
         if len(rays) > 6:
-            rel = float(out["scale_rel_std"]) if not fixed else float("inf")
+            rel, parts = total_scale_std(rays, out["R"], out["t"], out, calibration_std)
+            info.update(parts)
+            if fixed:
+                rel = float("inf")
             info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
             if rel <= max_scale_rel_std:
                 k = 1.0 + 3.0 * max_scale_rel_std
                 info["scale_profile"] = scale_profile(rays, R, t, out["final_cost"],
                                                       out["sigma2"], (1.0 / k, k))
-                if info["scale_profile"] < 9.0:
-                    rel = float("inf")
     sol["critical_angles"] = critical_angles(R, t, camera_ids(rays)[2], sol["five_camera"])
     info["critical_angles"] = sol["critical_angles"]
+    # a profile that does not exclude |t| x/ (1 + 3 max_scale_rel_std) makes
+    # the verdict "not observable" (it sees the non-linear cost); rel keeps
+    # the first-order std, which says whether a metric estimate exists at all
     verdict = scale_verdict(rays, np.ones(len(rays), bool), R, t, rel, max_scale_rel_std,
-                            fixed)
+                            fixed, profile=info.get("scale_profile", float("nan")))
     info["t_metric"] = np.array(t)   # metric estimate, whatever the verdict
+    # t is the maximum-likelihood metric estimate wherever the data define a
+    # scale at all (the verdict says how far to trust it), a unit direction
+    # where they do not (mcgeom.observability.scale_determined)
+    zero = float("nan")
+    if not verdict.observable and out is not None and len(rays) > 6 and \
+            scale_determined(rel, fixed):
+        zero = scale_profile(rays, R, t, out["final_cost"], out["sigma2"], (ZERO_FACTOR,))
+    info["scale_determined"] = scale_determined(rel, fixed, zero)
     if not verdict.observable:
-        nt = np.linalg.norm(t)
-        t = travel_direction(rays, np.ones(len(rays), bool), R, t)
-        info["t_metric"] = nt * t
+        info["t_direction"] = travel_direction(rays, np.ones(len(rays), bool), R, t)
+        if not info["scale_determined"]:
+            t = info["t_direction"]
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
     return RigMotion(R, t, verdict, "five_plus_one", float(np.sqrt(np.mean(r ** 2))), None, info)
 

@@ -29,6 +29,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
     "ch10": ("ch10", "thesis ch. 10.5.1: B&B+LP against E+SOCP, and the preemptive test"),
     "minimal_5p1": ("minimal_5p1", "noise-free minimal 5+1 samples: how often the true "
                                    "motion is among the solutions"),
+    "calibration_coverage": ("calibration_coverage", "synthetic rigs with perturbed "
+                                                     "extrinsics: does the 3-sigma interval "
+                                                     "of |t| contain the truth?"),
     "robust_vs_poselib": ("robust_vs_poselib", "robust rig motion from pixels: mcgeom "
                                                "against PoseLib (needs poselib)"),
     "real_data": ("real_data", "the robust pipeline on the real recordings (KITTI, DDAD, "

@@ -2,11 +2,21 @@
 
 Random non-critical configurations: a 2-camera rig with random centres (up to
 1 m apart) and orientations, a random motion (rotation 2-30 deg, |t| 0.2-2 m),
-five points seen by camera 0 and one by camera 1 at both times, depth 2-20 m.
+five points seen by camera 0 and one by camera 1 at both times, depth 2-20 m,
+in front of the camera at both times (within 80 deg of its axis at time 2).
 A configuration counts as solved when one returned motion has rotation error
 and relative translation error below 1e-8. The issue's target is 99.9 %
 (poselib's 5+1 solver: ~97 %); poselib's general 6-point solver
 ``gen_relpose_6pt`` runs on the same rays for comparison.
+
+The same configurations also go through the façades, which must return ONE
+motion: :func:`mcgeom.cv.estimate` on the pixels of a rig whose two cameras
+have the configuration's centres and orientations (focal 500 px, 1000 x 1000),
+and :func:`mcgeom.estimate` (``five_plus_one``) on the rays. A façade run
+counts as solved when its rotation error is below 1e-6 rad and its metric
+translation ``info['t_metric']`` is within 1e-6 relative of the truth (pixels
+round-trip through ``K`` in floating point; the minimal problem has no
+redundancy, so nothing is averaged out).
 ``mcgeom experiment minimal_5p1 --trials 10000`` (``--no-poselib`` without it)
 """
 
@@ -17,17 +27,29 @@ import time
 
 import numpy as np
 
-from mcgeom import metrics, synth
+from mcgeom import cv, estimate, metrics, synth
 from mcgeom.estimators.five_plus_one_minimal import critical_angles, minimal_solutions
+from mcgeom.rig import Camera, Rig
 from mcgeom.types import RayPairs
 
 from .common import Progress, add_count_and_seed, import_peer, no_progress
 
 TOL = 1e-8
+#: tolerance of a façade run (rotation radians, translation relative)
+FACADE_TOL = 1e-6
+_F, _SIZE = 500.0, 1000
 
 
 def configuration(rng: np.random.Generator):
     """(rays, R, t) of one random non-critical 5+1 configuration."""
+    rays, R, t, _ = configuration_with_rig(rng)
+    return rays, R, t
+
+
+def configuration_with_rig(rng: np.random.Generator):
+    """(rays, R, t, rig) of one random non-critical 5+1 configuration; ``rig``
+    has the two cameras (cam_from_rig rotations and centres) the rays come from,
+    focal :data:`_F` px, principal point at the image centre."""
     while True:
         centres = np.vstack([np.zeros(3), rng.uniform(-0.5, 0.5, 3)])
         Rc = [synth.random_rotation(rng, np.pi) for _ in range(2)]   # cam_from_rig
@@ -41,14 +63,40 @@ def configuration(rng: np.random.Generator):
         o1, d1, o2, d2, cams = [], [], [], [], []
         for cam, count in ((0, 5), (1, 1)):
             c, Rcam = centres[cam], Rc[cam]
-            for _ in range(count):
+            while count:
                 v = np.array([*rng.uniform(-0.6, 0.6, 2), 1.0])
                 X = c + Rcam.T @ (v / np.linalg.norm(v)) * rng.uniform(2.0, 20.0)
                 X2 = R @ X + t
+                # a real point is in front of its camera at both times (and a
+                # pixel exists for it); within 80 deg of the optical axis
+                if (Rcam @ (X2 - c))[2] < np.cos(np.radians(80)) * np.linalg.norm(X2 - c):
+                    continue
+                count -= 1
                 o1.append(c), d1.append(X - c), o2.append(c), d2.append(X2 - c), cams.append(cam)
         rays = RayPairs(np.array(o1), np.array(d1), np.array(o2), np.array(d2),
                         np.array(cams), np.array(cams))
-        return rays, R, t
+        K = np.array([[_F, 0.0, (_SIZE - 1) / 2], [0.0, _F, (_SIZE - 1) / 2], [0.0, 0.0, 1.0]])
+        rig = Rig(tuple(Camera(f"c{k}", K, np.zeros(0), "pinhole", Rc[k], -Rc[k] @ centres[k],
+                               _SIZE, _SIZE) for k in range(2)))
+        return rays, R, t, rig
+
+
+def _pixels(rig: Rig, rays: RayPairs) -> tuple[np.ndarray, np.ndarray]:
+    """The pixels of the rays' scene points in their cameras at both times."""
+    px = []
+    for o, d, cam in ((rays.origins1, rays.dirs1, rays.cam1), (rays.origins2, rays.dirs2, rays.cam2)):
+        p = np.empty((len(rays), 2))
+        for k in range(len(rays)):
+            p[k] = rig.project(int(cam[k]), (o[k] + d[k])[None])[0][0]
+        px.append(p)
+    return px[0], px[1]
+
+
+def facade_solved(m, R, t) -> bool:
+    """True if the one motion of a façade is the truth to :data:`FACADE_TOL`."""
+    tm = m.info.get("t_metric", m.t)
+    return bool(metrics.rotation_error(m.R, R) < FACADE_TOL
+                and np.linalg.norm(tm - t) < FACADE_TOL * np.linalg.norm(t))
 
 
 def solved(sols, R, t) -> bool:
@@ -71,21 +119,30 @@ def poselib_6pt(rays: RayPairs) -> list:
 
 
 def run(trials: int = 1000, seed: int = 0, with_poselib: bool = True,
-        progress: Progress = no_progress) -> dict:
-    """Success rates and mean time per configuration (microseconds)."""
+        progress: Progress = no_progress, facades: bool = True) -> dict:
+    """Success rates and mean time per configuration (microseconds): the
+    minimal solver (truth among its solutions), the façades (their one motion
+    is the truth; ``facades``) and PoseLib's 6-point solver."""
     rng = np.random.default_rng(seed)
-    ok = okp = 0
+    ok = okp = ok_cv = ok_est = 0
     t_ours = t_pl = 0.0
     for _ in progress(range(trials), total=trials, desc="minimal_5p1"):
-        rays, R, t = configuration(rng)
+        rays, R, t, rig = configuration_with_rig(rng)
         t0 = time.perf_counter()
         ok += solved(minimal_solutions(rays), R, t)
         t_ours += time.perf_counter() - t0
+        if facades:
+            p1, p2 = _pixels(rig, rays)
+            ok_cv += facade_solved(cv.estimate(p1, p2, rays.cam1, rays.cam2, rig), R, t)
+            ok_est += facade_solved(estimate(rays, "five_plus_one"), R, t)
         if with_poselib:
             t0 = time.perf_counter()
             okp += solved(poselib_6pt(rays), R, t)
             t_pl += time.perf_counter() - t0
+    nan = float("nan")
     return {"trials": trials, "mcgeom_success": ok / trials, "mcgeom_us": 1e6 * t_ours / trials,
+            "cv_estimate_success": ok_cv / trials if facades else nan,
+            "estimate_success": ok_est / trials if facades else nan,
             "poselib_6pt_success": okp / trials if with_poselib else float("nan"),
             "poselib_6pt_us": 1e6 * t_pl / trials if with_poselib else float("nan")}
 

@@ -514,6 +514,8 @@ def evaluate_pair(seq: Sequence, corr: Corr, k1: int, k2: int, mode: str,
         scale_err=abs(np.linalg.norm(tm) / np.linalg.norm(t_gt) - 1.0)
         if np.linalg.norm(t_gt) >= STATIC_T else float("nan"),
         observable=bool(m.scale.observable), reason=m.scale.reason,
+        rel_std=float(m.scale.rel_std),
+        rel_std_calibration=float(m.info.get("scale_rel_std_calibration", float("nan"))),
         crit=float(np.degrees(m.scale.critical_angle)),
         gt_rot=rot_angle_deg(R_gt),
     )
@@ -573,6 +575,11 @@ def summarize(seq: Sequence, results: list, out=print) -> list[dict]:
                 v = [r[k] for r in sel if np.isfinite(r[k])]
                 return float(np.median(v)) if v else float("nan")
             obs = [r for r in ok if r["observable"]]
+            # issue 18: |scale - 1| <= 3 rel_std on the moving pairs reported observable
+            cov = [r["scale_err"] <= 3.0 * r["rel_std"] for r in obs
+                   if np.isfinite(r["scale_err"])]
+            row.update(covered=int(sum(cov)), covered_of=len(cov),
+                       rel_std=med("rel_std", obs) if obs else float("nan"))
             row.update(rot=med("rot_err"), tdir=med("tdir_err"), scale=med("scale_err"),
                        scale_obs=med("scale_err", obs) if obs else float("nan"),
                        t_est=med("t_est"), obs_frac=len(obs) / len(ok), time=med("time"),
@@ -598,10 +605,13 @@ def summarize(seq: Sequence, results: list, out=print) -> list[dict]:
             alt = (" (vs %s %.3f)" % (seq.alt_gt_name, row["scale_alt"])
                    if "scale_alt" in row else "")
             desc = ("median rot err %.3f deg | tdir %.2f deg | scale err %.3f%s, over observable "
-                    "verdicts %s | observable %d/%d" % (
+                    "verdicts %s | observable %d/%d | |scale-1| <= 3 rel_std on %d/%d observable "
+                    "(median rel_std %s)" % (
                         row["rot"], row["tdir"], row["scale"], alt,
                         "%.3f" % row["scale_obs"] if np.isfinite(row["scale_obs"]) else "-",
-                        round(row["obs_frac"] * len(ok)), len(ok)))
+                        round(row["obs_frac"] * len(ok)), len(ok), row["covered"],
+                        row["covered_of"],
+                        "%.4f" % row["rel_std"] if np.isfinite(row["rel_std"]) else "-"))
         out("  %-11s %2d pairs%s: %s | median crit %.3f deg | median inliers %.0f | "
             "median time %.2f s" % (mode, len(rs), (", %d FAILED" % row["failed"]) if row["failed"]
                                     else "", desc, row["crit"], row["inl"], row["time"]))
@@ -669,19 +679,20 @@ def print_summary_table(summary: list, out=print) -> None:
     out("")
     out("=" * 100)
     out("SUMMARY (medians over pairs)")
-    out("%-16s %-11s %5s %8s %9s %9s %8s %6s %8s" % (
+    out("%-16s %-11s %5s %8s %9s %9s %8s %6s %8s %9s" % (
         "data set", "mode", "pairs", "rot(deg)", "tdir(deg)", "scale_err", "|t_est|", "obs",
-        "time(s)"))
+        "time(s)", "in 3sig"))
     for r in summary:
         if "rot" not in r:
             out("%-16s %-11s %5d  all FAILED" % (r["key"], r["mode"], r["pairs"]))
             continue
         static = r["key"] in ("euroc", "dgp_scene_01")
-        out("%-16s %-11s %5d %8.3f %9s %9s %8.4f %6s %8.2f%s" % (
+        out("%-16s %-11s %5d %8.3f %9s %9s %8.4f %6s %8.2f %9s%s" % (
             r["key"], r["mode"], r["pairs"], r["rot"],
             "n/a*" if static else "%.2f" % r["tdir"],
             "n/a*" if static else "%.3f" % r["scale"], r["t_est"],
             "%d%%" % round(100 * r["obs_frac"]), r["time"],
+            "-" if static or not r["covered_of"] else "%d/%d" % (r["covered"], r["covered_of"]),
             ("  (%d failed)" % r["failed"]) if r["failed"] else ""))
 
 

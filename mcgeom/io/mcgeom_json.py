@@ -14,10 +14,17 @@ Layout (written by :func:`save_mcgeom_json`, read by :func:`load_mcgeom_json`)::
           "K": [[fx, s, cx], [0, fy, cy], [0, 0, 1]],
           "dist": [k1, k2, p1, p2, k3],    # OpenCV order; fisheye: [k1, k2, k3, k4]
           "R_cam_from_rig": [[...], [...], [...]],
-          "t_cam_from_rig": [tx, ty, tz]   # metres
+          "t_cam_from_rig": [tx, ty, tz],  # metres
+          "extrinsic_std_mm": 1.0,         # optional: 1-sigma centre error per axis, mm
+          "extrinsic_std_deg": 0.05        # optional: 1-sigma rotation error per axis, deg
         }
       ]
     }
+
+The two optional ``extrinsic_std_*`` keys state the calibration's accuracy
+(:attr:`mcgeom.rig.Rig.calibration_std`); they go together, on every camera
+or on none (then :data:`mcgeom.rig.DEFAULT_EXTRINSIC_STD` applies, and they
+are not written).
 
 The values are a :class:`mcgeom.rig.Camera`'s fields unchanged: cam_from_rig extrinsics
 ``X_cam = R X_rig + t`` (metres), OpenCV lens models and OpenCV pixel coordinates (see
@@ -33,6 +40,8 @@ import json
 import os
 from dataclasses import replace
 from typing import Any, Union
+
+import numpy as np
 
 from mcgeom.io._common import describe_path
 from mcgeom.rig import Camera, Rig
@@ -74,10 +83,38 @@ def _camera_from_dict(d: Any, where: str) -> Camera:
         raise ValueError(f"{where}: {exc}") from None
 
 
+_STD_KEYS = ("extrinsic_std_mm", "extrinsic_std_deg")
+
+
 def rig_to_dict(rig: Rig) -> dict:
     """JSON-ready dict of ``rig`` in the ``mcgeom-rig`` version 1 format (module docstring)."""
+    cams = [_camera_to_dict(c) for c in rig.cameras]
+    if rig.calibration_std is not None:
+        for d, (pos, rot) in zip(cams, rig.calibration_std):
+            d[_STD_KEYS[0]], d[_STD_KEYS[1]] = 1e3 * pos, float(np.degrees(rot))
     return {"format": RIG_FORMAT, "version": RIG_FORMAT_VERSION, "frame": rig.frame,
-            "cameras": [_camera_to_dict(c) for c in rig.cameras]}
+            "cameras": cams}
+
+
+def _calibration_std(cams: list) -> Any:
+    """The per-camera (metres, radians) of the optional ``extrinsic_std_*`` keys, or None."""
+    have = [[k in c for k in _STD_KEYS] for c in cams if isinstance(c, dict)]
+    if not any(any(h) for h in have):
+        return None
+    if not all(all(h) for h in have):
+        raise ValueError(f"rig description: {_STD_KEYS[0]!r} and {_STD_KEYS[1]!r} must be "
+                         "given together on every camera, or on none")
+    out = []
+    for i, c in enumerate(cams):
+        vals = []
+        for k in _STD_KEYS:
+            v = c[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not (
+                    np.isfinite(v) and v >= 0):
+                raise ValueError(f"cameras[{i}]: {k!r} must be a number >= 0, got {v!r}")
+            vals.append(float(v))
+        out.append((1e-3 * vals[0], float(np.radians(vals[1]))))
+    return out
 
 
 def rig_from_dict(d: Any) -> Rig:
@@ -99,7 +136,8 @@ def rig_from_dict(d: Any) -> Rig:
     if frame is not None and (not isinstance(frame, str) or not frame):
         raise ValueError(f"rig description: 'frame' must be a non-empty string naming the rig "
                          f"frame, got {frame!r}")
-    rig = Rig(tuple(_camera_from_dict(c, f"cameras[{i}]") for i, c in enumerate(cams)))
+    rig = Rig(tuple(_camera_from_dict(c, f"cameras[{i}]") for i, c in enumerate(cams)),
+              calibration_std=_calibration_std(cams))
     if frame is None or frame == "unspecified":
         # a file without the label (or written from a rig built in code): say what
         # the extrinsics show -- a camera at the origin defines the frame

@@ -287,7 +287,7 @@ def _segment_centres(rig: Rig, tracks: Tracks, keep: np.ndarray, motions: list,
         if m is None:
             c[1] = np.nan
             return c, False, "none", {}
-        t = m.t if observed[0] else m.t / np.linalg.norm(m.t)
+        t = m.t if observed[0] else _travel(m)
         # centre of rig k+1 in rig k's orientation: c = -R_world_rig(k+1) t
         c[1] = -Rloc[a + 1] @ t
         return c, bool(observed[0]), "two-frame" if observed[0] else "none", {}
@@ -368,12 +368,11 @@ def _solve_segment(track: np.ndarray, view: np.ndarray, origins: np.ndarray,
     # against 0.93 m true, while the two-frame |t| were within 0.5 %).
     disp = np.empty((b - a + 1, 3))
     for i, k in enumerate(range(a, b + 1)):
-        t = motions[k].t
         if observed[i]:
-            disp[i] = -Rloc[k + 1] @ t
+            disp[i] = -Rloc[k + 1] @ motions[k].t
         else:
-            n = float(np.linalg.norm(t))
-            disp[i] = (-Rloc[k + 1] @ t) / n * (s * d[i]) if n > 0 else np.nan
+            u = _travel(motions[k])
+            disp[i] = (-Rloc[k + 1] @ u) * (s * d[i]) if np.any(u != 0) else np.nan
     out = np.zeros_like(c)
     out[1:] = np.cumsum(disp, axis=0)
     return out, True, "steps", info
@@ -430,6 +429,18 @@ def estimate_trajectory(rig: Rig, tracks: Tracks, *, window: int = 2,
                                metric, source, n_corr[k], n_inl[k], si))
     return Trajectory(poses=_world_poses(F, segments, Rloc, chain), steps=tuple(steps),
                       segments=tuple(segments))
+
+
+def _travel(m: RigMotion) -> np.ndarray:
+    """Unit direction of travel of a step whose scale is not observable: the
+    estimator's ``info['t_direction']`` (the cameras' travel, see
+    :func:`mcgeom.estimators._common.travel_direction`) where it gives one --
+    its ``t`` is then the metric estimate, whose direction a near-critical
+    refinement may have bent -- else ``t`` normalised (zeros for t = 0)."""
+    u = m.info.get("t_direction") if m.info else None
+    t = np.asarray(m.t if u is None else u, dtype=np.float64)
+    n = float(np.linalg.norm(t))
+    return t / n if n > 0 else np.zeros(3)
 
 
 def _step(k: int, m: Optional[RigMotion], reason: str, T1: np.ndarray, T2: np.ndarray,

@@ -1,0 +1,106 @@
+"""Issue 18: the relative std of |t| includes the rig's calibration error
+(mcgeom.observability.calibration_scale_std), is carried by the rig
+(Rig.calibration_std, mcgeom JSON), and is calibrated: the 3-sigma interval
+of |t| contains the truth when the extrinsics are off by the stated error."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mcgeom
+from mcgeom import synth
+from mcgeom.cv import estimate as cv_estimate
+from mcgeom.experiments import calibration_coverage
+from mcgeom.io.mcgeom_json import rig_from_dict, rig_to_dict
+from mcgeom.observability import calibration_scale_std
+from mcgeom.rig import DEFAULT_EXTRINSIC_STD, Rig
+
+
+def test_three_sigma_interval_covers_the_truth_with_perturbed_extrinsics():
+    res = calibration_coverage.run(trials=40, seed=1, std_mm=1.0, std_deg=0.05, noise=0.5)
+    assert res["coverage_3sigma"] >= 0.95
+    # without the calibration term the interval is too narrow (the "before")
+    assert res["coverage_3sigma_noise_only"] < res["coverage_3sigma"]
+
+
+def test_first_order_calibration_std_matches_monte_carlo():
+    """The propagated std against the spread of the non-robust 5+1 estimate
+    over rigs perturbed by the stated error (noise-free pixels)."""
+    rng = np.random.default_rng(2)
+    rig = synth.vehicle8()
+    std = (2e-3, np.radians(0.1))
+    Rw = synth.rotation_about([0, 0, 1], np.radians(10))
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    p = synth.make_problem(rig, R, t, 300, rng, cross_fraction=0.1)
+    scales = []
+    for _ in range(40):
+        wrong = calibration_coverage.perturbed_rig(rig, *std, rng)
+        rays = wrong.ray_pairs(p.pixels1, p.pixels2, p.cam1, p.cam2)
+        m = mcgeom.estimate(rays, "five_plus_one")
+        scales.append(np.linalg.norm(m.info["t_metric"]) / np.linalg.norm(t))
+    predicted, cov = calibration_scale_std(p.rays, R, t, std)
+    assert cov.shape == (6, 6)
+    assert 0.6 < np.std(scales) / predicted < 1.6
+
+
+def test_calibration_std_zero_and_scaling():
+    rng = np.random.default_rng(3)
+    rig = synth.vehicle8()
+    Rw = synth.rotation_about([0, 0, 1], np.radians(10))
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    p = synth.make_problem(rig, R, t, 200, rng, cross_fraction=0.1)
+    assert calibration_scale_std(p.rays, R, t, (0.0, 0.0))[0] == 0.0
+    a = calibration_scale_std(p.rays, R, t, (1e-3, 0.0))[0]
+    b = calibration_scale_std(p.rays, R, t, (2e-3, 0.0))[0]
+    assert a > 0 and b == pytest.approx(2 * a, rel=1e-3)   # first order: linear in the std
+
+
+def test_rig_default_override_and_json_round_trip():
+    cams = synth.vehicle8().cameras
+    rig = Rig(cams)
+    assert rig.calibration_std is None
+    assert np.allclose(rig.extrinsic_std, np.tile(DEFAULT_EXTRINSIC_STD, (8, 1)))
+    assert np.all(synth.vehicle8().extrinsic_std == 0)
+    per = [(1e-3 * (k + 1), np.radians(0.01 * (k + 1))) for k in range(8)]
+    rig2 = Rig(cams, calibration_std=per)
+    back = rig_from_dict(rig_to_dict(rig2))
+    assert np.allclose(back.extrinsic_std, rig2.extrinsic_std, rtol=1e-12, atol=0)
+    assert rig_from_dict(rig_to_dict(rig)).calibration_std is None
+    assert "extrinsic_std_mm" not in rig_to_dict(rig)["cameras"][0]
+    assert rig2.in_frame(np.eye(3), np.ones(3)).calibration_std == rig2.calibration_std
+
+
+@pytest.mark.parametrize("bad,match", [((1.0,), "calibration_std"), ((-1.0, 0.0), ">= 0"),
+                                       ("x", "calibration_std"), ((np.nan, 0.0), ">= 0")])
+def test_bad_calibration_std_names_it(bad, match):
+    with pytest.raises(ValueError, match=match):
+        Rig(synth.vehicle8().cameras, calibration_std=bad)
+
+
+def test_bad_json_std_names_the_key():
+    d = rig_to_dict(Rig(synth.stereo_head().cameras, calibration_std=(1e-3, 1e-3)))
+    del d["cameras"][1]["extrinsic_std_deg"]
+    with pytest.raises(ValueError, match="extrinsic_std_deg"):
+        rig_from_dict(d)
+    d = rig_to_dict(Rig(synth.stereo_head().cameras, calibration_std=(1e-3, 1e-3)))
+    d["cameras"][0]["extrinsic_std_mm"] = -2
+    with pytest.raises(ValueError, match="extrinsic_std_mm"):
+        rig_from_dict(d)
+
+
+def test_facade_override_enters_rel_std_and_the_verdict():
+    rng = np.random.default_rng(4)
+    rig = synth.vehicle8()
+    Rw = synth.rotation_about([0, 0, 1], np.radians(10))
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    p = synth.make_problem(rig, R, t, 400, rng, pixel_noise=0.5, cross_fraction=0.1)
+    exact = cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig)
+    assert exact.info["scale_rel_std_calibration"] == 0.0 and exact.scale.observable
+    loose = cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig,
+                        calibration_std=(0.05, np.radians(2.0)))
+    assert loose.scale.rel_std > exact.scale.rel_std
+    assert loose.info["scale_rel_std_calibration"] > 0.1 and not loose.scale.observable
+    assert loose.info["covariance"].shape == (6, 6)
+    with pytest.raises(ValueError, match="calibration_std"):
+        cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, calibration_std=(1.0, 2.0, 3.0))
