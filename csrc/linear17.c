@@ -5,14 +5,26 @@
  * Algorithm 4 / eq. 8.36 for the locally-central and axial kinds and the plain
  * SVD for the most-general kind (Algorithm 2), decomposition of E into its
  * rotation candidates, the translation WITH scale from eq. 8.15, and the
- * alternation of ch. 8.4.3 (R given t, then t given R).
+ * refinement of ch. 8.4.3.
  *
- * Why everything works on the 18 x 18 Gram matrix M = A^T A:
+ * Why the linear step works on the 18 x 18 Gram matrix M = A^T A:
  * |A x|^2 = x^T M x for every x = (vec E, vec R), so after one O(N) pass over
- * the rays the linear step, the candidate choice and every alternation step
- * cost O(18^2) regardless of N. Squaring the condition number is harmless
- * here: rows are normalised (Algorithm 2 step 1) and the alternation polishes
- * the final R, t on a 3-parameter well-conditioned problem.
+ * the rays the linear step and the candidate choice cost O(18^2) regardless
+ * of N. Squaring the condition number is harmless here: rows are normalised
+ * (Algorithm 2 step 1) and the refinement re-fits R, t on the rays.
+ *
+ * Which optimum the refinement seeks: the alternation of ch. 8.4.3
+ * (R given t, then t given R) minimises the algebraic cost x^T M x. For a
+ * rig whose correspondences stay in one camera, (0, I) is in the null space
+ * of A, so that cost vanishes at R = I, t = 0, and its minimiser is biased
+ * towards a short t: on the cases of issue 22 (mcgeom experiment
+ * linear17_accuracy) it doubled the median scale error of the linear step,
+ * which is itself worse than OpenGV's seventeenpt there. The refinement
+ * therefore minimises the Sampson angular error of each correspondence
+ * (the residual of refine.c), a first-order geometric error with no such
+ * trivial minimum (Levenberg-Marquardt, a few O(N) passes). When only the
+ * direction of t is determined (unit mode) the alternation is kept: with
+ * |t| = 1 fixed the algebraic cost has no trivial zero.
  *
  * Frames: inputs and outputs in the rig frame; internally the normalised frame
  * X' = s (X - o) (o = centroid of the ray origins, s = 1 / RMS distance), which
@@ -501,6 +513,7 @@ static int geometric_refine(const raydata *rd, const mcg_linear17_options *o,
     *cost = sampson_pass(rd, r, t, h, g);
     for (it = 0; it < o->max_iterations; it++) {
         double a[36], rhs[6], d[6], dr[9], rn[9], tn[3], cn, nw, nt, lim, sc;
+        int small;
         for (i = 0; i < 6; i++) {
             for (j = i; j < 6; j++)
                 a[6 * i + j] = a[6 * j + i] = h[6 * i + j];
@@ -532,6 +545,28 @@ static int geometric_refine(const raydata *rd, const mcg_linear17_options *o,
         mul33(dr, r, rn);
         for (i = 0; i < 3; i++)
             tn[i] = t[i] + d[3 + i];
+        {   /* the decrease the Gauss-Newton model predicts for the step */
+            double hd[6], pred = 0.0;
+            for (i = 0; i < 6; i++) {
+                hd[i] = 0.0;
+                for (j = 0; j < 6; j++)
+                    hd[i] += h[i <= j ? 6 * i + j : 6 * j + i] * d[j];
+            }
+            for (i = 0; i < 6; i++)
+                pred -= g[i] * d[i] + 0.5 * d[i] * hd[i];
+            small = !(pred > o->tolerance * *cost);
+        }
+        if (small) {
+            /* the step would lower the cost by less than the tolerance: take
+             * it (it is the Newton correction of the last digits) without
+             * another pass over the rays; h and the cost stay those of the
+             * previous point, which differ by the square of the step */
+            memcpy(r, rn, sizeof rn);
+            memcpy(t, tn, sizeof tn);
+            *converged = 1;
+            it++;
+            break;
+        }
         cn = sampson_pass(rd, rn, tn, hn, gn);
         if (cn <= *cost) {
             double dec = *cost - cn;
@@ -1135,6 +1170,42 @@ static int same_origins(int n, const double *o1, const double *o2, double scale)
     return 1;
 }
 
+/* The minimal sample of the most-general kind: with n >= 17 pairs, fewer
+ * distinct ones than this is reported as degenerate (the registry's
+ * check_distinct, done here in O(n)). */
+#define MIN_DISTINCT 17
+
+static int same_pair(const double *o1, const double *d1, const double *o2,
+                     const double *d2, int i, int j)
+{
+    int k;
+    for (k = 0; k < 3; k++)
+        if (o1[3 * i + k] != o1[3 * j + k] || d1[3 * i + k] != d1[3 * j + k] ||
+            o2[3 * i + k] != o2[3 * j + k] || d2[3 * i + k] != d2[3 * j + k])
+            return 0;
+    return 1;
+}
+
+/* Number of distinct pairs (exact repeats counted once), counted up to
+ * `enough`: each pair is compared with the distinct ones kept so far (at
+ * most enough - 1), so the cost is O(n enough) at worst and a handful of
+ * comparisons per pair when the data have no repeats. */
+static int count_distinct(int n, const double *o1, const double *d1, const double *o2,
+                          const double *d2, int enough)
+{
+    int kept[MIN_DISTINCT], nk = 0, i, j;
+    if (enough > MIN_DISTINCT)
+        enough = MIN_DISTINCT;
+    for (i = 0; i < n && nk < enough; i++) {
+        for (j = 0; j < nk; j++)
+            if (same_pair(o1, d1, o2, d2, i, kept[j]))
+                break;
+        if (j == nk)
+            kept[nk++] = i;
+    }
+    return nk;
+}
+
 /* Below this ratio to the largest eigenvalue of A_R^T A_R an eigenvalue is a
  * structural zero: the rows of a locally-central or axial camera annihilate
  * (0, I) etc. exactly, so their eigenvalue is rounding (~1e-16 and below).
@@ -1174,6 +1245,9 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
                     &res->norm_scale);
     if (st != MCG_OK)
         return st;
+    res->n_distinct = count_distinct(n, origins1, dirs1, origins2, dirs2, MIN_DISTINCT);
+    if (n >= MIN_DISTINCT && res->n_distinct < MIN_DISTINCT)
+        return MCG_EDEGENERATE;
     for (i = 0; i < NX; i++)
         tr_m += m[i * NX + i];
     if (!(tr_m > 0.0) || !isfinite(tr_m))
