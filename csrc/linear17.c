@@ -408,10 +408,13 @@ typedef struct {
  * mcg_gec_residuals, radians, invariant to the normalisation), and with h
  * and g non-NULL the Gauss-Newton normal equations J^T J (6 x 6, upper
  * triangle, order [dw, dt] of R <- exp([dw]x) R, t <- t + dt) and J^T r.
- * With unit bearings a = R d1, b = d2, cA = c x a, bc = b x c:
- *   e = b.cA,  D = |cA|^2 + |bc|^2 - 2 e^2,  r = e / sqrt(D),
+ * r is homogeneous of degree 0 in the directions, so they are used as given
+ * (no square root to normalise them): with a = R d1, b = d2, cA = c x a,
+ * bc = b x c,
+ *   e = b.cA,  D = |b|^2 |cA|^2 + |a|^2 |bc|^2 - 2 e^2,  r = e / sqrt(D),
  *   de/dw = (R o1) x (a x b) + a x bc,  de/dt = a x b,
- *   dD = 2 dc.(a x cA) + 2 dw.(a x (cA x c)) + 2 dc.(bc x b) - 4 e de,
+ *   dD = 2 |b|^2 (dc.(a x cA) + dw.(a x (cA x c))) + 2 |a|^2 dc.(bc x b)
+ *        - 4 e de,
  *   dc = dw x (R o1) + dt, so dc.v = dw.((R o1) x v) + dt.v;
  *   dr = de / sqrt(D) - e dD / (2 D^(3/2)).
  * Where D vanishes the residual is capped at +-pi/2 (as in refine.c) and
@@ -427,26 +430,21 @@ static double sampson_pass(const raydata *rd, const double r[9], const double t[
     }
     for (k = 0; k < rd->n; k++) {
         const double *pd1 = rd->d1 + 3 * k, *pd2 = rd->d2 + 3 * k;
-        double p[3], q[3], u1[3], b[3], a[3], rp[3], c[3], ca[3], bc[3];
-        double n1, n2, e, dd, dm, res;
+        double p[3], q[3], a[3], rp[3], c[3], ca[3], bc[3];
+        double na2 = dot3(pd1, pd1), nb2 = dot3(pd2, pd2), e, dd, dm, res;
+        const double *b = pd2;
         for (i = 0; i < 3; i++) {
             p[i] = rd->scale * (rd->o1[3 * k + i] - rd->origin[i]);
             q[i] = rd->scale * (rd->o2[3 * k + i] - rd->origin[i]);
         }
-        n1 = 1.0 / sqrt(dot3(pd1, pd1));
-        n2 = 1.0 / sqrt(dot3(pd2, pd2));
-        for (i = 0; i < 3; i++) {
-            u1[i] = pd1[i] * n1;
-            b[i] = pd2[i] * n2;
-        }
-        mat_vec(r, u1, a);
+        mat_vec(r, pd1, a);
         mat_vec(r, p, rp);
         for (i = 0; i < 3; i++)
             c[i] = t[i] + rp[i] - q[i];
         cross3(c, a, ca);
         cross3(b, c, bc);
         e = dot3(b, ca);
-        dd = dot3(ca, ca) + dot3(bc, bc) - 2.0 * e * e;
+        dd = nb2 * dot3(ca, ca) + na2 * dot3(bc, bc) - 2.0 * e * e;
         dm = INV_HALF_PI2 * e * e;
         if (dd > dm && dd > DBL_MIN) {
             double isd = 1.0 / sqrt(dd), ab[3], v1[3], v2[3], jr[6], tmp[3], tmp2[3];
@@ -463,14 +461,14 @@ static double sampson_pass(const raydata *rd, const double r[9], const double t[
             cross3(a, ca, v1);              /* d|cA|^2 / dc = 2 v1 */
             cross3(bc, b, v2);              /* d|bc|^2 / dc = 2 v2 */
             for (i = 0; i < 3; i++) {
-                ddt[i] = 2.0 * (v1[i] + v2[i]) - 4.0 * e * ab[i];
-                tmp[i] = v1[i] + v2[i];
+                tmp[i] = nb2 * v1[i] + na2 * v2[i];
+                ddt[i] = 2.0 * tmp[i] - 4.0 * e * ab[i];
             }
             cross3(rp, tmp, tmp2);
             cross3(ca, c, tmp);
             cross3(a, tmp, ddw);
             for (i = 0; i < 3; i++)
-                ddw[i] = 2.0 * (tmp2[i] + ddw[i]) - 4.0 * e * dew[i];
+                ddw[i] = 2.0 * (tmp2[i] + nb2 * ddw[i]) - 4.0 * e * dew[i];
             fe = isd;
             fd = -0.5 * res * isd * isd;
             for (i = 0; i < 3; i++) {
