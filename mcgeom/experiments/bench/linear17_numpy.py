@@ -13,20 +13,22 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["linear17_numpy"]
+__all__ = ["linear17_numpy", "skew", "exp_so3"]
 
 _W = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
 
 
-def _skew(v: np.ndarray) -> np.ndarray:
+def skew(v: np.ndarray) -> np.ndarray:
+    """[v]x, the 3 x 3 matrix of the cross product with v."""
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _exp(w: np.ndarray) -> np.ndarray:
+def exp_so3(w: np.ndarray) -> np.ndarray:
+    """The rotation exp([w]x) (Rodrigues; w in radians)."""
     th = np.linalg.norm(w)
     if th < 1e-300:
         return np.eye(3)
-    k = _skew(w / th)
+    k = skew(w / th)
     return np.eye(3) + np.sin(th) * k + (1.0 - np.cos(th)) * k @ k
 
 
@@ -38,12 +40,12 @@ def _rows(d1, m1, d2, m2):
 
 
 def _x(R, t):
-    return np.concatenate([(_skew(t) @ R).ravel(), R.ravel()])
+    return np.concatenate([(skew(t) @ R).ravel(), R.ravel()])
 
 
 def _solve_t(A, R):
     # A x(R, t) = J t - b with J_k = A_E vec([e_k]x R), b = -A_R vec(R)  (eq. 8.15)
-    J = np.stack([A[:, :9] @ (_skew(e) @ R).ravel() for e in np.eye(3)], axis=1)
+    J = np.stack([A[:, :9] @ (skew(e) @ R).ravel() for e in np.eye(3)], axis=1)
     b = -A[:, 9:] @ R.ravel()
     t = np.linalg.lstsq(J, b, rcond=None)[0]
     return t, float(np.sum((J @ t - b) ** 2))
@@ -106,7 +108,7 @@ def _refine_sampson(R, t, a, p, b, q, max_iterations, tolerance):
     (R <- exp([w]x) R, t <- t + dt), from (R, t); the Jacobian by central
     differences."""
     def resid(x, R0):
-        return _sampson(_exp(x[:3]) @ R0, x[3:], a, p, b, q)
+        return _sampson(exp_so3(x[:3]) @ R0, x[3:], a, p, b, q)
 
     x = np.concatenate([np.zeros(3), t])
     r = resid(x, R)
@@ -123,7 +125,7 @@ def _refine_sampson(R, t, a, p, b, q, max_iterations, tolerance):
         rn = resid(xn, R)
         cn = float(rn @ rn)
         if cn <= cost:
-            R = _exp(xn[:3]) @ R
+            R = exp_so3(xn[:3]) @ R
             x = np.concatenate([np.zeros(3), xn[3:]])
             dec, cost, r = cost - cn, cn, rn
             lam = max(lam * 0.1, 1e-12)
