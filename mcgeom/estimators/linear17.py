@@ -56,8 +56,8 @@ def _verdict(r: dict) -> ScaleVerdict:
     family="linear",
     needs_rotation=False,
     recovers_scale=True,
-    description="linear 17-point generalized essential matrix with constrained SVD and "
-                "alternation (thesis ch. 8)",
+    description="linear 17-point generalized essential matrix with constrained SVD, refined "
+                "to the Sampson-error optimum (thesis ch. 8)",
     options={"refine": "run the refinement of ch. 8.4.3 to the Sampson-error optimum "
                        "(default True)",
              "max_iterations": "cap on refinement iterations (default 100)",
