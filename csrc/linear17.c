@@ -5,14 +5,26 @@
  * Algorithm 4 / eq. 8.36 for the locally-central and axial kinds and the plain
  * SVD for the most-general kind (Algorithm 2), decomposition of E into its
  * rotation candidates, the translation WITH scale from eq. 8.15, and the
- * alternation of ch. 8.4.3 (R given t, then t given R).
+ * refinement of ch. 8.4.3.
  *
- * Why everything works on the 18 x 18 Gram matrix M = A^T A:
+ * Why the linear step works on the 18 x 18 Gram matrix M = A^T A:
  * |A x|^2 = x^T M x for every x = (vec E, vec R), so after one O(N) pass over
- * the rays the linear step, the candidate choice and every alternation step
- * cost O(18^2) regardless of N. Squaring the condition number is harmless
- * here: rows are normalised (Algorithm 2 step 1) and the alternation polishes
- * the final R, t on a 3-parameter well-conditioned problem.
+ * the rays the linear step and the candidate choice cost O(18^2) regardless
+ * of N. Squaring the condition number is harmless here: rows are normalised
+ * (Algorithm 2 step 1) and the refinement re-fits R, t on the rays.
+ *
+ * Which optimum the refinement seeks: the alternation of ch. 8.4.3
+ * (R given t, then t given R) minimises the algebraic cost x^T M x. For a
+ * rig whose correspondences stay in one camera, (0, I) is in the null space
+ * of A, so that cost vanishes at R = I, t = 0, and its minimiser is biased
+ * towards a short t: on the cases of issue 22 (mcgeom experiment
+ * linear17_accuracy) it doubled the median scale error of the linear step,
+ * which is itself worse than OpenGV's seventeenpt there. The refinement
+ * therefore minimises the Sampson angular error of each correspondence
+ * (the residual of refine.c), a first-order geometric error with no such
+ * trivial minimum (Levenberg-Marquardt, a few O(N) passes). When only the
+ * direction of t is determined (unit mode) the alternation is kept: with
+ * |t| = 1 fixed the algebraic cost has no trivial zero.
  *
  * Frames: inputs and outputs in the rig frame; internally the normalised frame
  * X' = s (X - o) (o = centroid of the ray origins, s = 1 / RMS distance), which
@@ -38,20 +50,6 @@ static void matvec(int n, const double *m, const double *x, double *y)
         double acc = 0.0;
         for (j = 0; j < n; j++)
             acc += m[i * n + j] * x[j];
-        y[i] = acc;
-    }
-}
-
-/* y (+)= M[:, c0:c0+9] x for the 18 x 18 Gram matrix M. */
-static void matvec_cols(const double *m, int c0, const double x[9], double y[NX],
-                        int add)
-{
-    int i, k;
-    for (i = 0; i < NX; i++) {
-        const double *mi = m + i * NX + c0;
-        double acc = add ? y[i] : 0.0;
-        for (k = 0; k < 9; k++)
-            acc += mi[k] * x[k];
         y[i] = acc;
     }
 }
@@ -390,134 +388,238 @@ static int step_r(const double *m, double r[9], const double t[3], double *cost)
     return MCG_OK;
 }
 
-/* Joint Gauss-Newton polish on (R, t) after the alternation: block
- * coordinate descent converges linearly (and zig-zags when R and t are
- * coupled), so a few joint steps take the estimate to the exact minimum of
- * the same cost; the result is then reproducible to rounding whatever the
- * frame, order or scale of the input. Returns the number of steps taken. */
+/* ------------------------------------- geometric refinement (ch. 8.4.3) */
+
+/* The rays and their normalisation (Algorithm 2 step 1), for the passes over
+ * the rays after the linear step. */
 typedef struct {
     int n;
     const double *o1, *d1, *o2, *d2, *origin;
     double scale;
 } raydata;
 
-/* M x computed as sum_i row_i (row_i . x) straight from the rays: near the
- * solution the residuals row_i . x are tiny and exact to rounding, whereas
- * M x from the Gram matrix carries the rounding of M (|M| eps), which limits
- * weakly conditioned directions (the scale) to ~1e-8. */
-static void exact_mx(const raydata *rd, const double x[NX], double mx[NX])
+#define HALF_PI 1.5707963267948966
+#define INV_HALF_PI2 0.40528473456935109 /* (2 / pi)^2 */
+
+/* One pass over the rays at the motion (R, t) of the normalised frame: the
+ * sum of the squared Sampson angular errors of the generalized epipolar
+ * constraint (eq. 8.15 read as the epipolar constraint of the camera pair,
+ * F = [c]x R with c = t + R o1 - o2; the residual of csrc/refine.c and
+ * mcg_gec_residuals, radians, invariant to the normalisation), and with h
+ * and g non-NULL the Gauss-Newton normal equations J^T J (6 x 6, upper
+ * triangle, order [dw, dt] of R <- exp([dw]x) R, t <- t + dt) and J^T r.
+ * r is homogeneous of degree 0 in the directions, so they are used as given
+ * (no square root to normalise them): with a = R d1, b = d2, cA = c x a,
+ * bc = b x c,
+ *   e = b.cA,  D = |b|^2 |cA|^2 + |a|^2 |bc|^2 - 2 e^2,  r = e / sqrt(D),
+ *   de/dw = (R o1) x (a x b) + a x bc,  de/dt = a x b,
+ *   dD = 2 |b|^2 (dc.(a x cA) + dw.(a x (cA x c))) + 2 |a|^2 dc.(bc x b)
+ *        - 4 e de,
+ *   dc = dw x (R o1) + dt, so dc.v = dw.((R o1) x v) + dt.v;
+ *   dr = de / sqrt(D) - e dD / (2 D^(3/2)).
+ * Where D vanishes the residual is capped at +-pi/2 (as in refine.c) and
+ * contributes no Jacobian row. */
+static double sampson_pass(const raydata *rd, const double r[9], const double t[3],
+                           double h[36], double g[6])
 {
-    int k, i;
-    memset(mx, 0, NX * sizeof(double));
+    double cost = 0.0;
+    int k, i, j;
+    if (h) {
+        memset(h, 0, 36 * sizeof(double));
+        memset(g, 0, 6 * sizeof(double));
+    }
     for (k = 0; k < rd->n; k++) {
-        double row[NX], r = 0.0;
-        if (!make_row(rd->o1 + 3 * k, rd->d1 + 3 * k, rd->o2 + 3 * k, rd->d2 + 3 * k,
-                      rd->origin, rd->scale, row))
-            continue;
-        for (i = 0; i < NX; i++)
-            r += row[i] * x[i];
-        for (i = 0; i < NX; i++)
-            mx[i] += row[i] * r;
-    }
-}
-
-/* One joint Gauss-Newton step on (R, t), R <- exp([d_w]x) R, t <- t + d_t.
- * With rd the gradient J^T M x is computed exactly from the rays (an
- * iterative-refinement step, always taken); otherwise from the Gram matrix
- * and the step is taken only if it does not raise the cost beyond the
- * rounding of M (trm = trace M). Returns 1 if taken, 0 if not, and the step
- * length in *len. */
-static int gn_step(const double *m, const raydata *rd, double trm, double r[9],
-                   double t[3], double *cost, double *len)
-{
-    double x0[NX], j[6][NX], mj[6][NX], mx0[NX], a[36], rhs[6], d[6];
-    double tr = 0.0, rn[9], tn[3], dr[9], xn[NX], cn;
-    int k, l, i;
-    motion_vector(r, t, x0);
-    if (rd)
-        exact_mx(rd, x0, mx0);
-    else
-        matvec(NX, m, x0, mx0);
-    for (k = 0; k < 3; k++) {
-        double e[3] = {0.0, 0.0, 0.0}, er[9];
-        e[k] = 1.0;
-        skew_times(e, r, er);
-        skew_times(t, er, j[k]);              /* d x / d w_k */
-        memcpy(j[k] + 9, er, sizeof er);
-        memcpy(j[3 + k], er, sizeof er);      /* d x / d t_k */
-        memset(j[3 + k] + 9, 0, 9 * sizeof(double));
-    }
-    /* M j with the zero R-part of the t-columns skipped: M [q; p] =
-     * M_:E q + M_:R p and M [p; 0] = M_:E p */
-    for (k = 0; k < 3; k++) {
-        matvec_cols(m, 0, j[k], mj[k], 0);
-        matvec_cols(m, 9, j[k] + 9, mj[k], 1);
-        matvec_cols(m, 0, j[3 + k], mj[3 + k], 0);
-    }
-    for (k = 0; k < 6; k++) {
-        rhs[k] = 0.0;
-        for (i = 0; i < NX; i++)
-            rhs[k] -= j[k][i] * mx0[i];
-        for (l = k; l < 6; l++) { /* J^T M J is symmetric */
-            double acc = 0.0;
-            for (i = 0; i < NX; i++)
-                acc += j[k][i] * mj[l][i];
-            a[6 * k + l] = acc;
-            a[6 * l + k] = acc;
+        const double *pd1 = rd->d1 + 3 * k, *pd2 = rd->d2 + 3 * k;
+        double p[3], q[3], a[3], rp[3], c[3], ca[3], bc[3];
+        double na2 = dot3(pd1, pd1), nb2 = dot3(pd2, pd2), e, dd, dm, res;
+        const double *b = pd2;
+        for (i = 0; i < 3; i++) {
+            p[i] = rd->scale * (rd->o1[3 * k + i] - rd->origin[i]);
+            q[i] = rd->scale * (rd->o2[3 * k + i] - rd->origin[i]);
         }
-        tr += a[7 * k];
+        mat_vec(r, pd1, a);
+        mat_vec(r, p, rp);
+        for (i = 0; i < 3; i++)
+            c[i] = t[i] + rp[i] - q[i];
+        cross3(c, a, ca);
+        cross3(b, c, bc);
+        e = dot3(b, ca);
+        dd = nb2 * dot3(ca, ca) + na2 * dot3(bc, bc) - 2.0 * e * e;
+        dm = INV_HALF_PI2 * e * e;
+        if (dd > dm && dd > DBL_MIN) {
+            double isd = 1.0 / sqrt(dd), ab[3], v1[3], v2[3], jr[6], tmp[3], tmp2[3];
+            double dew[3], ddw[3], ddt[3], fe, fd;
+            res = e * isd;
+            cost += res * res;
+            if (!h)
+                continue;
+            cross3(a, b, ab);
+            cross3(rp, ab, dew);
+            cross3(a, bc, tmp);
+            for (i = 0; i < 3; i++)
+                dew[i] += tmp[i];
+            cross3(a, ca, v1);              /* d|cA|^2 / dc = 2 v1 */
+            cross3(bc, b, v2);              /* d|bc|^2 / dc = 2 v2 */
+            for (i = 0; i < 3; i++) {
+                tmp[i] = nb2 * v1[i] + na2 * v2[i];
+                ddt[i] = 2.0 * tmp[i] - 4.0 * e * ab[i];
+            }
+            cross3(rp, tmp, tmp2);
+            cross3(ca, c, tmp);
+            cross3(a, tmp, ddw);
+            for (i = 0; i < 3; i++)
+                ddw[i] = 2.0 * (tmp2[i] + nb2 * ddw[i]) - 4.0 * e * dew[i];
+            fe = isd;
+            fd = -0.5 * res * isd * isd;
+            for (i = 0; i < 3; i++) {
+                jr[i] = fe * dew[i] + fd * ddw[i];
+                jr[3 + i] = fe * ab[i] + fd * ddt[i];
+            }
+            for (i = 0; i < 6; i++) {
+                double ji = jr[i];
+                g[i] += ji * res;
+                for (j = i; j < 6; j++)
+                    h[6 * i + j] += ji * jr[j];
+            }
+        } else if (e != 0.0) {
+            cost += HALF_PI * HALF_PI; /* no first-order error exists */
+        }
     }
-    *len = 0.0;
-    if (!(tr > 0.0))
-        return 0;
-    for (k = 0; k < 6; k++)
-        a[7 * k] += 1e-14 * tr;
-    if (mcg_spd_solve(6, a, rhs, d) != MCG_OK)
-        return 0;
-    if (mcg_rot_from_angle_axis(d, dr) != MCG_OK)
-        return 0;
-    mul33(dr, r, rn);
-    for (k = 0; k < 3; k++)
-        tn[k] = t[k] + d[3 + k];
-    motion_vector(rn, tn, xn);
-    cn = quad18(m, xn);
-    /* near the minimum the cost is flat to rounding (|M| eps) long before
-     * the parameters are: accept steps that do not raise it beyond that */
-    if (!rd && !(cn <= *cost + 64.0 * DBL_EPSILON * trm))
-        return 0;
-    memcpy(r, rn, sizeof rn);
-    memcpy(t, tn, sizeof tn);
-    *cost = cn > 0.0 ? cn : 0.0;
-    for (k = 0; k < 6; k++)
-        *len += d[k] * d[k];
-    *len = sqrt(*len);
-    return 1;
+    return cost;
 }
 
-#define POLISH_MAX_STEPS 20
-#define POLISH_EXACT_STEPS 1
-
-static int polish(const double *m, double r[9], double t[3], double *cost,
-                  const raydata *rd)
+/* Levenberg-Marquardt on the Sampson angular error from the linear estimate
+ * (R, t) of the normalised frame: the alternation of ch. 8.4.3 taken to the
+ * geometric optimum instead of the algebraic one. The algebraic cost
+ * x^T M x of a locally-central or axial rig vanishes at the trivial motion
+ * R = I, t = 0 ((0, I) is in the null space of A), so its minimisers are
+ * biased towards a short t (linear17_accuracy: median scale errors 2-3 x
+ * those of the linear step); the Sampson error divides each residual by
+ * its first-order sensitivity, which vanishes there, and has no such
+ * minimum. A step turns R by at most 0.5 rad and moves t by at most half of
+ * max(|t|, 1) (the rig size is 1 in this frame), so that a weakly observable
+ * |t| does not overshoot. Returns the iterations (trial steps) taken; on
+ * return h holds J^T J at (R, t) (for the scale evidence) and *cost the
+ * Sampson cost there. */
+static int geometric_refine(const raydata *rd, const mcg_linear17_options *o,
+                            double r[9], double t[3], double *cost, double h[36],
+                            int *converged)
 {
-    double trm = 0.0, len, prev = HUGE_VAL;
-    int k, steps = 0;
-    for (k = 0; k < NX; k++)
-        trm += m[k * NX + k];
-    /* Gauss-Newton on the Gram matrix contracts the step geometrically until
-     * the rounding of M is reached; past that the steps only wander at the
-     * noise floor. Stop when a step is refused, tiny or no longer shrinking. */
-    while (steps < POLISH_MAX_STEPS) {
-        int taken = gn_step(m, NULL, trm, r, t, cost, &len);
-        steps++;
-        if (!taken || len <= 1e-15 * (1.0 + sqrt(dot3(t, t))) || len > 0.5 * prev)
+    double g[6], lambda = 1e-8, hn[36], gn[6];
+    int it, i, j;
+    *converged = 0;
+    *cost = sampson_pass(rd, r, t, h, g);
+    for (it = 0; it < o->max_iterations; it++) {
+        double a[36], rhs[6], d[6], dr[9], rn[9], tn[3], cn, nw, nt, lim, sc;
+        int small;
+        for (i = 0; i < 6; i++) {
+            for (j = i; j < 6; j++)
+                a[6 * i + j] = a[6 * j + i] = h[6 * i + j];
+            a[7 * i] += lambda * h[7 * i] + 1e-300;
+            rhs[i] = -g[i];
+        }
+        if (!(*cost > 0.0)) {
+            *converged = 1;
             break;
-        prev = len;
+        }
+        if (mcg_spd_solve(6, a, rhs, d) != MCG_OK) {
+            lambda = lambda < 1e-6 ? 1e-6 : 10.0 * lambda;
+            if (lambda > 1e16)
+                break;
+            continue;
+        }
+        nw = sqrt(dot3(d, d));
+        nt = sqrt(dot3(d + 3, d + 3));
+        lim = 0.5 * (sqrt(dot3(t, t)) > 1.0 ? sqrt(dot3(t, t)) : 1.0);
+        sc = 1.0;
+        if (nw > 0.5)
+            sc = 0.5 / nw;
+        if (nt * sc > lim)
+            sc = lim / nt;
+        for (i = 0; i < 6; i++)
+            d[i] *= sc;
+        if (mcg_rot_from_angle_axis(d, dr) != MCG_OK)
+            break;
+        mul33(dr, r, rn);
+        for (i = 0; i < 3; i++)
+            tn[i] = t[i] + d[3 + i];
+        {   /* the decrease the Gauss-Newton model predicts for the step */
+            double hd[6], pred = 0.0;
+            for (i = 0; i < 6; i++) {
+                hd[i] = 0.0;
+                for (j = 0; j < 6; j++)
+                    hd[i] += h[i <= j ? 6 * i + j : 6 * j + i] * d[j];
+            }
+            for (i = 0; i < 6; i++)
+                pred -= g[i] * d[i] + 0.5 * d[i] * hd[i];
+            small = !(pred > o->tolerance * *cost);
+        }
+        if (small) {
+            /* the step would lower the cost by less than the tolerance: take
+             * it (it is the Newton correction of the last digits) without
+             * another pass over the rays; h and the cost stay those of the
+             * previous point, which differ by the square of the step */
+            memcpy(r, rn, sizeof rn);
+            memcpy(t, tn, sizeof tn);
+            *converged = 1;
+            it++;
+            break;
+        }
+        cn = sampson_pass(rd, rn, tn, hn, gn);
+        if (cn <= *cost) {
+            double dec = *cost - cn;
+            memcpy(r, rn, sizeof rn);
+            memcpy(t, tn, sizeof tn);
+            memcpy(h, hn, sizeof hn);
+            memcpy(g, gn, sizeof gn);
+            *cost = cn;
+            lambda = lambda * 0.1 > 1e-12 ? lambda * 0.1 : 1e-12;
+            if (dec <= o->tolerance * (dec + cn) ||
+                (nw * sc <= 1e-12 && nt * sc <= 1e-12 * (1.0 + sqrt(dot3(t, t))))) {
+                *converged = 1;
+                it++;
+                break;
+            }
+        } else {
+            lambda = lambda < 1e-6 ? 1e-6 : 10.0 * lambda;
+            if (lambda > 1e16)
+                break;
+        }
     }
-    /* then exact-gradient steps reach the minimum to rounding of the rays */
-    for (k = 0; k < POLISH_EXACT_STEPS; k++, steps++)
-        gn_step(m, rd, trm, r, t, cost, &len);
-    return steps;
+    return it;
+}
+
+/* Relative std of |t| from the Gauss-Newton information J^T J of the
+ * Sampson error (upper triangle of h) at the refined motion: sigma2 =
+ * cost / (n - 6), var|t| = sigma2 u^T S^-1 u with S = H_tt - H_tw H_ww^-1
+ * H_wt the information of t with the rotation marginalised out, u = t/|t|.
+ * HUGE_VAL where S is singular along u. */
+static double geometric_rel_std(const double h[36], double cost, int n, const double t[3])
+{
+    double hww[9], hwt[9], x[3], s[9], u[3], su[3], nt = sqrt(dot3(t, t));
+    int i, j, k;
+    if (!(nt > 0.0) || n <= 6)
+        return HUGE_VAL;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            int a = i < j ? i : j, b = i < j ? j : i;
+            hww[3 * i + j] = h[6 * a + b];
+            hwt[3 * i + j] = h[6 * i + 3 + j];
+            s[3 * i + j] = h[6 * (3 + a) + 3 + b];
+        }
+    for (j = 0; j < 3; j++) {       /* s -= H_tw H_ww^-1 H_wt, column j */
+        double col[3] = {hwt[j], hwt[3 + j], hwt[6 + j]};
+        if (mcg_spd_solve(3, hww, col, x) != MCG_OK)
+            return HUGE_VAL;
+        for (i = 0; i < 3; i++)
+            for (k = 0; k < 3; k++)
+                s[3 * i + j] -= hwt[3 * k + i] * x[k];
+    }
+    for (i = 0; i < 3; i++)
+        u[i] = t[i] / nt;
+    if (mcg_spd_solve(3, s, u, su) != MCG_OK)
+        return HUGE_VAL;
+    return sqrt(cost / (n - 6) * dot3(u, su)) / nt;
 }
 
 /* ------------------------------------------------- cheirality */
@@ -738,19 +840,15 @@ static int rotation_candidates(const double e[9], const double r[9], int use_r,
     return MCG_OK;
 }
 
-/* The rays of a problem with their normalisation (Algorithm 2 step 1):
- * what the phases below need besides the Gram matrix. */
-typedef struct {
-    int n;
-    const double *o1, *d1, *o2, *d2;
-} rayset;
-
 /* The motion being estimated, in the normalised frame: R, t, the algebraic
  * cost x^T M x at them, and unit_mode: 1 when |t| is not determined (only
  * its direction is solved for, ch. 7.3.2). */
 typedef struct {
     double r[9], t[3], cost;
     int unit_mode;
+    double geo_cost;  /* Sampson cost (rad^2) after the geometric refinement */
+    double h[36];     /* its Gauss-Newton information J^T J (upper triangle) */
+    int have_h;       /* 1 once h and geo_cost are set */
 } motion;
 
 /* A translation in the normalised frame (t' = s (t - o + R o)) back to the
@@ -770,7 +868,7 @@ static void to_rig_frame(const mcg_linear17_result *res, const double r[9],
  * or a central camera |t| is not determined: then (unit mode) the rotation
  * is chosen among the equally good candidates, and the sign of the unit
  * direction, by cheirality. */
-static int choose_candidate(const double *m, const rayset *rays,
+static int choose_candidate(const double *m, const raydata *rays,
                             const mcg_linear17_options *o, int gc, double tiny,
                             double cand[4][9], int ncand, mcg_linear17_result *res,
                             motion *mo)
@@ -832,18 +930,29 @@ static int choose_candidate(const double *m, const rayset *rays,
     return MCG_OK;
 }
 
-/* The alternation of ch. 8.4.3 (R given t, then t given R) from the linear
- * estimate, then (metric mode) the joint Gauss-Newton polish; a refinement
- * that slid towards the trivial solution is discarded. */
-static int alternate_and_polish(const double *m, const rayset *rays,
-                                const mcg_linear17_options *o, double tiny,
-                                mcg_linear17_result *res, motion *mo)
+/* The refinement of ch. 8.4.3 from the linear estimate. Metric mode: the
+ * geometric refinement (Levenberg-Marquardt on the Sampson error, see
+ * geometric_refine); mo->cost becomes the algebraic cost x^T M x at the
+ * refined motion (the residual scale of the scale evidence) and mo->h the
+ * information of the Sampson error there. Unit mode (|t| not determined: a
+ * central camera or a critical motion, ch. 7.3.2): the alternation (R given
+ * t, then the unit t given R) on the algebraic cost, which has no trivial
+ * zero once |t| = 1 is fixed. */
+static int refine_motion(const double *m, const raydata *rd,
+                         const mcg_linear17_options *o, double tiny,
+                         mcg_linear17_result *res, motion *mo)
 {
-    double rlin[9], tlin[3], costlin = mo->cost;
     int k;
     tsolve ts;
-    memcpy(rlin, mo->r, sizeof rlin);
-    memcpy(tlin, mo->t, sizeof tlin);
+    if (!mo->unit_mode) {
+        double x[NX];
+        res->iterations = geometric_refine(rd, o, mo->r, mo->t, &mo->geo_cost, mo->h,
+                                           &res->converged);
+        mo->have_h = 1;
+        motion_vector(mo->r, mo->t, x);
+        mo->cost = quad18(m, x);
+        return MCG_OK;
+    }
     for (k = 0; k < o->max_iterations; k++) {
         double prev = mo->cost;
         if (mo->cost <= tiny) {
@@ -852,9 +961,9 @@ static int alternate_and_polish(const double *m, const rayset *rays,
         }
         if (step_r(m, mo->r, mo->t, &mo->cost) != MCG_OK)
             return MCG_ENUMERIC;
-        if (solve_t(m, mo->r, mo->unit_mode, mo->t, 0, &ts) != MCG_OK)
+        if (solve_t(m, mo->r, 1, mo->t, 0, &ts) != MCG_OK)
             return MCG_ENUMERIC;
-        if (ts.cost <= mo->cost || !mo->unit_mode) {
+        if (ts.cost <= mo->cost) {
             memcpy(mo->t, ts.t, sizeof mo->t);
             mo->cost = ts.cost;
         }
@@ -862,30 +971,6 @@ static int alternate_and_polish(const double *m, const rayset *rays,
         if (prev - mo->cost <= o->tolerance * prev) {
             res->converged = 1;
             break;
-        }
-    }
-    if (!mo->unit_mode) {
-        raydata rd;
-        rd.n = rays->n;
-        rd.o1 = rays->o1; rd.d1 = rays->d1; rd.o2 = rays->o2; rd.d2 = rays->d2;
-        rd.origin = res->norm_origin;
-        rd.scale = res->norm_scale;
-        res->polish_steps = polish(m, mo->r, mo->t, &mo->cost, &rd);
-    }
-    /* Guard: for locally-central rigs (0, I) is in the null space of A,
-     * so the algebraic cost has a trivial zero at R = I, t = 0 and a
-     * descent from a poor start can slide towards it. The linear step
-     * minimised the cost with |E| = 1 fixed; a refinement that shrinks
-     * |t| (|E| = sqrt(2)|t|) by half or raises that normalised cost
-     * (f / |t|^2) fourfold went the wrong way: keep the linear estimate. */
-    if (!mo->unit_mode) {
-        double nl = dot3(tlin, tlin), nr = dot3(mo->t, mo->t);
-        if (!(nr >= 0.25 * nl) || !(mo->cost / nr <= 4.0 * costlin / nl)) {
-            memcpy(mo->r, rlin, sizeof rlin);
-            memcpy(mo->t, tlin, sizeof tlin);
-            mo->cost = costlin;
-            res->converged = 0;
-            res->refine_rejected = 1;
         }
     }
     return MCG_OK;
@@ -933,6 +1018,13 @@ static int scale_evidence(const double *m, const mcg_linear17_options *o, int n,
             rho2 = 1.0;
         if (1.0 - rho2 > res->scale_rel_std)
             res->scale_rel_std = 1.0 - rho2;
+        /* and the first-order std of the geometric (Sampson) fit, whose
+         * optimum the refinement returns */
+        if (mo->have_h) {
+            double gs = geometric_rel_std(mo->h, mo->geo_cost, n, mo->t);
+            if (!(gs <= res->scale_rel_std))
+                res->scale_rel_std = gs;
+        }
     }
     res->scale_observable = !mo->unit_mode &&
                             res->scale_conditioning >= o->min_scale_conditioning &&
@@ -946,7 +1038,7 @@ static int scale_evidence(const double *m, const mcg_linear17_options *o, int n,
  * direction is reported then: choose its sign by cheirality, as unit
  * mode does, at a length (100 in the normalised frame, where the origins
  * spread over ~1) that dwarfs the rotation-induced part o - R o. */
-static void orient_by_cheirality(const rayset *rays, const mcg_linear17_result *res,
+static void orient_by_cheirality(const raydata *rays, const mcg_linear17_result *res,
                                  motion *mo)
 {
     double nt = sqrt(dot3(mo->t, mo->t)), ro[3], tp[3], tm[3];
@@ -967,7 +1059,7 @@ static void orient_by_cheirality(const rayset *rays, const mcg_linear17_result *
 
 /* The motion into res in the rig frame: t_metric always (metric mode), t
  * with unit norm when only its direction is meaningful. */
-static void report_motion(const rayset *rays, const motion *mo, mcg_linear17_result *res)
+static void report_motion(const raydata *rays, const motion *mo, mcg_linear17_result *res)
 {
     int i;
     memcpy(res->R, mo->r, sizeof mo->r);
@@ -990,7 +1082,7 @@ static void report_motion(const rayset *rays, const motion *mo, mcg_linear17_res
 
 /* Everything after the case detection, for the kind gc (nullity of A_R):
  * the linear step (Algorithm 2), the rotation candidates, the translation
- * with scale (eq. 8.15), the alternation and polish (ch. 8.4.3), and the
+ * with scale (eq. 8.15), the refinement (ch. 8.4.3), and the
  * scale evidence; res (whose eigenvalue diagnostics are already filled)
  * gets the motion in the rig frame.
  * pinv_rtol: eigenvalues of M_RR at or below pinv_rtol * max are treated as
@@ -1003,11 +1095,14 @@ static int solve_case(int n, const double *origins1, const double *dirs1,
 {
     double e[9], rpart[9], cand[4][9], tiny = 1e-26 * tr_m, ne = 0.0;
     int st, i, ncand = 0;
-    rayset rays;
+    raydata rays;
     motion mo;
 
     rays.n = n;
     rays.o1 = origins1; rays.d1 = dirs1; rays.o2 = origins2; rays.d2 = dirs2;
+    rays.origin = res->norm_origin;
+    rays.scale = res->norm_scale;
+    mo.have_h = 0;
     res->gc_case = gc;
     res->rank_ar = 9 - nullity;
     res->rank_a = 17 - (gc == MCG_GC_CENTRAL ? 9 : nullity);
@@ -1034,20 +1129,24 @@ static int solve_case(int n, const double *origins1, const double *dirs1,
      * data it rounds to a tiny negative number (found by fuzz_linear17) */
     if (mo.cost < 0.0)
         mo.cost = 0.0;
-    res->cost_linear = sqrt(mo.cost / n);
+    /* reported costs: RMS Sampson angular error (radians), the same
+     * measure before and after the refinement and in every frame */
+    res->cost_linear = sqrt(sampson_pass(&rays, mo.r, mo.t, NULL, NULL) / n);
+    res->cost_final = res->cost_linear;
 
     res->converged = 0;
     if (opt->refine) {
-        st = alternate_and_polish(m, &rays, opt, tiny, res, &mo);
+        st = refine_motion(m, &rays, opt, tiny, res, &mo);
         if (st != MCG_OK)
             return st;
+        res->cost_final = sqrt((mo.have_h ? mo.geo_cost
+                                : sampson_pass(&rays, mo.r, mo.t, NULL, NULL)) / n);
     }
     if (mo.cost < 0.0)
         mo.cost = 0.0; /* rounding of x^T M x, as above */
     st = scale_evidence(m, opt, n, &mo, res);
     if (st != MCG_OK)
         return st;
-    res->cost_final = sqrt(mo.cost / n);
     if (!mo.unit_mode && !res->scale_observable)
         orient_by_cheirality(&rays, res, &mo);
     report_motion(&rays, &mo, res);
@@ -1067,6 +1166,42 @@ static int same_origins(int n, const double *o1, const double *o2, double scale)
             if (!(fabs(o1[3 * i + k] - o2[3 * i + k]) * scale <= 1e-12))
                 return 0;
     return 1;
+}
+
+/* The minimal sample of the most-general kind: with n >= 17 pairs, fewer
+ * distinct ones than this is reported as degenerate (the registry's
+ * check_distinct, done here in O(n)). */
+#define MIN_DISTINCT 17
+
+static int same_pair(const double *o1, const double *d1, const double *o2,
+                     const double *d2, int i, int j)
+{
+    int k;
+    for (k = 0; k < 3; k++)
+        if (o1[3 * i + k] != o1[3 * j + k] || d1[3 * i + k] != d1[3 * j + k] ||
+            o2[3 * i + k] != o2[3 * j + k] || d2[3 * i + k] != d2[3 * j + k])
+            return 0;
+    return 1;
+}
+
+/* Number of distinct pairs (exact repeats counted once), counted up to
+ * `enough`: each pair is compared with the distinct ones kept so far (at
+ * most enough - 1), so the cost is O(n enough) at worst and a handful of
+ * comparisons per pair when the data have no repeats. */
+static int count_distinct(int n, const double *o1, const double *d1, const double *o2,
+                          const double *d2, int enough)
+{
+    int kept[MIN_DISTINCT], nk = 0, i, j;
+    if (enough > MIN_DISTINCT)
+        enough = MIN_DISTINCT;
+    for (i = 0; i < n && nk < enough; i++) {
+        for (j = 0; j < nk; j++)
+            if (same_pair(o1, d1, o2, d2, i, kept[j]))
+                break;
+        if (j == nk)
+            kept[nk++] = i;
+    }
+    return nk;
 }
 
 /* Below this ratio to the largest eigenvalue of A_R^T A_R an eigenvalue is a
@@ -1108,6 +1243,9 @@ int mcg_linear17(int n, const double *origins1, const double *dirs1,
                     &res->norm_scale);
     if (st != MCG_OK)
         return st;
+    res->n_distinct = count_distinct(n, origins1, dirs1, origins2, dirs2, MIN_DISTINCT);
+    if (n >= MIN_DISTINCT && res->n_distinct < MIN_DISTINCT)
+        return MCG_EDEGENERATE;
     for (i = 0; i < NX; i++)
         tr_m += m[i * NX + i];
     if (!(tr_m > 0.0) || !isfinite(tr_m))

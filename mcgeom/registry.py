@@ -180,9 +180,15 @@ class EstimatorInfo:
     sampler: Optional[Sampler] = None
     proposer: Optional[Proposer] = None
     objective: Optional[Objective] = None
+    #: True when the estimator itself raises DegenerateError for fewer than
+    #: ``min_sample`` distinct correspondences (e.g. in its C kernel, in the
+    #: same pass as its other checks): the registry then skips
+    #: :func:`check_distinct`, whose sort costs more than a fast estimator
+    checks_distinct: bool = False
 
     def __call__(self, rays: RayPairs, **options: Any) -> RigMotion:
-        check_distinct(rays, self.min_sample, self.name)
+        if not self.checks_distinct:
+            check_distinct(rays, self.min_sample, self.name)
         return self.func(rays, **options)
 
 
@@ -209,6 +215,7 @@ def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family:
              description: str = "", options: Optional[dict] = None,
              minimal_solver: Optional[MinimalSolver] = None, sampler: Optional[Sampler] = None,
              proposer: Optional[Proposer] = None, objective: Optional[Objective] = None,
+             checks_distinct: bool = False,
              replace: bool = False) -> Callable[[Estimator], Estimator]:
     """Decorator registering ``fn(rays, **options) -> RigMotion`` under ``name``.
 
@@ -216,6 +223,9 @@ def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family:
     ``minimal_solver``, ``sampler`` and ``proposer`` (see :class:`EstimatorInfo`) let
     :mod:`mcgeom.robust` drive the estimator with minimal samples; ``objective``
     declares the value a set-valued global optimum minimises.
+    ``checks_distinct=True`` promises that the estimator raises DegenerateError
+    by itself when repeated correspondences leave fewer than ``min_sample``
+    distinct ones (the registry then does not check it again).
     Registering an existing name raises ValueError unless ``replace=True``.
     """
     kinds = tuple(camera_kinds)
@@ -236,7 +246,7 @@ def register(name: str, *, min_sample: int, camera_kinds: Iterable[str], family:
                                         bool(needs_rotation), bool(recovers_scale),
                                         description or (fn.__doc__ or "").strip().split("\n")[0],
                                         dict(options or {}), minimal_solver, sampler,
-                                        proposer, objective)
+                                        proposer, objective, bool(checks_distinct))
         return fn
 
     return deco

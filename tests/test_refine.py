@@ -222,13 +222,17 @@ def test_noise_level_and_scale_uncertainty_are_consistent():
 
 @pytest.mark.parametrize("kind", ["locally-central-and-axial", "most-general"])
 def test_refinement_improves_linear17_under_noise(kind):
-    """The geometric (Sampson) cost beats the algebraic one of linear17: over 20
-    noisy problems the median errors of R and of the metric t go down."""
+    """The geometric (Sampson) cost beats the algebraic one of linear17's linear
+    step: over 20 noisy problems the median errors of R and of the metric t go
+    down. (linear17's own refinement minimises the same Sampson cost since
+    issue 22: started there, refine stays at its optimum.)"""
     er_l, er_r, et_l, et_r = [], [], [], []
     for seed in range(20):
         p = make(kind, seed, n=100, angular_noise=1e-3)
-        lin = mcgeom.estimate(p.rays, "linear17")
+        lin = mcgeom.estimate(p.rays, "linear17", refine=False)
         m = mcgeom.estimate(p.rays, "refine", initial=(lin.R, lin.info["t_metric"]), loss="none")
+        full = mcgeom.estimate(p.rays, "linear17")
+        assert rot_err(m.R, full.R) < 1e-6
         er_l.append(rot_err(lin.R, p.R))
         er_r.append(rot_err(m.R, p.R))
         et_l.append(np.linalg.norm(lin.info["t_metric"] - p.t))

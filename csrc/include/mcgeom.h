@@ -256,8 +256,12 @@ int mcg_cls_range(int m, int n, int r, const double *a, const double *g,
  * max_scale_rel_std 0.1. Valid: refine 0/1, tolerance >= 0, rank_rtol in
  * (0, 1), min_scale_conditioning >= 0, max_scale_rel_std > 0. */
 typedef struct {
-    int refine;             /* 1: alternation refinement of ch. 8.4.3 */
-    int max_iterations;     /* cap on alternation iterations (0..10000) */
+    int refine;             /* 1: the refinement of ch. 8.4.3, to the
+                               geometric optimum (Levenberg-Marquardt on the
+                               Sampson angular error; the alternation on the
+                               algebraic cost when only the direction of t
+                               is determined) */
+    int max_iterations;     /* cap on refinement iterations (0..10000) */
     double tolerance;       /* stop when the relative cost decrease < tol */
     double rank_rtol;       /* relative eigenvalue tolerance for null(A_R) */
     double min_scale_conditioning; /* below: scale reported unobservable */
@@ -281,14 +285,14 @@ typedef struct {
                                (relative to its trace) */
     double candidate_cost[4]; /* cost of the rotation candidates */
     int n_candidates;
-    double cost_linear;     /* RMS algebraic residual after the linear step */
-    double cost_final;      /* RMS algebraic residual at return */
-    int iterations;         /* alternation iterations performed */
-    int converged;          /* 1 if the alternation met the tolerance */
-    int polish_steps;       /* joint Gauss-Newton steps after the alternation
-                               (to the exact minimum of the same cost) */
-    int refine_rejected;    /* 1 if the refinement slid towards the trivial
-                               solution R = I, t = 0 and was discarded */
+    double cost_linear;     /* RMS Sampson angular error (radians, as
+                               mcg_gec_residuals) after the linear step */
+    double cost_final;      /* RMS Sampson angular error at return */
+    int iterations;         /* refinement iterations performed */
+    int converged;          /* 1 if the refinement met the tolerance */
+    int n_distinct;         /* distinct correspondences, counted up to 17
+                               (a pair repeating an earlier one exactly adds
+                               no constraint) */
     int scale_observable;   /* 1 if the metric scale is determined */
     double scale_conditioning; /* how well the data fix |t| (0 = not at all) */
     double scale_rel_std;   /* relative uncertainty of |t|: the larger of the
@@ -307,8 +311,10 @@ void mcg_linear17_default_options(mcg_linear17_options *opt);
  * correspondences given by origins and directions (each n x 3, rig frame,
  * directions of any non-zero length). For the axial cases the origins must be
  * points on the rig axis (camera centres), not arbitrary points on the rays.
- * opt may be NULL (defaults). Returns MCG_EDEGENERATE when the data do not
- * determine E (e.g. no translation, or too few independent rays for the
+ * opt may be NULL (defaults). Returns MCG_EDEGENERATE when n >= 17 pairs
+ * hold fewer than 17 distinct ones (res->n_distinct; exact repeats), or
+ * when the data do not determine E (e.g. no translation, or too few
+ * independent rays for the
  * detected case: repeated rays add no rank, and the test is against the
  * whole Gram matrix); res is then filled with the diagnostics known so far.
  * The kind (ch. 8.3) comes from the null space of A_R; a locally-central or
@@ -316,13 +322,13 @@ void mcg_linear17_default_options(mcg_linear17_options *opt);
  * rounding level (<= 1e-14 of the largest) and, for locally central, every
  * pair has the same origin at both times. Otherwise (a cross-camera rig that
  * hardly moves nearly annihilates (0, I) by accident) the most-general
- * solve is run as well and the motion of lower algebraic cost is returned;
+ * solve is run as well and the motion of lower Sampson error is returned;
  * MCG_EDEGENERATE if the most-general reading is not unique either.
  * The result is in the caller's rig frame (R, t: rig2_from_rig1, t in the
  * unit of the origins). n in [14, 2^26]. MCG_EINVAL: NULL, n, bad options,
  * NaN/inf, a zero direction; MCG_ENUMERIC: an inner decomposition failed.
- * The alternation runs at most opt->max_iterations steps, the polish at
- * most a fixed number (res->iterations, res->polish_steps). No workspace. */
+ * The refinement runs at most opt->max_iterations steps (res->iterations),
+ * each one O(n) pass over the rays. No workspace. */
 int mcg_linear17(int n, const double *origins1, const double *dirs1,
                  const double *origins2, const double *dirs2,
                  const mcg_linear17_options *opt, mcg_linear17_result *res);

@@ -209,6 +209,74 @@ int main(void)
         st = mcg_linear17(N, o1, d1, o2, d2, NULL, &res);
         CHECK(st == MCG_EDEGENERATE, "zero motion reported degenerate (status %d)", st);
     }
+    /* repeated correspondences: 16 distinct pairs among 60 are not enough */
+    {
+        double rr[9], w[3] = {0.1, -0.2, 0.05};
+        int k;
+        mcg_rot_from_angle_axis(w, rr);
+        make_rays(N, 4, general, 1, rr, t, o1, d1, o2, d2);
+        for (k = 16; k < N; k++) {
+            memcpy(o1 + 3 * k, o1 + 3 * (k % 16), 3 * sizeof(double));
+            memcpy(d1 + 3 * k, d1 + 3 * (k % 16), 3 * sizeof(double));
+            memcpy(o2 + 3 * k, o2 + 3 * (k % 16), 3 * sizeof(double));
+            memcpy(d2 + 3 * k, d2 + 3 * (k % 16), 3 * sizeof(double));
+        }
+        st = mcg_linear17(N, o1, d1, o2, d2, NULL, &res);
+        CHECK(st == MCG_EDEGENERATE && res.n_distinct == 16,
+              "16 distinct of 60: status %d, n_distinct %d", st, res.n_distinct);
+        make_rays(N, 4, general, 1, rr, t, o1, d1, o2, d2);
+        st = mcg_linear17(N, o1, d1, o2, d2, NULL, &res);
+        CHECK(st == MCG_OK && res.n_distinct == 17, "60 distinct: status %d, n_distinct %d "
+              "(counted up to 17)", st, res.n_distinct);
+    }
+    /* the refinement stops at a stationary point of the Sampson error, checked
+     * on the independent residuals of mcg_gec_residuals (refine.c) by central
+     * differences over R <- exp([w]x) R, t <- t + dt, against the gradient at
+     * the linear estimate */
+    {
+        double rr[9], w[3] = {0.1, -0.2, 0.05}, grad[2], rs[N];
+        int k, pass;
+        mcg_rot_from_angle_axis(w, rr);
+        make_rays(N, 4, general, 0, rr, t, o1, d1, o2, d2);
+        for (k = 0; k < 3 * N; k++)
+            d2[k] += 2e-3 * srand1();
+        for (pass = 0; pass < 2; pass++) {
+            double g2 = 0.0;
+            int j;
+            mcg_linear17_default_options(&opt);
+            opt.refine = pass;
+            st = mcg_linear17(N, o1, d1, o2, d2, &opt, &res);
+            CHECK(st == MCG_OK, "stationarity: status %d", st);
+            for (j = 0; j < 6; j++) {
+                double f[2];
+                int sg;
+                for (sg = 0; sg < 2; sg++) {
+                    double dw[3] = {0.0, 0.0, 0.0}, dr[9], rn[9], tn[3], h = 1e-6;
+                    double step = sg ? -h : h, cost = 0.0;
+                    int i;
+                    memcpy(tn, res.t_metric, sizeof tn);
+                    if (j < 3)
+                        dw[j] = step;
+                    else
+                        tn[j - 3] += step;
+                    mcg_rot_from_angle_axis(dw, dr);
+                    for (i = 0; i < 9; i++) {
+                        int a = i / 3, c = i % 3;
+                        rn[i] = dr[3 * a] * res.R[c] + dr[3 * a + 1] * res.R[3 + c] +
+                                dr[3 * a + 2] * res.R[6 + c];
+                    }
+                    mcg_gec_residuals(N, o1, d1, o2, d2, rn, tn, rs);
+                    for (i = 0; i < N; i++)
+                        cost += rs[i] * rs[i];
+                    f[sg] = cost;
+                }
+                g2 += ((f[0] - f[1]) / 2e-6) * ((f[0] - f[1]) / 2e-6);
+            }
+            grad[pass] = sqrt(g2);
+        }
+        CHECK(grad[1] < 1e-4 * grad[0], "stationarity: |gradient| %.3g after the refinement, "
+              "%.3g at the linear estimate", grad[1], grad[0]);
+    }
     printf("%s: %d failure(s)\n", failures ? "FAILED" : "PASSED", failures);
     return failures ? 1 : 0;
 }

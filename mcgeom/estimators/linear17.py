@@ -4,12 +4,16 @@ Thesis Algorithm 2 with the constrained least squares of Algorithm 4
 (eq. 8.36) for the locally-central, axial and locally-central-and-axial
 generalized cameras, the plain SVD for the most-general one (cross-camera
 correspondences), the translation with metric scale from eq. 8.15 and the
-alternation refinement of ch. 8.4.3. The whole computation runs in one C call
-(``csrc/linear17.c``); this module only validates, converts and reports.
+refinement of ch. 8.4.3. The whole computation, the check for repeated
+correspondences included, runs in one C call (``csrc/linear17.c``); this
+module only converts and reports.
 
-The cost minimised is the algebraic residual of the generalized epipolar
+The linear step minimises the algebraic residual of the generalized epipolar
 constraint ``d2^T [t]x R d1 + d2^T R m1 + m2^T R d1`` in the normalised frame of
-Algorithm 2 step 1 (``residual_rms`` is its RMS, dimensionless).
+Algorithm 2 step 1; the refinement then minimises the Sampson angular error of
+each correspondence (radians; ``residual_rms`` is its RMS), whose optimum,
+unlike the algebraic one, is not biased towards a short t (issue 22,
+``mcgeom experiment linear17_accuracy``).
 """
 
 from __future__ import annotations
@@ -52,14 +56,16 @@ def _verdict(r: dict) -> ScaleVerdict:
     family="linear",
     needs_rotation=False,
     recovers_scale=True,
-    description="linear 17-point generalized essential matrix with constrained SVD and "
-                "alternation (thesis ch. 8)",
-    options={"refine": "run the alternation of ch. 8.4.3 (default True)",
-             "max_iterations": "cap on alternation iterations (default 100)",
+    description="linear 17-point generalized essential matrix with constrained SVD, refined "
+                "to the Sampson-error optimum (thesis ch. 8)",
+    options={"refine": "run the refinement of ch. 8.4.3 to the Sampson-error optimum "
+                       "(default True)",
+             "max_iterations": "cap on refinement iterations (default 100)",
              "tolerance": "relative cost decrease that stops the alternation (1e-10)",
              "max_scale_rel_std": "relative std of |t| above which the scale is "
                                   "reported unobservable (0.1)"},
     minimal_solver=lambda sample: _minimal(sample),
+    checks_distinct=True,
 )
 def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[int] = None,
              tolerance: Optional[float] = None, max_scale_rel_std: Optional[float] = None,
@@ -69,9 +75,10 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     ``rays`` are in the rig frame (metres); origins must be the camera centres
     for axial rigs. Returns ``RigMotion`` rig2_from_rig1 (``X2 = R X1 + t``);
     ``info`` reports the detected generalized-camera kind, the ranks, the
-    alternation iterations and convergence. Raises ValueError on bad input
+    refinement iterations and convergence. Raises ValueError on bad input
     (NaN/inf, zero directions, fewer than 14 rays) and DegenerateError when the
-    data do not determine E (no translation, or too few rays for the kind).
+    data do not determine E (no translation, too few rays for the kind, or
+    fewer than 17 distinct correspondences among 17 or more).
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -96,8 +103,6 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
         "rank_A": r["rank_a"],
         "iterations": r["iterations"],
         "converged": r["converged"],
-        "polish_steps": r["polish_steps"],
-        "refine_rejected": r["refine_rejected"],
         "cost_linear": r["cost_linear"],
         "t_metric": r["t_metric"],
         "candidate_cost": r["candidate_cost"],
@@ -128,6 +133,10 @@ def _raise(status: int, r: dict, rays: RayPairs, n: int) -> None:
                 raise ValueError(f"rays.{name} contains a zero-length direction")
         _core.raise_for(status, "linear17")
     if status == _core.STATUS_EDEGENERATE:
+        if n >= 17 and r["n_distinct"] < 17:
+            raise DegenerateError(f"linear17: only {r['n_distinct']} distinct correspondence(s) "
+                                  f"among {n} (the others repeat them); linear17 needs at "
+                                  "least 17")
         kind = r["gc_case"]
         if kind == "degenerate":
             raise DegenerateError(

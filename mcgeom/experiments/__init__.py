@@ -27,6 +27,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
     "ch8": ("ch8", "thesis ch. 8.5.1: linear17 next to PoseLib on three rigs (needs poselib)"),
     "ch9": ("ch9", "thesis ch. 10.5.1 set-up: E+SOCP next to linear17 and five_plus_one"),
     "ch10": ("ch10", "thesis ch. 10.5.1: B&B+LP against E+SOCP, and the preemptive test"),
+    "linear17_accuracy": ("linear17_accuracy", "issue 22: the steps of linear17 varied one "
+                                               "at a time against OpenGV's reported approach "
+                                               "and the previous version, paired"),
     "minimal_5p1": ("minimal_5p1", "noise-free minimal 5+1 samples: how often the true "
                                    "motion is among the solutions"),
     "calibration_coverage": ("calibration_coverage", "synthetic rigs with perturbed "

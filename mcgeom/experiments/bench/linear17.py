@@ -1,8 +1,18 @@
-"""``mcgeom bench linear17``: time the C estimator against the numpy reference.
+"""``mcgeom bench linear17``: where the time of a linear17 call goes.
 
-Both run the same algorithm on the same synthetic problems (a 4-camera
-non-axial rig, intra-camera correspondences, 0.05 deg angular noise) for each
-N; the mcgeom time is the full Python API call (RayPairs in, RigMotion out).
+For each N, on one synthetic problem (a 4-camera non-axial rig,
+intra-camera correspondences, 0.05 deg angular noise), the best mean time of:
+
+- ``public``: ``mcgeom.estimate(rays, "linear17")``, what a user calls
+  (RayPairs in, RigMotion with its scale verdict out: the registry, the
+  plugin, the cffi wrapper and the kernel);
+- ``wrapper``: ``mcgeom._core.linear17`` (the cffi wrapper: buffers in, the
+  result struct as a dict of numpy views out);
+- ``C``: the kernel ``mcg_linear17`` alone through cffi, its pointers made
+  beforehand (the C time plus one foreign call);
+- ``numpy``: the same algorithm written with numpy (``linear17_numpy``).
+
+``python`` = public - C is what the layers above the kernel cost.
 """
 
 from __future__ import annotations
@@ -11,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mcgeom import estimate, synth
+from mcgeom import _core, estimate, synth
 from ..common import Progress, no_progress
 from .linear17_numpy import linear17_numpy
 from .timing import best_of
@@ -21,20 +31,37 @@ __all__ = ["Linear17Timing", "bench_linear17"]
 
 @dataclass(frozen=True)
 class Linear17Timing:
+    """Microseconds per call at ``n`` rays (see the module docstring)."""
+
     n: int
-    mcgeom_us: float
+    public_us: float
+    wrapper_us: float
+    c_us: float
     numpy_us: float
     iterations: int
 
     @property
+    def python_us(self) -> float:
+        """Time spent above the kernel: public call minus C."""
+        return self.public_us - self.c_us
+
+    @property
     def ratio(self) -> float:
-        return self.numpy_us / self.mcgeom_us
+        """numpy / public."""
+        return self.numpy_us / self.public_us
+
+
+def _timed(fn, budget_s: float) -> float:
+    once = best_of(fn, 1, 3)
+    number = max(1, int(budget_s / 5 / max(once, 1e-7)))
+    return best_of(fn, 5, number)
 
 
 def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float = 0.5,
                    progress: Progress = no_progress) -> list[Linear17Timing]:
-    """Time linear17 (C, via the Python API) and the numpy reference for each N
-    (microseconds per call, best of batches; ``budget_s`` seconds per timing)."""
+    """Time linear17 through the public call, the wrapper and the bare kernel,
+    and the numpy reference, for each N (microseconds per call, best of
+    batches; ``budget_s`` seconds per timing)."""
     rng = np.random.default_rng(seed)
     rig = synth.generic_rig(4, rng)
     out = []
@@ -44,12 +71,14 @@ def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float 
                                   require_visible=False)
         rays = prob.rays
         m = estimate(rays, "linear17")
-        c_once = best_of(lambda: estimate(rays, "linear17"), 1, 3)
-        number = max(1, int(budget_s / 5 / max(c_once, 1e-7)))
-        c_t = best_of(lambda: estimate(rays, "linear17"), 5, number)
         args = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
-        np_once = best_of(lambda: linear17_numpy(*args), 1, 1)
-        number = max(1, int(budget_s / 5 / np_once))
-        np_t = best_of(lambda: linear17_numpy(*args), 5, number)
-        out.append(Linear17Timing(n, c_t * 1e6, np_t * 1e6, m.info["iterations"]))
+        ptrs = [_core.ffi.from_buffer("double[]", a) for a in args]
+        res = _core.ffi.new("mcg_linear17_result *")
+        kernel = _core.lib.mcg_linear17
+        public_t = _timed(lambda: estimate(rays, "linear17"), budget_s)
+        wrapper_t = _timed(lambda: _core.linear17(*args), budget_s)
+        c_t = _timed(lambda: kernel(n, *ptrs, _core.ffi.NULL, res), budget_s)
+        np_t = _timed(lambda: linear17_numpy(*args), budget_s)
+        out.append(Linear17Timing(n, public_t * 1e6, wrapper_t * 1e6, c_t * 1e6, np_t * 1e6,
+                                  m.info["iterations"]))
     return out
