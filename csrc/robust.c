@@ -142,7 +142,7 @@ size_t mcg_robust_work_size(int n, int n_cameras)
      * its weights, the grouped indices and the group offsets */
     s = mul_sz(nn, 16, &ok);
     s = add_sz(s, ints_as_doubles(nn), &ok);
-    s = add_sz(s, ints_as_doubles((size_t)n_cameras + 2), &ok);
+    s = add_sz(s, ints_as_doubles(2 * (size_t)n_cameras + 2), &ok);
     return ok ? s : 0;
 }
 
@@ -157,6 +157,7 @@ typedef struct {
     /* workspace */
     double *rbest, *rcur, *fsc, *sub, *wsub;
     int *perm, *off; /* indices grouped: intra of camera 0, 1, ..., cross */
+    int *usable;     /* per camera: 1 if it can be the 5-point camera */
     /* derived */
     double thr2, med_focal, loss_scale;
     int const_focal;
@@ -520,7 +521,7 @@ static int sample(ctx *c, const double *w)
     const int *off = c->off;
     for (k = 0; k < c->ncam; k++) {
         cnt = off[k + 1] - off[k];
-        total += cnt >= 5 ? cnt : 0;
+        total += cnt >= 5 && c->usable[k] ? cnt : 0;
     }
     if (total == 0)
         return -1;
@@ -528,7 +529,7 @@ static int sample(ctx *c, const double *w)
     m = rng_below(&c->rng, total);
     for (a = 0; a < c->ncam; a++) {
         cnt = off[a + 1] - off[a];
-        if (cnt < 5)
+        if (cnt < 5 || !c->usable[a])
             continue;
         if (m < cnt)
             break;
@@ -619,6 +620,7 @@ static void carve(ctx *c, double *work)
     c->wsub = work + 15 * n;
     c->perm = (int *)(work + 16 * n);
     c->off = (int *)(work + 16 * n + ints_as_doubles(n));
+    c->usable = c->off + c->ncam + 2;
 }
 
 /* Counting sort of the pairs by group: camera k's intra-camera pairs, then
@@ -641,6 +643,40 @@ static void group(ctx *c)
     for (g = c->ncam; g > 0; g--)
         off[g] = off[g - 1];
     off[0] = 0;
+}
+
+/* RMS distance (radians, small angles) of the unit bearings of camera g's
+ * intra-camera pairs (time 1: d = d1, else d2) from their best plane through
+ * the centre: sqrt of the smallest eigenvalue of mean(u u^T). */
+static double plane_rms(const ctx *c, int g, int time2)
+{
+    double m[9] = {0.0}, ev[3], vec[9];
+    int j, i, k, cnt = c->off[g + 1] - c->off[g];
+    for (j = c->off[g]; j < c->off[g + 1]; j++) {
+        const double *d = (time2 ? c->d2 : c->d1) + 3 * (size_t)c->perm[j];
+        double u[3];
+        if (!unit3(d, u))
+            continue;
+        for (i = 0; i < 3; i++)
+            for (k = 0; k < 3; k++)
+                m[3 * i + k] += u[i] * u[k] / cnt;
+    }
+    if (mcg_sym_eig(3, m, ev, vec) != MCG_OK)
+        return 0.0;
+    return ev[0] > 0.0 ? sqrt(ev[0]) : 0.0;
+}
+
+/* A camera whose bearings (all of them, outliers too) lie within the
+ * threshold of one plane through its centre at either time has no
+ * determined essential matrix (points on a line, or a plane through the
+ * camera): it is never the 5-point camera (as bearings_planar in
+ * mcgeom.estimators.essential). */
+static void mark_usable(ctx *c)
+{
+    int g;
+    for (g = 0; g < c->ncam; g++)
+        c->usable[g] = c->off[g + 1] - c->off[g] >= 5 &&
+                       plane_rms(c, g, 0) > c->loss_scale && plane_rms(c, g, 1) > c->loss_scale;
 }
 
 /* k-th smallest of x[0..n) (Hoare's selection; x is reordered) */
@@ -856,6 +892,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         }
     }
     c.loss_scale = c.opt.threshold / c.med_focal;
+    mark_usable(&c);
     /* the LO weights live in fsc until the final stage reuses it */
     wlo = c.lo_rounds > 0 ? fixed_weights(&c) : NULL;
 

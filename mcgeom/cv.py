@@ -29,7 +29,7 @@ import numpy as np
 
 from . import registry
 from . import robust as _robust   # (the name robust is estimate()'s flag)
-from .pixel_noise import pixels_per_radian, sampson_pixel_scale
+from .pixel_noise import camera_table, pixels_per_radian, sampson_pixel_scale
 from .rig import Rig
 from .types import RigMotion
 
@@ -140,7 +140,8 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         # thresholds in pixels: the pixel-noise model of the rig converts them
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                            seed=seed, focal=pixels_per_radian(rig, rays),
-                           motion_focal=sampson_pixel_scale(rig), **options)
+                           motion_focal=sampson_pixel_scale(rig),
+                           pixel_cameras=camera_table(rig), **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:

@@ -35,7 +35,7 @@ from .errors import DegenerateError
 # travel_direction: the direction an estimator reports when |t| is not
 # observable; the robust layer finishes any estimator's motion and must report
 # the same (see mcgeom.estimators._common: no estimator imports this module)
-from .estimators._common import travel_direction
+from .estimators._common import camera_ids, travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import scale_profile, scale_verdict
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
@@ -58,7 +58,11 @@ class RansacOptions:
     refine: bool = True
     loss: str = "cauchy"            # final refinement (scale: the threshold)
     max_scale_rel_std: float = 0.1
+    # "auto": the C entry point (csrc/robust.c) for five_plus_one, else the
+    # estimator's proposer, else its minimal solver; "proposer" and "minimal"
+    # force the Python drivers below
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
+    max_seconds: float = 0.0        # wall-time budget of the C search (0: none)
 
     def __post_init__(self) -> None:
         # numbers only: a string or None would otherwise fail inside numpy
@@ -258,7 +262,9 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
            threshold: Optional[float] = None, prob: float = 0.999, max_iters: int = 1000,
            seed: Optional[int] = 0, focal: Union[None, float, np.ndarray] = None,
            options: Optional[RansacOptions] = None,
-           motion_focal: Optional[MotionFocal] = None, **kw: Any) -> RigMotion:
+           motion_focal: Optional[MotionFocal] = None,
+           pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]] = None,
+           **kw: Any) -> RigMotion:
     """Robust rig motion rig2_from_rig1 from correspondences with outliers.
 
     ``method`` is a registered estimator with a minimal solver or a proposer.
@@ -270,6 +276,15 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     the pixels per radian of every residual at motion (R, t), for the final
     refinement (see :meth:`_Scorer.scaling_at`). Further ``RansacOptions``
     fields may be passed as keywords.
+
+    ``five_plus_one`` with ``strategy="auto"`` runs as one call of the C
+    entry point ``mcg_robust_rig_motion`` (csrc/robust.c: 5+1 sampling,
+    MSAC, local optimisation, adaptive stop, final refinement); the verdict
+    stays here. ``pixel_cameras = (focal, axes)``, the (M,) focal lengths
+    (pixels) and (M, 3) optical axes (rig frame) of the rig's cameras (see
+    :func:`mcgeom.pixel_noise.camera_table`), is the camera table that
+    ``motion_focal`` is computed from: the C search uses it for the final
+    refinement (with ``motion_focal`` but without it, the Python drivers run).
 
     Returns a ``RigMotion`` with the boolean ``inliers`` mask, the scale verdict
     (from the covariance of the final refinement, plus the estimator's own
@@ -293,9 +308,12 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     rays.check_finite()
     registry.check_distinct(rays, info_est.min_sample, method)
     f = _focal_array(focal, n)
-    rng = np.random.default_rng(options.seed)
     if motion_focal is not None and f is None:
         raise ValueError("motion_focal needs focal (thresholds in pixels)")
+    if method == "five_plus_one" and options.strategy == "auto" and \
+            (motion_focal is None or pixel_cameras is not None):
+        return _ransac_c(rays, f, options, pixel_cameras, t_start)
+    rng = np.random.default_rng(options.seed)
     scorer = _Scorer(rays, options.threshold, f, options, motion_focal)
 
     use_proposer = info_est.proposer is not None and options.strategy in ("auto", "proposer")
@@ -419,8 +437,8 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     inl = scorer.best_inliers
     info: dict = {"iterations": iterations, "hypotheses": scorer.n_hyp,
                   "local_optimizations": scorer.n_lo}
-    rel_std = float("inf")
     r = None
+    out = used = scale_used = w_used = None
     if options.refine:
         # All six degrees of freedom are refined even when |t| turns out to be
         # unobservable: where the cost is flat in |t| the refinement may move it
@@ -454,19 +472,38 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
             if np.array_equal(sel, used) or np.count_nonzero(sel) < _MIN_REFIT:
                 break
         inl = r < options.threshold
-        rel_std = float(out["scale_rel_std"])
-        info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
     if r is None:
         r = scorer.best_residuals
-    info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start,
-                score=scorer.best_score)
+    info["score"] = scorer.best_score
+    fit = (out, used, scale_used, w_used) if options.refine else None
+    return _conclude(rays, R, t, r, inl, fit, scorer.loss_scale, np.linalg.norm(scorer.best[1]),
+                     options, method, info, t_start)
+
+
+def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: np.ndarray, inl: np.ndarray,
+              fit: Optional[tuple], loss_scale: float, n0: float, options: RansacOptions,
+              method: str, info: dict, t_start: float) -> RigMotion:
+    """Scale verdict and the returned ``RigMotion`` of a robust estimate.
+
+    ``r`` are the residuals at the final (R, t) (pixels when thresholds are),
+    ``inl`` the inliers; ``fit`` = (refinement dict, the mask of the pairs it
+    used, its loss scale (radians), their weights) of the final refinement,
+    None without one (``loss_scale`` then sets the noise level); ``n0`` the
+    length of the robust hypothesis' t before the refinement.
+    """
+    rel_std = float("inf")
     profile = float("nan")
-    if options.refine and rel_std <= options.max_scale_rel_std:
+    if fit is not None:
+        out, used, scale_used, w_used = fit
+        rel_std = float(out["scale_rel_std"])
+        info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
+    info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start)
+    if fit is not None and rel_std <= options.max_scale_rel_std:
         k = 1.0 + 3.0 * options.max_scale_rel_std
         profile = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
                                 (1.0 / k, k), options.loss, scale_used, w_used)
         info["scale_profile"] = profile
-    noise_level = scale_used if options.refine else scorer.loss_scale
+    noise_level = fit[2] if fit is not None else loss_scale
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std,
                             noise_level=noise_level, profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
@@ -480,7 +517,6 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         t = np.zeros(3)
     elif not verdict.observable:
         nt = np.linalg.norm(t)
-        n0 = np.linalg.norm(scorer.best[1])
         # Slid out along the flat valley (|t| grew more than 10x: the cost
         # keeps falling towards |t| = infinity, the central-camera limit):
         # keep the robust hypothesis' length. A large drop is no such slide:
@@ -494,3 +530,57 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
                      float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan"),
                      inl, info)
+
+
+def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions,
+              pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
+              t_start: float) -> RigMotion:
+    """five_plus_one: the search and the final refinement in one C call
+    (``_core.robust_rig_motion``, csrc/robust.c), the verdict here."""
+    method = "five_plus_one"
+    cam1, cam2, centres = camera_ids(rays)
+    cam_focal = cam_axes = None
+    n_cameras = len(centres)
+    if pixel_cameras is not None:
+        cam_focal, cam_axes = pixel_cameras
+        if focal is None:
+            raise ValueError("pixel_cameras needs focal (thresholds in pixels)")
+        if len(cam_focal) < n_cameras:
+            raise ValueError(f"pixel_cameras describes {len(cam_focal)} cameras, the rays "
+                             f"use camera ids up to {n_cameras - 1}")
+        n_cameras = len(cam_focal)
+    intra = cam1 == cam2
+    if not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
+        raise ValueError(f"too few correspondences: {method} needs 5 intra-camera "
+                         f"correspondences in one camera ({_per_camera(rays)})")
+    out = _core.robust_rig_motion(
+        rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
+        focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=options.threshold,
+        prob=options.prob, min_iterations=min(options.min_iters, options.max_iters),
+        max_iterations=int(options.max_iters), max_seconds=options.max_seconds,
+        seed=options.seed if options.seed is not None else int(np.random.SeedSequence().entropy
+                                                                % (1 << 63)),
+        lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
+        refine=options.refine, loss=options.loss)
+    if out is None:
+        scorer = _Scorer(rays, options.threshold, focal, options)
+        still = _no_translation(rays, scorer, options, method, t_start)
+        if still is not None:
+            return still
+        raise DegenerateError(f"{method}: no motion found that explains at least 6 "
+                              f"correspondences: degenerate data (e.g. points collinear or "
+                              f"coplanar in every camera, or too few correspondences per "
+                              f"camera: {_per_camera(rays)})")
+    R, t, inl = out["R"], out["t"], out["inliers"]
+    r = _residuals(rays, R, t, focal)
+    info = {k: out[k] for k in ("iterations", "hypotheses", "local_optimizations", "score",
+                                "stop")}
+    info["c_seconds"] = out["seconds"]
+    fit = None
+    if out["refinement"] is not None:
+        used = out["used"]
+        w = out["weights"][used]
+        fit = (out["refinement"], used, out["loss_scale"],
+               None if focal is None or np.ptp(w) == 0 else w)
+    return _conclude(rays, R, t, r, inl, fit, out["loss_scale"],
+                     float(np.linalg.norm(out["t_hypothesis"])), options, method, info, t_start)
