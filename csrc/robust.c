@@ -859,40 +859,39 @@ static const double *final_weights(ctx *c, const double R[9], const double t[3],
 
 /* The final refinement (all six degrees of freedom) on the pairs within
  * WIDE thresholds of the best motion, once more if that set moved; the
- * residuals of the result end in rbest. mask bit 2: used in the last fit. */
-static int finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *weights_out)
+ * residuals of the result end in rbest. mask bit 1: the pairs of the last
+ * refinement that succeeded (bit 2, the set to fit next, is scratch). */
+static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *weights_out)
 {
     double R[9], t[3], cen[3], scale;
-    int round, k, m = 0, n_inl;
+    const double wide = WIDE * c->opt.threshold;
+    int round, k, m, n_inl, moved = 1;
     const double *w;
     mcg_refine_result rr;
     memcpy(R, c->R, sizeof R);
     memcpy(t, c->t, sizeof t);
     res->refined = 0;
     for (k = 0; k < c->n; k++)
-        mask[k] = c->rbest[k] < WIDE * c->opt.threshold ? 2 : 0;
-    for (round = 0; round < 2; round++) {
-        int same = 1;
+        mask[k] = c->rbest[k] < wide ? 4 : 0;
+    for (round = 0; round < 2 && moved; round++) {
         w = final_weights(c, R, t, &scale);
         for (k = 0; k < c->n; k++)
-            c->rcur[k] = (mask[k] & 2) ? 0.0 : 1.0; /* gather the used set */
+            c->rcur[k] = (mask[k] & 4) ? 0.0 : 1.0; /* gather the set to fit */
         m = gather(c, c->rcur, 0.5, w, cen);
         if (m < MIN_REFIT)
             break;
-        if (weights_out)
-            for (k = 0; k < c->n; k++)
-                weights_out[k] = (mask[k] & 2) ? (w ? w[k] : 1.0) : 0.0;
         if (refine_subset(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr) != MCG_OK)
             break;
         res->refined = 1;
         res->refinement = rr;
         res->loss_scale = scale;
         res->n_used = m;
-        (void)msac(c, R, t, INFINITY, &n_inl);
         for (k = 0; k < c->n; k++) {
-            unsigned char u = c->rcur[k] < WIDE * c->opt.threshold ? 2 : 0;
-            same &= u == (mask[k] & 2);
+            mask[k] = (mask[k] & 4) ? 2 : 0;
+            if (weights_out)
+                weights_out[k] = (mask[k] & 2) ? (w ? w[k] : 1.0) : 0.0;
         }
+        (void)msac(c, R, t, INFINITY, &n_inl);
         memcpy(c->R, R, sizeof R);
         memcpy(c->t, t, sizeof t);
         {
@@ -900,17 +899,19 @@ static int finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *w
             c->rbest = c->rcur;
             c->rcur = tmp;
         }
-        if (same)
-            break;
+        /* refit once more if the set moved (and is large enough) */
+        moved = 0;
         m = 0;
-        for (k = 0; k < c->n; k++)
-            m += c->rbest[k] < WIDE * c->opt.threshold;
-        if (m < MIN_REFIT)
-            break;
-        for (k = 0; k < c->n; k++)
-            mask[k] = c->rbest[k] < WIDE * c->opt.threshold ? 2 : 0;
+        for (k = 0; k < c->n; k++) {
+            int in = c->rbest[k] < wide;
+            moved |= in != ((mask[k] >> 1) & 1);
+            m += in;
+            mask[k] = (unsigned char)(mask[k] | (in ? 4 : 0));
+        }
+        moved = moved && m >= MIN_REFIT;
     }
-    return MCG_OK;
+    for (k = 0; k < c->n; k++)
+        mask[k] &= 2;
 }
 
 int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const double *o2,
