@@ -29,6 +29,7 @@ __all__ = [
     "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
     "skyline_eig",
+    "essential5", "essential_decompose",
 ]
 
 GC_CASE_NAMES = {
@@ -1082,6 +1083,62 @@ def skyline_eig(first: Any, ptr: Any, a: Any, b: Any, *, shift: float = 0.0, p: 
     return {"vals": vals, "vecs": vecs, "resid": resid, "iters": int(iters[0])}
 
 
+# -------------------------------------------------------------- essential5.c
+
+def _bearing_error(status: int, what: str, named: tuple) -> None:
+    """Raise for a failed 5-point kernel, naming the bad bearing array first."""
+    if status == lib.MCG_EINVAL:
+        for name, a in named:
+            if not np.isfinite(a).all():
+                raise ValueError(f"{what}: {name} contains NaN or inf")
+            bad = np.flatnonzero(np.einsum("ij,ij->i", a, a) <= 1e-100)
+            if bad.size:
+                raise ValueError(f"{what}: {name}[{bad[0]}] is a zero-length bearing "
+                                 "(|d| < 1e-50)")
+    _check(status, what)
+
+
+def essential5(d1: Any, d2: Any) -> list[np.ndarray]:
+    """Every real essential matrix of five correspondences (``mcg_essential5``,
+    Nister's 5-point solver, PAMI 2004).
+
+    ``d1``, ``d2``: (5, 3) bearings of the same five points in the camera
+    frames at times 1 and 2 (any non-zero length). Returns the 0..10
+    solutions E (3 x 3, unit Frobenius norm, sign arbitrary) with
+    ``d2_k^T E d1_k = 0``, ``det E = 0`` and ``2 E E^T E = tr(E E^T) E``; for
+    the motion ``X2 = R X1 + t`` of the camera, ``E = [t]x R`` up to scale.
+    An empty list when there is no real solution or the data is degenerate
+    (e.g. a repeated correspondence).
+    """
+    a = _f64("d1", d1, (5, 3))
+    b = _f64("d2", d2, (5, 3))
+    E = np.empty((10, 3, 3))
+    ns = ffi.new("int *")
+    st = lib.mcg_essential5(_p(a), _p(b), _p(E), ns)
+    if st != lib.MCG_OK:
+        _bearing_error(st, "essential5", (("d1", a), ("d2", b)))
+    return list(E[: ns[0]])
+
+
+def essential_decompose(E: Any, d1: Any, d2: Any) -> tuple[np.ndarray, np.ndarray, int]:
+    """The motion ``(R, t)`` (``X2 = R X1 + t``, ``|t| = 1``) of the essential
+    matrix ``E`` that puts the most correspondences in front of both cameras
+    (``mcg_essential_decompose``).
+
+    ``E``: 3 x 3, any non-zero scale and sign; ``d1``, ``d2``: (N, 3), N >= 1,
+    bearings in the camera frames at times 1 and 2. Returns ``(R, t,
+    n_front)``, ``n_front`` the number of correspondences triangulated in
+    front of both cameras by ``(R, t)``. Raises DegenerateError when E has
+    rank <= 1.
+    """
+    E = _arr("E", E, (3, 3))
+    d1 = _arr("d1", d1, (-1, 3))
+    _nonempty("d1", d1)
+    d2 = _arr("d2", d2, (d1.shape[0], 3))
+    R, t, nf = np.empty((3, 3)), np.empty(3), ffi.new("int *")
+    _check(lib.mcg_essential_decompose(_p(E), _p(d1), _p(d2), d1.shape[0], _p(R), _p(t), nf),
+           "essential_decompose")
+    return R, t, int(nf[0])
 # ------------------------------------------------------------------ robust.c
 
 __all__ += ["robust_rig_motion", "ROBUST_STOP_NAMES"]

@@ -30,6 +30,8 @@ BENCHES = {
     "cone": "L-infinity cone bisection (C) against clarabel SOCP steps (needs clarabel)",
     "bnb": "branch and bound over rotations, 4 cameras x 50 points, and its growth",
     "known_rotation": "multi-view translations with known rotations against dense numpy",
+    "essential5": "5-point essential-matrix solver (C) against OpenCV and PoseLib: success, "
+                  "solutions, time",
     "robust": "robust 5+1 façade (one C call) against PoseLib on three rigs, and its "
               "scaling to 1e6 correspondences (needs poselib)",
 }
@@ -37,7 +39,7 @@ BENCHES = {
 BENCH_SIZES = {"linear17": (17, 100, 1000, 10000), "cone": (3, 6, 20, 100, 1000),
                "robust": (1000, 10000, 100000, 1000000)}
 #: the default ``--problems`` per benchmark
-BENCH_PROBLEMS = {"bnb": 10, "robust": 100}
+BENCH_PROBLEMS = {"bnb": 10, "robust": 100, "essential5": 10000}
 
 
 def _cmd_methods(args: argparse.Namespace) -> int:
@@ -192,7 +194,8 @@ def _cmd_batch(args: argparse.Namespace) -> int:
 
 def _cmd_bench(args: argparse.Namespace) -> int:
     return {"linear17": _bench_linear17, "cone": _bench_cone, "bnb": _bench_bnb,
-            "known_rotation": _bench_known_rotation, "robust": _bench_robust}[args.what](args)
+            "known_rotation": _bench_known_rotation, "robust": _bench_robust,
+            "essential5": _bench_essential5}[args.what](args)
 
 
 def _problems(args: argparse.Namespace) -> int:
@@ -267,6 +270,24 @@ def _bench_known_rotation(args: argparse.Namespace) -> int:
                  f"{r.numpy_s:9.3f} {r.ratio:7.1f} {r.max_diff:9.1e}")
         print(f"{r.views:6d} {r.tracks:7d} {r.relation:>10} {r.relations:9d} "
               f"{r.mcgeom_s:9.4f} {dense}")
+    return 0
+
+
+def _bench_essential5(args: argparse.Namespace) -> int:
+    from .experiments.bench.essential5 import bench_essential5
+
+    n = _problems(args)
+    rows, c_us, note = bench_essential5(problems=n, budget_s=args.budget,
+                                        progress=progress_bar)
+    print(f"essential5: {n} random noise-free minimal problems; found = true E among the "
+          "solutions (to 1e-6); times per call through Python")
+    print(f"{'solver':>8} {'found':>8} {'solutions':>9} {'us/call':>8} {'vs mcgeom':>9}")
+    for r in rows:
+        print(f"{r.name:>8} {r.found:8.4f} {r.mean_solutions:9.3f} {r.us_per_call:8.2f} "
+              f"{r.us_per_call / rows[0].us_per_call:9.2f}")
+    print(f"mcgeom C kernel alone (cffi, preallocated buffers): {c_us:.2f} us per call")
+    if note:
+        print(f"poselib not compared: {note}")
     return 0
 
 
@@ -434,13 +455,14 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("what", choices=list(BENCHES), metavar="NAME",
                    help="benchmark: " + ", ".join(BENCHES))
     b.add_argument("--problems", type=positive_int, default=None,
-                   help="problems per row (bnb: default 10; robust: per case, default 100)")
+                   help="problems per row (bnb: default 10; essential5: default 10000; "
+                        "robust: per case, default 100)")
     b.add_argument("--sizes", type=positive_int_list, default=None,
                    help="comma-separated N (linear17, cone, robust; default: linear17 "
                         "17,100,1000,10000, cone 3,6,20,100,1000, robust "
                         "1000,10000,100000,1000000)")
     b.add_argument("--budget", type=positive_float, default=0.5,
-                   help="seconds per timing (linear17, cone)")
+                   help="seconds per timing (linear17, cone, essential5)")
     b.set_defaults(func=_cmd_bench)
 
     e = sub.add_parser("experiment", formatter_class=HelpFormatter,

@@ -893,6 +893,34 @@ int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const dou
                             const double *axis1, const double *axis2, const double *f1,
                             const double *f2, double min_var_ratio, double *scale);
 
+/* ------------------------------------------------------------ essential5.c */
+
+/* The minimal 5-point relative pose of a central camera (Nister, PAMI 2004):
+ * every real essential matrix E with d2_k^T E d1_k = 0 for the five
+ * correspondences k = 0..4, det E = 0 and 2 E E^T E - tr(E E^T) E = 0.
+ * d1, d2: 5 x 3 bearings (row-major) in the camera frames at times 1 and 2
+ * (any non-zero length; normalised inside). For the motion X2 = R X1 + t of
+ * that camera, E = [t]x R up to scale. Outputs: *n_solutions (0..10) and the
+ * solutions E[9 s .. 9 s + 8] (row-major 3 x 3, unit Frobenius norm, sign
+ * arbitrary); the rest of E is unspecified. The real roots of the degree-10
+ * polynomial are found with Sturm sequences. Returns MCG_OK also when there
+ * is no solution (*n_solutions = 0: no real root, or degenerate data such as
+ * repeated correspondences, for which the constraints have rank < 5).
+ * MCG_EINVAL: NULL pointers, NaN/inf, a zero-length bearing (|d| < 1e-50).
+ * Fixed stack (about 12 KB), no workspace. */
+int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *n_solutions);
+
+/* The motion (R, t), t of unit length, of the essential matrix E (any
+ * non-zero scale and sign; E = [t]x R for X2 = R X1 + t) that puts the most
+ * of the n correspondences d1 <-> d2 (n x 3 bearings in the frames at times
+ * 1 and 2, any length) in front of both cameras: of the four (R, +-t) with
+ * R from the twisted pair, the one with the most positive depth pairs
+ * (first on ties); *n_front is that count. E is first scaled to
+ * tr(E E^T) = 2; R = cof(E) -+ [t]x E, projected onto SO(3) when E is not
+ * exactly essential (a noisy E). MCG_EINVAL: NULL pointers, n outside
+ * [1, 2^26], NaN/inf. MCG_EDEGENERATE: E = 0 or of rank <= 1. */
+int mcg_essential_decompose(const double E[9], const double *d1, const double *d2, int n,
+                            double R[9], double t[3], int *n_front);
 /* --------------------------------------------------------------- robust.c */
 
 /* Options of mcg_robust_rig_motion (mcg_robust_default_options in brackets). */
