@@ -68,6 +68,12 @@
 #define PARALLEL_EPS 1e-12 /* 1 - cos^2 below: rays parallel, no depth */
 #define SCALE_PAIRS 4096   /* cross-camera pairs of the scale search (at most) */
 #define SCALE_PROPOSALS 64 /* 1-point scale proposals per search */
+/* inliers the local optimisation fits at most (a random subset beyond):
+ * LO improves a hypothesis, whose consensus is then scored on all pairs;
+ * a few thousand inliers fix six parameters to far below the noise, and
+ * the cap keeps its cost independent of N (Lebeda, Matas & Chum 2012 cap
+ * the inner sample of LO-RANSAC likewise). The final refinement uses all. */
+#define LO_MAX 4096
 
 static double now_seconds(void)
 {
@@ -105,6 +111,7 @@ void mcg_robust_default_options(mcg_robust_options *opt)
     opt->lo_rounds = 2;
     opt->refine = 1;
     opt->loss = MCG_LOSS_CAUCHY;
+    opt->max_scale_rel_std = 0.0;
 }
 
 static int check_options(const mcg_robust_options *o)
@@ -124,6 +131,9 @@ static int check_options(const mcg_robust_options *o)
     if (o->refine != 0 && o->refine != 1)
         return 0;
     if (o->loss < MCG_LOSS_NONE || o->loss > MCG_LOSS_SOFT_L1)
+        return 0;
+    if (!(isfinite(o->max_scale_rel_std) && o->max_scale_rel_std >= 0.0 &&
+          o->max_scale_rel_std <= 10.0))
         return 0;
     return 1;
 }
@@ -236,14 +246,17 @@ static void take_best(ctx *c, const double R[9], const double t[3], double score
  * centroid cen (the frame of mcgeom.geometry.refine_centred: |t| held by
  * fix_scale is then the centroid's travel, independent of the rig origin),
  * with weights w(k) (NULL: all 1). Returns the count. */
-static int gather(ctx *c, const double *res, double limit, const double *w, double cen[3])
+static int gather(ctx *c, const double *res, double limit, const double *w, double cen[3],
+                  double keep)
 {
     int k, m = 0, i;
+    /* keep < 1: each selected pair is taken with that probability */
+    const uint64_t cut = keep < 1.0 ? (uint64_t)(keep * 18446744073709551615.0) : UINT64_MAX;
     double *so1 = c->sub, *sd1 = c->sub + 3 * (size_t)c->n, *so2 = c->sub + 6 * (size_t)c->n,
            *sd2 = c->sub + 9 * (size_t)c->n;
     cen[0] = cen[1] = cen[2] = 0.0;
     for (k = 0; k < c->n; k++) {
-        if (!(res[k] < limit))
+        if (!(res[k] < limit) || (cut != UINT64_MAX && rng_next(&c->rng) > cut))
             continue;
         for (i = 0; i < 3; i++) {
             so1[3 * m + i] = c->o1[3 * k + i];
@@ -323,7 +336,8 @@ static void local_optimise(ctx *c, const double *w)
         mcg_refine_result rr;
         if (c->n_inl < MIN_REFIT)
             return;
-        m = gather(c, c->rbest, c->opt.threshold, w, cen);
+        m = gather(c, c->rbest, c->opt.threshold, w, cen,
+                   c->n_inl > LO_MAX ? (double)LO_MAX / c->n_inl : 1.0);
         if (m < MIN_REFIT)
             return;
         memcpy(R, c->R, sizeof R);
@@ -877,7 +891,7 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
         w = final_weights(c, R, t, &scale);
         for (k = 0; k < c->n; k++)
             c->rcur[k] = (mask[k] & 4) ? 0.0 : 1.0; /* gather the set to fit */
-        m = gather(c, c->rcur, 0.5, w, cen);
+        m = gather(c, c->rcur, 0.5, w, cen, 1.0);
         if (m < MIN_REFIT)
             break;
         if (refine_subset(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr) != MCG_OK)
@@ -912,6 +926,44 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
     }
     for (k = 0; k < c->n; k++)
         mask[k] &= 2;
+}
+
+/* The scale profile of the final refinement (the statistic of
+ * mcgeom.observability.scale_profile): the motion re-optimised on the same
+ * pairs with the centroid's translation held at 1/k and k times its length
+ * (k = 1 + 3 max_scale_rel_std; rotation and direction free), the smaller
+ * cost increase over the free optimum in units of sigma2: a likelihood
+ * ratio, ~chi^2 with 1 dof, that sees the non-linearity of near-critical
+ * motions where the first-order std does not. 0 when a refit fails. */
+static double scale_profile(ctx *c, const mcg_robust_result *res, const unsigned char *mask,
+                            const double *weights)
+{
+    const double k = 1.0 + 3.0 * c->opt.max_scale_rel_std, f[2] = {1.0 / k, k};
+    double cen[3], worst = INFINITY, rc[3], shift[3];
+    int j, i, m;
+    const mcg_refine_result *fr = &res->refinement;
+    if (!(isfinite(fr->sigma2) && fr->sigma2 > 0.0))
+        return 0.0;
+    for (j = 0; j < c->n; j++)
+        c->rcur[j] = (mask[j] & 2) ? 0.0 : 1.0;
+    m = gather(c, c->rcur, 0.5, weights, cen, 1.0);
+    if (m < MIN_REFIT)
+        return 0.0;
+    mat_vec(res->R, cen, rc);
+    for (i = 0; i < 3; i++)
+        shift[i] = rc[i] - cen[i];
+    for (j = 0; j < 2; j++) {
+        double R[9], t[3];
+        mcg_refine_result rr;
+        memcpy(R, res->R, sizeof R);
+        for (i = 0; i < 3; i++)
+            t[i] = (res->t[i] + shift[i]) * f[j] - shift[i];
+        if (refine_subset(c, m, cen, weights != NULL, c->opt.loss, res->loss_scale, 1, R, t,
+                          &rr) != MCG_OK)
+            return 0.0;
+        worst = fmin(worst, (rr.final_cost - fr->final_cost) / fr->sigma2);
+    }
+    return worst > 0.0 ? worst : 0.0;
 }
 
 int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const double *o2,
@@ -1029,8 +1081,14 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         for (k = 0; k < n; k++)
             weights[k] = 0.0;
     res->loss_scale = focal ? c.loss_scale : c.opt.threshold;
+    res->scale_profile = NAN;
     if (c.opt.refine)
         finish(&c, res, mask, weights);
+    if (res->refined && c.opt.max_scale_rel_std > 0.0 &&
+        res->refinement.scale_rel_std <= c.opt.max_scale_rel_std)
+        res->scale_profile = scale_profile(
+            &c, res, mask,
+            weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL));
     memcpy(res->R, c.R, sizeof c.R);
     memcpy(res->t, c.t, sizeof c.t);
     res->n_inliers = 0;

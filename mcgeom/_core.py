@@ -1156,7 +1156,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                       cam_focal: Any = None, threshold: float = 1e-3, prob: float = 0.999,
                       min_iterations: int = 0, max_iterations: int = 1000,
                       max_seconds: float = 0.0, seed: int = 0, lo_rounds: int = 2,
-                      refine: bool = True, loss: str = "cauchy") -> Optional[dict]:
+                      refine: bool = True, loss: str = "cauchy",
+                      max_scale_rel_std: float = 0.0) -> Optional[dict]:
     """The whole robust 5+1 estimate in C (``mcg_robust_rig_motion``).
 
     Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins the
@@ -1166,6 +1167,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     3) unit optical axes (rig frame) and ``cam_focal`` (n_cameras,) focal
     lengths (pixels) switch the final refinement to the exact pixel scaling
     at the motion. ``loss`` of the final refinement: a name of ``LOSS_NAMES``.
+    ``max_scale_rel_std`` > 0: when the refinement's ``scale_rel_std`` is at
+    most this, the result's ``scale_profile`` is computed (the statistic of
+    :func:`mcgeom.observability.scale_profile` at ``1 +- 3 max_scale_rel_std``).
 
     Returns None when no motion explains 6 correspondences (degenerate data),
     else a dict: ``R`` (3, 3), ``t`` (3,) (metres, metric only if the verdict
@@ -1175,7 +1179,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     refinement (0 where unused), ``loss_scale`` (radians), ``score``,
     ``iterations``, ``hypotheses``, ``local_optimizations``, ``stop`` (a name
     of ``ROBUST_STOP_NAMES``), ``seconds`` and ``refinement`` (the dict of
-    :func:`refine_motion` of the final refinement, or None if it did not run).
+    :func:`refine_motion` of the final refinement, or None if it did not run),
+    ``scale_profile`` (NaN if not computed).
     Raises ValueError naming the bad argument.
     """
     rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
@@ -1217,6 +1222,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         opt.threshold = float(threshold)
         opt.prob = float(prob)
         opt.max_seconds = float(max_seconds)
+        opt.max_scale_rel_std = float(max_scale_rel_std)
     except (TypeError, ValueError):
         raise ValueError(f"threshold, prob and max_seconds must be numbers, got {threshold!r}, "
                          f"{prob!r}, {max_seconds!r}") from None
@@ -1232,6 +1238,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         raise ValueError(f"prob must be in (0, 1), got {prob!r}")
     if not (np.isfinite(opt.max_seconds) and 0.0 <= opt.max_seconds <= 1e9):
         raise ValueError(f"max_seconds must be in [0, 1e9] (0: no limit), got {max_seconds!r}")
+    if not (np.isfinite(opt.max_scale_rel_std) and 0.0 <= opt.max_scale_rel_std <= 10.0):
+        raise ValueError(f"max_scale_rel_std must be in [0, 10], got {max_scale_rel_std!r}")
     if opt.min_iterations > opt.max_iterations:
         raise ValueError(f"min_iterations {min_iterations} exceeds max_iterations "
                          f"{max_iterations}")
@@ -1261,5 +1269,6 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         "n_inliers": res.n_inliers, "iterations": res.iterations,
         "hypotheses": res.hypotheses, "local_optimizations": res.local_optimizations,
         "stop": ROBUST_STOP_NAMES.get(res.stop, "unknown"), "seconds": res.seconds,
+        "scale_profile": res.scale_profile,
         "refinement": _refine_dict(res.refinement, R, t) if res.refined else None,
     }

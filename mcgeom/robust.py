@@ -482,26 +482,31 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
 
 def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: np.ndarray, inl: np.ndarray,
               fit: Optional[tuple], loss_scale: float, n0: float, options: RansacOptions,
-              method: str, info: dict, t_start: float) -> RigMotion:
+              method: str, info: dict, t_start: float,
+              profile: Optional[float] = None) -> RigMotion:
     """Scale verdict and the returned ``RigMotion`` of a robust estimate.
 
     ``r`` are the residuals at the final (R, t) (pixels when thresholds are),
     ``inl`` the inliers; ``fit`` = (refinement dict, the mask of the pairs it
     used, its loss scale (radians), their weights) of the final refinement,
     None without one (``loss_scale`` then sets the noise level); ``n0`` the
-    length of the robust hypothesis' t before the refinement.
+    length of the robust hypothesis' t before the refinement; ``profile`` the
+    statistic of :func:`scale_profile`, when already computed (by C).
     """
     rel_std = float("inf")
-    profile = float("nan")
+    given, profile = profile, float("nan")
     if fit is not None:
         out, used, scale_used, w_used = fit
         rel_std = float(out["scale_rel_std"])
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
     info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start)
     if fit is not None and rel_std <= options.max_scale_rel_std:
-        k = 1.0 + 3.0 * options.max_scale_rel_std
-        profile = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
-                                (1.0 / k, k), options.loss, scale_used, w_used)
+        if given is not None and np.isfinite(given):
+            profile = float(given)
+        else:
+            k = 1.0 + 3.0 * options.max_scale_rel_std
+            profile = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
+                                    (1.0 / k, k), options.loss, scale_used, w_used)
         info["scale_profile"] = profile
     noise_level = fit[2] if fit is not None else loss_scale
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std,
@@ -561,7 +566,8 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
         seed=options.seed if options.seed is not None else int(np.random.SeedSequence().entropy
                                                                 % (1 << 63)),
         lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
-        refine=options.refine, loss=options.loss)
+        refine=options.refine, loss=options.loss,
+        max_scale_rel_std=options.max_scale_rel_std)
     if out is None:
         scorer = _Scorer(rays, options.threshold, focal, options)
         still = _no_translation(rays, scorer, options, method, t_start)
@@ -583,4 +589,5 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
         fit = (out["refinement"], used, out["loss_scale"],
                None if focal is None or np.ptp(w) == 0 else w)
     return _conclude(rays, R, t, r, inl, fit, out["loss_scale"],
-                     float(np.linalg.norm(out["t_hypothesis"])), options, method, info, t_start)
+                     float(np.linalg.norm(out["t_hypothesis"])), options, method, info, t_start,
+                     out["scale_profile"])

@@ -938,6 +938,11 @@ typedef struct {
     int refine;          /* 1: final refinement on the inliers [1] */
     int loss;            /* MCG_LOSS_* of the final refinement, scale: the
                             threshold [MCG_LOSS_CAUCHY] */
+    double max_scale_rel_std; /* > 0: when the final refinement's
+                            scale_rel_std is at most this, also compute
+                            the scale profile at 1/k and k times the
+                            centroid's travel, k = 1 + 3 max_scale_rel_std
+                            (0 = never), [0, 10] [0] */
 } mcg_robust_options;
 
 /* mcg_robust_result.stop: why the search ended */
@@ -964,6 +969,10 @@ typedef struct {
     int refined;            /* 1 if the final refinement ran */
     double loss_scale;      /* loss scale of the final refinement, radians */
     double seconds;         /* wall time of the call */
+    double scale_profile;   /* min over the two factors of (cost with the
+                               centroid's travel held at that factor -
+                               final cost) / sigma2 (~chi^2, 1 dof; NaN if
+                               not computed, 0 if a refit failed) */
     mcg_refine_result refinement; /* of the last final refinement, in the
                                frame centred on its pairs' origins */
 } mcg_robust_result;
