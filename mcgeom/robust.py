@@ -330,15 +330,22 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     if not use_proposer:
         iterations += _run_minimal(info_est, rays, scorer, options, rng)
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
-        still = _no_translation(rays, scorer, options, method, t_start)
-        if still is not None:
-            return still
-        raise DegenerateError(f"{method}: no motion found that explains at least "
-                              f"{max(6, info_est.min_sample)} correspondences "
-                              f"({scorer.n_hyp} hypotheses from {iterations} samples): degenerate "
-                              f"data (e.g. points collinear or coplanar in every camera, or "
-                              f"too few correspondences per camera: {_per_camera(rays)})")
+        return _nothing_found(rays, scorer, options, method, t_start, max(6, info_est.min_sample),
+                              f" ({scorer.n_hyp} hypotheses from {iterations} samples)")
     return _finish(rays, scorer, options, method, iterations, t_start)
+
+
+def _nothing_found(rays: RayPairs, scorer: "_Scorer", options: RansacOptions, method: str,
+                   t_start: float, need: int, counts: str) -> RigMotion:
+    """No motion explains ``need`` correspondences: a static rig or pure
+    rotation (:func:`_no_translation`), else DegenerateError."""
+    still = _no_translation(rays, scorer, options, method, t_start)
+    if still is not None:
+        return still
+    raise DegenerateError(f"{method}: no motion found that explains at least {need} "
+                          f"correspondences{counts}: degenerate data (e.g. points collinear or "
+                          f"coplanar in every camera, or too few correspondences per camera: "
+                          f"{_per_camera(rays)})")
 
 
 def _per_camera(rays: RayPairs) -> str:
@@ -569,14 +576,8 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
         refine=options.refine, loss=options.loss,
         max_scale_rel_std=options.max_scale_rel_std)
     if out is None:
-        scorer = _Scorer(rays, options.threshold, focal, options)
-        still = _no_translation(rays, scorer, options, method, t_start)
-        if still is not None:
-            return still
-        raise DegenerateError(f"{method}: no motion found that explains at least 6 "
-                              f"correspondences: degenerate data (e.g. points collinear or "
-                              f"coplanar in every camera, or too few correspondences per "
-                              f"camera: {_per_camera(rays)})")
+        return _nothing_found(rays, _Scorer(rays, options.threshold, focal, options), options,
+                              method, t_start, 6, "")
     R, t, inl = out["R"], out["t"], out["inliers"]
     r = _residuals(rays, R, t, focal)
     info = {k: out[k] for k in ("iterations", "hypotheses", "local_optimizations", "score",

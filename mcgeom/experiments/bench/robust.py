@@ -41,8 +41,8 @@ from mcgeom import metrics, robust, synth
 from mcgeom.cv import estimate
 from mcgeom.rig import Rig
 
-from ..common import Progress, import_peer, no_progress
-from ..robust_vs_poselib import ring4
+from ..common import Progress, no_progress
+from ..robust_vs_poselib import poselib_estimate, poselib_setup, ring4
 
 __all__ = ["SpeedRow", "ScaleRow", "bench_speed", "bench_scaling", "CASES"]
 
@@ -81,36 +81,6 @@ class SpeedRow:
     outside_c: float   # fraction of the time outside the C entry point (mcgeom only)
 
 
-def _poselib_setup(rig: Rig):
-    poselib = import_peer("poselib", "bench robust")
-    exts, cams = [], []
-    for c in rig.cameras:
-        pose = poselib.CameraPose()
-        pose.R, pose.t = c.R, c.t
-        exts.append(pose)
-        K = c.K
-        cams.append({"model": "PINHOLE", "width": int(c.width), "height": int(c.height),
-                     "params": [K[0, 0], K[1, 1], K[0, 2], K[1, 2]]})
-    return poselib, exts, cams
-
-
-def _poselib_run(setup, p, ransac_opt: dict) -> tuple[np.ndarray, np.ndarray]:
-    poselib, exts, cams = setup
-    matches = []
-    m = len(cams)
-    for i in range(m):
-        for j in range(m):
-            sel = (p.cam1 == i) & (p.cam2 == j)
-            if sel.any():
-                pm = poselib.PairwiseMatches()
-                pm.cam_id1, pm.cam_id2 = i, j
-                pm.x1, pm.x2 = p.pixels1[sel], p.pixels2[sel]
-                matches.append(pm)
-    pose, _ = poselib.estimate_generalized_relative_pose(matches, exts, cams, exts, cams,
-                                                         ransac_opt, {})
-    return np.asarray(pose.R), np.asarray(pose.t)
-
-
 def _errors(R, t, Rt, tt) -> tuple[float, float]:
     return (float(np.degrees(metrics.rotation_error(R, Rt))),
             abs(float(np.linalg.norm(t) / np.linalg.norm(tt)) - 1.0))
@@ -123,7 +93,7 @@ def bench_speed(problems: int = 100, seed: int = 0,
     for name, (make_rig, n, outl, noise, motion) in CASES.items():
         rng = np.random.default_rng(seed)
         rig = make_rig()
-        setup = _poselib_setup(rig)
+        setup = poselib_setup(rig, "bench robust")
         methods = {
             "mcgeom": None,
             "poselib min_it=100": {"max_epipolar_error": 1.0, "min_iterations": 100},
@@ -143,7 +113,7 @@ def bench_speed(problems: int = 100, seed: int = 0,
                                  seed=seed_k)
                     Re, te = m.R, m.info["t_metric"]
                 else:
-                    Re, te = _poselib_run(setup, p, opt)
+                    Re, te = poselib_estimate(setup, p, opt)
                 dt = time.perf_counter() - t0
                 secs[meth].append(dt)
                 err[meth].append(_errors(Re, te, R, t))
