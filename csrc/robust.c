@@ -1084,13 +1084,13 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     res->scale_profile = NAN;
     if (c.opt.refine)
         finish(&c, res, mask, weights);
+    memcpy(res->R, c.R, sizeof c.R);
+    memcpy(res->t, c.t, sizeof c.t);
     if (res->refined && c.opt.max_scale_rel_std > 0.0 &&
         res->refinement.scale_rel_std <= c.opt.max_scale_rel_std)
         res->scale_profile = scale_profile(
             &c, res, mask,
             weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL));
-    memcpy(res->R, c.R, sizeof c.R);
-    memcpy(res->t, c.t, sizeof c.t);
     res->n_inliers = 0;
     for (k = 0; k < n; k++) {
         int in = c.rbest[k] < c.opt.threshold;

@@ -79,6 +79,11 @@ class RansacOptions:
             raise ValueError(f"maxIters must be an integer, got {self.max_iters}")
         if int(self.max_iters) < 1:
             raise ValueError(f"maxIters must be >= 1, got {self.max_iters}")
+        if isinstance(self.max_seconds, (bool, np.bool_)) or \
+                not isinstance(self.max_seconds, (int, float, np.number)) or \
+                not (np.isfinite(self.max_seconds) and 0 <= self.max_seconds <= 1e9):
+            raise ValueError(f"max_seconds must be a number in [0, 1e9] (0: no limit), got "
+                             f"{self.max_seconds!r}")
         if self.strategy not in ("auto", "proposer", "minimal"):
             raise ValueError(f"strategy must be 'auto', 'proposer' or 'minimal', got "
                              f"{self.strategy!r}")

@@ -160,6 +160,15 @@ static void outliers_case(void)
           "iterations within the budget", res.iterations, opt.max_iterations);
     check(res.refined == 1 && res.n_used >= res.n_inliers, "final refinement ran on >= inliers",
           res.n_used, res.n_inliers);
+    check(isnan(res.scale_profile), "no scale profile unless asked", res.scale_profile, 0.0);
+    opt.max_scale_rel_std = 0.1;
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res2, mask, NULL, work, lwork);
+    /* |t| well determined here (cross-camera pairs, a rotation): scaling the
+     * centroid's travel by 1.3 costs far more than the noise */
+    check(st == MCG_OK && res2.scale_profile > 25.0, "scale profile: |t| x/ 1.3 excluded (chi^2)",
+          res2.scale_profile, 25.0);
+    opt.max_scale_rel_std = 0.0;
     st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res2, mask, NULL, work, lwork);
     check(st == MCG_OK && memcmp(res.R, res2.R, sizeof res.R) == 0 &&

@@ -13,7 +13,8 @@
  * rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
- * of the threshold excepted), n_inliers counts it and n_used counts bit 1.
+ * of the threshold excepted), n_inliers counts it, n_used counts bit 1 and
+ * the scale profile is NaN (not asked) or >= 0.
  * Bounded time: max_iterations <= 200 and max_seconds = 0.5 here, and
  * libFuzzer's timeout catches any loop that ignores them.
  */
@@ -96,6 +97,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     opt.loss = fz_int(&in, 0, 3);
     opt.threshold = use_focal ? fz_range(&in, 0.1, 5.0) : fz_range(&in, 1e-5, 0.1);
     opt.prob = fz_range(&in, 0.5, 0.9999);
+    opt.max_scale_rel_std = fz_u8(&in) & 1 ? fz_range(&in, 0.0, 0.5) : 0.0;
     opt_ok = 1;
     if (fz_u8(&in) % 16 == 0) {
         switch (fz_u8(&in) % 4) {
@@ -153,5 +155,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              cnt0);
     FZ_CHECK(!res.refined || cnt1 == res.n_used, "n_used %d, mask bit 1 set %d times",
              res.n_used, cnt1);
+    FZ_CHECK(isnan(res.scale_profile) || res.scale_profile >= 0.0,
+             "scale profile %g is negative", res.scale_profile);
     return 0;
 }
