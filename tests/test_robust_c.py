@@ -101,8 +101,12 @@ def test_bad_arguments_are_named(kw, name):
 def test_bad_camera_ids_are_named():
     rig, p, R, t = _problem(8, n=60)
     r = p.rays
-    with pytest.raises(ValueError, match="cam2"):
+    with pytest.raises(ValueError, match=r"cam1 holds camera ids outside \[0, 3\)"):
         _core.robust_rig_motion(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1, r.cam2, 3)
+    bad = r.cam2.copy()
+    bad[0] = 6
+    with pytest.raises(ValueError, match="cam2"):
+        _core.robust_rig_motion(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1, bad, 6)
     with pytest.raises(ValueError, match="cam1"):
         _core.robust_rig_motion(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1[:-1], r.cam2, 6)
     with pytest.raises(ValueError, match="n_cameras"):
