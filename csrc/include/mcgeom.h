@@ -46,8 +46,8 @@
  * internal caps (Jacobi sweeps, QR steps, bisections) or caller-set budgets
  * (mcg_linear17_options.max_iterations, mcg_refine_options.max_iterations,
  * mcg_cone_options.max_iterations / max_newton, mcg_bnb_options.max_blocks /
- * max_seconds), and the result structs report what was used and why the
- * routine stopped.
+ * max_seconds, mcg_robust_options.max_iterations / max_seconds), and the
+ * result structs report what was used and why the routine stopped.
  *
  * Thread safety. Every function is re-entrant: concurrent calls from several
  * threads are safe as long as they do not share output buffers or
