@@ -181,6 +181,7 @@ typedef struct {
     size_t lxwork;
     /* derived */
     double thr2, med_focal, loss_scale;
+    double size;     /* RMS spread of the origins + |their centroid| (metres) */
     int const_focal;
     uint64_t rng;
     /* state */
@@ -397,7 +398,11 @@ static int offer(ctx *c, const double R[9], const double t0[3], const double u[3
                              c->xs + 9 * (size_t)c->nx, R, t0, u, c->nx, c->xorder,
                              SCALE_PROPOSALS, c->loss_scale, c->opt.prob, &lam2, &sc2, NULL,
                              c->xwork, c->lxwork) == MCG_OK &&
-            lam2 != lam) {
+            lam2 != lam &&
+            /* not the trivial root lam = 0 of pairs whose cameras sit at
+             * camera a's centre (a central rig: every F vanishes there, a
+             * zero-residual false consensus), found up to rounding */
+            lam2 > 1e-9 * (c->size + sqrt(dot3(t0, t0)))) {
             c->n_hyp++;
             for (i = 0; i < 3; i++)
                 t[i] = t0[i] + lam2 * u[i];
@@ -1079,6 +1084,11 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         }
     }
     c.loss_scale = c.opt.threshold / c.med_focal;
+    {
+        double cen[3];
+        c.size = origin_spread(n, o1, o2, cen);
+        c.size += sqrt(dot3(cen, cen));
+    }
     mark_usable(&c);
     gather_cross(&c);
     /* the LO weights live in fsc until the final stage reuses it */
