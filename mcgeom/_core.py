@@ -610,6 +610,11 @@ def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
             raise ValueError("refine_motion: R0 is not a rotation matrix "
                              "(|R R^T - I| > 1e-6 or det R <= 0)")
         _ray_error(st, "refine_motion", rays)
+    return _refine_dict(res, R, t)
+
+
+def _refine_dict(res: Any, R: np.ndarray, t: np.ndarray) -> dict:
+    """The dict of :func:`refine_motion` from an ``mcg_refine_result``."""
     return {
         "R": R,
         "t": t,
@@ -1140,3 +1145,136 @@ def essential_decompose(E: Any, d1: Any, d2: Any) -> tuple[np.ndarray, np.ndarra
     _check(lib.mcg_essential_decompose(_p(E), _p(d1), _p(d2), d1.shape[0], _p(R), _p(t), nf),
            "essential_decompose")
     return R, t, int(nf[0])
+# ------------------------------------------------------------------ robust.c
+
+__all__ += ["robust_rig_motion", "ROBUST_STOP_NAMES"]
+
+#: why the search of :func:`robust_rig_motion` ended
+ROBUST_STOP_NAMES = {
+    lib.MCG_ROBUST_STOP_CONFIDENCE: "confidence",
+    lib.MCG_ROBUST_STOP_MAX_ITERATIONS: "max_iterations",
+    lib.MCG_ROBUST_STOP_TIME: "max_seconds",
+}
+
+
+def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: Any,
+                      cam2: Any, n_cameras: int, *, focal: Any = None, cam_axes: Any = None,
+                      cam_focal: Any = None, threshold: float = 1e-3, prob: float = 0.999,
+                      min_iterations: int = 0, max_iterations: int = 1000,
+                      max_seconds: float = 0.0, seed: int = 0, lo_rounds: int = 2,
+                      refine: bool = True, loss: str = "cauchy",
+                      max_scale_rel_std: float = 0.0) -> Optional[dict]:
+    """The whole robust 5+1 estimate in C (``mcg_robust_rig_motion``).
+
+    Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins the
+    camera centres in metres); ``cam1``, ``cam2`` (N,) camera ids in
+    ``[0, n_cameras)``. ``focal`` (N,) pixels per radian of each residual
+    (then ``threshold`` is in pixels, else radians); ``cam_axes`` (n_cameras,
+    3) unit optical axes (rig frame) and ``cam_focal`` (n_cameras,) focal
+    lengths (pixels) switch the final refinement to the exact pixel scaling
+    at the motion. ``loss`` of the final refinement: a name of ``LOSS_NAMES``.
+    ``max_scale_rel_std`` > 0: when the refinement's ``scale_rel_std`` is at
+    most this, the result's ``scale_profile`` is computed (the statistic of
+    :func:`mcgeom.observability.scale_profile` at ``1 +- 3 max_scale_rel_std``).
+
+    Returns None when no motion explains 6 correspondences (degenerate data),
+    else a dict: ``R`` (3, 3), ``t`` (3,) (metres, metric only if the verdict
+    says so), ``t_hypothesis`` (the best 5+1 hypothesis' t before the final
+    refinement), ``inliers`` and ``used`` (N,) bool (``|r| < threshold`` at
+    (R, t); the pairs of the final refinement), ``weights`` (N,) of the final
+    refinement (0 where unused), ``loss_scale`` (radians), ``score``,
+    ``iterations``, ``hypotheses``, ``local_optimizations``, ``stop`` (a name
+    of ``ROBUST_STOP_NAMES``), ``seconds`` and ``refinement`` (the dict of
+    :func:`refine_motion` of the final refinement, or None if it did not run),
+    ``scale_profile`` (NaN if not computed).
+    Raises ValueError naming the bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+    n = rays[0].shape[0]
+    ids = []
+    for name, c in (("cam1", cam1), ("cam2", cam2)):
+        a = np.asarray(c)
+        if a.shape != (n,) or (n and a.dtype.kind not in "iu"):
+            raise ValueError(f"{name} must be {n} integer camera ids, got shape {a.shape} "
+                             f"and dtype {a.dtype}")
+        ids.append(np.ascontiguousarray(a, dtype=np.int32))
+    if isinstance(n_cameras, bool) or not isinstance(n_cameras, (int, np.integer)) \
+            or not 1 <= int(n_cameras) <= 4096:
+        raise ValueError(f"n_cameras must be an integer in 1..4096, got {n_cameras!r}")
+    for name, a in (("cam1", ids[0]), ("cam2", ids[1])):
+        if a.size and (a.min() < 0 or a.max() >= n_cameras):
+            raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
+    f_ptr = ax_ptr = cf_ptr = ffi.NULL
+    if focal is not None:
+        f = _arr("focal", focal, (n,))
+        if not (f > 0).all():
+            raise ValueError("focal must be > 0 (pixels per radian)")
+        f_ptr = _p(f)
+    if (cam_axes is None) != (cam_focal is None):
+        raise ValueError("cam_axes and cam_focal go together (both or neither)")
+    if cam_axes is not None:
+        if focal is None:
+            raise ValueError("cam_axes and cam_focal need focal (thresholds in pixels)")
+        ax = _arr("cam_axes", cam_axes, (int(n_cameras), 3))
+        cf = _arr("cam_focal", cam_focal, (int(n_cameras),))
+        if not (cf > 0).all():
+            raise ValueError("cam_focal must be > 0 (pixels)")
+        ax_ptr, cf_ptr = _p(ax), _p(cf)
+    if not isinstance(loss, str) or loss not in LOSS_NAMES:
+        raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
+    opt = ffi.new("mcg_robust_options *")
+    lib.mcg_robust_default_options(opt)
+    try:
+        opt.threshold = float(threshold)
+        opt.prob = float(prob)
+        opt.max_seconds = float(max_seconds)
+        opt.max_scale_rel_std = float(max_scale_rel_std)
+    except (TypeError, ValueError):
+        raise ValueError(f"threshold, prob and max_seconds must be numbers, got {threshold!r}, "
+                         f"{prob!r}, {max_seconds!r}") from None
+    for name, v, lo, hi in (("min_iterations", min_iterations, 0, 10 ** 7),
+                            ("max_iterations", max_iterations, 1, 10 ** 7),
+                            ("lo_rounds", lo_rounds, 0, 100)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi:
+            raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
+        setattr(opt, name, int(v))
+    if not (np.isfinite(opt.threshold) and opt.threshold > 0):
+        raise ValueError(f"threshold must be a finite number > 0, got {threshold!r}")
+    if not 0.0 < opt.prob < 1.0:
+        raise ValueError(f"prob must be in (0, 1), got {prob!r}")
+    if not (np.isfinite(opt.max_seconds) and 0.0 <= opt.max_seconds <= 1e9):
+        raise ValueError(f"max_seconds must be in [0, 1e9] (0: no limit), got {max_seconds!r}")
+    if not (np.isfinite(opt.max_scale_rel_std) and 0.0 <= opt.max_scale_rel_std <= 10.0):
+        raise ValueError(f"max_scale_rel_std must be in [0, 10], got {max_scale_rel_std!r}")
+    if opt.min_iterations > opt.max_iterations:
+        raise ValueError(f"min_iterations {min_iterations} exceeds max_iterations "
+                         f"{max_iterations}")
+    opt.seed = int(seed) % (1 << 64) if seed is not None else 0
+    opt.lo_rounds = int(lo_rounds)
+    opt.refine = 1 if refine else 0
+    opt.loss = LOSS_NAMES[loss]
+    work = _work(lib.mcg_robust_work_size(n, int(n_cameras)))
+    mask = np.empty(n, dtype=np.uint8)
+    weights = np.empty(n)
+    res = ffi.new("mcg_robust_result *")
+    st = lib.mcg_robust_rig_motion(
+        n, *map(_p, rays), ffi.from_buffer("int[]", ids[0]), ffi.from_buffer("int[]", ids[1]),
+        int(n_cameras), f_ptr, ax_ptr, cf_ptr, opt, res, ffi.from_buffer("unsigned char[]", mask),
+        _p(weights), _p(work), work.size)
+    if st == lib.MCG_EDEGENERATE:
+        return None
+    if st != lib.MCG_OK:
+        _ray_error(st, "robust_rig_motion", rays)
+    R = np.frombuffer(ffi.buffer(res.R), dtype=np.float64).reshape(3, 3).copy()
+    t = np.frombuffer(ffi.buffer(res.t), dtype=np.float64).copy()
+    return {
+        "R": R, "t": t,
+        "t_hypothesis": np.frombuffer(ffi.buffer(res.t_hypothesis), dtype=np.float64).copy(),
+        "inliers": (mask & 1).view(bool), "used": (mask >> 1).view(bool),
+        "weights": weights, "loss_scale": res.loss_scale, "score": res.score,
+        "n_inliers": res.n_inliers, "iterations": res.iterations,
+        "hypotheses": res.hypotheses, "local_optimizations": res.local_optimizations,
+        "stop": ROBUST_STOP_NAMES.get(res.stop, "unknown"), "seconds": res.seconds,
+        "scale_profile": res.scale_profile,
+        "refinement": _refine_dict(res.refinement, R, t) if res.refined else None,
+    }

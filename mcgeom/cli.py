@@ -32,9 +32,14 @@ BENCHES = {
     "known_rotation": "multi-view translations with known rotations against dense numpy",
     "essential5": "5-point essential-matrix solver (C) against OpenCV and PoseLib: success, "
                   "solutions, time",
+    "robust": "robust 5+1 façade (one C call) against PoseLib on three rigs, and its "
+              "scaling to 1e6 correspondences (needs poselib)",
 }
 #: the default N of ``--sizes`` per benchmark
-BENCH_SIZES = {"linear17": (17, 100, 1000, 10000), "cone": (3, 6, 20, 100, 1000)}
+BENCH_SIZES = {"linear17": (17, 100, 1000, 10000), "cone": (3, 6, 20, 100, 1000),
+               "robust": (1000, 10000, 100000, 1000000)}
+#: the default ``--problems`` per benchmark
+BENCH_PROBLEMS = {"bnb": 10, "robust": 100, "essential5": 10000}
 
 
 def _cmd_methods(args: argparse.Namespace) -> int:
@@ -206,8 +211,36 @@ def _cmd_batch(args: argparse.Namespace) -> int:
 
 def _cmd_bench(args: argparse.Namespace) -> int:
     return {"linear17": _bench_linear17, "cone": _bench_cone, "bnb": _bench_bnb,
-            "known_rotation": _bench_known_rotation,
+            "known_rotation": _bench_known_rotation, "robust": _bench_robust,
             "essential5": _bench_essential5}[args.what](args)
+
+
+def _problems(args: argparse.Namespace) -> int:
+    return BENCH_PROBLEMS.get(args.what, 10) if args.problems is None else args.problems
+
+
+def _bench_robust(args: argparse.Namespace) -> int:
+    from .experiments.bench.robust import bench_scaling, bench_speed
+
+    rows = bench_speed(_problems(args), progress=progress_bar)
+    print(f"robust: mcgeom.cv.estimate (pixels in, 5+1 in one C call, verdict in Python) vs "
+          f"PoseLib estimate_generalized_relative_pose, {_problems(args)} problems per case, "
+          f"1 px threshold; medians")
+    print(f"{'case':<22} {'method':<19} {'rot deg':>8} {'scale err':>9} {'ms':>7} "
+          f"{'mcgeom/this':>11} {'outside C':>9}")
+    ms = {(r.case, r.method): r.ms for r in rows}
+    for r in rows:
+        out = "" if r.method != "mcgeom" else f"{100 * r.outside_c:8.0f}%"
+        print(f"{r.case:<22} {r.method:<19} {r.rot_deg:8.4f} {r.scale_err:9.4f} {r.ms:7.3f} "
+              f"{ms[(r.case, 'mcgeom')] / r.ms:10.2f}x {out:>9}")
+    print("\nscaling: 4-camera ring, 20 % outliers, rays in (mcgeom.robust.ransac)")
+    print(f"{'N':>8} {'seconds':>8} {'us/corr':>8} {'peak MB':>8} {'input MB':>8} "
+          f"{'peak/input':>10} {'rot deg':>8} {'inliers':>7}")
+    for r in bench_scaling(_sizes(args), progress=progress_bar):
+        print(f"{r.n:8d} {r.seconds:8.3f} {r.us_per_corr:8.3f} {r.peak_mb:8.1f} "
+              f"{r.input_mb:8.1f} {r.peak_mb / r.input_mb:10.2f} {r.rot_deg:8.4f} "
+              f"{r.inlier_ratio:7.3f}")
+    return 0
 
 
 def _sizes(args: argparse.Namespace) -> tuple[int, ...]:
@@ -264,7 +297,7 @@ def _bench_known_rotation(args: argparse.Namespace) -> int:
 def _bench_essential5(args: argparse.Namespace) -> int:
     from .experiments.bench.essential5 import bench_essential5
 
-    n = 10000 if args.problems is None else args.problems
+    n = _problems(args)
     rows, c_us, note = bench_essential5(problems=n, budget_s=args.budget,
                                         progress=progress_bar)
     print(f"essential5: {n} random noise-free minimal problems; found = true E among the "
@@ -293,12 +326,11 @@ def _bench_bnb(args: argparse.Namespace) -> int:
     print("bnb: branch and bound over rotations to 1e-4 rad (4 cameras x 50 points, "
           "0.5 px; medians)")
     print(head + f" {'glpk s':>9} {'glpk/nat':>7}")
-    problems = 10 if args.problems is None else args.problems
-    print(row(bench_bnb(problems=problems, progress=progress_bar)))
+    print(row(bench_bnb(problems=_problems(args), progress=progress_bar)))
     print("published: thesis ch. 10.5.1 about 3.5 s (C++ with GLPK)")
     print("\ngrowth with points (4 cameras) and cameras (50 points each)")
     print(head)
-    for r in growth(problems=max(3, problems // 2), progress=progress_bar):
+    for r in growth(problems=max(3, _problems(args) // 2), progress=progress_bar):
         print(row(r))
     return 0
 
@@ -451,10 +483,12 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("what", choices=list(BENCHES), metavar="NAME",
                    help="benchmark: " + ", ".join(BENCHES))
     b.add_argument("--problems", type=positive_int, default=None,
-                   help="problems per row (bnb: default 10; essential5: default 10000)")
+                   help="problems per row (bnb: default 10; essential5: default 10000; "
+                        "robust: per case, default 100)")
     b.add_argument("--sizes", type=positive_int_list, default=None,
-                   help="comma-separated N (linear17, cone; default: linear17 "
-                        "17,100,1000,10000, cone 3,6,20,100,1000)")
+                   help="comma-separated N (linear17, cone, robust; default: linear17 "
+                        "17,100,1000,10000, cone 3,6,20,100,1000, robust "
+                        "1000,10000,100000,1000000)")
     b.add_argument("--budget", type=positive_float, default=0.5,
                    help="seconds per timing (linear17, cone, essential5)")
     b.set_defaults(func=_cmd_bench)

@@ -30,9 +30,9 @@ from typing import Any, Optional
 import numpy as np
 
 from . import registry
-from . import robust as _robust
-from .errors import ScaleNotObservableWarning   # (the name robust is estimate()'s flag)
-from .pixel_noise import pixels_per_radian, sampson_pixel_scale
+from . import robust as _robust   # (the name robust is estimate()'s flag)
+from .errors import ScaleNotObservableWarning
+from .pixel_noise import camera_table, pixels_per_radian, sampson_pixel_scale
 from .rig import Rig
 from .types import RigMotion
 from .validation import integral_camera_ids
@@ -177,7 +177,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                            seed=seed, focal=pixels_per_radian(rig, rays),
                            motion_focal=sampson_pixel_scale(rig), calibration_std=cal,
-                           **options)
+                           pixel_cameras=camera_table(rig), **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:

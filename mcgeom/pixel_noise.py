@@ -28,11 +28,16 @@ from . import _core
 from .rig import Rig
 from .types import MotionFocal, RayPairs
 
-__all__ = ["pixels_per_radian", "sampson_pixel_scale"]
+__all__ = ["pixels_per_radian", "sampson_pixel_scale", "camera_table"]
 
 
-def _focal_and_axes(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
-    """(M,) mean focal lengths (pixels) and (M, 3) optical axes (rig frame) of the cameras."""
+def camera_table(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
+    """(M,) mean focal lengths (pixels) and (M, 3) optical axes (rig frame) of the cameras.
+
+    The pixel-noise model of every camera of ``rig`` (the table that
+    :func:`sampson_pixel_scale` evaluates; :func:`mcgeom.robust.ransac` passes
+    it to the C search as ``pixel_cameras``).
+    """
     Ks = rig.intrinsics
     return 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1]), rig.rotations[:, 2, :]
 
@@ -48,7 +53,7 @@ def pixels_per_radian(rig: Rig, rays: RayPairs) -> np.ndarray:
     their pixel-noise variance. (``cos`` is clipped to [1e-3, 1]: a bearing at
     or behind the image plane keeps a finite value.)
     """
-    focal, axes = _focal_and_axes(rig)
+    focal, axes = camera_table(rig)
     var = np.zeros(len(rays))
     for ids, d in ((rays.cam1, rays.dirs1), (rays.cam2, rays.dirs2)):
         cz = np.clip(np.einsum("ij,ij->i", axes[ids], d), 1e-3, 1.0)
@@ -75,7 +80,7 @@ def sampson_pixel_scale(rig: Rig) -> MotionFocal:
     the pixel variance vanishes (no first-order constraint). Computed by
     ``_core.sampson_pixel_scale``.
     """
-    focal, axes = _focal_and_axes(rig)
+    focal, axes = camera_table(rig)
     min_var_ratio = 1e-12 / float(np.square(focal).max())
 
     def motion_focal(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> np.ndarray:

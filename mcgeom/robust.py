@@ -35,7 +35,7 @@ from .errors import DegenerateError
 # travel_direction: the direction an estimator reports when |t| is not
 # observable; the robust layer finishes any estimator's motion and must report
 # the same (see mcgeom.estimators._common: no estimator imports this module)
-from .estimators._common import travel_direction
+from .estimators._common import camera_ids, travel_direction
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
                             total_scale_std)
@@ -60,7 +60,11 @@ class RansacOptions:
     refine: bool = True
     loss: str = "cauchy"            # final refinement (scale: the threshold)
     max_scale_rel_std: float = 0.1
+    # "auto": the C entry point (csrc/robust.c) for five_plus_one, else the
+    # estimator's proposer, else its minimal solver; "proposer" and "minimal"
+    # force the Python drivers below
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
+    max_seconds: float = 0.0        # wall-time budget of the C search (0: none)
 
     def __post_init__(self) -> None:
         # numbers only: a string or None would otherwise fail inside numpy
@@ -78,6 +82,11 @@ class RansacOptions:
         if int(self.max_iters) < 1:
             raise ValueError(f"maxIters must be >= 1, got {self.max_iters}")
         object.__setattr__(self, "seed", check_seed(self.seed))
+        if isinstance(self.max_seconds, (bool, np.bool_)) or \
+                not isinstance(self.max_seconds, (int, float, np.number)) or \
+                not (np.isfinite(self.max_seconds) and 0 <= self.max_seconds <= 1e9):
+            raise ValueError(f"max_seconds must be a number in [0, 1e9] (0: no limit), got "
+                             f"{self.max_seconds!r}")
         if self.strategy not in ("auto", "proposer", "minimal"):
             raise ValueError(f"strategy must be 'auto', 'proposer' or 'minimal', got "
                              f"{self.strategy!r}")
@@ -262,6 +271,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
            seed: Optional[int] = 0, focal: Union[None, float, np.ndarray] = None,
            options: Optional[RansacOptions] = None,
            motion_focal: Optional[MotionFocal] = None, calibration_std: Any = None,
+           pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]] = None,
            **kw: Any) -> RigMotion:
     """Robust rig motion rig2_from_rig1 from correspondences with outliers.
 
@@ -279,6 +289,15 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     the rig's): the relative std of ``|t|`` and the verdict include its
     effect (:func:`mcgeom.observability.calibration_scale_std`); None = rays
     known exactly. Further ``RansacOptions`` fields may be passed as keywords.
+
+    ``five_plus_one`` with ``strategy="auto"`` runs as one call of the C
+    entry point ``mcg_robust_rig_motion`` (csrc/robust.c: 5+1 sampling,
+    MSAC, local optimisation, adaptive stop, final refinement); the verdict
+    stays here. ``pixel_cameras = (focal, axes)``, the (M,) focal lengths
+    (pixels) and (M, 3) optical axes (rig frame) of the rig's cameras (see
+    :func:`mcgeom.pixel_noise.camera_table`), is the camera table that
+    ``motion_focal`` is computed from: the C search uses it for the final
+    refinement (with ``motion_focal`` but without it, the Python drivers run).
 
     Returns a ``RigMotion`` with the boolean ``inliers`` mask, the scale verdict
     (from the covariance of the final refinement, plus the estimator's own
@@ -302,9 +321,12 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     rays.check_finite()
     registry.check_distinct(rays, info_est.min_sample, method)
     f = _focal_array(focal, n)
-    rng = np.random.default_rng(options.seed)
     if motion_focal is not None and f is None:
         raise ValueError("motion_focal needs focal (thresholds in pixels)")
+    if method == "five_plus_one" and options.strategy == "auto" and \
+            (motion_focal is None or pixel_cameras is not None):
+        return _ransac_c(rays, f, options, pixel_cameras, t_start, calibration_std)
+    rng = np.random.default_rng(options.seed)
     scorer = _Scorer(rays, options.threshold, f, options, motion_focal)
     _check_threshold_angle(options.threshold, scorer.loss_scale, f)
 
@@ -322,15 +344,8 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     if not use_proposer:
         iterations += _run_minimal(info_est, rays, scorer, options, rng)
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
-        still = _no_translation(rays, scorer, options, method, t_start)
-        if still is not None:
-            return still
-        _threshold_too_small(rays, scorer, options, method, max(6, info_est.min_sample))
-        raise DegenerateError(f"{method}: no motion found that explains at least "
-                              f"{max(6, info_est.min_sample)} correspondences "
-                              f"({scorer.n_hyp} hypotheses from {iterations} samples): degenerate "
-                              f"data (e.g. points collinear or coplanar in every camera, or "
-                              f"too few correspondences per camera: {_per_camera(rays)})")
+        return _nothing_found(rays, scorer, options, method, t_start, max(6, info_est.min_sample),
+                              f" ({scorer.n_hyp} hypotheses from {iterations} samples)")
     return _finish(rays, scorer, options, method, iterations, t_start, calibration_std)
 
 
@@ -384,6 +399,20 @@ def _threshold_too_small(rays: RayPairs, scorer: "_Scorer", options: RansacOptio
                          f"threshold; pass a threshold of the order of the pixel noise "
                          f"(e.g. 1 px; if it is that already, the data do not determine the "
                          f"motion)")
+
+
+def _nothing_found(rays: RayPairs, scorer: "_Scorer", options: RansacOptions, method: str,
+                   t_start: float, need: int, counts: str) -> RigMotion:
+    """No motion explains ``need`` correspondences: a static rig or pure
+    rotation (:func:`_no_translation`), else DegenerateError."""
+    still = _no_translation(rays, scorer, options, method, t_start)
+    if still is not None:
+        return still
+    _threshold_too_small(rays, scorer, options, method, need)
+    raise DegenerateError(f"{method}: no motion found that explains at least {need} "
+                          f"correspondences{counts}: degenerate data (e.g. points collinear or "
+                          f"coplanar in every camera, or too few correspondences per camera: "
+                          f"{_per_camera(rays)})")
 
 
 def _per_camera(rays: RayPairs) -> str:
@@ -482,8 +511,8 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     inl = scorer.best_inliers
     info: dict = {"iterations": iterations, "hypotheses": scorer.n_hyp,
                   "local_optimizations": scorer.n_lo}
-    rel_std = float("inf")
     r = None
+    out = used = scale_used = w_used = None
     if options.refine:
         # All six degrees of freedom are refined even when |t| turns out to be
         # unobservable: where the cost is flat in |t| the refinement may move it
@@ -517,22 +546,46 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
             if np.array_equal(sel, used) or np.count_nonzero(sel) < _MIN_REFIT:
                 break
         inl = r < options.threshold
-        rel_std = float(out["scale_rel_std"])
+    if r is None:
+        r = scorer.best_residuals
+    info["score"] = scorer.best_score
+    fit = (out, used, scale_used, w_used) if options.refine else None
+    return _conclude(rays, R, t, r, inl, fit, scorer.loss_scale, np.linalg.norm(scorer.best[1]),
+                     options, method, info, t_start, calibration_std=calibration_std)
+
+
+def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: np.ndarray, inl: np.ndarray,
+              fit: Optional[tuple], loss_scale: float, n0: float, options: RansacOptions,
+              method: str, info: dict, t_start: float,
+              profile: Optional[float] = None, calibration_std: Any = None) -> RigMotion:
+    """Scale verdict and the returned ``RigMotion`` of a robust estimate.
+
+    ``r`` are the residuals at the final (R, t) (pixels when thresholds are),
+    ``inl`` the inliers; ``fit`` = (refinement dict, the mask of the pairs it
+    used, its loss scale (radians), their weights) of the final refinement,
+    None without one (``loss_scale`` then sets the noise level); ``n0`` the
+    length of the robust hypothesis' t before the refinement; ``profile`` the
+    statistic of :func:`scale_profile`, when already computed (by C);
+    ``calibration_std`` as in :func:`ransac` (its effect enters ``rel_std``).
+    """
+    rel_std = float("inf")
+    given, profile = profile, float("nan")
+    if fit is not None:
+        out, used, scale_used, w_used = fit
         info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
         rel_std, parts = total_scale_std(rays.take(used), R, t, out, calibration_std, w_used,
                                          options.loss, scale_used)
         info.update(parts)
-    if r is None:
-        r = scorer.best_residuals
-    info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start,
-                score=scorer.best_score)
-    profile = float("nan")
-    if options.refine and rel_std <= options.max_scale_rel_std:
-        k = 1.0 + 3.0 * options.max_scale_rel_std
-        profile = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
-                                (1.0 / k, k), options.loss, scale_used, w_used)
+    info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start)
+    if fit is not None and rel_std <= options.max_scale_rel_std:
+        if given is not None and np.isfinite(given):
+            profile = float(given)
+        else:
+            k = 1.0 + 3.0 * options.max_scale_rel_std
+            profile = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
+                                    (1.0 / k, k), options.loss, scale_used, w_used)
         info["scale_profile"] = profile
-    noise_level = scale_used if options.refine else scorer.loss_scale
+    noise_level = fit[2] if fit is not None else loss_scale
     verdict = scale_verdict(rays, inl, R, t, rel_std, options.max_scale_rel_std,
                             noise_level=noise_level, profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
@@ -548,7 +601,6 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         t = np.zeros(3)
     elif not verdict.observable:
         nt = np.linalg.norm(t)
-        n0 = np.linalg.norm(scorer.best[1])
         # Slid out along the flat valley (|t| grew more than 10x: the cost
         # keeps falling towards |t| = infinity, the central-camera limit):
         # keep the robust hypothesis' length. A large drop is no such slide:
@@ -561,7 +613,7 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         direction = travel_direction(rays, inl, R, t)
         info["t_direction"] = direction
         zero = float("nan")
-        if not slid and scale_determined(rel_std):
+        if fit is not None and not slid and scale_determined(rel_std):
             zero = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
                                  (ZERO_FACTOR,), options.loss, scale_used, w_used)
         if slid or not scale_determined(rel_std, zero_profile=zero):
@@ -578,3 +630,65 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]",
                      float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan"),
                      inl, info)
+
+
+def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions,
+              pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
+              t_start: float, calibration_std: Any = None) -> RigMotion:
+    """five_plus_one: the search and the final refinement in one C call
+    (``_core.robust_rig_motion``, csrc/robust.c), the verdict here."""
+    method = "five_plus_one"
+    cam1, cam2, centres = camera_ids(rays)
+    cam_focal = cam_axes = None
+    n_cameras = len(centres)
+    if pixel_cameras is not None:
+        cam_focal, cam_axes = pixel_cameras
+        if focal is None:
+            raise ValueError("pixel_cameras needs focal (thresholds in pixels)")
+        if len(cam_focal) < n_cameras:
+            raise ValueError(f"pixel_cameras describes {len(cam_focal)} cameras, the rays "
+                             f"use camera ids up to {n_cameras - 1}")
+        n_cameras = len(cam_focal)
+    intra = cam1 == cam2
+    if not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
+        raise ValueError(f"too few correspondences: {method} needs 5 intra-camera "
+                         f"correspondences in one camera ({_per_camera(rays)})")
+    scorer = _Scorer(rays, options.threshold, focal, options)
+    _check_threshold_angle(options.threshold, scorer.loss_scale, focal)
+    seed = options.seed if options.seed is not None else \
+        int(np.random.SeedSequence().entropy % (1 << 63))
+
+    def search(threshold: float, refine: bool) -> Optional[dict]:
+        return _core.robust_rig_motion(
+            rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
+            focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=threshold,
+            prob=options.prob, min_iterations=min(options.min_iters, options.max_iters),
+            max_iterations=int(options.max_iters), max_seconds=options.max_seconds,
+            seed=seed, lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
+            refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std)
+
+    out = search(options.threshold, options.refine)
+    if out is None:
+        # nothing explains 6 correspondences within the threshold: a probe at
+        # the angle of a plain fit (_FITS_RAD) tells a too small threshold
+        # (named by _threshold_too_small) from degenerate data
+        wide = _FITS_RAD if focal is None else _FITS_RAD * float(np.median(focal))
+        probe = search(wide, False) if options.threshold < wide else None
+        if probe is not None:
+            scorer.best = (probe["R"], probe["t"])
+            scorer.n_hyp = int(probe["hypotheses"])
+        return _nothing_found(rays, scorer, options, method, t_start, 6, "")
+    R, t, inl = out["R"], out["t"], out["inliers"]
+    r = _residuals(rays, R, t, focal)
+    info = {k: out[k] for k in ("iterations", "hypotheses", "local_optimizations", "score",
+                                "stop")}
+    info["c_seconds"] = out["seconds"]
+    fit = None
+    if out["refinement"] is not None:
+        used = out["used"]
+        w = out["weights"][used]
+        fit = (out["refinement"], used, out["loss_scale"],
+               None if focal is None or np.ptp(w) == 0 else w)
+    return _conclude(rays, R, t, r, inl, fit, out["loss_scale"],
+                     float(np.linalg.norm(out["t_hypothesis"])), options, method, info, t_start,
+                     out["scale_profile"], calibration_std)

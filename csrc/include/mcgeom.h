@@ -46,8 +46,8 @@
  * internal caps (Jacobi sweeps, QR steps, bisections) or caller-set budgets
  * (mcg_linear17_options.max_iterations, mcg_refine_options.max_iterations,
  * mcg_cone_options.max_iterations / max_newton, mcg_bnb_options.max_blocks /
- * max_seconds), and the result structs report what was used and why the
- * routine stopped.
+ * max_seconds, mcg_robust_options.max_iterations / max_seconds), and the
+ * result structs report what was used and why the routine stopped.
  *
  * Thread safety. Every function is re-entrant: concurrent calls from several
  * threads are safe as long as they do not share output buffers or
@@ -928,6 +928,104 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
  * [1, 2^26], NaN/inf. MCG_EDEGENERATE: E = 0 or of rank <= 1. */
 int mcg_essential_decompose(const double E[9], const double *d1, const double *d2, int n,
                             double R[9], double t[3], int *n_front);
+/* --------------------------------------------------------------- robust.c */
+
+/* Options of mcg_robust_rig_motion (mcg_robust_default_options in brackets). */
+typedef struct {
+    double threshold;    /* inlier threshold on |r|: pixels when focal is
+                            given, else radians; > 0 [1e-3] */
+    double prob;         /* confidence of the adaptive stop, (0, 1) [0.999] */
+    int min_iterations;  /* samples drawn at least, 0..max_iterations [0] */
+    int max_iterations;  /* samples drawn at most, 1..1e7 [1000] */
+    double max_seconds;  /* wall-time budget of the search, 0 = none,
+                            [0, 1e9] [0] (the final refinement runs after) */
+    unsigned long long seed; /* of the splitmix64 stream: same seed, same
+                            result [0] */
+    int lo_rounds;       /* local optimisation rounds per new best, 0..100 [2] */
+    int refine;          /* 1: final refinement on the inliers [1] */
+    int loss;            /* MCG_LOSS_* of the final refinement, scale: the
+                            threshold [MCG_LOSS_CAUCHY] */
+    double max_scale_rel_std; /* > 0: when the final refinement's
+                            scale_rel_std is at most this, also compute
+                            the scale profile at 1/k and k times the
+                            centroid's travel, k = 1 + 3 max_scale_rel_std
+                            (0 = never), [0, 10] [0] */
+} mcg_robust_options;
+
+/* mcg_robust_result.stop: why the search ended */
+enum {
+    MCG_ROBUST_STOP_CONFIDENCE = 0,     /* the adaptive stop (prob) */
+    MCG_ROBUST_STOP_MAX_ITERATIONS = 1, /* max_iterations samples drawn */
+    MCG_ROBUST_STOP_TIME = 2            /* max_seconds spent */
+};
+
+typedef struct {
+    double R[9];            /* rig2_from_rig1 rotation (row-major) */
+    double t[3];            /* translation, metres (the unit of the origins);
+                               metric only if the data fix the scale: judge
+                               that with refinement.scale_rel_std */
+    double t_hypothesis[3]; /* t of the best hypothesis before the final
+                               refinement (its length is the 5+1 scale) */
+    double score;           /* MSAC score of that hypothesis (threshold^2) */
+    int n_inliers;          /* |r| < threshold at (R, t) (mask bit 0) */
+    int n_used;             /* pairs of the final refinement (mask bit 1) */
+    int iterations;         /* 5+1 samples drawn */
+    int hypotheses;         /* motions scored */
+    int local_optimizations;/* LO refinements run */
+    int stop;               /* MCG_ROBUST_STOP_* */
+    int refined;            /* 1 if the final refinement ran */
+    double loss_scale;      /* loss scale of the final refinement, radians */
+    double seconds;         /* wall time of the call */
+    double scale_profile;   /* min over the two factors of (cost with the
+                               centroid's travel held at that factor -
+                               final cost) / sigma2 (~chi^2, 1 dof; NaN if
+                               not computed, 0 if a refit failed) */
+    mcg_refine_result refinement; /* of the last final refinement, in the
+                               frame centred on its pairs' origins */
+} mcg_robust_result;
+
+/* Fill *opt with the defaults in brackets above (no-op for NULL). */
+void mcg_robust_default_options(mcg_robust_options *opt);
+
+/* Doubles of workspace for mcg_robust_rig_motion: about 16.5 n (0 for n
+ * outside [6, 2^26] or n_cameras outside [1, 4096]). */
+size_t mcg_robust_work_size(int n, int n_cameras);
+
+/* Robust rig motion rig2_from_rig1 from n ray correspondences with
+ * outliers, in one call: camera-balanced 5+1 sampling (5 intra-camera
+ * correspondences of one camera -> mcg_essential5 -> rotation and
+ * translation direction by cheirality; the metric scale from a sixth
+ * correspondence of another camera pair by thesis eq. 7.4, kept only in
+ * front of its rays), MSAC scoring of the Sampson residuals of
+ * mcg_gec_residuals, local optimisation of each new best by
+ * mcg_refine_motion on its inliers, the adaptive stop from opt->prob, and
+ * the final refinement (opt->loss) on the pairs within 2 thresholds.
+ * Pair k: rays (o1, d1) <-> (o2, d2) (n x 3 each, rig frames at times 1
+ * and 2, origins the camera centres in metres, directions of any non-zero
+ * length), cameras cam1[k], cam2[k] in [0, n_cameras) (intra-camera when
+ * equal). focal (may be NULL): n pixels-per-radian values > 0, making
+ * residuals and threshold pixels and weighting the refinements by
+ * (focal / median)^2; cam_axes (n_cameras x 3, unit optical axes in the rig
+ * frame) and cam_focal (n_cameras, pixels), both NULL or both given (then
+ * focal is required), make the final refinement use the exact first-order
+ * pixel scaling at the motion (mcg_sampson_pixel_scale). opt: NULL =
+ * defaults. Outputs: res; mask (n bytes): bit 0 inlier, bit 1 used by the
+ * final refinement; weights (may be NULL): the final refinement's weights
+ * (0 for unused pairs). Returns MCG_OK, MCG_EDEGENERATE when no motion
+ * explains 6 correspondences (res has the counts; e.g. no camera with 5
+ * intra-camera correspondences, a static rig, degenerate scenes),
+ * MCG_EINVAL (NULL, sizes, camera ids out of range, NaN/inf, zero
+ * directions, focal <= 0, bad options), MCG_ENOMEM (lwork below
+ * mcg_robust_work_size). Budgets: opt->max_iterations samples and
+ * opt->max_seconds for the search; each refinement is capped by
+ * mcg_refine_motion's defaults. Cost O(n) per hypothesis scored (early
+ * exit once its score exceeds the best) and per refinement iteration. */
+int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const double *o2,
+                          const double *d2, const int *cam1, const int *cam2, int n_cameras,
+                          const double *focal, const double *cam_axes,
+                          const double *cam_focal, const mcg_robust_options *opt,
+                          mcg_robust_result *res, unsigned char *mask, double *weights,
+                          double *work, size_t lwork);
 
 /* MCG_CDEF_END */
 

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import time
-from typing import Callable
 
 import numpy as np
 
@@ -71,8 +70,9 @@ CASES: dict[str, tuple] = {
 }
 
 
-def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
-    poselib = import_peer("poselib", "robust_vs_poselib")
+def poselib_setup(rig: Rig, who: str = "robust_vs_poselib") -> tuple:
+    """PoseLib's module and the rig's camera poses and models, once per rig."""
+    poselib = import_peer("poselib", who)
     exts, cams = [], []
     for c in rig.cameras:
         pose = poselib.CameraPose()
@@ -81,8 +81,15 @@ def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
         K = c.K
         cams.append({"model": "PINHOLE", "width": int(c.width), "height": int(c.height),
                      "params": [K[0, 0], K[1, 1], K[0, 2], K[1, 2]]})
+    return poselib, exts, cams
+
+
+def poselib_estimate(setup: tuple, p, ransac_options: dict) -> tuple[np.ndarray, np.ndarray]:
+    """PoseLib's ``estimate_generalized_relative_pose`` on the pixels of problem ``p``
+    (one match set per camera pair), with ``ransac_options``: (R, t)."""
+    poselib, exts, cams = setup
     matches = []
-    m = len(rig.cameras)
+    m = len(cams)
     for i in range(m):
         for j in range(m):
             sel = (p.cam1 == i) & (p.cam2 == j)
@@ -92,8 +99,12 @@ def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
                 pm.x1, pm.x2 = p.pixels1[sel], p.pixels2[sel]
                 matches.append(pm)
     pose, _ = poselib.estimate_generalized_relative_pose(matches, exts, cams, exts, cams,
-                                                         {"max_epipolar_error": 1.0}, {})
+                                                         ransac_options, {})
     return np.asarray(pose.R), np.asarray(pose.t)
+
+
+def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
+    return poselib_estimate(poselib_setup(rig), p, {"max_epipolar_error": 1.0})
 
 
 def _mcgeom(rig: Rig, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

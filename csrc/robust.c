@@ -1,0 +1,1163 @@
+/*
+ * robust.c -- the whole robust estimate of a rig motion in one call:
+ * camera-balanced 5+1 sampling (thesis ch. 7), MSAC scoring, adaptive
+ * stopping, local optimisation and the final refinement (LO-RANSAC, Chum,
+ * Matas & Kittler 2003; MSAC, Torr & Zisserman 2000).
+ *
+ * Phases of mcg_robust_rig_motion (static functions below):
+ *   check inputs   sizes, pointers, finiteness, camera ids, options;
+ *   carve          the caller's workspace into residual buffers, the
+ *                  gathered subset of the refinements and the index groups;
+ *   group          correspondences by camera: the intra-camera ones of each
+ *                  camera (the 5-point camera's candidates) and the
+ *                  cross-camera ones (cam1 != cam2);
+ *   search         the sampling loop: 5 intra-camera correspondences of a
+ *                  camera a drawn with probability proportional to its count
+ *                  -> mcg_essential5 (unit bearings in rig axes: for camera
+ *                  a, s2 d2 = s1 R d1 + u with u = t + R c_a - c_a, so
+ *                  d2^T [u]x R d1 = 0 is an ordinary essential matrix) ->
+ *                  both rotations of each E with the sign of u that puts the
+ *                  five points in front (cheirality) -> the metric scale of
+ *                  t(lam) = t0 + lam u, t0 = c_a - R c_a, from the sixth
+ *                  correspondence by eq. 7.4 (lam = -a / b), kept only when
+ *                  lam > 0 and the sixth point is in front of both its rays
+ *                  (issue 18: the minimal problem must pick the candidate
+ *                  that satisfies cheirality) -> MSAC score over all
+ *                  correspondences (mcg_gec_residuals in blocks, abandoned
+ *                  once the partial score exceeds the best) -> every new best
+ *                  is locally optimised (re-estimated on its inliers by
+ *                  mcg_refine_motion with |t| held, Cauchy loss, while the
+ *                  score improves) -> the adaptive stop
+ *                  k = log(1 - prob) / log(1 - w^6), w the inlier ratio;
+ *   finish         the final refinement of all six degrees of freedom on the
+ *                  correspondences within 2 thresholds (robust loss of the
+ *                  threshold's scale), refitted once if that set moved, and
+ *                  the inlier mask.
+ *
+ * The sixth correspondence is drawn among the cross-camera ones when there
+ * are at least MIN_CROSS of them (they fix the scale whatever the motion,
+ * while near the critical motion of ch. 7.3.2 the intra-camera ones of the
+ * other cameras hardly depend on it), else among all correspondences not of
+ * camera a: what mcgeom.estimators.five_plus_one.propose did in Python.
+ *
+ * Units: the residual is the Sampson angular error (radians); with
+ * per-correspondence pixels per radian `focal` it is r * focal pixels, and
+ * the threshold is in pixels. The refinements weigh a residual by
+ * (focal / median focal)^2 and use the loss scale threshold / median focal
+ * (radians); with the optional camera table (optical axes and focal lengths)
+ * the final refinement uses the exact first-order pixel scaling of every
+ * residual at the motion (mcg_sampson_pixel_scale) instead.
+ */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
+
+#include "mcgeom.h"
+#include "internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#define MAX_PAIRS (1 << 26)
+#define MAX_CAMERAS 4096
+#define MIN_CROSS 20       /* cross-camera correspondences that take the 6th draw */
+#define SCORE_BLOCK 64     /* residuals per block of the early-exit scoring */
+#define CLOCK_EVERY 8      /* samples between two reads of the clock */
+#define MIN_REFIT 6        /* fewest correspondences a refinement can fit */
+#define WIDE 2.0           /* the final refinement uses r < WIDE * threshold */
+#define PARALLEL_EPS 1e-12 /* 1 - cos^2 below: rays parallel, no depth */
+#define SCALE_PAIRS 4096   /* cross-camera pairs of the scale search (at most) */
+#define SCALE_PROPOSALS 64 /* 1-point scale proposals per search */
+/* inliers the local optimisation fits at most (a random subset beyond):
+ * LO improves a hypothesis, whose consensus is then scored on all pairs;
+ * a few thousand inliers fix six parameters to far below the noise, and
+ * the cap keeps its cost independent of N (Lebeda, Matas & Chum 2012 cap
+ * the inner sample of LO-RANSAC likewise). The final refinement uses all. */
+#define LO_MAX 4096
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* splitmix64 (Steele, Lea & Flood 2014): a seeded, stateless-to-copy stream */
+static uint64_t rng_next(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* uniform integer in [0, m), m >= 1 (the modulo bias is below 2^-40 for the
+ * sizes accepted here) */
+static int rng_below(uint64_t *s, int m)
+{
+    return (int)(rng_next(s) % (uint64_t)m);
+}
+
+void mcg_robust_default_options(mcg_robust_options *opt)
+{
+    if (!opt)
+        return;
+    opt->threshold = 1e-3;
+    opt->prob = 0.999;
+    opt->min_iterations = 0;
+    opt->max_iterations = 1000;
+    opt->max_seconds = 0.0;
+    opt->seed = 0;
+    opt->lo_rounds = 2;
+    opt->refine = 1;
+    opt->loss = MCG_LOSS_CAUCHY;
+    opt->max_scale_rel_std = 0.0;
+}
+
+static int check_options(const mcg_robust_options *o)
+{
+    if (!(isfinite(o->threshold) && o->threshold > 0.0))
+        return 0;
+    if (!(o->prob > 0.0 && o->prob < 1.0))
+        return 0;
+    if (o->max_iterations < 1 || o->max_iterations > 10000000)
+        return 0;
+    if (o->min_iterations < 0 || o->min_iterations > o->max_iterations)
+        return 0;
+    if (!(isfinite(o->max_seconds) && o->max_seconds >= 0.0 && o->max_seconds <= 1e9))
+        return 0;
+    if (o->lo_rounds < 0 || o->lo_rounds > 100)
+        return 0;
+    if (o->refine != 0 && o->refine != 1)
+        return 0;
+    if (o->loss < MCG_LOSS_NONE || o->loss > MCG_LOSS_SOFT_L1)
+        return 0;
+    if (!(isfinite(o->max_scale_rel_std) && o->max_scale_rel_std >= 0.0 &&
+          o->max_scale_rel_std <= 10.0))
+        return 0;
+    return 1;
+}
+
+/* ------------------------------------------------------------ workspace */
+
+/* doubles for n ints (rounded up) */
+static size_t ints_as_doubles(size_t n) { return (n * sizeof(int) + sizeof(double) - 1) / sizeof(double); }
+
+size_t mcg_robust_work_size(int n, int n_cameras)
+{
+    int ok = 1;
+    size_t s, nn;
+    if (n < 6 || n > MAX_PAIRS || n_cameras < 1 || n_cameras > MAX_CAMERAS)
+        return 0;
+    nn = (size_t)n;
+    /* best and current residuals, pixel scaling, gathered subset (12 n) and
+     * its weights, the grouped indices and the group offsets */
+    s = mul_sz(nn, 16, &ok);
+    s = add_sz(s, ints_as_doubles(nn), &ok);
+    s = add_sz(s, ints_as_doubles(2 * (size_t)n_cameras + 2), &ok);
+    /* the scale search: its pairs (12 m), its workspace and order, m <= SCALE_PAIRS */
+    nn = min_sz(nn, SCALE_PAIRS);
+    s = add_sz(s, 12 * nn + mcg_scale_ransac_work_size((int)nn) + ints_as_doubles(nn), &ok);
+    return ok ? s : 0;
+}
+
+typedef struct {
+    /* inputs */
+    int n, ncam;
+    const double *o1, *d1, *o2, *d2, *focal;
+    const int *cam1, *cam2;
+    const double *cam_axes, *cam_focal;
+    double min_var_ratio;
+    mcg_robust_options opt;
+    /* workspace */
+    double *rbest, *rcur, *fsc, *sub, *wsub;
+    int *perm, *off; /* indices grouped: intra of camera 0, 1, ..., cross */
+    int *usable;     /* per camera: 1 if it can be the 5-point camera */
+    double *xs;      /* the scale search's cross-camera pairs: o1 d1 o2 d2 */
+    double *xwork;   /* its mcg_scale_ransac workspace */
+    int *xorder;     /* its proposal order */
+    int nx;          /* its pairs (0: no scale search) */
+    int nx_others;   /* 1: they are another camera's (gather_others) */
+    size_t lxwork;
+    /* derived */
+    double thr2, med_focal, loss_scale;
+    double size;     /* RMS spread of the origins + |their centroid| (metres) */
+    int const_focal;
+    uint64_t rng;
+    /* state */
+    double R[9], t[3], score;
+    int have, n_inl, n_wide, n_hyp, n_lo, lo_rounds;
+} ctx;
+
+/* ------------------------------------------------------------ scoring */
+
+/* MSAC score of (R, t) over all pairs (rcur receives |r| in the threshold's
+ * unit); stops early and returns +inf once the partial sum reaches `bound`.
+ * *n_inl: residuals below the threshold, *n_wide below WIDE thresholds (when
+ * completed). */
+static double msac2(ctx *c, const double R[9], const double t[3], double bound, int *n_inl,
+                    int *n_wide)
+{
+    double s = 0.0, w2 = WIDE * WIDE * c->thr2;
+    int k0, k, m = 0, mw = 0;
+    for (k0 = 0; k0 < c->n; k0 += SCORE_BLOCK) {
+        int nb = c->n - k0 < SCORE_BLOCK ? c->n - k0 : SCORE_BLOCK;
+        double *r = c->rcur + k0;
+        if (mcg_gec_residuals(nb, c->o1 + 3 * k0, c->d1 + 3 * k0, c->o2 + 3 * k0,
+                              c->d2 + 3 * k0, R, t, r) != MCG_OK)
+            return INFINITY;
+        for (k = 0; k < nb; k++) {
+            double a = fabs(r[k]) * (c->focal ? c->focal[k0 + k] : 1.0), z = a * a;
+            r[k] = a;
+            m += z < c->thr2;
+            mw += z < w2;
+            s += z < c->thr2 ? z : c->thr2;
+        }
+        if (s >= bound)
+            return INFINITY;
+    }
+    *n_inl = m;
+    *n_wide = mw;
+    return s;
+}
+
+static double msac(ctx *c, const double R[9], const double t[3], double bound, int *n_inl)
+{
+    int mw;
+    return msac2(c, R, t, bound, n_inl, &mw);
+}
+
+/* Make (R, t) with residuals in rcur the best; the buffers swap. */
+static void take_best(ctx *c, const double R[9], const double t[3], double score, int n_inl,
+                      int n_wide)
+{
+    double *tmp = c->rbest;
+    c->n_wide = n_wide;
+    memcpy(c->R, R, sizeof c->R);
+    memcpy(c->t, t, sizeof c->t);
+    c->score = score;
+    c->n_inl = n_inl;
+    c->have = 1;
+    c->rbest = c->rcur;
+    c->rcur = tmp;
+}
+
+/* --------------------------------------------------- refinement on a subset */
+
+/* Gather the pairs with sel(k) into the subset buffers, shifted to their
+ * centroid cen (the frame of mcgeom.geometry.refine_centred: |t| held by
+ * fix_scale is then the centroid's travel, independent of the rig origin),
+ * with weights w(k) (NULL: all 1). Returns the count. */
+static int gather(ctx *c, const double *res, double limit, const double *w, double cen[3],
+                  double keep)
+{
+    int k, m = 0, i;
+    /* keep < 1: each selected pair is taken with that probability */
+    const uint64_t cut = keep < 1.0 ? (uint64_t)(keep * 18446744073709551615.0) : UINT64_MAX;
+    double *so1 = c->sub, *sd1 = c->sub + 3 * (size_t)c->n, *so2 = c->sub + 6 * (size_t)c->n,
+           *sd2 = c->sub + 9 * (size_t)c->n;
+    cen[0] = cen[1] = cen[2] = 0.0;
+    for (k = 0; k < c->n; k++) {
+        if (!(res[k] < limit) || (cut != UINT64_MAX && rng_next(&c->rng) > cut))
+            continue;
+        for (i = 0; i < 3; i++) {
+            so1[3 * m + i] = c->o1[3 * k + i];
+            sd1[3 * m + i] = c->d1[3 * k + i];
+            so2[3 * m + i] = c->o2[3 * k + i];
+            sd2[3 * m + i] = c->d2[3 * k + i];
+            cen[i] += c->o1[3 * k + i] + c->o2[3 * k + i];
+        }
+        c->wsub[m] = w ? w[k] : 1.0;
+        m++;
+    }
+    if (m == 0)
+        return 0;
+    for (i = 0; i < 3; i++)
+        cen[i] /= 2.0 * m;
+    for (k = 0; k < m; k++)
+        for (i = 0; i < 3; i++) {
+            so1[3 * k + i] -= cen[i];
+            so2[3 * k + i] -= cen[i];
+        }
+    return m;
+}
+
+/* mcg_refine_motion on the gathered m pairs, (R, t) in the rig frame
+ * (converted to and from the centroid frame: t' = t + R c - c). */
+static int refine_subset(ctx *c, int m, const double cen[3], int weighted, int loss,
+                         double scale, int fix_scale, double R[9], double t[3],
+                         mcg_refine_result *out)
+{
+    mcg_refine_options ro;
+    double tc[3], rc[3];
+    int st, i;
+    mcg_refine_default_options(&ro);
+    ro.loss = loss;
+    ro.loss_scale = scale;
+    ro.fix_scale = fix_scale;
+    mat_vec(R, cen, rc);
+    for (i = 0; i < 3; i++)
+        tc[i] = t[i] + rc[i] - cen[i];
+    if (fix_scale && !(dot3(tc, tc) > 0.0))
+        return MCG_EDEGENERATE;
+    st = mcg_refine_motion(m, c->sub, c->sub + 3 * (size_t)c->n, c->sub + 6 * (size_t)c->n,
+                           c->sub + 9 * (size_t)c->n, weighted ? c->wsub : NULL, &ro, R, tc,
+                           out);
+    if (st != MCG_OK)
+        return st;
+    mat_vec(R, cen, rc);
+    for (i = 0; i < 3; i++)
+        t[i] = tc[i] - rc[i] + cen[i];
+    return MCG_OK;
+}
+
+/* Weights (focal_k / median)^2 of the fixed pixel scaling, or NULL when
+ * every focal is the same (or there is none). */
+static const double *fixed_weights(ctx *c)
+{
+    int k;
+    if (!c->focal || c->const_focal)
+        return NULL;
+    for (k = 0; k < c->n; k++) {
+        double f = c->focal[k] / c->med_focal;
+        c->fsc[k] = f * f;
+    }
+    return c->fsc;
+}
+
+/* Local optimisation of the best motion (thesis ch. 8.5's refinement used as
+ * LO): re-estimated on its inliers with the length of the centroid's
+ * translation held (near the critical motion a free fit slides |t|; the
+ * final stage frees it), Cauchy loss, kept while the MSAC score improves. */
+static void local_optimise(ctx *c, const double *w)
+{
+    int round;
+    for (round = 0; round < c->lo_rounds; round++) {
+        double R[9], t[3], cen[3], sc;
+        int m, n_inl, n_wide, same, k;
+        mcg_refine_result rr;
+        if (c->n_inl < MIN_REFIT)
+            return;
+        m = gather(c, c->rbest, c->opt.threshold, w, cen,
+                   c->n_inl > LO_MAX ? (double)LO_MAX / c->n_inl : 1.0);
+        if (m < MIN_REFIT)
+            return;
+        memcpy(R, c->R, sizeof R);
+        memcpy(t, c->t, sizeof t);
+        c->n_lo++;
+        if (refine_subset(c, m, cen, w != NULL, MCG_LOSS_CAUCHY, c->loss_scale, 1, R, t,
+                          &rr) != MCG_OK)
+            return;
+        sc = msac2(c, R, t, c->score * (1.0 - 1e-9), &n_inl, &n_wide);
+        if (!(sc < c->score * (1.0 - 1e-9)))
+            return;
+        same = 1;
+        for (k = 0; k < c->n && same; k++)
+            same = (c->rcur[k] < c->opt.threshold) == (c->rbest[k] < c->opt.threshold);
+        take_best(c, R, t, sc, n_inl, n_wide);
+        if (same) /* the same inliers would give the same fit again */
+            return;
+    }
+}
+
+/* Score a hypothesis on the line t(lam) = t0 + lam u of its 5-point camera
+ * (t = t0 + lam u); keep and locally optimise it if it is the best. A new
+ * best first has its scale searched again on the cross-camera pairs (or,
+ * with fewer than MIN_CROSS of them, on the pairs not of its 5-point camera
+ * a, as the Python proposer did: one noisy sixth pair is a poor start where
+ * |t| is weakly observable; measured on the car rig driving forward, 40
+ * problems, median scale error of the metric estimate 0.35 -> 0.26)
+ * (thesis ch. 7.4: the 1-point scale RANSAC of mcg_scale_ransac, scored on
+ * those pairs only): they fix the scale whatever the motion, while the
+ * intra-camera pairs, usually most of the data, hardly depend on it near
+ * the critical motion and let a wrong scale win the MSAC over all pairs
+ * (seen on the DGP surround rig: 4109 vs 4227 inliers, |t| 22 % short). */
+static int gather_others(ctx *c, int a);
+
+static int offer(ctx *c, const double R[9], const double t0[3], const double u[3],
+                 double lam, const double *w, int a)
+{
+    double sc, t[3];
+    int n_inl = 0, n_wide = 0, i;
+    for (i = 0; i < 3; i++)
+        t[i] = t0[i] + lam * u[i];
+    c->n_hyp++;
+    sc = msac2(c, R, t, c->have ? c->score : INFINITY, &n_inl, &n_wide);
+    if (!(sc < (c->have ? c->score : INFINITY)))
+        return 0;
+    take_best(c, R, t, sc, n_inl, n_wide);
+    if (c->nx > 0 || (a >= 0 && gather_others(c, a) > 0)) {
+        double lam2, sc2;
+        int j;
+        for (j = 0; j < c->nx; j++) { /* a fresh random order of the proposals */
+            int r = j + rng_below(&c->rng, c->nx - j), tmp = c->xorder[j];
+            c->xorder[j] = c->xorder[r];
+            c->xorder[r] = tmp;
+        }
+        if (mcg_scale_ransac(c->nx, c->xs, c->xs + 3 * (size_t)c->nx, c->xs + 6 * (size_t)c->nx,
+                             c->xs + 9 * (size_t)c->nx, R, t0, u, c->nx, c->xorder,
+                             SCALE_PROPOSALS, c->loss_scale, c->opt.prob, &lam2, &sc2, NULL,
+                             c->xwork, c->lxwork) == MCG_OK &&
+            lam2 != lam &&
+            /* not the trivial root lam = 0 of pairs whose cameras sit at
+             * camera a's centre (a central rig: every F vanishes there, a
+             * zero-residual false consensus), found up to rounding */
+            lam2 > 1e-9 * (c->size + sqrt(dot3(t0, t0)))) {
+            c->n_hyp++;
+            for (i = 0; i < 3; i++)
+                t[i] = t0[i] + lam2 * u[i];
+            sc = msac2(c, R, t, c->score, &n_inl, &n_wide);
+            if (sc < c->score)
+                take_best(c, R, t, sc, n_inl, n_wide);
+        }
+        if (c->nx_others)
+            c->nx = c->nx_others = 0; /* that set belonged to camera a */
+    }
+    if (c->lo_rounds > 0)
+        local_optimise(c, w);
+    return 1;
+}
+
+/* The pairs of the scale search: up to SCALE_PAIRS cross-camera pairs
+ * (a random subset when there are more: the scale is one number), when
+ * there are at least MIN_CROSS of them. */
+static void gather_cross(ctx *c)
+{
+    int g0 = c->off[c->ncam], m = c->off[c->ncam + 1] - g0, k, i, j;
+    int take = m < SCALE_PAIRS ? m : SCALE_PAIRS;
+    c->nx = 0;
+    if (m < MIN_CROSS)
+        return;
+    for (j = 0; j < take; j++) {
+        int r = j + rng_below(&c->rng, m - j), tmp = c->perm[g0 + j];
+        c->perm[g0 + j] = c->perm[g0 + r];
+        c->perm[g0 + r] = tmp;
+        k = c->perm[g0 + j];
+        for (i = 0; i < 3; i++) {
+            c->xs[3 * j + i] = c->o1[3 * (size_t)k + i];
+            c->xs[3 * (size_t)take + 3 * j + i] = c->d1[3 * (size_t)k + i];
+            c->xs[6 * (size_t)take + 3 * j + i] = c->o2[3 * (size_t)k + i];
+            c->xs[9 * (size_t)take + 3 * j + i] = c->d2[3 * (size_t)k + i];
+        }
+        c->xorder[j] = j;
+    }
+    c->nx = take;
+}
+
+/* The pairs of the scale search when there are few cross-camera pairs: up
+ * to SCALE_PAIRS of those not of camera a (each kept with probability
+ * SCALE_PAIRS / their count), gathered for one search. */
+static int gather_others(ctx *c, int a)
+{
+    int start = c->off[a], cnt = c->off[a + 1] - start, nother = c->n - cnt, j, i, m = 0;
+    int cap = c->n < SCALE_PAIRS ? c->n : SCALE_PAIRS;
+    uint64_t cut = nother > cap ? (uint64_t)((double)cap / nother * 18446744073709551615.0)
+                                : UINT64_MAX;
+    double *xo1 = c->xs, *xd1 = c->xs + 3 * (size_t)cap, *xo2 = c->xs + 6 * (size_t)cap,
+           *xd2 = c->xs + 9 * (size_t)cap;
+    if (nother < 1)
+        return 0;
+    for (j = 0; j < c->n && m < cap; j++) {
+        int k;
+        if (j >= start && j < start + cnt)
+            continue;
+        if (cut != UINT64_MAX && rng_next(&c->rng) > cut)
+            continue;
+        k = c->perm[j];
+        for (i = 0; i < 3; i++) {
+            xo1[3 * m + i] = c->o1[3 * (size_t)k + i];
+            xd1[3 * m + i] = c->d1[3 * (size_t)k + i];
+            xo2[3 * m + i] = c->o2[3 * (size_t)k + i];
+            xd2[3 * m + i] = c->d2[3 * (size_t)k + i];
+        }
+        c->xorder[m] = m;
+        m++;
+    }
+    if (m == 0)
+        return 0;
+    /* the four arrays contiguous for mcg_scale_ransac (m <= cap) */
+    if (m < cap) {
+        memmove(c->xs + 3 * (size_t)m, xd1, 3 * (size_t)m * sizeof *xd1);
+        memmove(c->xs + 6 * (size_t)m, xo2, 3 * (size_t)m * sizeof *xo2);
+        memmove(c->xs + 9 * (size_t)m, xd2, 3 * (size_t)m * sizeof *xd2);
+    }
+    c->nx = m;
+    c->nx_others = 1;
+    return m;
+}
+
+/* ------------------------------------------------------- the 5+1 sample */
+
+/* Unit copy of a 3-vector; 0 if it has no length. */
+static int unit3(const double *v, double u[3])
+{
+    double s = sqrt(dot3(v, v));
+    if (!(s > 0.0) || !isfinite(s))
+        return 0;
+    u[0] = v[0] / s;
+    u[1] = v[1] / s;
+    u[2] = v[2] / s;
+    return 1;
+}
+
+/* Depths (s1, s2) of the closest points of the rays s1 a + p and s2 b
+ * (unit a, b): min |s1 a + p - s2 b|; 0 if the rays are parallel. */
+static int depths(const double a[3], const double b[3], const double p[3], double *s1,
+                  double *s2)
+{
+    double cab = dot3(a, b), den = 1.0 - cab * cab, ap = dot3(a, p), bp = dot3(b, p);
+    if (!(den > PARALLEL_EPS))
+        return 0;
+    *s1 = (-ap + cab * bp) / den;
+    *s2 = (bp - cab * ap) / den;
+    return 1;
+}
+
+/* Unit null vector of the 3 x 3 matrix's rows (transpose: 1) from the
+ * largest cross product of two of them (E has rank 2). */
+static int null_vector(const double *e, int transpose, double v[3])
+{
+    double r[3][3], x[3][3], best = 0.0;
+    int i, j, k = -1;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            r[i][j] = transpose ? e[3 * j + i] : e[3 * i + j];
+    cross3(r[0], r[1], x[0]);
+    cross3(r[1], r[2], x[1]);
+    cross3(r[2], r[0], x[2]);
+    for (i = 0; i < 3; i++) {
+        double s = dot3(x[i], x[i]);
+        if (s > best) {
+            best = s;
+            k = i;
+        }
+    }
+    return k >= 0 && unit3(x[k], v);
+}
+
+/* Re-orthonormalise a near-rotation (Gram-Schmidt on its rows): the
+ * closed-form decomposition leaves rounding of the 5-point solution that
+ * mcg_refine_motion's rotation check (1e-6) could reject. */
+static int orthonormalise(double r[9])
+{
+    double a[3], b[3], c3[3], x;
+    if (!unit3(r, a))
+        return 0;
+    x = dot3(a, r + 3);
+    b[0] = r[3] - x * a[0];
+    b[1] = r[4] - x * a[1];
+    b[2] = r[5] - x * a[2];
+    if (!unit3(b, b))
+        return 0;
+    cross3(a, b, c3);
+    memcpy(r, a, sizeof a);
+    memcpy(r + 3, b, sizeof b);
+    memcpy(r + 6, c3, sizeof c3);
+    return 1;
+}
+
+/* The two rotations of an essential matrix E = [u]x R (|u| = 1 after
+ * scaling |E|_F = sqrt 2): [u]x E = (u u^T - I) R and R^T u = v, the right
+ * null vector, give R = u v^T - [u]x E for the sign of v with det R = +1
+ * (the other sign gives det -1); the twisted pair is (2 u u^T - I) R
+ * (Hartley & Zisserman 9.6.2). u is returned unit, of arbitrary sign. */
+static int decompose(const double E[9], double R1[9], double R2[9], double u[3])
+{
+    double e[9], v[3], ue[9], s = 0.0;
+    int i, j;
+    for (i = 0; i < 9; i++)
+        s += E[i] * E[i];
+    if (!(s > 0.0) || !isfinite(s))
+        return 0;
+    s = sqrt(2.0 / s);
+    for (i = 0; i < 9; i++)
+        e[i] = E[i] * s;
+    if (!null_vector(e, 1, u) || !null_vector(e, 0, v))
+        return 0;
+    skew_times(u, e, ue); /* [u]x E */
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++)
+            R1[3 * i + j] = u[i] * v[j] - ue[3 * i + j];
+    if (det33(R1) < 0.0)
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++)
+                R1[3 * i + j] -= 2.0 * u[i] * v[j];
+    if (!orthonormalise(R1))
+        return 0;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            double h[3] = {2.0 * u[i] * u[0] - (i == 0), 2.0 * u[i] * u[1] - (i == 1),
+                           2.0 * u[i] * u[2] - (i == 2)};
+            R2[3 * i + j] = h[0] * R1[j] + h[1] * R1[3 + j] + h[2] * R1[6 + j];
+        }
+    return orthonormalise(R2);
+}
+
+/* The motion of one rotation candidate of a 5+1 sample: the sign of the
+ * camera's translation direction u from the cheirality of its five points
+ * (all in front), the scale lam > 0 from the sixth correspondence (eq. 7.4:
+ * a + lam b = 0 with a = d2.((t0 + R o1 - o2) x R d1), b = d2.((u) x R d1),
+ * unit bearings), then the sixth point in front of both its rays.
+ * `six` < 0: a rig with one camera, lam = 1 (direction only). */
+static int candidate(const ctx *c, const double R[9], const double u_in[3],
+                     const double b1[15], const double b2[15], const double ca[3], int six,
+                     double t0[3], double u[3], double *lam_out)
+{
+    double rca[3], A[3], t_out[3];
+    int k, plus = 0, minus = 0, usable = 0, i;
+    for (k = 0; k < 5; k++) {
+        double s1, s2;
+        mat_vec(R, b1 + 3 * k, A);
+        if (!depths(A, b2 + 3 * k, u_in, &s1, &s2))
+            continue;
+        usable++;
+        plus += s1 > 0.0 && s2 > 0.0;
+        minus += s1 < 0.0 && s2 < 0.0;
+    }
+    if (usable < 3 || (plus < usable && minus < usable))
+        return 0;
+    for (i = 0; i < 3; i++)
+        u[i] = plus == usable ? u_in[i] : -u_in[i];
+    mat_vec(R, ca, rca);
+    for (i = 0; i < 3; i++)
+        t0[i] = ca[i] - rca[i];
+    *lam_out = 1.0;
+    if (six < 0)
+        return 1;
+    {
+        const double *o1 = c->o1 + 3 * (size_t)six, *o2 = c->o2 + 3 * (size_t)six;
+        double e1[3], e2[3], ro1[3], s0[3], x[3], a, b, lam, g[3], s1, s2;
+        if (!unit3(c->d1 + 3 * (size_t)six, e1) || !unit3(c->d2 + 3 * (size_t)six, e2))
+            return 0;
+        mat_vec(R, e1, A);
+        mat_vec(R, o1, ro1);
+        for (i = 0; i < 3; i++)
+            s0[i] = t0[i] + ro1[i] - o2[i];
+        if (dot3(s0, s0) <= 1e-24 * (1.0 + dot3(o1, o1) + dot3(ca, ca))) {
+            /* the sixth pair's cameras sit at camera a's centre (a central
+             * rig): a = 0 for every lam, no scale; direction only */
+            return 1;
+        }
+        cross3(s0, A, x);
+        a = dot3(e2, x);
+        cross3(u, A, x);
+        b = dot3(e2, x);
+        if (!(fabs(b) > 1e-12 * (1.0 + fabs(a))))
+            return 0; /* critical for this pair: no scale */
+        lam = -a / b;
+        if (!(lam > 0.0) || !isfinite(lam))
+            return 0;
+        for (i = 0; i < 3; i++) {
+            t_out[i] = t0[i] + lam * u[i];
+            g[i] = ro1[i] + t_out[i] - o2[i];
+        }
+        /* s1 R d1 + (R o1 + t - o2) = s2 d2: both depths positive */
+        if (depths(A, e2, g, &s1, &s2) && !(s1 > 0.0 && s2 > 0.0))
+            return 0;
+        *lam_out = lam;
+    }
+    return 1;
+}
+
+/* One 5+1 sample: returns the number of hypotheses offered. */
+static int sample(ctx *c, const double *w)
+{
+    int total = 0, a, k, m, cnt, start, six = -1, n_e = 0, j, offered = 0;
+    double b1[15], b2[15], E[90], ca[3];
+    const int *off = c->off;
+    for (k = 0; k < c->ncam; k++) {
+        cnt = off[k + 1] - off[k];
+        total += cnt >= 5 && c->usable[k] ? cnt : 0;
+    }
+    if (total == 0)
+        return -1;
+    /* camera a with probability proportional to its intra-camera count */
+    m = rng_below(&c->rng, total);
+    for (a = 0; a < c->ncam; a++) {
+        cnt = off[a + 1] - off[a];
+        if (cnt < 5 || !c->usable[a])
+            continue;
+        if (m < cnt)
+            break;
+        m -= cnt;
+    }
+    start = off[a];
+    cnt = off[a + 1] - start;
+    /* five distinct ones: a partial Fisher-Yates shuffle of camera a's group */
+    for (j = 0; j < 5; j++) {
+        int r = j + rng_below(&c->rng, cnt - j), tmp = c->perm[start + j], idx;
+        c->perm[start + j] = c->perm[start + r];
+        c->perm[start + r] = tmp;
+        idx = c->perm[start + j];
+        if (!unit3(c->d1 + 3 * (size_t)idx, b1 + 3 * j) ||
+            !unit3(c->d2 + 3 * (size_t)idx, b2 + 3 * j))
+            return 0;
+    }
+    memcpy(ca, c->o1 + 3 * (size_t)c->perm[start], sizeof ca);
+    /* the sixth: a cross-camera one when there are enough, else any one not
+     * of camera a (the grouped order skips a's group) */
+    {
+        int ncross = off[c->ncam + 1] - off[c->ncam], nother = c->n - cnt;
+        if (ncross >= MIN_CROSS) {
+            six = c->perm[off[c->ncam] + rng_below(&c->rng, ncross)];
+        } else if (nother > 0) {
+            int r = rng_below(&c->rng, nother);
+            six = c->perm[r < start ? r : r + cnt];
+        }
+    }
+    if (mcg_essential5(b1, b2, E, &n_e) != MCG_OK)
+        return 0;
+    for (j = 0; j < n_e; j++) {
+        double R1[9], R2[9], u[3], t0[3], us[3], lam;
+        if (!decompose(E + 9 * j, R1, R2, u))
+            continue;
+        if (candidate(c, R1, u, b1, b2, ca, six, t0, us, &lam)) {
+            offer(c, R1, t0, us, lam, w, six >= 0 ? a : -1);
+            offered++;
+        }
+        if (candidate(c, R2, u, b1, b2, ca, six, t0, us, &lam)) {
+            offer(c, R2, t0, us, lam, w, six >= 0 ? a : -1);
+            offered++;
+        }
+    }
+    return offered;
+}
+
+/* ------------------------------------------------------------ phases */
+
+static int check_inputs(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const int *cam1, const int *cam2, int n_cameras,
+                        const double *focal, const double *cam_axes, const double *cam_focal)
+{
+    int k;
+    if (n < 6 || n > MAX_PAIRS || n_cameras < 1 || n_cameras > MAX_CAMERAS)
+        return MCG_EINVAL;
+    if (!all_finite(o1, 3 * (size_t)n) || !all_finite(d1, 3 * (size_t)n) ||
+        !all_finite(o2, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
+        return MCG_EINVAL;
+    for (k = 0; k < n; k++) {
+        if (cam1[k] < 0 || cam1[k] >= n_cameras || cam2[k] < 0 || cam2[k] >= n_cameras)
+            return MCG_EINVAL;
+        if (!(dot3(d1 + 3 * k, d1 + 3 * k) >= 1e-100) ||
+            !(dot3(d2 + 3 * k, d2 + 3 * k) >= 1e-100))
+            return MCG_EINVAL;
+        if (focal && !(isfinite(focal[k]) && focal[k] > 0.0))
+            return MCG_EINVAL;
+    }
+    if ((cam_axes == NULL) != (cam_focal == NULL))
+        return MCG_EINVAL;
+    if (cam_axes) {
+        if (!focal || !all_finite(cam_axes, 3 * (size_t)n_cameras))
+            return MCG_EINVAL;
+        for (k = 0; k < n_cameras; k++)
+            if (!(isfinite(cam_focal[k]) && cam_focal[k] > 0.0))
+                return MCG_EINVAL;
+    }
+    return MCG_OK;
+}
+
+static void carve(ctx *c, double *work)
+{
+    size_t n = (size_t)c->n;
+    c->rbest = work;
+    c->rcur = work + n;
+    c->fsc = work + 2 * n;
+    c->sub = work + 3 * n;
+    c->wsub = work + 15 * n;
+    c->perm = (int *)(work + 16 * n);
+    c->off = (int *)(work + 16 * n + ints_as_doubles(n));
+    c->usable = c->off + c->ncam + 2;
+    {
+        size_t m = min_sz(n, SCALE_PAIRS);
+        c->xs = work + 16 * n + ints_as_doubles(n) + ints_as_doubles(2 * (size_t)c->ncam + 2);
+        c->xwork = c->xs + 12 * m;
+        c->lxwork = mcg_scale_ransac_work_size((int)m);
+        c->xorder = (int *)(c->xwork + c->lxwork);
+    }
+}
+
+/* Counting sort of the pairs by group: camera k's intra-camera pairs, then
+ * the cross-camera ones (group ncam). */
+static void group(ctx *c)
+{
+    int k, g;
+    int *off = c->off;
+    for (g = 0; g <= c->ncam + 1; g++)
+        off[g] = 0;
+    for (k = 0; k < c->n; k++)
+        off[(c->cam1[k] == c->cam2[k] ? c->cam1[k] : c->ncam) + 1]++;
+    for (g = 0; g <= c->ncam; g++)
+        off[g + 1] += off[g];
+    /* place with running positions (off[g] advanced, then restored) */
+    for (k = 0; k < c->n; k++) {
+        g = c->cam1[k] == c->cam2[k] ? c->cam1[k] : c->ncam;
+        c->perm[off[g]++] = k;
+    }
+    for (g = c->ncam; g > 0; g--)
+        off[g] = off[g - 1];
+    off[0] = 0;
+}
+
+/* RMS distance (radians, small angles) of the unit bearings of camera g's
+ * intra-camera pairs (time 1: d = d1, else d2) from their best plane through
+ * the centre: sqrt of the smallest eigenvalue of mean(u u^T). */
+static double plane_rms(const ctx *c, int g, int time2)
+{
+    double m[9] = {0.0}, ev[3], vec[9];
+    int j, i, k, cnt = c->off[g + 1] - c->off[g];
+    for (j = c->off[g]; j < c->off[g + 1]; j++) {
+        const double *d = (time2 ? c->d2 : c->d1) + 3 * (size_t)c->perm[j];
+        double u[3];
+        if (!unit3(d, u))
+            continue;
+        for (i = 0; i < 3; i++)
+            for (k = 0; k < 3; k++)
+                m[3 * i + k] += u[i] * u[k] / cnt;
+    }
+    if (mcg_sym_eig(3, m, ev, vec) != MCG_OK)
+        return 0.0;
+    return ev[0] > 0.0 ? sqrt(ev[0]) : 0.0;
+}
+
+/* A camera whose bearings (all of them, outliers too) lie within the
+ * threshold of one plane through its centre at either time has no
+ * determined essential matrix (points on a line, or a plane through the
+ * camera): it is never the 5-point camera (as bearings_planar in
+ * mcgeom.estimators.essential). */
+static void mark_usable(ctx *c)
+{
+    int g;
+    for (g = 0; g < c->ncam; g++)
+        c->usable[g] = c->off[g + 1] - c->off[g] >= 5 &&
+                       plane_rms(c, g, 0) > c->loss_scale && plane_rms(c, g, 1) > c->loss_scale;
+}
+
+/* k-th smallest of x[0..n) (Hoare's selection; x is reordered) */
+static double select_kth(double *x, int n, int k)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        double p = x[lo + (hi - lo) / 2];
+        int i = lo, j = hi;
+        while (i <= j) {
+            while (x[i] < p)
+                i++;
+            while (x[j] > p)
+                j--;
+            if (i <= j) {
+                double tmp = x[i];
+                x[i] = x[j];
+                x[j] = tmp;
+                i++;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return x[k];
+    }
+    return x[k];
+}
+
+/* median of x[0..n) as numpy's (mean of the two middle values for even n),
+ * computed on the scratch copy y */
+static double median(const double *x, double *y, int n)
+{
+    double hi, lo;
+    int k;
+    memcpy(y, x, (size_t)n * sizeof *y);
+    hi = select_kth(y, n, n / 2);
+    if (n % 2)
+        return hi;
+    lo = y[0];
+    for (k = 1; k < n / 2; k++) /* the largest of the lower half */
+        lo = y[k] > lo ? y[k] : lo;
+    return 0.5 * (lo + hi);
+}
+
+/* Pixel scaling of the final refinement at (R, t): with the camera table,
+ * the exact first-order scaling of every residual (mcg_sampson_pixel_scale,
+ * 0 -> the fixed focal), else the fixed focal. Writes the weights
+ * (f / median f)^2 into fsc (or returns NULL when they are all equal) and the
+ * loss scale (radians). */
+static const double *final_weights(ctx *c, const double R[9], const double t[3],
+                                   double *scale)
+{
+    int k0, k, i;
+    if (!c->focal) {
+        *scale = c->opt.threshold;
+        return NULL;
+    }
+    if (!c->cam_axes) {
+        *scale = c->loss_scale;
+        return fixed_weights(c);
+    }
+    for (k0 = 0; k0 < c->n; k0 += SCORE_BLOCK) {
+        int nb = c->n - k0 < SCORE_BLOCK ? c->n - k0 : SCORE_BLOCK;
+        double z1[3 * SCORE_BLOCK], z2[3 * SCORE_BLOCK], f1[SCORE_BLOCK], f2[SCORE_BLOCK];
+        for (k = 0; k < nb; k++) {
+            int a = c->cam1[k0 + k], b = c->cam2[k0 + k];
+            for (i = 0; i < 3; i++) {
+                z1[3 * k + i] = c->cam_axes[3 * a + i];
+                z2[3 * k + i] = c->cam_axes[3 * b + i];
+            }
+            f1[k] = c->cam_focal[a];
+            f2[k] = c->cam_focal[b];
+        }
+        if (mcg_sampson_pixel_scale(nb, c->o1 + 3 * k0, c->d1 + 3 * k0, c->o2 + 3 * k0,
+                                    c->d2 + 3 * k0, R, t, z1, z2, f1, f2, c->min_var_ratio,
+                                    c->fsc + k0) != MCG_OK)
+            for (k = 0; k < nb; k++)
+                c->fsc[k0 + k] = 0.0;
+        for (k = 0; k < nb; k++)
+            if (!(c->fsc[k0 + k] > 0.0))
+                c->fsc[k0 + k] = c->focal[k0 + k];
+    }
+    {
+        double med = median(c->fsc, c->rcur, c->n);
+        *scale = c->opt.threshold / med;
+        for (k = 0; k < c->n; k++) {
+            double f = c->fsc[k] / med;
+            c->fsc[k] = f * f;
+        }
+    }
+    return c->fsc;
+}
+
+/* The final refinement (all six degrees of freedom) on the pairs within
+ * WIDE thresholds of the best motion, once more if that set moved; the
+ * residuals of the result end in rbest. mask bit 1: the pairs of the last
+ * refinement that succeeded (bit 2, the set to fit next, is scratch). */
+static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *weights_out)
+{
+    double R[9], t[3], cen[3], scale;
+    const double wide = WIDE * c->opt.threshold;
+    int round, k, m, n_inl, moved = 1;
+    const double *w;
+    mcg_refine_result rr;
+    memcpy(R, c->R, sizeof R);
+    memcpy(t, c->t, sizeof t);
+    res->refined = 0;
+    for (k = 0; k < c->n; k++)
+        mask[k] = c->rbest[k] < wide ? 4 : 0;
+    for (round = 0; round < 2 && moved; round++) {
+        w = final_weights(c, R, t, &scale);
+        for (k = 0; k < c->n; k++)
+            c->rcur[k] = (mask[k] & 4) ? 0.0 : 1.0; /* gather the set to fit */
+        m = gather(c, c->rcur, 0.5, w, cen, 1.0);
+        if (m < MIN_REFIT)
+            break;
+        if (refine_subset(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr) != MCG_OK)
+            break;
+        res->refined = 1;
+        res->refinement = rr;
+        res->loss_scale = scale;
+        res->n_used = m;
+        for (k = 0; k < c->n; k++) {
+            mask[k] = (mask[k] & 4) ? 2 : 0;
+            if (weights_out)
+                weights_out[k] = (mask[k] & 2) ? (w ? w[k] : 1.0) : 0.0;
+        }
+        (void)msac(c, R, t, INFINITY, &n_inl);
+        memcpy(c->R, R, sizeof R);
+        memcpy(c->t, t, sizeof t);
+        {
+            double *tmp = c->rbest;
+            c->rbest = c->rcur;
+            c->rcur = tmp;
+        }
+        /* refit once more if the set moved (and is large enough) */
+        moved = 0;
+        m = 0;
+        for (k = 0; k < c->n; k++) {
+            int in = c->rbest[k] < wide;
+            moved |= in != ((mask[k] >> 1) & 1);
+            m += in;
+            mask[k] = (unsigned char)(mask[k] | (in ? 4 : 0));
+        }
+        moved = moved && m >= MIN_REFIT;
+    }
+    for (k = 0; k < c->n; k++)
+        mask[k] &= 2;
+}
+
+/* The scale profile of the final refinement (the statistic of
+ * mcgeom.observability.scale_profile): the motion re-optimised on the same
+ * pairs with the centroid's translation held at 1/k and k times its length
+ * (k = 1 + 3 max_scale_rel_std; rotation and direction free), the smaller
+ * cost increase over the free optimum in units of sigma2: a likelihood
+ * ratio, ~chi^2 with 1 dof, that sees the non-linearity of near-critical
+ * motions where the first-order std does not. 0 when a refit fails. */
+static double scale_profile(ctx *c, const mcg_robust_result *res, const unsigned char *mask,
+                            const double *weights)
+{
+    const double k = 1.0 + 3.0 * c->opt.max_scale_rel_std, f[2] = {1.0 / k, k};
+    double cen[3], worst = INFINITY, rc[3], shift[3];
+    int j, i, m;
+    const mcg_refine_result *fr = &res->refinement;
+    if (!(isfinite(fr->sigma2) && fr->sigma2 > 0.0))
+        return 0.0;
+    for (j = 0; j < c->n; j++)
+        c->rcur[j] = (mask[j] & 2) ? 0.0 : 1.0;
+    m = gather(c, c->rcur, 0.5, weights, cen, 1.0);
+    if (m < MIN_REFIT)
+        return 0.0;
+    mat_vec(res->R, cen, rc);
+    for (i = 0; i < 3; i++)
+        shift[i] = rc[i] - cen[i];
+    for (j = 0; j < 2; j++) {
+        double R[9], t[3];
+        mcg_refine_result rr;
+        memcpy(R, res->R, sizeof R);
+        for (i = 0; i < 3; i++)
+            t[i] = (res->t[i] + shift[i]) * f[j] - shift[i];
+        if (refine_subset(c, m, cen, weights != NULL, c->opt.loss, res->loss_scale, 1, R, t,
+                          &rr) != MCG_OK)
+            return 0.0;
+        worst = fmin(worst, (rr.final_cost - fr->final_cost) / fr->sigma2);
+    }
+    return worst > 0.0 ? worst : 0.0;
+}
+
+int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const double *o2,
+                          const double *d2, const int *cam1, const int *cam2, int n_cameras,
+                          const double *focal, const double *cam_axes,
+                          const double *cam_focal, const mcg_robust_options *opt,
+                          mcg_robust_result *res, unsigned char *mask, double *weights,
+                          double *work, size_t lwork)
+{
+    ctx c;
+    double t_start, deadline, nw;
+    int st, k, iters = 0, k_needed;
+    const double *wlo;
+
+    if (!o1 || !d1 || !o2 || !d2 || !cam1 || !cam2 || !res || !mask || !work)
+        return MCG_EINVAL;
+    memset(res, 0, sizeof *res);
+    memset(&c, 0, sizeof c);
+    if (opt)
+        c.opt = *opt;
+    else
+        mcg_robust_default_options(&c.opt);
+    if (!check_options(&c.opt))
+        return MCG_EINVAL;
+    st = check_inputs(n, o1, d1, o2, d2, cam1, cam2, n_cameras, focal, cam_axes, cam_focal);
+    if (st != MCG_OK)
+        return st;
+    if (lwork < mcg_robust_work_size(n, n_cameras))
+        return MCG_ENOMEM;
+    t_start = now_seconds();
+    deadline = c.opt.max_seconds > 0.0 ? t_start + c.opt.max_seconds : INFINITY;
+    c.n = n;
+    c.ncam = n_cameras;
+    c.o1 = o1;
+    c.d1 = d1;
+    c.o2 = o2;
+    c.d2 = d2;
+    c.cam1 = cam1;
+    c.cam2 = cam2;
+    c.focal = focal;
+    c.cam_axes = cam_axes;
+    c.cam_focal = cam_focal;
+    c.thr2 = c.opt.threshold * c.opt.threshold;
+    c.rng = (uint64_t)c.opt.seed;
+    c.lo_rounds = c.opt.lo_rounds;
+    carve(&c, work);
+    group(&c);
+    c.med_focal = 1.0;
+    c.const_focal = 1;
+    if (focal) {
+        double fmax = focal[0];
+        c.med_focal = median(focal, c.rcur, n);
+        for (k = 0; k < n; k++) {
+            c.const_focal &= focal[k] == focal[0];
+            fmax = focal[k] > fmax ? focal[k] : fmax;
+        }
+        if (cam_axes) {
+            double cf = 0.0;
+            for (k = 0; k < n_cameras; k++)
+                cf = cam_focal[k] > cf ? cam_focal[k] : cf;
+            c.min_var_ratio = 1e-12 / (cf * cf);
+        }
+    }
+    c.loss_scale = c.opt.threshold / c.med_focal;
+    {
+        double cen[3];
+        c.size = origin_spread(n, o1, o2, cen);
+        c.size += sqrt(dot3(cen, cen));
+    }
+    mark_usable(&c);
+    gather_cross(&c);
+    /* the LO weights live in fsc until the final stage reuses it */
+    wlo = c.lo_rounds > 0 ? fixed_weights(&c) : NULL;
+
+    /* search */
+    k_needed = c.opt.max_iterations;
+    while (iters < c.opt.max_iterations &&
+           (iters < k_needed || iters < c.opt.min_iterations)) {
+        int before = c.have ? c.n_wide : -1, got;
+        iters++;
+        got = sample(&c, wlo);
+        if (got < 0)
+            break; /* no camera with 5 intra-camera correspondences */
+        if (c.have && c.n_wide != before) {
+            /* the fraction of true inliers: those within WIDE thresholds
+             * (at 1 threshold the tail of the noise, ~16 % of the inliers at
+             * 0.5 px noise and 1 px, would count as outliers and more than
+             * double the samples drawn for an all-inlier 6-sample) */
+            nw = pow((double)c.n_wide / n, 6.0);
+            if (nw >= 1.0)
+                k_needed = 1;
+            else if (nw > 0.0) {
+                double kk = log1p(-c.opt.prob) / log1p(-nw);
+                k_needed = kk < c.opt.max_iterations ? (int)ceil(kk) : c.opt.max_iterations;
+            }
+        }
+        if (iters % CLOCK_EVERY == 0 && now_seconds() > deadline) {
+            res->stop = MCG_ROBUST_STOP_TIME;
+            break;
+        }
+    }
+    if (res->stop != MCG_ROBUST_STOP_TIME)
+        res->stop = iters >= c.opt.max_iterations ? MCG_ROBUST_STOP_MAX_ITERATIONS
+                                                   : MCG_ROBUST_STOP_CONFIDENCE;
+    res->iterations = iters;
+    res->hypotheses = c.n_hyp;
+    res->local_optimizations = c.n_lo;
+    if (!c.have || c.n_inl < MIN_REFIT) {
+        res->n_inliers = c.have ? c.n_inl : 0;
+        res->seconds = now_seconds() - t_start;
+        return MCG_EDEGENERATE;
+    }
+    memcpy(res->t_hypothesis, c.t, sizeof c.t);
+    res->score = c.score;
+
+    /* finish */
+    for (k = 0; k < n; k++)
+        mask[k] = 0;
+    if (weights)
+        for (k = 0; k < n; k++)
+            weights[k] = 0.0;
+    res->loss_scale = focal ? c.loss_scale : c.opt.threshold;
+    res->scale_profile = NAN;
+    if (c.opt.refine)
+        finish(&c, res, mask, weights);
+    memcpy(res->R, c.R, sizeof c.R);
+    memcpy(res->t, c.t, sizeof c.t);
+    if (res->refined && c.opt.max_scale_rel_std > 0.0 &&
+        res->refinement.scale_rel_std <= c.opt.max_scale_rel_std)
+        res->scale_profile = scale_profile(
+            &c, res, mask,
+            weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL));
+    res->n_inliers = 0;
+    for (k = 0; k < n; k++) {
+        int in = c.rbest[k] < c.opt.threshold;
+        mask[k] = (unsigned char)((mask[k] & 2) | in);
+        res->n_inliers += in;
+    }
+    res->seconds = now_seconds() - t_start;
+    return MCG_OK;
+}

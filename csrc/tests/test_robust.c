@@ -1,0 +1,332 @@
+/*
+ * test_robust.c -- plain-C checks of csrc/robust.c (mcg_robust_rig_motion,
+ * the whole robust 5+1 estimate): on a 4-camera ring with intra- and
+ * cross-camera pairs, bearing noise and 30 % gross outliers the motion is
+ * found (rotation, metric translation), the mask agrees with residuals
+ * recomputed independently by mcg_gec_residuals, the outliers are flagged,
+ * R is orthonormal and the same seed gives the same result; on noise-free
+ * minimal 5+1 problems (5 pairs in one camera, 1 in another) the true
+ * motion or another exact solution with all points in front is returned
+ * (issue 18: candidates are chosen by cheirality), the true one in at least
+ * 90 % of the trials; pixel units (focal) and the camera table;
+ * the status codes of invalid arguments, a too small workspace and data
+ * without 5 intra-camera pairs in any camera. Exit status 0 iff every
+ * check passes.
+ */
+#include "mcgeom.h"
+
+#define TEST_SEED 0x0b0b05eedULL
+#include "testutil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NMAX 400
+#define NCAM 4
+
+static double o1[3 * NMAX], d1[3 * NMAX], o2[3 * NMAX], d2[3 * NMAX], focal[NMAX];
+static int cam1[NMAX], cam2[NMAX], is_out[NMAX];
+static unsigned char mask[NMAX];
+static double wts[NMAX], res_chk[NMAX];
+static double *work;
+static size_t lwork;
+
+static void rot_err(const double A[9], const double B[9], double *deg)
+{
+    /* angle of A B^T */
+    double tr = 0.0, c;
+    int i, k;
+    for (i = 0; i < 3; i++)
+        for (k = 0; k < 3; k++)
+            tr += A[3 * i + k] * B[3 * i + k];
+    c = 0.5 * (tr - 1.0);
+    c = c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c);
+    *deg = acos(c) * 57.29577951308232;
+}
+
+static double rel_err3(const double a[3], const double b[3])
+{
+    double e = 0.0, nb = 0.0;
+    int i;
+    for (i = 0; i < 3; i++) {
+        e += (a[i] - b[i]) * (a[i] - b[i]);
+        nb += b[i] * b[i];
+    }
+    return sqrt(e / nb);
+}
+
+/* A ring of NCAM cameras (radius 0.5 m, looking outward), motion (R, t)
+ * with a rotation of ~0.15 rad and |t| ~ 1 m; n pairs: camera k % NCAM at
+ * time 1, the same camera at time 2 except every 5th pair (the next camera:
+ * cross-camera); the first n_out get a random time-2 bearing; bearing noise
+ * of sigma radians on each component. */
+static void scene(int n, int n_out, double sigma, double R[9], double t[3])
+{
+    double c[NCAM][3], ax[NCAM][3], aa[3];
+    int k, i;
+    for (k = 0; k < NCAM; k++) {
+        double a = 6.283185307179586 * k / NCAM;
+        ax[k][0] = cos(a);
+        ax[k][1] = sin(a);
+        ax[k][2] = 0.0;
+        for (i = 0; i < 3; i++)
+            c[k][i] = 0.5 * ax[k][i];
+    }
+    for (i = 0; i < 3; i++)
+        aa[i] = 0.09 * nrand();
+    mcg_rot_from_angle_axis(aa, R);
+    for (i = 0; i < 3; i++)
+        t[i] = 0.6 * nrand();
+    for (k = 0; k < n; k++) {
+        int g = k % NCAM, h = k % 5 == 4 ? (g + 1) % NCAM : g;
+        double X[3], X2[3], depth = 3.0 + 12.0 * urand();
+        for (i = 0; i < 3; i++)
+            X[i] = c[g][i] + depth * (ax[g][i] + 0.6 * (urand() - 0.5)) +
+                   (i == 2 ? depth * 0.6 * (urand() - 0.5) : 0.0);
+        for (i = 0; i < 3; i++)
+            X2[i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+        for (i = 0; i < 3; i++) {
+            o1[3 * k + i] = c[g][i];
+            o2[3 * k + i] = c[h][i];
+            d1[3 * k + i] = X[i] - c[g][i];
+            d2[3 * k + i] = k < n_out ? nrand() : X2[i] - c[h][i];
+        }
+        {
+            double n1 = sqrt(d1[3 * k] * d1[3 * k] + d1[3 * k + 1] * d1[3 * k + 1] +
+                             d1[3 * k + 2] * d1[3 * k + 2]);
+            double n2 = sqrt(d2[3 * k] * d2[3 * k] + d2[3 * k + 1] * d2[3 * k + 1] +
+                             d2[3 * k + 2] * d2[3 * k + 2]);
+            for (i = 0; i < 3; i++) {
+                d1[3 * k + i] = d1[3 * k + i] / n1 + sigma * nrand();
+                d2[3 * k + i] = d2[3 * k + i] / n2 + sigma * nrand();
+            }
+        }
+        cam1[k] = g;
+        cam2[k] = h;
+        is_out[k] = k < n_out;
+        focal[k] = 800.0 + 400.0 * urand();
+    }
+}
+
+static int orthonormal(const double R[9])
+{
+    double e = 0.0;
+    int i, j, k;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            double s = 0.0;
+            for (k = 0; k < 3; k++)
+                s += R[3 * i + k] * R[3 * j + k];
+            e = fmax(e, fabs(s - (i == j)));
+        }
+    return e < 1e-9 && R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) +
+                               R[2] * (R[3] * R[7] - R[4] * R[6]) > 0.0;
+}
+
+static void outliers_case(void)
+{
+    const int n = 300, n_out = 90;
+    double R[9], t[3], err, thr = 3e-3;
+    mcg_robust_options opt;
+    mcg_robust_result res, res2;
+    int k, st, agree = 1, caught = 0, kept = 0;
+    scene(n, n_out, 1e-3, R, t);
+    mcg_robust_default_options(&opt);
+    opt.threshold = thr;
+    opt.seed = 7;
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, wts, work, lwork);
+    check_status(st, MCG_OK, "30 % outliers: status");
+    rot_err(res.R, R, &err);
+    check(err < 0.2, "30 % outliers: rotation error (deg)", err, 0.2);
+    err = rel_err3(res.t, t);
+    check(err < 0.05, "30 % outliers: metric translation, relative error", err, 0.05);
+    check(orthonormal(res.R), "R orthonormal, det +1", 0.0, 1e-9);
+    /* the mask against residuals recomputed here */
+    mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
+    for (k = 0; k < n; k++) {
+        agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) < thr);
+        caught += is_out[k] && !(mask[k] & 1);
+        kept += !is_out[k] && (mask[k] & 1);
+    }
+    check(agree, "mask bit 0 == (|r| < threshold) at the returned motion", 0.0, 0.0);
+    check(caught >= n_out * 95 / 100, "outliers flagged (count of 90)", caught, 86);
+    check(kept >= (n - n_out) * 90 / 100, "inliers kept (count of 210)", kept, 189);
+    check(res.n_inliers == kept + (n_out - caught), "n_inliers counts mask bit 0",
+          res.n_inliers, 0.0);
+    check(res.iterations <= opt.max_iterations && res.iterations >= 1,
+          "iterations within the budget", res.iterations, opt.max_iterations);
+    check(res.refined == 1 && res.n_used >= res.n_inliers, "final refinement ran on >= inliers",
+          res.n_used, res.n_inliers);
+    check(isnan(res.scale_profile), "no scale profile unless asked", res.scale_profile, 0.0);
+    opt.max_scale_rel_std = 0.1;
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res2, mask, NULL, work, lwork);
+    /* |t| well determined here (cross-camera pairs, a rotation): scaling the
+     * centroid's travel by 1.3 costs far more than the noise */
+    check(st == MCG_OK && res2.scale_profile > 25.0, "scale profile: |t| x/ 1.3 excluded (chi^2)",
+          res2.scale_profile, 25.0);
+    opt.max_scale_rel_std = 0.0;
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res2, mask, NULL, work, lwork);
+    check(st == MCG_OK && memcmp(res.R, res2.R, sizeof res.R) == 0 &&
+              memcmp(res.t, res2.t, sizeof res.t) == 0,
+          "same seed, same motion", 0.0, 0.0);
+
+    /* pixels: threshold 2 px with ~1 px noise; the camera table path */
+    {
+        double axes[3 * NCAM], cf[NCAM];
+        for (k = 0; k < NCAM; k++) {
+            axes[3 * k] = cos(6.283185307179586 * k / NCAM);
+            axes[3 * k + 1] = sin(6.283185307179586 * k / NCAM);
+            axes[3 * k + 2] = 0.0;
+            cf[k] = 1000.0;
+        }
+        opt.threshold = 3.0;
+        st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, focal, axes, cf, &opt,
+                                   &res, mask, wts, work, lwork);
+        check_status(st, MCG_OK, "pixels + camera table: status");
+        rot_err(res.R, R, &err);
+        check(err < 0.2, "pixels + camera table: rotation error (deg)", err, 0.2);
+        mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
+        agree = 1;
+        for (k = 0; k < n; k++)
+            agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) * focal[k] < 3.0);
+        check(agree, "pixels: mask bit 0 == (|r| focal < threshold)", 0.0, 0.0);
+    }
+}
+
+/* Depths of pair k under (R, t): s1 R d1 + (R o1 + t - o2) = s2 d2 in the
+ * least-squares sense (an independent triangulation: normal equations of
+ * the 3 x 2 system); 1 if both are positive. */
+static int in_front(const double *a1, const double *b1, const double *a2, const double *b2,
+                    const double R[9], const double t[3])
+{
+    double A[3], g[3], aa = 0, ab = 0, bb = 0, ag = 0, bg = 0, det, s1, s2;
+    int i;
+    for (i = 0; i < 3; i++) {
+        A[i] = R[3 * i] * b1[0] + R[3 * i + 1] * b1[1] + R[3 * i + 2] * b1[2];
+        g[i] = R[3 * i] * a1[0] + R[3 * i + 1] * a1[1] + R[3 * i + 2] * a1[2] + t[i] - a2[i];
+    }
+    for (i = 0; i < 3; i++) {
+        aa += A[i] * A[i];
+        ab += A[i] * b2[i];
+        bb += b2[i] * b2[i];
+        ag += A[i] * g[i];
+        bg += b2[i] * g[i];
+    }
+    /* minimise |s1 A - s2 b2 + g|^2 */
+    det = aa * bb - ab * ab;
+    s1 = (-ag * bb + ab * bg) / det;
+    s2 = (aa * bg - ab * ag) / det;
+    return s1 > 0.0 && s2 > 0.0;
+}
+
+/* Noise-free minimal problems: 5 pairs of camera 0, 1 of camera 1. Every
+ * returned motion must be an exact solution of the six constraints with all
+ * six points in front of both rays (issue 18: the candidate is chosen by
+ * cheirality); the true motion must be returned in at least 90 % of the
+ * trials -- the rest are problems where another real solution of the
+ * polynomial system satisfies cheirality too, which six correspondences
+ * cannot tell apart. */
+static void minimal_case(void)
+{
+    const int trials = scaled(2000);
+    int trial, solved = 0, valid = 0, ran = 0, k, i;
+    mcg_robust_options opt;
+    mcg_robust_result res;
+    mcg_robust_default_options(&opt);
+    opt.threshold = 1e-7;
+    opt.max_iterations = 20;
+    for (trial = 0; trial < trials; trial++) {
+        double R[9], t[3], err, a[3 * 6], b[3 * 6], c[3 * 6], d[3 * 6], r6[6];
+        int keep[6] = {0, 8, 12, 16, 20, 1}, c1[6], c2[6], ok = 1;
+        scene(24, 0, 0.0, R, t); /* then keep 5 pairs of camera 0 and one of 1 */
+        for (k = 0; k < 6; k++) {
+            for (i = 0; i < 3; i++) {
+                a[3 * k + i] = o1[3 * keep[k] + i];
+                b[3 * k + i] = d1[3 * keep[k] + i];
+                c[3 * k + i] = o2[3 * keep[k] + i];
+                d[3 * k + i] = d2[3 * keep[k] + i];
+            }
+            c1[k] = cam1[keep[k]];
+            c2[k] = cam2[keep[k]];
+        }
+        opt.seed = (unsigned long long)trial;
+        if (mcg_robust_rig_motion(6, a, b, c, d, c1, c2, NCAM, NULL, NULL, NULL, &opt, &res,
+                                  mask, NULL, work, lwork) != MCG_OK)
+            continue;
+        ran++;
+        mcg_gec_residuals(6, a, b, c, d, res.R, res.t, r6);
+        for (k = 0; k < 6; k++)
+            ok &= fabs(r6[k]) < 1e-9 && in_front(a + 3 * k, b + 3 * k, c + 3 * k, d + 3 * k,
+                                                  res.R, res.t);
+        valid += ok;
+        rot_err(res.R, R, &err);
+        solved += err < 1e-5 && rel_err3(res.t, t) < 1e-6;
+    }
+    check(ran == trials, "minimal 5+1 noise-free: a motion returned (of trials)", ran, trials);
+    check(valid == ran, "minimal: every motion exact on its 6 pairs, all in front", valid, ran);
+    check(solved >= trials * 9 / 10, "minimal: the true motion (of trials)", solved, trials);
+}
+
+static void status_case(void)
+{
+    double R[9], t[3];
+    mcg_robust_options opt;
+    mcg_robust_result res;
+    int st, k;
+    scene(40, 0, 0.0, R, t);
+    mcg_robust_default_options(&opt);
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, 10);
+    check_status(st, MCG_ENOMEM, "workspace too small");
+    cam2[3] = NCAM;
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "camera id out of range");
+    cam2[3] = cam1[3];
+    d1[5] = NAN;
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "NaN in a direction");
+    d1[5] = 0.3;
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, NULL, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "NULL camera ids");
+    opt.prob = 1.0;
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "prob = 1");
+    mcg_robust_default_options(&opt);
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, (const double *)R,
+                               NULL, &opt, &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "camera axes without camera focal lengths");
+    /* 16 pairs, 4 per camera: no camera has the five of a sample */
+    st = mcg_robust_rig_motion(16, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EDEGENERATE, "no camera with 5 intra-camera pairs");
+    for (k = 0; k < 40; k++)
+        focal[k] = k == 7 ? 0.0 : 500.0;
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, focal, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "focal <= 0");
+    check(mcg_robust_work_size(5, 1) == 0 && mcg_robust_work_size(10, 0) == 0,
+          "work size 0 for n < 6 or no camera", 0.0, 0.0);
+}
+
+int main(void)
+{
+    lwork = mcg_robust_work_size(NMAX, NCAM);
+    work = malloc(lwork * sizeof *work);
+    if (!work)
+        return 2;
+    outliers_case();
+    minimal_case();
+    status_case();
+    free(work);
+    printf("%d checks, %d failed\n", n_checks, n_failed);
+    return n_failed != 0;
+}

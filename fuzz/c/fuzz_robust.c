@@ -1,0 +1,161 @@
+/*
+ * fuzz_robust.c -- libFuzzer harness of mcg_robust_rig_motion (and its work
+ * size), the whole robust 5+1 estimate of csrc/robust.c.
+ *
+ * Inputs: mode 0 a synthetic rig scene (1-8 cameras, intra- and
+ * cross-camera pairs, a few entries arbitrary), mode 1 arbitrary arrays;
+ * camera ids (1 in 16 out of range), optional per-pair focal lengths and
+ * camera table, options valid or not (threshold, prob, iteration budgets,
+ * LO rounds, loss), and a workspace 1 double short 1 in 16 times.
+ * Invariants: the status is known; bad sizes give MCG_EINVAL and a work
+ * size of 0, a short workspace MCG_ENOMEM, bad options, ids or focal
+ * lengths MCG_EINVAL, NaN/inf inputs never MCG_OK; on MCG_OK R is a
+ * rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
+ * within max_iterations, mask bit 0 agrees with the residuals of
+ * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
+ * of the threshold excepted), n_inliers counts it, n_used counts bit 1 and
+ * the scale profile is NaN (not asked) or >= 0.
+ * Bounded time: max_iterations <= 200 and max_seconds = 0.5 here, and
+ * libFuzzer's timeout catches any loop that ignores them.
+ */
+#include "fuzz_input.h"
+#include "mcgeom.h"
+
+/* routines selected by the first input byte (fuzz/make_corpus.py writes
+ * seeds for each) */
+#define FUZZ_MODES 2
+
+#define MAXN 64
+#define MAXCAM 8
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_in in = fz_make(data, size);
+    int mode = fz_u8(&in) % FUZZ_MODES, valid, st, i, ncams, ids_ok = 1, opt_ok, f_ok = 1;
+    int n = fz_size(&in, 6, MAXN, &valid), use_focal, use_table, short_work, cnt0, cnt1;
+    static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], res_chk[MAXN];
+    static double focal[MAXN], axes[3 * MAXCAM], cfocal[MAXCAM], wts[MAXN];
+    static int cam1[MAXN], cam2[MAXN];
+    static unsigned char mask[MAXN];
+    double R[9], tt[3], *work;
+    size_t lwork;
+    mcg_robust_options opt;
+    mcg_robust_result res;
+
+    if (n == (1 << 21))
+        n = (1 << 26) + 1; /* the limit is 2^26 pairs */
+    ncams = fz_int(&in, 1, MAXCAM);
+    if (!valid) {
+        double w1[1];
+        st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, ncams, NULL, NULL, NULL, NULL,
+                                   &res, mask, NULL, w1, 1);
+        FZ_CHECK(st == MCG_EINVAL, "robust_rig_motion(n = %d) returned %d", n, st);
+        FZ_CHECK(mcg_robust_work_size(n, ncams) == 0, "work size of n = %d not 0", n);
+        return 0;
+    }
+    if (mode == 0) {
+        fz_rotation(&in, R);
+        for (i = 0; i < 3; ++i)
+            tt[i] = fz_range(&in, -2.0, 2.0);
+        {
+            const int cross = fz_u8(&in) & 1;
+            fz_scene(&in, n, ncams, cross, R, tt, o1, d1, o2, d2, NULL);
+            for (i = 0; i < n; ++i) { /* the pairing of fz_scene */
+                cam1[i] = i % ncams;
+                cam2[i] = cross && i % 4 == 3 ? (cam1[i] + 1) % ncams : cam1[i];
+            }
+        }
+    } else {
+        fz_rays(&in, (size_t)n, o1, d1, o2, d2);
+        for (i = 0; i < n; ++i) {
+            cam1[i] = fz_int(&in, 0, ncams - 1);
+            cam2[i] = fz_u8(&in) % 4 == 0 ? fz_int(&in, 0, ncams - 1) : cam1[i];
+        }
+    }
+    if (fz_u8(&in) % 16 == 0) {
+        i = fz_int(&in, 0, n - 1);
+        cam2[i] = fz_u8(&in) & 1 ? ncams : -1;
+        ids_ok = 0;
+    }
+    use_focal = fz_u8(&in) & 1;
+    use_table = use_focal && (fz_u8(&in) & 1);
+    for (i = 0; use_focal && i < n; ++i) {
+        focal[i] = fz_u8(&in) % 32 == 0 ? fz_double(&in) : fz_range(&in, 100.0, 2000.0);
+        f_ok &= isfinite(focal[i]) && focal[i] > 0.0;
+    }
+    for (i = 0; use_table && i < ncams; ++i) {
+        fz_doubles(&in, axes + 3 * i, 3);
+        cfocal[i] = fz_range(&in, 100.0, 2000.0);
+    }
+    mcg_robust_default_options(&opt);
+    opt.max_iterations = fz_int(&in, 1, 200);
+    opt.min_iterations = fz_int(&in, 0, opt.max_iterations);
+    opt.max_seconds = 0.5;
+    opt.seed = fz_u64(&in);
+    opt.lo_rounds = fz_int(&in, 0, 3);
+    opt.refine = fz_u8(&in) & 1;
+    opt.loss = fz_int(&in, 0, 3);
+    opt.threshold = use_focal ? fz_range(&in, 0.1, 5.0) : fz_range(&in, 1e-5, 0.1);
+    opt.prob = fz_range(&in, 0.5, 0.9999);
+    opt.max_scale_rel_std = fz_u8(&in) & 1 ? fz_range(&in, 0.0, 0.5) : 0.0;
+    opt_ok = 1;
+    if (fz_u8(&in) % 16 == 0) {
+        switch (fz_u8(&in) % 4) {
+        case 0: opt.threshold = fz_double(&in); break;
+        case 1: opt.prob = fz_double(&in); break;
+        case 2: opt.min_iterations = opt.max_iterations + 1; break;
+        default: opt.loss = 7; break;
+        }
+        opt_ok = isfinite(opt.threshold) && opt.threshold > 0.0 && opt.prob > 0.0 &&
+                 opt.prob < 1.0 && opt.min_iterations <= opt.max_iterations && opt.loss <= 3;
+    }
+    lwork = mcg_robust_work_size(n, ncams);
+    FZ_CHECK(lwork > 0, "work size 0 for n = %d, %d cameras", n, ncams);
+    short_work = fz_u8(&in) % 16 == 0;
+    work = fz_alloc(lwork - (size_t)short_work);
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, ncams, use_focal ? focal : NULL,
+                               use_table ? axes : NULL, use_table ? cfocal : NULL, &opt, &res,
+                               mask, wts, work, lwork - (size_t)short_work);
+    free(work);
+    FZ_CHECK(fz_status_known(st), "unknown status %d", st);
+    if (!ids_ok || !opt_ok || !f_ok || (use_table && !fz_all_finite(axes, 3 * (size_t)ncams))) {
+        FZ_CHECK(st == MCG_EINVAL, "bad ids/options/focal/axes gave status %d", st);
+        return 0;
+    }
+    if (!fz_all_finite(o1, 3 * (size_t)n) || !fz_all_finite(d1, 3 * (size_t)n) ||
+        !fz_all_finite(o2, 3 * (size_t)n) || !fz_all_finite(d2, 3 * (size_t)n)) {
+        FZ_CHECK(st == MCG_EINVAL, "NaN/inf input gave status %d", st);
+        return 0;
+    }
+    if (short_work && st != MCG_EINVAL) {
+        FZ_CHECK(st == MCG_ENOMEM, "short workspace gave status %d", st);
+        return 0;
+    }
+    if (st != MCG_OK)
+        return 0;
+    FZ_CHECK(fz_is_rotation(res.R, 1e-9), "R not a rotation (orthogonality error %g)",
+             fz_orth_err3(res.R));
+    FZ_CHECK(fz_all_finite(res.t, 3), "t not finite");
+    FZ_CHECK(res.iterations >= 1 && res.iterations <= opt.max_iterations,
+             "iterations %d outside [1, %d]", res.iterations, opt.max_iterations);
+    st = mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
+    FZ_CHECK(st == MCG_OK, "residuals at the result: status %d", st);
+    cnt0 = cnt1 = 0;
+    for (i = 0; i < n; ++i) {
+        double r = fabs(res_chk[i]) * (use_focal ? focal[i] : 1.0);
+        int in_mask = mask[i] & 1;
+        cnt0 += in_mask;
+        cnt1 += (mask[i] >> 1) & 1;
+        FZ_CHECK(in_mask == (r < opt.threshold) ||
+                     fabs(r - opt.threshold) <= 1e-9 * opt.threshold,
+                 "mask bit 0 of pair %d is %d but |r| = %.17g vs threshold %.17g", i, in_mask,
+                 r, opt.threshold);
+    }
+    FZ_CHECK(cnt0 == res.n_inliers, "n_inliers %d, mask bit 0 set %d times", res.n_inliers,
+             cnt0);
+    FZ_CHECK(!res.refined || cnt1 == res.n_used, "n_used %d, mask bit 1 set %d times",
+             res.n_used, cnt1);
+    FZ_CHECK(isnan(res.scale_profile) || res.scale_profile >= 0.0,
+             "scale profile %g is negative", res.scale_profile);
+    return 0;
+}

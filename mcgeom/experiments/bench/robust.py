@@ -1,0 +1,191 @@
+"""``mcgeom bench robust``: the robust 5+1 façade against PoseLib, and its scaling in N.
+
+Speed (issue 19): the three cases of the issue, the same pixels for both
+libraries, timed side by side in one run (the problems interleaved, so that
+the load of the machine falls on both alike):
+
+* ``ring4 4x50 0.5px``: 4 cameras on a ring (:func:`..robust_vs_poselib.ring4`),
+  200 intra-camera correspondences, 0.5 px noise;
+* ``ladybug6 300c 30%out``: the Ladybug2-like 6-camera head, 300
+  correspondences, 30 % outliers, 0.5 px;
+* ``car8 forward 320c``: the 8-camera vehicle rig of thesis ch. 7.5.2 driving
+  forward 0.5-2 m with a yaw under 2 deg (the near-critical motion), 320
+  correspondences, 0.5 px.
+
+mcgeom runs :func:`mcgeom.cv.estimate` (pixels in, verdict out, threshold
+1 px); PoseLib ``estimate_generalized_relative_pose`` with
+``max_epipolar_error`` 1 px, once with ``min_iterations=100`` and once with its
+defaults. Printed per case and method: median rotation error (deg), median
+scale error ``| |t| / |t_true| - 1 |`` (mcgeom's metric estimate
+``info["t_metric"]``, whatever its verdict), median wall time, the ratio of
+mcgeom's median time to each PoseLib setting, and the fraction of mcgeom's
+time spent outside the C entry point (``info["c_seconds"]``).
+
+Scaling: the robust estimate on 1e3 .. 1e6 correspondences of a 4-camera
+ring with 20 % outliers (rays in, :func:`mcgeom.robust.ransac`): seconds,
+microseconds per correspondence, and the peak memory allocated during the
+call (``tracemalloc``: numpy's buffers and the C workspace, which _core
+allocates with numpy) against the size of the input arrays.
+"""
+
+from __future__ import annotations
+
+import time
+import tracemalloc
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from mcgeom import metrics, robust, synth
+from mcgeom.cv import estimate
+from mcgeom.rig import Rig
+
+from ..common import Progress, no_progress
+from ..robust_vs_poselib import poselib_estimate, poselib_setup, ring4
+
+__all__ = ["SpeedRow", "ScaleRow", "bench_speed", "bench_scaling", "CASES"]
+
+
+def _generic_motion(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    R = synth.random_rotation(rng, 0.3)
+    while metrics.rotation_error(R, np.eye(3)) < 0.05:
+        R = synth.random_rotation(rng, 0.3)
+    t = rng.normal(size=3)
+    return R, t / np.linalg.norm(t)
+
+
+def _forward_motion(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    # as mcgeom.experiments.ch7.trial: the vehicle drives forward
+    yaw = np.radians(rng.uniform(-2.0, 2.0))
+    Rw = synth.rotation_about([0, 0, 1], yaw)
+    return Rw.T, -Rw.T @ np.array([rng.uniform(0.5, 2.0), 0.0, 0.0])
+
+
+#: name: (rig, correspondences, outlier fraction, pixel noise, motion)
+CASES: dict[str, tuple[Callable[[], Rig], int, float, float, Callable]] = {
+    "ring4 4x50 0.5px": (ring4, 200, 0.0, 0.5, _generic_motion),
+    "ladybug6 300c 30%out": (synth.ladybug2, 300, 0.3, 0.5, _generic_motion),
+    "car8 forward 320c": (synth.vehicle8, 320, 0.0, 0.5, _forward_motion),
+}
+
+
+@dataclass
+class SpeedRow:
+    """Medians of one method on one case (degrees, relative, milliseconds)."""
+    case: str
+    method: str
+    rot_deg: float
+    scale_err: float
+    ms: float
+    outside_c: float   # fraction of the time outside the C entry point (mcgeom only)
+
+
+def _errors(R, t, Rt, tt) -> tuple[float, float]:
+    return (float(np.degrees(metrics.rotation_error(R, Rt))),
+            abs(float(np.linalg.norm(t) / np.linalg.norm(tt)) - 1.0))
+
+
+def bench_speed(problems: int = 100, seed: int = 0,
+                progress: Progress = no_progress) -> list[SpeedRow]:
+    """Median errors and times of mcgeom's façade and PoseLib (two settings) per case."""
+    rows = []
+    for name, (make_rig, n, outl, noise, motion) in CASES.items():
+        rng = np.random.default_rng(seed)
+        rig = make_rig()
+        setup = poselib_setup(rig, "bench robust")
+        methods = {
+            "mcgeom": None,
+            "poselib min_it=100": {"max_epipolar_error": 1.0, "min_iterations": 100},
+            "poselib defaults": {"max_epipolar_error": 1.0},
+        }
+        err = {k: [] for k in methods}
+        secs = {k: [] for k in methods}
+        outside = []
+        for _ in progress(range(problems), total=problems, desc=name):
+            R, t = motion(rng)
+            p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
+            seed_k = int(rng.integers(1 << 31))
+            for meth, opt in methods.items():
+                t0 = time.perf_counter()
+                if opt is None:
+                    m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0,
+                                 seed=seed_k)
+                    Re, te = m.R, m.info["t_metric"]
+                else:
+                    Re, te = poselib_estimate(setup, p, opt)
+                dt = time.perf_counter() - t0
+                secs[meth].append(dt)
+                err[meth].append(_errors(Re, te, R, t))
+                if opt is None:
+                    outside.append(1.0 - m.info.get("c_seconds", 0.0) / dt)
+        for meth in methods:
+            e = np.array(err[meth])
+            rows.append(SpeedRow(name, meth, float(np.median(e[:, 0])),
+                                 float(np.median(e[:, 1])), 1e3 * float(np.median(secs[meth])),
+                                 float(np.median(outside)) if meth == "mcgeom" else float("nan")))
+    return rows
+
+
+@dataclass
+class ScaleRow:
+    """One size of the scaling run."""
+    n: int
+    seconds: float
+    us_per_corr: float
+    peak_mb: float       # peak memory allocated during the call (tracemalloc)
+    input_mb: float      # the four ray arrays, the focal lengths and the camera ids
+    rot_deg: float
+    inlier_ratio: float
+
+
+def _big_problem(n: int, rng: np.random.Generator, outliers: float = 0.2):
+    """Rays of a 4-camera ring (radius 0.25 m) moving by a generic motion, 0.5 px
+    noise at f = 500 px, ``outliers`` of them with a random time-2 bearing; built
+    with numpy directly (synth.make_problem draws point by point)."""
+    from mcgeom.types import RayPairs
+    R, t = _generic_motion(rng)
+    yaw = np.arange(4) * np.pi / 2
+    axes = np.stack([np.cos(yaw), np.sin(yaw), np.zeros(4)], axis=1)
+    centres = 0.25 * axes
+    cam = np.arange(n) % 4
+    d = axes[cam] + rng.uniform(-0.5, 0.5, size=(n, 3)) * np.array([1.0, 1.0, 0.6])
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    X = centres[cam] + d * rng.uniform(2.0, 20.0, size=(n, 1))
+    X2 = X @ R.T + t
+    d2 = X2 - centres[cam]
+    d2 /= np.linalg.norm(d2, axis=1, keepdims=True)
+    sig = 0.5 / 500.0
+    d1 = d + rng.normal(scale=sig, size=(n, 3))
+    d2 = d2 + rng.normal(scale=sig, size=(n, 3))
+    bad = rng.random(n) < outliers
+    d2[bad] = rng.normal(size=(int(bad.sum()), 3))
+    o = np.ascontiguousarray(centres[cam])
+    rays = RayPairs(o, np.ascontiguousarray(d1), o.copy(), np.ascontiguousarray(d2), cam, cam)
+    return rays, R, t
+
+
+def bench_scaling(sizes=(1000, 10000, 100000, 1000000), seed: int = 0,
+                  progress: Progress = no_progress) -> list[ScaleRow]:
+    """Seconds, per-correspondence cost and peak memory of the robust estimate per N."""
+    rows = []
+    for n in progress(list(sizes), total=len(sizes), desc="scaling"):
+        rng = np.random.default_rng(seed)
+        rays, R, t = _big_problem(int(n), rng)
+        focal = np.full(len(rays), 500.0)
+        inp = (4 * rays.origins1.nbytes + focal.nbytes + 2 * rays.cam1.nbytes) / 1e6
+        robust.ransac(rays, "five_plus_one", threshold=1.0, focal=focal, seed=seed)  # warm
+        tracemalloc.start()
+        t0 = time.perf_counter()
+        m = robust.ransac(rays, "five_plus_one", threshold=1.0, focal=focal, seed=seed)
+        dt = time.perf_counter() - t0
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        # the time without tracemalloc's bookkeeping
+        t0 = time.perf_counter()
+        robust.ransac(rays, "five_plus_one", threshold=1.0, focal=focal, seed=seed)
+        dt = min(dt, time.perf_counter() - t0)
+        rows.append(ScaleRow(int(n), dt, 1e6 * dt / n, peak / 1e6, inp,
+                             float(np.degrees(metrics.rotation_error(m.R, R))),
+                             float(m.info["inlier_ratio"])))
+    return rows

@@ -1,0 +1,127 @@
+"""The robust 5+1 estimate in one C call (csrc/robust.c, ``_core.robust_rig_motion``)
+and the thin Python path of ``robust.ransac`` over it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mcgeom import _core, metrics, robust, synth
+from mcgeom.observability import scale_profile
+from mcgeom.pixel_noise import camera_table, pixels_per_radian
+from problems import rot_err
+
+
+def _problem(seed, n=300, outliers=0.3, cross=0.2):
+    rng = np.random.default_rng(seed)
+    rig = synth.ladybug2()
+    R = synth.random_rotation(rng, 0.3)
+    while metrics.rotation_error(R, np.eye(3)) < 0.1:
+        R = synth.random_rotation(rng, 0.3)
+    t = rng.normal(size=3)
+    t /= np.linalg.norm(t)
+    p = synth.make_problem(rig, R, t, n, rng, pixel_noise=0.5, outlier_fraction=outliers,
+                           cross_fraction=cross)
+    return rig, p, R, t
+
+
+def _call(rays, **kw):
+    cam1, cam2 = rays.cam1, rays.cam2
+    return _core.robust_rig_motion(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1,
+                                   cam2, int(max(cam1.max(), cam2.max())) + 1, **kw)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_motion_among_outliers_and_mask_from_the_residuals(seed):
+    rig, p, R, t = _problem(seed)
+    f = pixels_per_radian(rig, p.rays)
+    axes_f, axes = camera_table(rig)
+    out = _call(p.rays, focal=f, cam_axes=axes, cam_focal=axes_f, threshold=1.0, seed=seed)
+    assert rot_err(out["R"], R) < np.radians(0.1)
+    assert abs(np.linalg.norm(out["t"]) - 1.0) < 0.2
+    # the mask against residuals recomputed independently (pixels)
+    r = np.abs(_core.gec_residuals(p.rays.origins1, p.rays.dirs1, p.rays.origins2,
+                                   p.rays.dirs2, out["R"], out["t"])) * f
+    near = np.abs(r - 1.0) < 1e-9
+    assert np.array_equal(out["inliers"][~near], (r < 1.0)[~near])
+    assert out["n_inliers"] == np.count_nonzero(out["inliers"])
+    planted = ~p.inlier
+    assert np.count_nonzero(out["inliers"] & planted) <= 0.05 * planted.sum()
+    assert out["refinement"] is not None and out["used"].sum() == out["refinement"]["n_used"]
+    assert np.all(out["weights"][~out["used"]] == 0)
+
+
+def test_same_seed_same_result_and_budget():
+    rig, p, R, t = _problem(4)
+    a = _call(p.rays, threshold=2e-3, seed=9, max_iterations=50)
+    b = _call(p.rays, threshold=2e-3, seed=9, max_iterations=50)
+    assert np.array_equal(a["R"], b["R"]) and np.array_equal(a["t"], b["t"])
+    assert a["iterations"] <= 50
+    c = _call(p.rays, threshold=2e-3, seed=9, min_iterations=40, max_iterations=40)
+    assert c["iterations"] == 40 and c["stop"] == "max_iterations"
+
+
+def test_scale_profile_in_c_matches_the_python_statistic():
+    rig, p, R, t = _problem(5, outliers=0.1)
+    f = pixels_per_radian(rig, p.rays)
+    out = _call(p.rays, focal=f, threshold=1.0, max_scale_rel_std=0.1, loss="cauchy")
+    ref = out["refinement"]
+    assert ref["scale_rel_std"] <= 0.1 and np.isfinite(out["scale_profile"])
+    used = out["used"]
+    w = out["weights"][used]
+    py = scale_profile(p.rays.take(used), out["R"], out["t"], ref["final_cost"], ref["sigma2"],
+                       (1 / 1.3, 1.3), "cauchy", out["loss_scale"], w)
+    assert out["scale_profile"] == pytest.approx(py, rel=1e-3, abs=1e-6)
+
+
+def test_no_camera_with_five_pairs_is_degenerate():
+    rig, p, R, t = _problem(6, outliers=0.0, cross=0.0)
+    keep = np.concatenate([np.flatnonzero(p.rays.cam1 == k)[:4] for k in range(6)])
+    assert _call(p.rays.take(keep), threshold=1e-3) is None
+
+
+@pytest.mark.parametrize("kw, name", [
+    (dict(threshold=-1.0), "threshold"),
+    (dict(prob=1.0), "prob"),
+    (dict(min_iterations=10, max_iterations=5), "min_iterations"),
+    (dict(lo_rounds=-1), "lo_rounds"),
+    (dict(loss="l2"), "loss"),
+    (dict(max_seconds=float("nan")), "max_seconds"),
+    (dict(focal=-1.0), "focal"),
+    (dict(cam_axes=np.zeros((6, 3))), "cam_axes"),
+])
+def test_bad_arguments_are_named(kw, name):
+    rig, p, R, t = _problem(7, n=60)
+    if "focal" in kw:
+        kw = dict(kw, focal=np.full(len(p.rays), kw["focal"]))
+    with pytest.raises(ValueError, match=name):
+        _call(p.rays, **kw)
+
+
+def test_bad_camera_ids_are_named():
+    rig, p, R, t = _problem(8, n=60)
+    r = p.rays
+    with pytest.raises(ValueError, match=r"cam1 holds camera ids outside \[0, 3\)"):
+        _core.robust_rig_motion(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1, r.cam2, 3)
+    bad = r.cam2.copy()
+    bad[0] = 6
+    with pytest.raises(ValueError, match="cam2"):
+        _core.robust_rig_motion(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1, bad, 6)
+    with pytest.raises(ValueError, match="cam1"):
+        _core.robust_rig_motion(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1[:-1], r.cam2, 6)
+    with pytest.raises(ValueError, match="n_cameras"):
+        _core.robust_rig_motion(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1, r.cam2, 0)
+
+
+def test_c_path_agrees_with_the_python_drivers():
+    """strategy="auto" (C) and "proposer" (the Python two-stage search) find
+    the same motion within the noise on the same problems."""
+    for seed in range(3):
+        rig, p, R, t = _problem(10 + seed)
+        f = pixels_per_radian(rig, p.rays)
+        a = robust.ransac(p.rays, threshold=1.0, focal=f, seed=seed)
+        b = robust.ransac(p.rays, threshold=1.0, focal=f, seed=seed, strategy="proposer")
+        assert rot_err(a.R, R) < np.radians(0.1) and rot_err(b.R, R) < np.radians(0.1)
+        assert rot_err(a.R, b.R) < np.radians(0.1)
+        assert abs(np.count_nonzero(a.inliers) - np.count_nonzero(b.inliers)) <= 0.05 * len(p.rays)
+        assert a.scale.observable == b.scale.observable
