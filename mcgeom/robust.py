@@ -668,6 +668,10 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std)
 
     out = search(options.threshold, options.refine)
+    if out is not None and len(rays) > 6 and np.count_nonzero(out["inliers"]) <= 6:
+        # only the sample itself within the threshold (a threshold below the
+        # noise: every exact minimal sample fits itself): no consensus
+        out = None
     if out is None:
         # nothing explains 6 correspondences within the threshold: a probe at
         # the angle of a plain fit (_FITS_RAD) tells a too small threshold

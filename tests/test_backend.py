@@ -170,7 +170,10 @@ def test_scaling_world_and_rig_scales_the_trajectory(s):
     ref = estimate_trajectory(RING, tracks)
     big = estimate_trajectory(_scaled_rig(RING, s), tracks)
     assert big.status == ref.status
-    np.testing.assert_allclose(big.centres, s * ref.centres, rtol=1e-6, atol=1e-6 * s)
+    # equal up to the refinements' convergence tolerance: the C search's LM stops
+    # on a relative decrease, so positions agree to ~2e-6 of the path's extent
+    extent = float(np.abs(ref.centres).max())
+    np.testing.assert_allclose(big.centres, s * ref.centres, rtol=0, atol=1e-5 * s * extent)
     np.testing.assert_allclose(big.poses[:, :3, :3], ref.poses[:, :3, :3], atol=1e-7)
 
 
