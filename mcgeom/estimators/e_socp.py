@@ -34,6 +34,7 @@ from ..observability import scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import intra_counts
+from ._static import check_static
 from .essential import LEAST_SQUARES, essential_motions
 
 __all__ = ["e_socp", "average_rotations"]
@@ -132,7 +133,14 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     # one order for any input order: the per-camera searches and the
     # bisections then give the same answer bit for bit
     rays = rays.take(rays.canonical_order())
-    per, centres = _per_camera(rays, robust_threshold, prob)
+    try:
+        per, centres = _per_camera(rays, robust_threshold, prob)
+    except DegenerateError:
+        # no camera's essential matrix: a static rig has none (E = 0)
+        still = check_static(rays, "e_socp", noise_level=robust_threshold)
+        if still is None:
+            raise
+        return still
     if not per:
         raise ValueError("too few correspondences: e_socp needs 5 intra-camera "
                          "correspondences in at least one camera")
@@ -168,4 +176,5 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     if not verdict.observable:
         t = t / max(np.linalg.norm(t), 1e-300)
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
-    return RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
+    m = RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
+    return check_static(rays, "e_socp", m) or m
