@@ -38,18 +38,19 @@ motion rig2_from_rig1 ``X2 = R X1 + t``, angles and noise levels in radians.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
+from typing import Callable, Optional
 
 import numpy as np
 
 from .. import _core
+from ..errors import DegenerateError
 from ..geometry import rcross, rotation_fit, rotation_only_residuals, same_camera, unit_rows
 from ..observability import NO_PARALLAX_FACTOR, no_parallax
 from ..types import RayPairs, RigMotion, ScaleVerdict
 from ._common import camera_ids
 
 __all__ = ["StaticTest", "NOISE_FACTOR", "DEFAULT_NOISE_LEVEL", "camera_residuals",
-           "noise_level_of",
+           "noise_level_of", "with_static_check",
            "static_test", "static_motion", "check_static"]
 
 #: noise level = this many robust standard deviations of the per-camera
@@ -281,3 +282,25 @@ def check_static(rays: RayPairs, method: str, full: Optional[RigMotion] = None, 
     if full is not None and isinstance(full.info, dict):
         extra = {**{k: v for k, v in full.info.items() if k != "t_metric"}, **extra}
     return static_motion(rays, method, test, extra)
+
+
+def with_static_check(rays: RayPairs, method: str, estimate: Callable[[], RigMotion], *,
+                      errors: tuple = (DegenerateError,),
+                      rotation: Optional[np.ndarray] = None) -> RigMotion:
+    """``estimate()`` (an estimator's own computation on ``rays``) followed by
+    :func:`check_static`, the way every estimator runs the shared test.
+
+    When ``estimate`` raises one of ``errors`` (the estimator found no motion
+    with a translation, e.g. ``E = 0``), the static answer is returned if the
+    data are static and the error re-raised otherwise; when it returns a
+    motion, the static answer replaces it if a pure rotation explains the data
+    as well. ``rotation``: the known rotation of estimators told it.
+    """
+    try:
+        m = estimate()
+    except errors:
+        still = check_static(rays, method, rotation=rotation)
+        if still is None:
+            raise
+        return still
+    return check_static(rays, method, m, rotation=rotation) or m

@@ -34,7 +34,7 @@ from ..observability import scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import camera_ids, intra_counts
-from ._static import check_static
+from ._static import with_static_check
 from .essential import LEAST_SQUARES, essential_motions
 
 __all__ = ["e_socp", "average_rotations"]
@@ -142,14 +142,15 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     # one order for any input order: the per-camera searches and the
     # bisections then give the same answer bit for bit
     rays = rays.take(rays.canonical_order())
-    try:
-        per, centres = _per_camera(rays, robust_threshold, prob)
-    except DegenerateError:
-        # no camera's essential matrix: a static rig has none (E = 0)
-        still = check_static(rays, "e_socp", noise_level=robust_threshold)
-        if still is None:
-            raise
-        return still
+    # no camera's essential matrix (DegenerateError): a static rig has none (E = 0)
+    return with_static_check(rays, "e_socp", lambda: _e_socp(
+        rays, robust_threshold, prob, tolerance, max_scale_rel_std))
+
+
+def _e_socp(rays: RayPairs, robust_threshold: Optional[float], prob: float, tolerance: float,
+            max_scale_rel_std: float) -> RigMotion:
+    """:func:`e_socp` on checked, canonically ordered rays, without the static-rig test."""
+    per, centres = _per_camera(rays, robust_threshold, prob)
     if not per:
         raise ValueError("too few correspondences: e_socp needs 5 intra-camera "
                          "correspondences in at least one camera")
@@ -198,8 +199,7 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     if not verdict.observable:
         t = t / max(np.linalg.norm(t), 1e-300)
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
-    m = RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
-    return check_static(rays, "e_socp", m) or m
+    return RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
 
 
 #: fewest correspondences of a cross-camera pair (camera a at time 1, b at
