@@ -15,10 +15,18 @@ minimises the largest angle between ``t - t0_i`` and ``w_i`` (eq. 9.3): the
 L-infinity triangulation, solved exactly by cone bisection in C
 (``csrc/cone.c``).
 
-Near-zero rotation makes every apex ``t0_i`` collapse to the origin: all
-half-lines then share their apex and the scale is free (ch. 9.5). The verdict
-says so, with the SOCP residual and the rotation angle in ``info`` so that a
-caller can reject such frames as ch. 9.5 suggests.
+Cross-camera correspondences (camera ``a`` at time 1, ``b`` at time 2) give
+one more cone per camera pair, of the same form with apex ``c_b - R c_a`` (see
+:func:`_cross_cones`): ch. 9's triangulation with the pair's baseline in place
+of a camera's own translation.
+
+Near-zero rotation makes every intra-camera apex ``t0_i`` collapse to the
+origin: without a cross-camera pair all half-lines then share their apex and
+the scale is free (ch. 9.5). The verdict says so, with the SOCP residual and
+the rotation angle in ``info`` so that a caller can reject such frames as
+ch. 9.5 suggests. Where the scale is fixed, its relative std is that of the
+correspondences the cones came from (least squares) combined with the distance
+of the L-infinity |t| from their optimum: the verdict reflects the data used.
 """
 
 from __future__ import annotations
