@@ -9,7 +9,6 @@ import pytest
 import mcgeom
 from mcgeom import _core
 from mcgeom.experiments.bench.linear17_numpy import linear17_numpy
-from mcgeom.errors import DegenerateError
 from problems import KIND_SETUPS, make, rot_err
 
 EXPECTED_RANK = {"most-general": 17, "locally-central": 16, "axial": 16,

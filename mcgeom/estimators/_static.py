@@ -63,6 +63,9 @@ DEFAULT_NOISE_LEVEL = 1e-3
 #: rounding would otherwise call a rotation that is exact only to rounding a
 #: translation
 _FLOOR = 1e-9
+#: fewest intra-camera correspondences of a camera whose residuals measure the
+#: noise (a static rig with 7 per camera and 3e-4 rad noise read as moving)
+_MIN_PER_CAMERA = 12
 #: 1 / the median of |N(0, 1)|: the standard deviation from the median absolute residual
 _MAD_TO_STD = 1.4826
 
@@ -106,7 +109,9 @@ def camera_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:
     -- which a near-critical estimate may have slid anywhere (a metric ``t`` of
     a few mm puts the epipoles where the rotation-induced shift ``R c - c``
     points, and its residuals are then the model's error, not the noise).
-    Cameras with fewer than 5 intra-camera correspondences are left out.
+    Cameras with fewer than :data:`_MIN_PER_CAMERA` intra-camera
+    correspondences are left out: with a handful of rays the fitted direction
+    (2 dof) absorbs the noise and its residuals understate it.
     """
     cam1, cam2, _ = camera_ids(rays)
     same = cam1 == cam2
@@ -114,7 +119,7 @@ def camera_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:
     out = []
     for k in np.unique(cam1[same]):
         idx = np.flatnonzero(same & (cam1 == k))
-        if idx.size < 5:
+        if idx.size < _MIN_PER_CAMERA:
             continue
         d1, d2 = unit_rows(rays.dirs1[idx]), unit_rows(rays.dirs2[idx])
         a = rcross(d1 @ R.T, d2)
@@ -170,7 +175,7 @@ def noise_level_of(rays: RayPairs, R: np.ndarray) -> float:
     median absolute value) of :func:`camera_residuals`, the smaller of those
     at ``R`` and at the best pure rotation (a wrong ``R`` must not inflate
     the noise and make a moving rig pass for a static one); at least 1e-9;
-    :data:`DEFAULT_NOISE_LEVEL` when no camera has 5 intra-camera
+    :data:`DEFAULT_NOISE_LEVEL` when no camera has 12 intra-camera
     correspondences.
     """
     best = float("inf")

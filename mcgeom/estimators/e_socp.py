@@ -36,7 +36,7 @@ from typing import Optional
 import numpy as np
 
 from .. import _core
-from ..errors import DegenerateError
+from ..errors import DegenerateError, InfeasibleError
 from ..geometry import rcross, refine_centred, unit_rows
 from ..observability import scale_verdict
 from ..registry import register
@@ -150,9 +150,11 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     # one order for any input order: the per-camera searches and the
     # bisections then give the same answer bit for bit
     rays = rays.take(rays.canonical_order())
-    # no camera's essential matrix (DegenerateError): a static rig has none (E = 0)
+    # no camera's essential matrix (DegenerateError): a static rig has none (E
+    # = 0); or its cameras' noise directions admit no common point (InfeasibleError)
     return with_static_check(rays, "e_socp", lambda: _e_socp(
-        rays, robust_threshold, prob, tolerance, max_scale_rel_std))
+        rays, robust_threshold, prob, tolerance, max_scale_rel_std),
+        errors=(DegenerateError, InfeasibleError))
 
 
 def _e_socp(rays: RayPairs, robust_threshold: Optional[float], prob: float, tolerance: float,
