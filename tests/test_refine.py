@@ -169,7 +169,10 @@ def test_estimator_recovers_truth_through_mcgeom_estimate(kind):
         assert m.scale.observable, m.scale.reason
         assert m.residual_rms < 1e-12
         assert m.info["covariance"].shape == (6, 6)
-    assert m.info["initial_method"] == "linear17"
+    # the default start is the candidate of lower robust cost (issue 18)
+    costs = m.info["start_costs"]["costs"]
+    assert set(costs) == {"five_plus_one", "linear17"}
+    assert costs[m.info["initial_method"]] == min(costs.values())
 
 
 @pytest.mark.parametrize("kind,seed", [("locally-central", 34), ("locally-central-and-axial", 49)])

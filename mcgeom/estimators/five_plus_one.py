@@ -25,7 +25,7 @@ Cross-camera correspondences do not have this limitation.
 
 from __future__ import annotations
 
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -38,6 +38,7 @@ from ..registry import register
 from ..types import RayPairs, RigMotion
 from ..validation import integral_camera_ids
 from ._common import camera_ids, intra_counts, travel_direction
+from ._static import with_static_check
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
 from .five_plus_one_minimal import (critical_angles, minimal_solutions, sample_five_plus_one,
                                     scale_terms)
@@ -194,7 +195,10 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     ``t`` is the metric estimate wherever the data determine a scale
     (``info['scale_determined']``), a unit direction where not. Raises
     ValueError when no camera has 5 intra-camera correspondences,
-    DegenerateError when the 5-point solver fails.
+    DegenerateError when the 5-point solver fails and the rig did translate.
+    A rig that did not translate measurably gives the rotation, ``t = 0`` and
+    the verdict "no translation detected" (the shared test of
+    :mod:`mcgeom.estimators._static`, the robust layer's statistic).
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -203,6 +207,13 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     if len(rays) < 6:
         raise ValueError(f"too few correspondences: five_plus_one needs at least 6, got {len(rays)}")
     rays.check_finite()
+    return with_static_check(rays, "five_plus_one", lambda: _five_plus_one(
+        rays, five_camera, refine, max_scale_rel_std, calibration_std))
+
+
+def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
+                   max_scale_rel_std: float, calibration_std: Any = None) -> RigMotion:
+    """:func:`five_plus_one` on checked rays, without the static-rig test."""
     if five_camera is None:
         # every camera that can be the 5-point camera, best final cost wins: the
         # refinement from a single camera's start can stop in a local minimum,
