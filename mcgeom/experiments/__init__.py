@@ -33,6 +33,8 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
                                                "against PoseLib (needs poselib)"),
     "real_data": ("real_data", "the robust pipeline on the real recordings (KITTI, DDAD, "
                                "EuRoC), against their ground truth"),
+    "bnb_real": ("bnb_real", "bnb_lp (ch. 10) on the 5+1 inliers of KITTI raw and DDAD: "
+                             "rotation, |t|, verdict, time, blocks, certified gap"),
     "ch6_kitti": ("ch6_kitti", "thesis ch. 6 on real data: the KITTI-00 stereo trajectory "
                                "from tracks with known rotations"),
     "odometry_kitti00": ("odometry_kitti00", "the sequence back end on the KITTI-00 stereo "
