@@ -26,7 +26,8 @@ from .geometry import (count_in_front, displacements, rcross, refine_centred, ro
                        same_camera)
 from .types import RayPairs, ScaleVerdict
 
-__all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile"]
+__all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
+           "no_parallax"]
 
 
 def rig_critical_angle(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> float:
@@ -104,6 +105,36 @@ def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sig
     return float(max(worst, 0.0))
 
 
+#: the no-parallax test: a pure rotation must explain this fraction of the
+#: intra-camera correspondences ...
+NO_PARALLAX_FRACTION = 0.9
+#: ... each within this many noise levels (the rotation residual is a 2-dof
+#: angle, the noise level that of the 1-dof Sampson distance)
+NO_PARALLAX_FACTOR = 1.5
+#: fewest intra-camera correspondences the no-parallax test decides on
+NO_PARALLAX_MIN = 5
+
+
+def no_parallax(angles: np.ndarray, noise_level: float) -> bool:
+    """The no-parallax statistic: does a pure rotation explain the correspondences?
+
+    ``angles`` (radians) are the residual angles between ``d2`` and ``R d1`` of
+    the intra-camera correspondences under the best pure rotation
+    (:func:`mcgeom.geometry.rotation_fit`); ``noise_level`` (radians) is the
+    inlier threshold of the Sampson distance (or its equivalent). True when
+    at least :data:`NO_PARALLAX_FRACTION` of them are within
+    :data:`NO_PARALLAX_FACTOR` noise levels (and there are at least
+    :data:`NO_PARALLAX_MIN`): the translation moves no point measurably. The
+    one statistic of the robust verdict (:func:`scale_verdict`) and of every
+    estimator's static-rig test (:mod:`mcgeom.estimators._static`).
+    """
+    angles = np.asarray(angles, dtype=np.float64)
+    if angles.size < NO_PARALLAX_MIN or not noise_level > 0:
+        return False
+    inside = np.count_nonzero(angles < NO_PARALLAX_FACTOR * noise_level)
+    return inside / angles.size >= NO_PARALLAX_FRACTION
+
+
 def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndarray,
                   rel_std: float, max_rel_std: float = 0.1,
                   direction_only: bool = False,
@@ -130,7 +161,7 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     same = same_camera(rays)   # shared by the no-parallax test and the centres
     if np.isfinite(noise_level):
         _, ang = rotation_fit(rays, inliers & same)
-        if ang.size >= 5 and np.count_nonzero(ang < 1.5 * noise_level) / ang.size >= 0.9:
+        if no_parallax(ang, noise_level):
             return ScaleVerdict(False, "no translation detected: a pure rotation explains the "
                                        f"correspondences (median residual "
                                        f"{np.degrees(np.median(ang)) * 3600:.3g} arcsec); static "

@@ -29,11 +29,12 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..geometry import refine_centred
+from ..geometry import rcross, refine_centred, unit_rows
 from ..observability import scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
-from ._common import intra_counts
+from ._common import camera_ids, intra_counts
+from ._static import check_static
 from .essential import LEAST_SQUARES, essential_motions
 
 __all__ = ["e_socp", "average_rotations"]
@@ -117,14 +118,23 @@ def _refine_camera(sub: RayPairs, c: np.ndarray, R: np.ndarray, w: np.ndarray,
 )
 def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: float = 0.999,
            tolerance: float = 1e-12, max_scale_rel_std: float = 0.1) -> RigMotion:
-    """Rig motion rig2_from_rig1 by E+SOCP (thesis ch. 9) from intra-camera correspondences.
+    """Rig motion rig2_from_rig1 by E+SOCP (thesis ch. 9).
 
-    ``rays`` in the rig frame, origins at the camera centres. Needs at least two
-    cameras with 5 intra-camera correspondences for the metric scale (one camera
-    gives R and the direction only); cross-camera correspondences are not used.
+    ``rays`` in the rig frame, origins at the camera centres. The rotation is
+    the mean of the rotations of the cameras with 5 intra-camera
+    correspondences; each such camera, and each cross-camera pair (camera a
+    at time 1, b at time 2) with 5 correspondences, is a cone on ``t``
+    (:func:`_cross_cones`); ``t`` is their L-infinity intersection (eq. 9.3).
+    The metric scale needs two cameras with enough rotation or a cross-camera
+    pair. The verdict rests on the correspondences the cones were built from:
+    the relative std of |t| is that of their least-squares optimum combined
+    with the relative distance of the L-infinity |t| from it (observable when
+    at most ``max_scale_rel_std``).
     ``info``: per-camera rotations' spread from their mean (radians), the SOCP
     residual (the optimal L-infinity angle, radians), the frame-to-frame
-    rotation angle (radians), the cameras used and the active cones.
+    rotation angle (radians), the cameras and cross pairs used, the active
+    cones, ``scale_ls_ratio`` (L-infinity over least-squares |t|) and
+    ``scale_rel_std_ls`` (the least-squares relative std alone).
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -132,18 +142,38 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     # one order for any input order: the per-camera searches and the
     # bisections then give the same answer bit for bit
     rays = rays.take(rays.canonical_order())
-    per, centres = _per_camera(rays, robust_threshold, prob)
+    try:
+        per, centres = _per_camera(rays, robust_threshold, prob)
+    except DegenerateError:
+        # no camera's essential matrix: a static rig has none (E = 0)
+        still = check_static(rays, "e_socp", noise_level=robust_threshold)
+        if still is None:
+            raise
+        return still
     if not per:
         raise ValueError("too few correspondences: e_socp needs 5 intra-camera "
                          "correspondences in at least one camera")
     R, spread = average_rotations(np.stack([p[1] for p in per]),
                                   np.array([p[4] for p in per], dtype=float))
-    apex = np.stack([centres[p[0]] - R @ centres[p[0]] for p in per])   # t0_i with the mean R
-    axis = np.stack([p[3] for p in per])
-    info = {"cameras": [p[0] for p in per], "rotation_spread": spread,
+    cross = _cross_cones(rays, R, centres)
+    # the cones: camera i's own half-line t = c_i - R c_i + lam w_i (eq. 9.2,
+    # mean R) and each cross-camera pair's t = c_b - R c_a + lam w_ab
+    apex = np.stack([centres[p[0]] - R @ centres[p[0]] for p in per] +
+                    [q[2] for q in cross])
+    axis = np.stack([p[3] for p in per] + [q[3] for q in cross])
+    names = [p[0] for p in per] + [(q[0], q[1]) for q in cross]
+    used = np.zeros(len(rays), bool)
+    cam1, cam2 = camera_ids(rays)[:2]
+    for p in per:
+        used |= (cam1 == p[0]) & (cam2 == p[0])
+    for q in cross:
+        used[q[4]] = True
+    info = {"cameras": [p[0] for p in per], "cross_pairs": [(q[0], q[1]) for q in cross],
+            "rotation_spread": spread, "n_used": int(np.count_nonzero(used)),
+            "n_cross_used": int(sum(len(q[4]) for q in cross)),
             "rotation_angle": float(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1)))}
-    degenerate_scale = len(per) == 1
-    if len(per) == 1:
+    degenerate_scale = len(apex) == 1
+    if len(apex) == 1:
         t = axis[0] + apex[0]
         info["socp_residual"] = 0.0
     else:
@@ -151,21 +181,100 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
         t = np.asarray(sol["X"], dtype=np.float64)
         info["socp_residual"] = float(sol["gamma"])
         info["socp_lower_bound"] = float(sol["gamma_lower"])
-        info["active_cones"] = [info["cameras"][k] for k in sol["active"]]
-        # all apexes equal (no rotation) or parallel half-lines: |t| is free
+        info["active_cones"] = [names[k] for k in sol["active"]]
+        # all apexes equal (no rotation, no cross-camera pair) or parallel
+        # half-lines: |t| is free
         degenerate_scale = bool(sol["coincident_apexes"] or sol["at_infinity"])
-    # evidence on |t|: the information matrix of the Sampson cost at (R, t)
-    rel = float("inf")
-    if not degenerate_scale and len(rays) >= 6:
-        try:
-            ev = refine_centred(rays, R, t, max_iterations=0)
-            rel = float(ev["scale_rel_std"])
-        except (ValueError, DegenerateError):
-            pass
-    verdict = scale_verdict(rays, np.ones(len(rays), bool), R, t, rel, max_scale_rel_std,
-                            degenerate_scale)
+    rel_ls, ratio = _scale_evidence(rays.take(np.flatnonzero(used)), R, t, degenerate_scale)
+    info["scale_ls_ratio"] = ratio
+    info["scale_rel_std_ls"] = rel_ls
+    # the uncertainty of the |t| returned: the least-squares one of the same
+    # data plus how far the L-infinity solution lies from that optimum (the
+    # L-infinity estimate is the less efficient one; a |t| several std from
+    # the data's optimum must not be reported with the optimum's std)
+    rel = float(np.hypot(rel_ls, ratio - 1.0)) if np.isfinite(ratio) else float("inf")
+    verdict = scale_verdict(rays, used, R, t, rel, max_scale_rel_std, degenerate_scale)
     info["t_metric"] = np.array(t)
     if not verdict.observable:
         t = t / max(np.linalg.norm(t), 1e-300)
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
-    return RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
+    m = RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
+    return check_static(rays, "e_socp", m) or m
+
+
+#: fewest correspondences of a cross-camera pair (camera a at time 1, b at
+#: time 2) that make a cone: 5, as a camera's own essential matrix
+_MIN_CROSS = 5
+
+
+def _cross_cones(rays: RayPairs, R: np.ndarray, centres: np.ndarray) -> list:
+    """One cone per cross-camera pair ``(a, b)`` with at least 5 correspondences.
+
+    With the rotation known, camera ``b`` at time 2 sits at ``R^T (c_b - t)``
+    in the time-1 rig frame; its baseline from camera ``a`` at time 1,
+    ``B = R^T (c_b - t) - c_a``, is coplanar with every pair of rays ``d1``,
+    ``R^T d2`` of the pair (the epipolar constraint of the two views, thesis
+    ch. 2.3): ``B . (d1 x R^T d2) = 0``. Its direction ``b`` is the
+    least-squares null vector of these rows (sign by cheirality), so that
+    ``t = c_b - R c_a - lam R b``, ``lam >= 0``: a half-line exactly like a
+    camera's own (eq. 9.2 with ``c_a`` at time 1 and ``c_b`` at time 2), and
+    its cone enters the same L-infinity problem (eq. 9.3). The apex ``c_b - R
+    c_a`` differs from the intra-camera apexes ``c_i - R c_i`` even without
+    rotation: the cross-camera pairs fix the scale where the intra-camera ones
+    cannot (ch. 7.3.2). Returns ``[(a, b, apex, axis, indices)]``.
+    """
+    cam1, cam2 = camera_ids(rays)[:2]
+    sel = np.flatnonzero(cam1 != cam2)
+    out = []
+    if sel.size < _MIN_CROSS:
+        return out
+    keys = np.unique(np.stack([cam1[sel], cam2[sel]], axis=1), axis=0)
+    for a, b in keys:
+        idx = sel[(cam1[sel] == a) & (cam2[sel] == b)]
+        if idx.size < _MIN_CROSS:
+            continue
+        d1 = unit_rows(rays.dirs1[idx])
+        d2 = unit_rows(rays.dirs2[idx]) @ R          # rows R^T d2: time-1 rig frame
+        rows = rcross(d1, d2)
+        w, v = np.linalg.eigh(rows.T @ rows)
+        if not w[1] > 1e-12 * max(w[2], 1e-300):
+            continue   # the rows do not fix a direction (all rays in one plane)
+        u = v[:, 0]
+        # cheirality: with B = +u the rays meet in front of both cameras
+        # (s1 d1 - s2 d2 = B by least squares, row by row)
+        dd = np.einsum("ij,ij->i", d1, d2)
+        den = 1.0 - dd * dd
+        ok = den > 1e-12
+        bu1, bu2 = d1 @ u, d2 @ u
+        s1 = (bu1 - dd * bu2) / np.where(ok, den, 1.0)
+        s2 = (dd * bu1 - bu2) / np.where(ok, den, 1.0)
+        plus = np.count_nonzero(ok & (s1 > 0) & (s2 > 0))
+        minus = np.count_nonzero(ok & (s1 < 0) & (s2 < 0))
+        if minus > plus:
+            u = -u
+        apex = centres[b] - R @ centres[a]
+        out.append((int(a), int(b), apex, -(R @ u), idx))
+    return out
+
+
+def _scale_evidence(used: RayPairs, R: np.ndarray, t: np.ndarray,
+                    degenerate: bool) -> tuple[float, float]:
+    """Relative std of |t| from the correspondences the cones were built from,
+    and the ratio of the L-infinity |t| to their least-squares optimum's.
+
+    The std is that of the Sampson least-squares optimum (first order, the
+    information matrix of :func:`mcgeom.geometry.refine_centred` started at
+    the cone solution); the ratio says whether the cone solution is where
+    these data put |t| (inf, nan when the data do not fix it).
+    """
+    if degenerate or len(used) < 6:
+        return float("inf"), float("nan")
+    try:
+        ls = refine_centred(used, R, t, max_iterations=50)
+    except (ValueError, DegenerateError):
+        return float("inf"), float("nan")
+    rel = float(ls["scale_rel_std"])
+    c = 0.5 * (used.origins1.mean(axis=0) + used.origins2.mean(axis=0))
+    tau = np.linalg.norm(t + R @ c - c)
+    tau_ls = np.linalg.norm(ls["t"] + ls["R"] @ c - c)
+    return rel, (tau / tau_ls if tau_ls > 0 else float("inf"))

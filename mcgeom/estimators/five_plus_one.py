@@ -36,6 +36,7 @@ from ..observability import scale_profile, scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import camera_ids, intra_counts, travel_direction
+from ._static import check_static
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
 from .five_plus_one_minimal import (critical_angles, minimal_solutions, sample_five_plus_one,
                                     scale_terms)
@@ -161,13 +162,30 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     refined jointly on all correspondences (Sampson angular error). ``info``
     holds the 5-point camera, the critical angles (radians) per camera, the
     linear scale and its relative std. Raises ValueError when no camera has 5
-    intra-camera correspondences, DegenerateError when the 5-point solver fails.
+    intra-camera correspondences, DegenerateError when the 5-point solver fails
+    and the rig did translate. A rig that did not translate measurably gives
+    the rotation, ``t = 0`` and the verdict "no translation detected" (the
+    shared test of :mod:`mcgeom.estimators._static`, the robust layer's
+    statistic).
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
     if len(rays) < 6:
         raise ValueError(f"too few correspondences: five_plus_one needs at least 6, got {len(rays)}")
     rays.check_finite()
+    try:
+        m = _five_plus_one(rays, five_camera, refine, max_scale_rel_std)
+    except DegenerateError:
+        still = check_static(rays, "five_plus_one")
+        if still is None:
+            raise
+        return still
+    return check_static(rays, "five_plus_one", m) or m
+
+
+def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
+                   max_scale_rel_std: float) -> RigMotion:
+    """:func:`five_plus_one` on checked rays, without the static-rig test."""
     if five_camera is None:
         # every camera that can be the 5-point camera, best final cost wins: the
         # refinement from a single camera's start can stop in a local minimum,

@@ -24,6 +24,7 @@ from .. import multiview
 from ..observability import critical_angle
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
+from ._static import check_static
 
 __all__ = ["known_rotation_translation", "solve"]
 
@@ -63,7 +64,10 @@ def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
     known rotation ``rotation`` from >= 3 ray correspondences (rig frame).
 
     Returns a ``RigMotion`` with ``R = rotation``; ``info`` holds the
-    multi-view result (eigenvalues, timing). Raises ValueError on bad input.
+    multi-view result (eigenvalues, timing). When the rotation alone explains
+    the intra-camera correspondences (a static rig or a pure rotation, the
+    shared test of :mod:`mcgeom.estimators._static`) ``t = 0`` with the
+    verdict "no translation detected". Raises ValueError on bad input.
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -72,12 +76,15 @@ def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
         raise ValueError(f"too few correspondences: known_rotation_translation needs 3, got {n}")
     rays.check_finite()
     R = _rotation(rotation)
-    k = np.arange(n)
-    res = multiview.translations_from_tracks(
-        np.r_[k, k], np.r_[np.zeros(n, np.int64), np.ones(n, np.int64)],
-        np.vstack([rays.dirs1, rays.dirs2]), np.stack([np.eye(3), R]),
-        origins=np.vstack([rays.origins1, rays.origins2]), relation="bilinear",
-        solver="constrained", max_rel_std=0.1 if max_rel_std is None else float(max_rel_std))
+    try:
+        res = _solve(rays, R, max_rel_std)
+    except ValueError:
+        # the relations carry no information: every bearing pair parallel
+        # after the rotation, a static rig (E = 0)
+        still = check_static(rays, "known_rotation_translation", rotation=R)
+        if still is None:
+            raise
+        return still
     t = -R @ res.centres[1]  # c = -R^T t
     if not res.scale.observable:
         t /= np.linalg.norm(t)  # the direction only (already unit up to rounding)
@@ -86,5 +93,18 @@ def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
                            critical_angle(rays, R, t))
     info = {"eigenvalues": res.eigenvalues, "converged": res.converged, "timing": res.timing,
             "metric": res.scale.observable}
-    return RigMotion(R.copy(), t, verdict, "known_rotation_translation", res.residual_rms,
-                     None, info)
+    info["t_metric"] = -R @ res.centres[1]   # metric estimate, whatever the verdict
+    m = RigMotion(R.copy(), t, verdict, "known_rotation_translation", res.residual_rms,
+                  None, info)
+    return check_static(rays, "known_rotation_translation", m, rotation=R) or m
+
+
+def _solve(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float]):
+    """The two-view case of :func:`mcgeom.multiview.translations_from_tracks`."""
+    n = len(rays)
+    k = np.arange(n)
+    return multiview.translations_from_tracks(
+        np.r_[k, k], np.r_[np.zeros(n, np.int64), np.ones(n, np.int64)],
+        np.vstack([rays.dirs1, rays.dirs2]), np.stack([np.eye(3), R]),
+        origins=np.vstack([rays.origins1, rays.origins2]), relation="bilinear",
+        solver="constrained", max_rel_std=0.1 if max_rel_std is None else float(max_rel_std))

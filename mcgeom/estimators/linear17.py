@@ -22,6 +22,7 @@ from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
+from ._static import check_static
 
 __all__ = ["linear17"]
 
@@ -69,10 +70,32 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     ``rays`` are in the rig frame (metres); origins must be the camera centres
     for axial rigs. Returns ``RigMotion`` rig2_from_rig1 (``X2 = R X1 + t``);
     ``info`` reports the detected generalized-camera kind, the ranks, the
-    alternation iterations and convergence. Raises ValueError on bad input
-    (NaN/inf, zero directions, fewer than 14 rays) and DegenerateError when the
-    data do not determine E (no translation, or too few rays for the kind).
+    alternation iterations and convergence. A rig that did not translate
+    measurably (static, pure rotation: ``E = 0``) gives the rotation, ``t = 0``
+    and the verdict "no translation detected" (the shared test of
+    :mod:`mcgeom.estimators._static`; the linear estimate is in
+    ``info["full_estimate"]`` when there was one). Raises ValueError on bad
+    input (NaN/inf, zero directions, fewer than 14 rays) and DegenerateError
+    when the data do not determine E otherwise (too few rays for the kind,
+    degenerate configurations).
     """
+    try:
+        m = _linear17(rays, refine=refine, max_iterations=max_iterations, tolerance=tolerance,
+                      max_scale_rel_std=max_scale_rel_std, options=options)
+    except DegenerateError:
+        # E = 0 has no null space of the right dimension: a static rig lands
+        # here (thesis ch. 8.3's kinds all assume t != 0)
+        still = check_static(rays, "linear17")
+        if still is None:
+            raise
+        return still
+    return check_static(rays, "linear17", m) or m
+
+
+def _linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[int] = None,
+              tolerance: Optional[float] = None, max_scale_rel_std: Optional[float] = None,
+              options: Optional[_core.Linear17Options] = None) -> RigMotion:
+    """:func:`linear17` without the static-rig test (RANSAC's minimal solver)."""
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
     n = len(rays)
@@ -109,7 +132,7 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
 def _minimal(sample: RayPairs) -> list:
     """The motion of a 17-ray sample for RANSAC (none if the sample is degenerate)."""
     try:
-        m = linear17(sample, refine=False)
+        m = _linear17(sample, refine=False)
     except DegenerateError:
         return []
     return [(m.R, m.t if m.scale.observable else m.info["t_metric"])]

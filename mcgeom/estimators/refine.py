@@ -26,8 +26,10 @@ import numpy as np
 
 from .. import _core
 from ..observability import critical_angle
-from ..registry import get, register
+from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
+from ._start import best_start, metric_translation
+from ._static import check_static
 
 __all__ = ["refine", "MAX_SCALE_REL_STD"]
 
@@ -38,14 +40,26 @@ _MIN_PAIRS = 6
 InitialLike = Union[RigMotion, tuple, list, None]
 
 
-def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarray, Optional[bool],
-                                                            str]:
-    """(R0, t0, observable-or-None, source) of the starting motion."""
+def _initial(rays: RayPairs, initial: InitialLike, loss_scale: float
+             ) -> tuple[np.ndarray, np.ndarray, Optional[bool], str, Optional[RigMotion], dict]:
+    """(R0, t0, observable-or-None, source, static start or None, start costs) of the
+    starting motion (the costs: ``best_start``'s report, empty for a given start).
+
+    By default the best of 5+1 and linear17 (lower robust cost,
+    :func:`mcgeom.estimators._start.best_start`); when every candidate found no
+    translation, that static motion is returned last (nothing to refine).
+    """
     if initial is None:
-        m = get("linear17")(rays)
-        return m.R, m.t, bool(m.scale.observable), "linear17"
+        m, report = best_start(rays, loss_scale)
+        if m.info.get("translation_detected") is False:
+            return m.R, m.t, False, report["chosen"], m, report
+        # the start's metric t even where its verdict made t a unit vector:
+        # holding |t| at a wrong length bends R to compensate (see
+        # mcgeom.robust._finish)
+        return (m.R, metric_translation(m), bool(m.scale.observable), report["chosen"], None,
+                report)
     if isinstance(initial, RigMotion):
-        return initial.R, initial.t, bool(initial.scale.observable), initial.method
+        return initial.R, initial.t, bool(initial.scale.observable), initial.method, None, {}
     if isinstance(initial, (tuple, list)) and len(initial) == 2:
         R0 = np.asarray(initial[0], dtype=np.float64) if _numeric(initial[0]) else None
         t0 = np.asarray(initial[1], dtype=np.float64) if _numeric(initial[1]) else None
@@ -54,7 +68,7 @@ def _initial(rays: RayPairs, initial: InitialLike) -> tuple[np.ndarray, np.ndarr
                              f"{np.shape(initial[0])}")
         if t0 is None or t0.shape != (3,):
             raise ValueError(f"initial: t must be a 3-vector, got shape {np.shape(initial[1])}")
-        return R0, t0, None, "given"
+        return R0, t0, None, "given", None, {}
     raise ValueError("initial must be None, a RigMotion or an (R, t) pair, got "
                      f"{type(initial).__name__}")
 
@@ -109,7 +123,8 @@ def _covariance(info: np.ndarray, sigma2: float) -> Optional[np.ndarray]:
     recovers_scale=True,
     description="Levenberg-Marquardt refinement of R, t (with metric scale) on the robust "
                 "Sampson angular error of the generalized epipolar constraint",
-    options={"initial": "start: RigMotion or (R, t); default: the linear17 estimate",
+    options={"initial": "start: RigMotion or (R, t); default: the better of the 5+1 and "
+                        "linear17 estimates (lower robust cost)",
              "loss": "robust loss: 'cauchy' (default), 'huber', 'soft_l1' or 'none'",
              "loss_scale": "scale of the loss, radians (default 5e-3)",
              "max_iterations": "Levenberg-Marquardt trial steps (default 50)",
@@ -124,7 +139,9 @@ def refine(rays: RayPairs, *, initial: InitialLike = None, loss: str = "cauchy",
 
     ``rays`` are ray correspondences in the rig frame (metres). ``initial`` is
     the starting rig2_from_rig1 motion: a :class:`RigMotion` or an ``(R, t)``
-    pair (``X2 = R X1 + t``); by default the ``linear17`` estimate. When
+    pair (``X2 = R X1 + t``); by default the better of the ``five_plus_one``
+    and ``linear17`` estimates, the one of lower robust cost (Cauchy of the
+    Sampson residuals at ``loss_scale``; ``info["start_costs"]``). When
     ``fix_scale`` is None it is set from the start's verdict: a start whose
     scale is unobservable (a unit ``t``) is refined with ``|t|`` kept fixed.
     Otherwise the refinement runs in two stages: rotation and direction of
@@ -156,7 +173,12 @@ def refine(rays: RayPairs, *, initial: InitialLike = None, loss: str = "cauchy",
         raise ValueError(f"too few correspondences: refine needs at least {_MIN_PAIRS}, got {n}")
     if not isinstance(loss, str) or loss not in _core.LOSS_NAMES:
         raise ValueError(f"loss must be one of {sorted(_core.LOSS_NAMES)}, got {loss!r}")
-    R0, t0, start_observable, source = _initial(rays, initial)
+    R0, t0, start_observable, source, still, report = _initial(rays, initial, loss_scale)
+    starts = {k: report[k] for k in ("costs", "errors") if k in report}
+    if still is not None:
+        # the rig did not translate (every start says so): R, t = 0, as 5+1
+        return replace(still, method="refine", info={**still.info, "initial_method": source,
+                                                     "start_costs": starts})
     fixed = bool(fix_scale) if fix_scale is not None else start_observable is False
     if fixed and not np.linalg.norm(t0) > 0:
         raise ValueError("fix_scale needs a non-zero initial t")
@@ -197,6 +219,10 @@ def refine(rays: RayPairs, *, initial: InitialLike = None, loss: str = "cauchy",
         "loss": loss,
         "loss_scale": float(loss_scale),
         "initial_method": source,
+        "start_costs": starts,
         "t_metric": None if fixed else t_metric,
     }
-    return RigMotion(r["R"], t, verdict, "refine", float(r["rms"]), None, info)
+    m = RigMotion(r["R"], t, verdict, "refine", float(r["rms"]), None, info)
+    # the refined motion is the best fit with a translation: is the rotation
+    # alone as good (a static rig whose free t absorbed calibration error)?
+    return check_static(rays, "refine", m) or m
