@@ -16,6 +16,11 @@
  *       of its wedges contains a non-zero direction (the single-camera test
  *       of ch. 10.3, an LP in 2 variables), and
  *   (b) all wedges have a common point t (the LP in 3 variables of ch. 10.3).
+ * Where R d1 and d2 are far apart (the cone about the mid-axis of d2 and
+ * -R d1 that holds both bearing cones is narrower than CAP_MAX) each wedge
+ * is capped by two more rows (cap_rows: that cone's tangent planes along
+ * the epipolar plane), a relaxation of eq. 10.5 as the wedge is, which keeps
+ * the relaxed tests of far blocks from passing on the wedges' far ends.
  * The L-infinity error at R is f(R) = min { eps : feasible(R, eps) } (the
  * thesis's residual, found by bisection: FindMinError). (a) matters: the
  * wedges are closed cones at their apexes, so without (a) t could sit on a
@@ -80,6 +85,7 @@
 #define EPS_MAX 1.5         /* a bound beyond this (rad) constrains nothing */
 #define SUBSET 8            /* widest-angle correspondences tested first */
 #define ROWS_PER 4          /* rows of a correspondence: its wedge and its cap */
+#define CAP_MAX 1.5         /* caps only of radius below this (rad, ~75 deg) */
 #define BLOCK_DOUBLES 5     /* centre (3), half-side, lower bound */
 #define WS_CAP 48           /* rows of a working set before a full LP */
 #define WS_ADD 4            /* most violated rows added per round */
@@ -150,67 +156,71 @@ static int wedge_sines(double eps, double s, double *sb, double *sa)
  * within eps_2 of d2: the conic hull of the cones about the axes a = d2 and
  * c = -R d1 (as wedge_rows orients them). The planes bound that hull across
  * the epipolar plane only; along the plane the wedge runs on to the
- * antipodes. When the axes are close (gamma = angle(a, c) < pi/2 - eps_1:
- * R d1 and d2 more than 90 deg apart, seen only at rotations far from the
- * motion, e.g. near pi about an axis across the cameras' view) the hull is
- * much smaller: every direction of either cone is within th = gamma + eps_1
- * of a (eps_1 >= eps_2), so the hull lies in the cone about a of
- * half-angle th, and in both half-spaces n.b >= 0, n = sin(th) a +- cos(th)
- * p, p the unit vector orthogonal to a in the plane of a and c (for b at
- * angle phi <= th from a: n.b >= sin(th - phi) >= 0). These two rows cap
- * the wedge along the epipolar plane; they never cut a baseline the exact
- * problem (eq. 10.5) allows, so f stays a relaxation of it. The bound of
- * the search stays valid: a block's relaxed test has eps_1 + s and an axis
- * within s of every rotation's, so its th is at least every rotation's th
- * and its half-spaces contain every rotation's cap cone. Without them the
- * relaxed test (eps_1 + s on R0 d1) keeps the far ends of the wedges open
- * until s falls below the axes' misalignment: on KITTI raw (300 inliers of
- * the stereo pair) 94 % of the blocks of the whole search went to the cubes
- * near |w| = pi, where f exceeds 0.17 rad (measured). Writes 0 or 2 rows. */
-static int cap_rows(const double a[3], const double cax[3], double sb, double *A,
+ * antipodes. Every direction of either cone is within th = gamma / 2 +
+ * max(eps_1, eps_2) of the mid-axis m = (a + c) / |a + c| (gamma =
+ * angle(a, c)), so the hull lies in the cone about m of half-angle th and,
+ * when th < pi/2, in both half-spaces n.b >= 0, n = sin(th) m +- cos(th) p,
+ * p = (a - c) / |a - c| (for b at angle phi <= th from m: n.b >= sin(th -
+ * phi) >= 0). These two rows cap the wedge along the epipolar plane. Like
+ * the wedge, they never cut a baseline the exact problem (eq. 10.5) allows,
+ * and the relaxed rows of a block (eps_1 + s about R0 d1, apex lowered by
+ * s |a1|) hold the hulls of all its rotations (each within s of R0 d1): the
+ * certificate is unchanged. Where the bearings nearly agree (gamma near pi,
+ * the usual case near the motion) th reaches pi/2 and the cap would be a
+ * half-space: no rows then (th >= CAP_MAX). Without caps, the relaxed test
+ * keeps the far ends of the wedges open until s falls below the axes'
+ * misalignment: on KITTI raw (300 inliers of the stereo pair, gap 1e-4)
+ * the whole search took 286667 blocks, 94 % of them in the cubes near
+ * |w| = pi where f exceeds 0.17 rad; with caps 26352 (measured). Writes 0
+ * or 2 rows at A, the cap's axis at z_cap. */
+static int cap_rows(const double a[3], const double cax[3], double sa, double sb, double *A,
                     double z_cap[3])
 {
-    double ca = dot3(a, cax), p[3], np_, th, st, ct;
+    double m[3], p[3], nm, np_, th, st, ct, e1;
     int k;
-    if (!(ca > sb))
-        return 0; /* gamma >= pi/2 - eps_1: the cap would be a half-space or more */
-    for (k = 0; k < 3; ++k)
-        p[k] = cax[k] - ca * a[k];
+    for (k = 0; k < 3; ++k) {
+        m[k] = a[k] + cax[k];
+        p[k] = a[k] - cax[k];
+    }
+    nm = sqrt(dot3(m, m));
     np_ = sqrt(dot3(p, p));
+    /* gamma / 2 = atan2(|a - c|, |a + c|); the wider cone sets the radius */
+    e1 = asin(sb > sa ? sb : sa);
+    if (!(nm > 0.0) || atan2(np_, nm) + e1 >= CAP_MAX)
+        return 0; /* the cap would be (nearly) a half-space: not worth its rows */
+    th = atan2(np_, nm) + e1;
+    th = th * (1.0 + 1e-12) + 1e-15; /* rounding never tightens it */
+    for (k = 0; k < 3; ++k)
+        m[k] /= nm;
     if (np_ > 1e-12) {
         for (k = 0; k < 3; ++k)
             p[k] /= np_;
     } else {
-        /* the axes coincide: any direction orthogonal to a */
+        /* the axes coincide: any direction orthogonal to them */
         double e[3] = {0.0, 0.0, 0.0};
         int imin = 0;
         for (k = 1; k < 3; ++k)
-            if (fabs(a[k]) < fabs(a[imin]))
+            if (fabs(m[k]) < fabs(m[imin]))
                 imin = k;
         e[imin] = 1.0;
-        cross3(a, e, p);
+        cross3(m, e, p);
         np_ = sqrt(dot3(p, p));
         for (k = 0; k < 3; ++k)
             p[k] /= np_;
     }
-    /* th = gamma + eps_1, enlarged so that rounding never tightens it */
-    th = atan2(np_, ca) + asin(sb);
-    th = th * (1.0 + 1e-12) + 1e-15;
-    if (!(th < 0.5 * PI - 1e-9))
-        return 0;
     st = sin(th);
     ct = cos(th);
     for (k = 0; k < 3; ++k) {
-        A[k] = st * a[k] + ct * p[k];
-        A[3 + k] = st * a[k] - ct * p[k];
-        z_cap[k] = a[k];
+        A[k] = st * m[k] + ct * p[k];
+        A[3 + k] = st * m[k] - ct * p[k];
+        z_cap[k] = m[k];
     }
     return 2;
 }
 
 /* Rows of correspondence i at rotation R (sines from wedge_sines, apex
  * slack s): its wedge (2 rows, none when the cones overlap) and its cap
- * (2 rows where the axes are close, cap_rows), written at row `row` of
+ * (2 rows where the bearings are far apart, cap_rows), written at row `row` of
  * A3/b3; returns the number (0-4). z: a direction every allowed baseline
  * meets with z.b >= 0, zero only on the edge (the wedge's centre n1 + n2,
  * else the cap's axis). */
@@ -231,7 +241,7 @@ static int wedge_rows(bnb_ctx *c, int i, const double R[9], double sb, double sa
             z[k] = n1[k] + n2[k];
         m = 2;
     }
-    if (cap_rows(c->u2 + 3 * i, v, sb, A + 3 * m, zc)) {
+    if (cap_rows(c->u2 + 3 * i, v, sa, sb, A + 3 * m, zc)) {
         if (m == 0)
             memcpy(z, zc, sizeof zc);
         m += 2;
