@@ -11,6 +11,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 import mcgeom
 from mcgeom import registry
 from problems import KIND_SETUPS, make, rigid, rot_err
+from mcgeom import synth
 
 CASES = [(e.name, kind) for e in registry.list_estimators()
          if e.family != "refinement"
@@ -169,3 +170,35 @@ def test_cross_camera_rays_fix_scale_without_rotation(name, seed):
     m = mcgeom.estimate(p.rays, name, **_given(name, np.eye(3)))
     assert m.scale.observable
     assert np.linalg.norm(m.t - t) < 1e-8
+
+
+#: estimators whose static-rig handling is wired on another branch of issue 18
+#: (bnb_lp: branch trust-bnb calls mcgeom.estimators._static.check_static)
+_STATIC_PENDING = {"bnb_lp"}
+
+
+@pytest.mark.parametrize("name", [
+    pytest.param(e.name, marks=pytest.mark.xfail(
+        reason="static-rig handling of bnb_lp is wired by its own change (issue 18)",
+        strict=False)) if e.name in _STATIC_PENDING else e.name
+    for e in registry.list_estimators()])
+@pytest.mark.parametrize("cross", [0.0, 0.5])
+@pytest.mark.parametrize("noise", [0.0, 3e-4])
+@settings(max_examples=5, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=seeds)
+def test_static_rig_reports_no_translation(name, cross, noise, seed):
+    """A rig that did not move (R = I, t = 0), noise-free or with angular noise
+    (radians), with and without cross-camera rays: every estimator returns the
+    rotation within the noise, t = 0 and the verdict "no translation detected"
+    (issue 18; as the robust pipeline does). Never a DegenerateError, never a
+    metric |t|."""
+    rng = np.random.default_rng(seed)
+    p = synth.make_problem(synth.generic_rig(4, rng), np.eye(3), np.zeros(3), _n(name), rng,
+                           cross_fraction=cross, angular_noise=noise, require_visible=False)
+    m = mcgeom.estimate(p.rays, name, **_given(name, np.eye(3)))
+    # the rotation of N rays with angular noise sigma is good to ~sigma / sqrt(N)
+    assert rot_err(m.R, np.eye(3)) < 1e-8 + noise
+    assert np.array_equal(m.t, np.zeros(3))
+    assert not m.scale.observable
+    assert m.scale.reason.startswith("no translation detected")
+    assert m.info["translation_detected"] is False

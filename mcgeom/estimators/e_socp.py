@@ -15,10 +15,18 @@ minimises the largest angle between ``t - t0_i`` and ``w_i`` (eq. 9.3): the
 L-infinity triangulation, solved exactly by cone bisection in C
 (``csrc/cone.c``).
 
-Near-zero rotation makes every apex ``t0_i`` collapse to the origin: all
-half-lines then share their apex and the scale is free (ch. 9.5). The verdict
-says so, with the SOCP residual and the rotation angle in ``info`` so that a
-caller can reject such frames as ch. 9.5 suggests.
+Cross-camera correspondences (camera ``a`` at time 1, ``b`` at time 2) give
+one more cone per camera pair, of the same form with apex ``c_b - R c_a`` (see
+:func:`_cross_cones`): ch. 9's triangulation with the pair's baseline in place
+of a camera's own translation.
+
+Near-zero rotation makes every intra-camera apex ``t0_i`` collapse to the
+origin: without a cross-camera pair all half-lines then share their apex and
+the scale is free (ch. 9.5). The verdict says so, with the SOCP residual and
+the rotation angle in ``info`` so that a caller can reject such frames as
+ch. 9.5 suggests. Where the scale is fixed, its relative std is that of the
+correspondences the cones came from (least squares) combined with the distance
+of the L-infinity |t| from their optimum: the verdict reflects the data used.
 """
 
 from __future__ import annotations
@@ -34,7 +42,7 @@ from ..observability import scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import camera_ids, intra_counts
-from ._static import check_static
+from ._static import with_static_check
 from .essential import LEAST_SQUARES, essential_motions
 
 __all__ = ["e_socp", "average_rotations"]
@@ -142,20 +150,21 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     # one order for any input order: the per-camera searches and the
     # bisections then give the same answer bit for bit
     rays = rays.take(rays.canonical_order())
-    try:
-        per, centres = _per_camera(rays, robust_threshold, prob)
-    except DegenerateError:
-        # no camera's essential matrix: a static rig has none (E = 0)
-        still = check_static(rays, "e_socp", noise_level=robust_threshold)
-        if still is None:
-            raise
-        return still
+    # no camera's essential matrix (DegenerateError): a static rig has none (E = 0)
+    return with_static_check(rays, "e_socp", lambda: _e_socp(
+        rays, robust_threshold, prob, tolerance, max_scale_rel_std))
+
+
+def _e_socp(rays: RayPairs, robust_threshold: Optional[float], prob: float, tolerance: float,
+            max_scale_rel_std: float) -> RigMotion:
+    """:func:`e_socp` on checked, canonically ordered rays, without the static-rig test."""
+    per, centres = _per_camera(rays, robust_threshold, prob)
     if not per:
         raise ValueError("too few correspondences: e_socp needs 5 intra-camera "
                          "correspondences in at least one camera")
     R, spread = average_rotations(np.stack([p[1] for p in per]),
                                   np.array([p[4] for p in per], dtype=float))
-    cross = _cross_cones(rays, R, centres)
+    cross = _cross_cones(rays, R, centres, robust_threshold)
     # the cones: camera i's own half-line t = c_i - R c_i + lam w_i (eq. 9.2,
     # mean R) and each cross-camera pair's t = c_b - R c_a + lam w_ab
     apex = np.stack([centres[p[0]] - R @ centres[p[0]] for p in per] +
@@ -198,8 +207,7 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
     if not verdict.observable:
         t = t / max(np.linalg.norm(t), 1e-300)
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
-    m = RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
-    return check_static(rays, "e_socp", m) or m
+    return RigMotion(R, t, verdict, "e_socp", float(np.sqrt(np.mean(r ** 2))), None, info)
 
 
 #: fewest correspondences of a cross-camera pair (camera a at time 1, b at
@@ -207,7 +215,8 @@ def e_socp(rays: RayPairs, *, robust_threshold: Optional[float] = 1e-3, prob: fl
 _MIN_CROSS = 5
 
 
-def _cross_cones(rays: RayPairs, R: np.ndarray, centres: np.ndarray) -> list:
+def _cross_cones(rays: RayPairs, R: np.ndarray, centres: np.ndarray,
+                 robust_threshold: Optional[float] = None) -> list:
     """One cone per cross-camera pair ``(a, b)`` with at least 5 correspondences.
 
     With the rotation known, camera ``b`` at time 2 sits at ``R^T (c_b - t)``
@@ -221,7 +230,10 @@ def _cross_cones(rays: RayPairs, R: np.ndarray, centres: np.ndarray) -> list:
     its cone enters the same L-infinity problem (eq. 9.3). The apex ``c_b - R
     c_a`` differs from the intra-camera apexes ``c_i - R c_i`` even without
     rotation: the cross-camera pairs fix the scale where the intra-camera ones
-    cannot (ch. 7.3.2). Returns ``[(a, b, apex, axis, indices)]``.
+    cannot (ch. 7.3.2). With ``robust_threshold`` (radians) the direction is
+    found by a 2-point RANSAC on the Sampson angular residuals and refitted
+    on its inliers (an L-infinity solution follows any outlier). Returns
+    ``[(a, b, apex, axis, indices used)]``.
     """
     cam1, cam2 = camera_ids(rays)[:2]
     sel = np.flatnonzero(cam1 != cam2)
@@ -236,16 +248,29 @@ def _cross_cones(rays: RayPairs, R: np.ndarray, centres: np.ndarray) -> list:
         d1 = unit_rows(rays.dirs1[idx])
         d2 = unit_rows(rays.dirs2[idx]) @ R          # rows R^T d2: time-1 rig frame
         rows = rcross(d1, d2)
-        w, v = np.linalg.eigh(rows.T @ rows)
+        sub = rays.take(idx)
+
+        def residuals(u: np.ndarray) -> np.ndarray:
+            # Sampson angular residuals of the pair for the baseline u (unit
+            # length: one pair of centres does not see the length)
+            return np.abs(_core.gec_residuals(sub.origins1, sub.dirs1, sub.origins2, sub.dirs2,
+                                              R, centres[b] - R @ (centres[a] + u)))
+
+        keep = np.ones(idx.size, bool)
+        if robust_threshold is not None:
+            keep = _robust_direction(rows, residuals, robust_threshold)
+            if np.count_nonzero(keep) < _MIN_CROSS:
+                continue
+        w, v = np.linalg.eigh(rows[keep].T @ rows[keep])
         if not w[1] > 1e-12 * max(w[2], 1e-300):
             continue   # the rows do not fix a direction (all rays in one plane)
         u = v[:, 0]
         # cheirality: with B = +u the rays meet in front of both cameras
         # (s1 d1 - s2 d2 = B by least squares, row by row)
-        dd = np.einsum("ij,ij->i", d1, d2)
+        dd = np.einsum("ij,ij->i", d1, d2)[keep]
         den = 1.0 - dd * dd
         ok = den > 1e-12
-        bu1, bu2 = d1 @ u, d2 @ u
+        bu1, bu2 = d1[keep] @ u, d2[keep] @ u
         s1 = (bu1 - dd * bu2) / np.where(ok, den, 1.0)
         s2 = (dd * bu1 - bu2) / np.where(ok, den, 1.0)
         plus = np.count_nonzero(ok & (s1 > 0) & (s2 > 0))
@@ -253,8 +278,34 @@ def _cross_cones(rays: RayPairs, R: np.ndarray, centres: np.ndarray) -> list:
         if minus > plus:
             u = -u
         apex = centres[b] - R @ centres[a]
-        out.append((int(a), int(b), apex, -(R @ u), idx))
+        out.append((int(a), int(b), apex, -(R @ u), idx[keep]))
     return out
+
+
+def _robust_direction(rows: np.ndarray, residuals, threshold: float,
+                      samples: int = 64) -> np.ndarray:
+    """Inlier mask of a baseline direction by 2-point RANSAC: two rows fix
+    the direction (their cross product), the one with most residuals under
+    ``threshold`` (radians) wins, then its least-squares refit's inliers. The
+    samples are the first pairs of a fixed pseudo-random order, so the result
+    depends on the (canonically ordered) data only."""
+    n = len(rows)
+    rng = np.random.default_rng(n)
+    best, best_count = np.ones(n, bool), -1
+    for _ in range(samples):
+        i, j = rng.choice(n, 2, replace=False)
+        u = np.cross(rows[i], rows[j])
+        nu = np.linalg.norm(u)
+        if not nu > 0:
+            continue
+        inl = residuals(u / nu) < threshold
+        c = int(np.count_nonzero(inl))
+        if c > best_count:
+            best, best_count = inl, c
+    if best_count < 2:
+        return best
+    u = np.linalg.eigh(rows[best].T @ rows[best])[1][:, 0]
+    return residuals(u) < threshold
 
 
 def _scale_evidence(used: RayPairs, R: np.ndarray, t: np.ndarray,

@@ -36,7 +36,7 @@ from ..observability import scale_profile, scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._common import camera_ids, intra_counts, travel_direction
-from ._static import check_static
+from ._static import with_static_check
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
 from .five_plus_one_minimal import (critical_angles, minimal_solutions, sample_five_plus_one,
                                     scale_terms)
@@ -173,14 +173,8 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     if len(rays) < 6:
         raise ValueError(f"too few correspondences: five_plus_one needs at least 6, got {len(rays)}")
     rays.check_finite()
-    try:
-        m = _five_plus_one(rays, five_camera, refine, max_scale_rel_std)
-    except DegenerateError:
-        still = check_static(rays, "five_plus_one")
-        if still is None:
-            raise
-        return still
-    return check_static(rays, "five_plus_one", m) or m
+    return with_static_check(rays, "five_plus_one", lambda: _five_plus_one(
+        rays, five_camera, refine, max_scale_rel_std))
 
 
 def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,

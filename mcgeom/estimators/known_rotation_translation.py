@@ -24,7 +24,7 @@ from .. import multiview
 from ..observability import critical_angle
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
-from ._static import check_static
+from ._static import with_static_check
 
 __all__ = ["known_rotation_translation", "solve"]
 
@@ -76,15 +76,16 @@ def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
         raise ValueError(f"too few correspondences: known_rotation_translation needs 3, got {n}")
     rays.check_finite()
     R = _rotation(rotation)
-    try:
-        res = _solve(rays, R, max_rel_std)
-    except ValueError:
-        # the relations carry no information: every bearing pair parallel
-        # after the rotation, a static rig (E = 0)
-        still = check_static(rays, "known_rotation_translation", rotation=R)
-        if still is None:
-            raise
-        return still
+    # a static rig: every relation vanishes after the rotation and the solver
+    # says they "carry no information" (ValueError; the input was checked above)
+    return with_static_check(rays, "known_rotation_translation",
+                             lambda: _known(rays, R, max_rel_std), errors=(ValueError,),
+                             rotation=R)
+
+
+def _known(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float]) -> RigMotion:
+    """:func:`known_rotation_translation` on checked input, without the static-rig test."""
+    res = _solve(rays, R, max_rel_std)
     t = -R @ res.centres[1]  # c = -R^T t
     if not res.scale.observable:
         t /= np.linalg.norm(t)  # the direction only (already unit up to rounding)
@@ -94,9 +95,8 @@ def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
     info = {"eigenvalues": res.eigenvalues, "converged": res.converged, "timing": res.timing,
             "metric": res.scale.observable}
     info["t_metric"] = -R @ res.centres[1]   # metric estimate, whatever the verdict
-    m = RigMotion(R.copy(), t, verdict, "known_rotation_translation", res.residual_rms,
-                  None, info)
-    return check_static(rays, "known_rotation_translation", m, rotation=R) or m
+    return RigMotion(R.copy(), t, verdict, "known_rotation_translation", res.residual_rms,
+                     None, info)
 
 
 def _solve(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float]):

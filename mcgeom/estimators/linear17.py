@@ -22,7 +22,7 @@ from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
-from ._static import check_static
+from ._static import with_static_check
 
 __all__ = ["linear17"]
 
@@ -79,17 +79,11 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     when the data do not determine E otherwise (too few rays for the kind,
     degenerate configurations).
     """
-    try:
-        m = _linear17(rays, refine=refine, max_iterations=max_iterations, tolerance=tolerance,
-                      max_scale_rel_std=max_scale_rel_std, options=options)
-    except DegenerateError:
-        # E = 0 has no null space of the right dimension: a static rig lands
-        # here (thesis ch. 8.3's kinds all assume t != 0)
-        still = check_static(rays, "linear17")
-        if still is None:
-            raise
-        return still
-    return check_static(rays, "linear17", m) or m
+    # E = 0 has no null space of the right dimension: a static rig raises
+    # DegenerateError in the kernel (thesis ch. 8.3's kinds all assume t != 0)
+    return with_static_check(rays, "linear17", lambda: _linear17(
+        rays, refine=refine, max_iterations=max_iterations, tolerance=tolerance,
+        max_scale_rel_std=max_scale_rel_std, options=options))
 
 
 def _linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[int] = None,
