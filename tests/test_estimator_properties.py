@@ -172,16 +172,7 @@ def test_cross_camera_rays_fix_scale_without_rotation(name, seed):
     assert np.linalg.norm(m.t - t) < 1e-8
 
 
-#: estimators whose static-rig handling is wired on another branch of issue 18
-#: (bnb_lp: branch trust-bnb calls mcgeom.estimators._static.check_static)
-_STATIC_PENDING = {"bnb_lp"}
-
-
-@pytest.mark.parametrize("name", [
-    pytest.param(e.name, marks=pytest.mark.xfail(
-        reason="static-rig handling of bnb_lp is wired by its own change (issue 18)",
-        strict=False)) if e.name in _STATIC_PENDING else e.name
-    for e in registry.list_estimators()])
+@pytest.mark.parametrize("name", [e.name for e in registry.list_estimators()])
 @pytest.mark.parametrize("cross", [0.0, 0.5])
 @pytest.mark.parametrize("noise", [0.0, 3e-4])
 @settings(max_examples=5, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -91,6 +91,9 @@ _MAD_TO_STD = 1.4826
 _PRUNE_FLOOR = 1e-7
 #: searches of the outlier guard (the first and at most two re-solves)
 _MAX_ROUNDS = 3
+#: a translation below this fraction of the rig's size (or of the start's
+#: |t|) is the apex of the intra-camera wedges, not a direction
+_AT_APEX = 1e-6
 #: correspondences within this (rad) of the optimum's error are its support
 #: set (the LP's and the bisection's precision)
 _PINNED = 1e-8
@@ -517,9 +520,17 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
         # central rays (one camera, coincident centres): the L-infinity t is
         # anywhere on the line t + lam u and says nothing of u; the rays do
         central = central_travel(cur, R)
-        t = travel_direction(cur, np.ones(len(cur), bool), R, t) if central is None else central
-        if not np.linalg.norm(t) > 0 and t0_used is not None:
-            t = t0_used / max(np.linalg.norm(t0_used), 1e-300)
+        hint = t
+        size = float(np.sqrt(np.mean(np.sum((cur.origins1 - cur.origins1.mean(axis=0)) ** 2,
+                                            axis=1))))
+        if t0_used is not None and not np.linalg.norm(t) > _AT_APEX * max(
+                size, float(np.linalg.norm(t0_used))):
+            # the LP's t sits on the apexes (intra-camera rays at R = I: every
+            # apex is 0, and the wedges are closed cones there) and says
+            # nothing of the direction; the start's does
+            hint = t0_used
+        t = travel_direction(cur, np.ones(len(cur), bool), R, hint) if central is None \
+            else central
     r = _core.gec_residuals(cur.origins1, cur.dirs1, cur.origins2, cur.dirs2, R, t_metric)
     mask_out = np.zeros(len(rays), bool)
     mask_out[used[keep]] = True
