@@ -150,6 +150,22 @@ static int wedge_sines(double eps, double s, double *sb, double *sa)
     return 1;
 }
 
+/* A unit vector orthogonal to the non-zero v: v x e_k, normalised, with
+ * e_k the axis of v's smallest component (never nearly parallel to v). */
+static void unit_orthogonal(const double v[3], double p[3])
+{
+    double e[3] = {0.0, 0.0, 0.0}, n;
+    int k, imin = 0;
+    for (k = 1; k < 3; ++k)
+        if (fabs(v[k]) < fabs(v[imin]))
+            imin = k;
+    e[imin] = 1.0;
+    cross3(v, e, p);
+    n = sqrt(dot3(p, p));
+    for (k = 0; k < 3; ++k)
+        p[k] /= n;
+}
+
 /* The cap of a wedge (this library's tightening of eqs. 10.9-10.13). The
  * wedge of correspondence i, two planes through its apex, stands for the
  * baselines b = l x1 - m x2 (l, m >= 0) with x1 within eps_1 of R d1 and x2
@@ -196,17 +212,7 @@ static int cap_rows(const double a[3], const double cax[3], double sa, double sb
         for (k = 0; k < 3; ++k)
             p[k] /= np_;
     } else {
-        /* the axes coincide: any direction orthogonal to them */
-        double e[3] = {0.0, 0.0, 0.0};
-        int imin = 0;
-        for (k = 1; k < 3; ++k)
-            if (fabs(m[k]) < fabs(m[imin]))
-                imin = k;
-        e[imin] = 1.0;
-        cross3(m, e, p);
-        np_ = sqrt(dot3(p, p));
-        for (k = 0; k < 3; ++k)
-            p[k] /= np_;
+        unit_orthogonal(m, p); /* the axes coincide: any direction orthogonal to them */
     }
     st = sin(th);
     ct = cos(th);
@@ -391,8 +397,8 @@ static int direction_ok(int m, const double *A, const double b[3], const double 
 static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3],
                            const double ap[3], const int *ids, int slot)
 {
-    double w2 = dot3(zc, zc), P[6], e[3] = {0, 0, 0}, nn;
-    int k, j, imin = 0;
+    double w2 = dot3(zc, zc), P[6], nn;
+    int k, j;
     double y[2];
     if (m < 4 || !(w2 > 1e-24))
         return 1; /* fewer than two wedges, or degenerate: always non-trivial */
@@ -407,14 +413,7 @@ static int cone_nontrivial(bnb_ctx *c, int m, const double *A, const double zc[3
         }
     }
     /* P: orthonormal basis of the plane orthogonal to zc */
-    for (k = 1; k < 3; ++k)
-        if (fabs(zc[k]) < fabs(zc[imin]))
-            imin = k;
-    e[imin] = 1.0;
-    cross3(zc, e, P);
-    nn = sqrt(dot3(P, P));
-    for (k = 0; k < 3; ++k)
-        P[k] /= nn;
+    unit_orthogonal(zc, P);
     P[3] = zc[1] * P[2] - zc[2] * P[1];
     P[4] = zc[2] * P[0] - zc[0] * P[2];
     P[5] = zc[0] * P[1] - zc[1] * P[0];
