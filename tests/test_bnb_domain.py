@@ -189,3 +189,21 @@ def test_bad_option_names_the_option(option, value):
     p = _problem(2, n=40)
     with pytest.raises(ValueError, match=option):
         mcgeom.estimate(p.rays, "bnb_lp", **{option: value})
+
+
+# ------------------------------------------------------------------ the experiment
+
+def test_experiment_bnb_real_rows():
+    from mcgeom.experiments import bnb_real
+    rays, R_gt, t_gt = _fixture("kitti_raw_0-1_inliers.npz")
+    case = {"key": "kitti_raw", "pair": (0, 1), "mode": "intra+cross", "static": False,
+            "rot_5p1": 0.017, "t_5p1": 0.93, "n_inliers": 300, "rays": rays, "R_gt": R_gt,
+            "t_gt": t_gt}
+    row = bnb_real.run_bnb(case, gap=1e-4)
+    assert row["ok"] and row["rot"] < 0.1 and row["pruned"] >= 1
+    assert abs(row["t_est"] / row["t_gt"] - 1.0) < 0.1
+    assert "kitti_raw" in bnb_real.format_row(row)
+    assert bnb_real.summary([row])[0].startswith("kitti_raw")
+    rows = bnb_real.ladybug_outliers(trials=2, seed=1, gap=1e-4)
+    assert len(rows) == 2 and all(r["rot_guard"] < 1.0 for r in rows)
+    assert len(bnb_real.ladybug_summary(rows)) == 4
