@@ -51,7 +51,11 @@ def _equally_optimal(name, rays_a, a, b, R_b_in_a):
     optimal within their certified gaps, evaluated in one frame; the
     rotations need only agree to the width of the near-optimal set."""
     f = registry.get(name).objective
-    fa, fb = f(rays_a, a.R), f(rays_a, R_b_in_a)
+    # over the correspondences each result used (bnb_lp's outlier guard may
+    # drop a few: its linf is the objective on its inliers)
+    used_a = rays_a if a.inliers is None else rays_a.take(np.flatnonzero(a.inliers))
+    used_b = rays_a if b.inliers is None else rays_a.take(np.flatnonzero(b.inliers))
+    fa, fb = f(used_a, a.R), f(used_b, R_b_in_a)
     assert abs(fa - a.info["linf"]) < 1e-8 and abs(fb - b.info["linf"]) < 1e-8
     slack = a.info["gap"] + b.info["gap"] + 1e-8
     assert fb >= a.info["lower_bound"] - 1e-8 and fa >= b.info["lower_bound"] - 1e-8
