@@ -243,21 +243,22 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--max-pairs", type=positive_int, default=None,
                     help="only the first pairs of each recording (default: all)")
     ap.add_argument("--inliers", type=positive_int, default=300,
-                    help="inliers of the 5+1 estimate given to bnb_lp (a seeded subset)")
+                    help="inliers of the 5+1 estimate given to bnb_lp (a seeded subset; default: 300)")
     ap.add_argument("--gap", type=non_negative_float, default=1e-4,
-                    help="bnb_lp's gap: stop when no block can improve by more (rad)")
+                    help="bnb_lp's gap: stop when no block can improve by more (rad; default: 1e-4)")
     ap.add_argument("--max-seconds", type=non_negative_float, default=0.0,
-                    help="bnb_lp's wall-time budget, seconds (0: none)")
+                    help="bnb_lp's wall-time budget, seconds (default: 0, none)")
     ap.add_argument("--threshold", type=positive_float, default=THRESHOLD_PX,
-                    help="inlier threshold of the 5+1 start, pixels")
-    ap.add_argument("--seed", type=int, default=0, help="seed of the inlier subset")
+                    help="inlier threshold of the 5+1 start, pixels (default: 1.5)")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the inlier subset and the Ladybug trials (default: 0)")
     ap.add_argument("--cache", type=Path, default=None,
-                    help="folder for the inlier rays (.npz), written once and then read")
+                    help="folder for the inlier rays (.npz), written once and then read "
+                         "(default: none, match every time)")
     ap.add_argument("--ladybug", type=non_negative_int, default=0, metavar="TRIALS",
                     help="also run the synthetic residual-outlier case (Ladybug head, 30 %% "
-                         "outliers) with this many trials, with and without the guard")
+                         "outliers) with this many trials, with and without the guard (default: 0)")
     ap.add_argument("--skip-real", action="store_true",
-                    help="only the synthetic case (no recordings needed)")
+                    help="only the synthetic case, no recordings needed (default: off)")
     add_data_argument(ap)
 
 
