@@ -593,8 +593,7 @@ def test_central_rig():
 
 @row("zero-motion", "a static rig (R = I, t = 0), 0.3 px noise",
      "pixels and rays: \"no translation detected: a pure rotation explains ...\", `t = 0`, "
-     "R = I, scale unobservable (every estimator; bnb_lp: `t` unit until it runs the shared "
-     "static test)")
+     "R = I, scale unobservable (every estimator)")
 def test_zero_motion():
     p = problem("static")
     m = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
@@ -605,17 +604,9 @@ def test_zero_motion():
     np.testing.assert_array_equal(t, np.zeros((3, 1)))
     for name in names():
         m = est(p.rays, name, np.eye(3))
-        if name in STATIC_PENDING:
-            check_unobservable(m, np.eye(3), None, name)
-            continue
         assert m.scale.reason.startswith("no translation detected"), (name, m.scale.reason)
         assert not m.scale.observable and rot_err(m.R, np.eye(3)) < R_TOL, name
         np.testing.assert_array_equal(m.t, np.zeros(3))
-
-
-#: estimators that do not yet run mcgeom.estimators._static (issue 18: bnb_lp's
-#: own change wires it; then drop it from here)
-STATIC_PENDING = {"bnb_lp"}
 
 
 @row("pure-translation", "R = I, t = (0.3, 0.1, 0) m, intra-camera correspondences only",

@@ -131,7 +131,9 @@ def test_global_optimality_200_problems():
     stats = []
     for seed in range(200):
         p = _problem(seed, n_per_cam=(5, 11))
-        m = mcgeom.estimate(p.rays, "bnb_lp")
+        # the search on every correspondence (the outlier guard, which may
+        # drop a few of 10-40 rays on a poor start, has its own tests)
+        m = mcgeom.estimate(p.rays, "bnb_lp", prune=False)
         info = m.info
         f_true, _ = linf_error(p.rays, p.R, tol=1e-10)
         f_samples, f_local = _dense_then_local(p.rays, m.R, seed + 7)
@@ -153,7 +155,7 @@ def test_global_optimality_200_problems():
 
 def test_returned_translation_is_feasible_at_linf():
     p = _problem(3)
-    m = mcgeom.estimate(p.rays, "bnb_lp")
+    m = mcgeom.estimate(p.rays, "bnb_lp", prune=False)   # every row checked below
     t = m.info["t_metric"]
     eps = m.info["linf"] + 1e-9
     for i in range(len(p.rays)):

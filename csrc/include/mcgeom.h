@@ -727,8 +727,8 @@ typedef struct {
 void mcg_bnb_default_options(mcg_bnb_options *opt);
 
 /* Doubles of workspace for mcg_bnb_linf (0 for invalid sizes/options):
- * about 32 n + 58 n_groups + 5 max_queue + the LP backend's work size for
- * 2 n rows; opt NULL: the defaults (a heap of 2e5 blocks, 8 MB). */
+ * about 50 n + 58 n_groups + 5 max_queue + the LP backend's work size for
+ * 4 n rows (a wedge and a cap per correspondence); opt NULL: the defaults (a heap of 2e5 blocks, 8 MB). */
 size_t mcg_bnb_work_size(int n, int n_groups, const mcg_bnb_options *opt);
 
 /* Globally optimal L-infinity rig motion (thesis ch. 10, Algorithm 7) by

@@ -39,6 +39,8 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
                                                "against PoseLib (needs poselib)"),
     "real_data": ("real_data", "the robust pipeline on the real recordings (KITTI, DDAD, "
                                "EuRoC), against their ground truth"),
+    "bnb_real": ("bnb_real", "bnb_lp (ch. 10) on the 5+1 inliers of KITTI raw and DDAD: "
+                             "rotation, |t|, verdict, time, blocks, certified gap"),
     "honesty": ("honesty", "every estimator on the inliers of the real recordings: rotation "
                            "error, |t| against the truth, verdict, rel_std, time"),
     "ch6_kitti": ("ch6_kitti", "thesis ch. 6 on real data: the KITTI-00 stereo trajectory "
