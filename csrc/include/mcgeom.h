@@ -893,6 +893,30 @@ int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const dou
                             const double *axis1, const double *axis2, const double *f1,
                             const double *f2, double min_var_ratio, double *scale);
 
+/* ------------------------------------------------------------- upright4.c */
+
+/* Upper bound on the solutions of mcg_upright4 (the degree of its polynomial). */
+enum { MCG_UPRIGHT4_MAX_SOLUTIONS = 8 };
+
+/* Minimal generalized relative pose with a known vertical direction (the
+ * "upright" 4-point problem; Sweeney et al. 3DV 2014, Lee et al. CVPR 2014):
+ * every motion rig2_from_rig1 (R, t), X2 = R X1 + t, with R g1 = g2 that
+ * satisfies the generalized epipolar constraint of the four correspondences
+ * (o1[k], d1[k]) <-> (o2[k], d2[k]) (4 x 3 each, rig frames at times 1 and 2,
+ * metres; directions of any non-zero length). g1, g2: the vertical (gravity)
+ * direction in rig frame 1 and rig frame 2 (any non-zero length; the same
+ * physical direction, so R g1 = g2). Writes *n_solutions (0..8) real
+ * solutions: R (row-major 3 x 3 each, 8 x 9 doubles) and t (8 x 3 doubles,
+ * metric). The yaw about the vertical is a root of a degree-8 polynomial in
+ * the tangent half-angle (derivation in csrc/upright4.c); a yaw of exactly
+ * 180 degrees is not represented. MCG_EINVAL: NULL pointers, NaN/inf, a
+ * zero-length direction or gravity (|v| < 1e-50). MCG_EDEGENERATE: the
+ * four determine no yaw (e.g. every ray from one centre: a central camera
+ * has no metric scale). No solution (*n_solutions = 0) is MCG_OK. */
+int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
+                 const double d2[12], const double g1[3], const double g2[3], double R[72],
+                 double t[24], int *n_solutions);
+
 /* MCG_CDEF_END */
 
 #if defined(__GNUC__) && __GNUC__ >= 4
