@@ -29,6 +29,7 @@ __all__ = [
     "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
     "skyline_eig",
+    "upright4",
 ]
 
 GC_CASE_NAMES = {
@@ -1075,3 +1076,36 @@ def skyline_eig(first: Any, ptr: Any, a: Any, b: Any, *, shift: float = 0.0, p: 
                                _p(vals), _p(vecs), _p(resid), iters, _p(work), work.size),
            "skyline_eig")
     return {"vals": vals, "vecs": vecs, "resid": resid, "iters": int(iters[0])}
+
+
+# ------------------------------------------------------------- upright4.c
+
+def upright4(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, gravity1: Any,
+             gravity2: Any) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Every motion of 4 correspondences with a known vertical (``mcg_upright4``).
+
+    Rays (4, 3) each as for :func:`gec_residuals` (rig frames at times 1 and 2,
+    metres); ``gravity1``/``gravity2`` (3,) the vertical direction in rig
+    frame 1 / rig frame 2 (any non-zero length, the same physical direction).
+    Returns the real solutions ``(R, t)`` rig2_from_rig1 (``X2 = R X1 + t``,
+    ``R gravity1 = gravity2`` up to their lengths, ``t`` metric), up to 8.
+    ValueError names a bad argument; DegenerateError when the four rays fix no
+    yaw (e.g. all from one centre).
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 4)
+    if rays[0].shape[0] != 4:
+        raise ValueError(f"upright4: exactly 4 correspondences needed, got {rays[0].shape[0]}")
+    g1 = _f64("gravity1", gravity1, (3,))
+    g2 = _f64("gravity2", gravity2, (3,))
+    R = np.empty((lib.MCG_UPRIGHT4_MAX_SOLUTIONS, 3, 3))
+    t = np.empty((lib.MCG_UPRIGHT4_MAX_SOLUTIONS, 3))
+    n = ffi.new("int *")
+    st = lib.mcg_upright4(_p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]), _p(g1), _p(g2),
+                          _p(R), _p(t), n)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL:
+            for name, g in (("gravity1", g1), ("gravity2", g2)):
+                if np.isfinite(g).all() and not g @ g >= 1e-100:
+                    raise ValueError(f"upright4: {name} has zero length")
+        _ray_error(st, "upright4", rays, (("gravity1", g1), ("gravity2", g2)))
+    return [(R[k], t[k]) for k in range(n[0])]

@@ -258,7 +258,8 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
            threshold: Optional[float] = None, prob: float = 0.999, max_iters: int = 1000,
            seed: Optional[int] = 0, focal: Union[None, float, np.ndarray] = None,
            options: Optional[RansacOptions] = None,
-           motion_focal: Optional[MotionFocal] = None, **kw: Any) -> RigMotion:
+           motion_focal: Optional[MotionFocal] = None,
+           solver_options: Optional[dict] = None, **kw: Any) -> RigMotion:
     """Robust rig motion rig2_from_rig1 from correspondences with outliers.
 
     ``method`` is a registered estimator with a minimal solver or a proposer.
@@ -268,8 +269,10 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     ``max_iters`` caps the number of samples; ``seed`` makes the run
     deterministic. ``motion_focal(rays, R, t)`` (with ``focal`` only) returns
     the pixels per radian of every residual at motion (R, t), for the final
-    refinement (see :meth:`_Scorer.scaling_at`). Further ``RansacOptions``
-    fields may be passed as keywords.
+    refinement (see :meth:`_Scorer.scaling_at`). ``solver_options`` are keyword
+    options of the estimator's minimal solver (e.g. ``gravity1``/``gravity2`` of
+    ``upright_four_point``). Further ``RansacOptions`` fields may be passed as
+    keywords.
 
     Returns a ``RigMotion`` with the boolean ``inliers`` mask, the scale verdict
     (from the covariance of the final refinement, plus the estimator's own
@@ -310,7 +313,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         # proposer's own search): fall back to minimal samples where possible
         use_proposer = scorer.best is not None or info_est.minimal_solver is None
     if not use_proposer:
-        iterations += _run_minimal(info_est, rays, scorer, options, rng)
+        iterations += _run_minimal(info_est, rays, scorer, options, rng, solver_options or {})
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
         still = _no_translation(rays, scorer, options, method, t_start)
         if still is not None:
@@ -362,7 +365,7 @@ def _ratio(mask: np.ndarray) -> float:
 
 
 def _run_minimal(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptions,
-                 rng: np.random.Generator) -> int:
+                 rng: np.random.Generator, solver_options: dict) -> int:
     """Classic LO-RANSAC loop over minimal samples with the adaptive stop."""
     sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
     k_needed = options.max_iters
@@ -371,7 +374,7 @@ def _run_minimal(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptio
         iterations += 1
         try:
             idx = sampler(rays, rng)
-            sols = info_est.minimal_solver(rays.take(idx))
+            sols = info_est.minimal_solver(rays.take(idx), **solver_options)
         except DegenerateError:
             continue
         for R, t in sols:

@@ -910,9 +910,9 @@ enum { MCG_UPRIGHT4_MAX_SOLUTIONS = 8 };
  * metric). The yaw about the vertical is a root of a degree-8 polynomial in
  * the tangent half-angle (derivation in csrc/upright4.c); a yaw of exactly
  * 180 degrees is not represented. MCG_EINVAL: NULL pointers, NaN/inf, a
- * zero-length direction or gravity (|v| < 1e-50). MCG_EDEGENERATE: the
- * four determine no yaw (e.g. every ray from one centre: a central camera
- * has no metric scale). No solution (*n_solutions = 0) is MCG_OK. */
+ * zero-length direction or gravity (|v| < 1e-50), magnitudes whose products
+ * overflow. MCG_EDEGENERATE: the four determine no yaw (e.g. every ray from
+ * one centre: a central camera has no metric scale). No solution (*n_solutions = 0) is MCG_OK. */
 int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
                  const double d2[12], const double g1[3], const double g2[3], double R[72],
                  double t[24], int *n_solutions);
