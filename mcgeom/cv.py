@@ -35,7 +35,7 @@ from .types import RigMotion
 
 __all__ = [
     "RIG_5P1_RANSAC", "RIG_LINEAR17", "RIG_LINEAR17_RANSAC", "RIG_5P1_DIRECT",
-    "estimateRigMotion", "estimate",
+    "RIG_UPRIGHT_RANSAC", "estimateRigMotion", "estimate",
 ]
 
 #: 5+1 method (thesis ch. 7) inside LO-RANSAC: the default
@@ -46,6 +46,32 @@ RIG_LINEAR17 = "linear17"
 RIG_LINEAR17_RANSAC = "ransac:linear17"
 #: 5+1 on all correspondences (no outlier rejection)
 RIG_5P1_DIRECT = "direct:five_plus_one"
+#: upright 4-point with a known vertical inside LO-RANSAC (chosen by itself when
+#: ``gravity1``/``gravity2`` are passed with the default method)
+RIG_UPRIGHT_RANSAC = "upright_four_point"
+
+
+def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) -> str:
+    """The method to run when a vertical prior may be given: the default 5+1
+    becomes the upright 4-point (4-samples instead of 6: fewer iterations at
+    a given outlier rate); the prior goes into ``options``. ValueError when
+    only one of the two is given, or the named method does not take it."""
+    if gravity1 is None and gravity2 is None:
+        return method
+    if gravity1 is None or gravity2 is None:
+        missing = "gravity1" if gravity1 is None else "gravity2"
+        raise ValueError(f"{missing} is missing: a vertical prior needs the gravity direction "
+                         "in the rig frame at both times (gravity1=, gravity2=)")
+    if not isinstance(method, str):
+        return method           # _resolve names the problem
+    if method == RIG_5P1_RANSAC:
+        method = RIG_UPRIGHT_RANSAC
+    base = method.split(":", 1)[1] if method.startswith(("ransac:", "direct:")) else method
+    if "gravity1" not in registry.get(base).options:
+        raise ValueError(f"gravity1/gravity2 are given but method {method!r} does not use a "
+                         f"vertical prior; use {RIG_UPRIGHT_RANSAC!r} (or the default method)")
+    options["gravity1"], options["gravity2"] = gravity1, gravity2
+    return method
 
 
 def _points(name: str, p: Any) -> np.ndarray:
@@ -100,7 +126,8 @@ def _resolve(method: str, robust_flag: Optional[bool]) -> tuple[str, bool]:
 def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
-             robust: Optional[bool] = None, **options: Any) -> RigMotion:
+             robust: Optional[bool] = None, gravity1: Any = None, gravity2: Any = None,
+             **options: Any) -> RigMotion:
     """Full :class:`RigMotion` rig2_from_rig1 from pixel correspondences of ``rig``.
 
     ``points1[k]`` (pixels, camera ``cameraIds1[k]``, time 1) and ``points2[k]``
@@ -110,6 +137,11 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     ``maxIters`` its iteration cap, ``mask`` (N, N x 1, nonzero = use) selects
     the correspondences to consider. The returned ``inliers`` mask has N entries
     (False for masked-out correspondences).
+
+    ``gravity1``/``gravity2`` (3-vectors, e.g. an IMU's gravity in the rig frame
+    at time 1 and at time 2) are a vertical prior: with the default method the
+    search then runs the upright 4-point solver (``RIG_UPRIGHT_RANSAC``); the
+    final refinement frees all six degrees of freedom.
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
@@ -129,6 +161,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
                              f"got dtype {m.dtype}" + (" with NaN or inf" if m.dtype.kind == "f"
                                                        else ""))
         use = m != 0
+    method = _gravity_method(method, gravity1, gravity2, options)
     name, run_robust = _resolve(method, robust)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
@@ -138,9 +171,12 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     rays = rays_all if keep is None else rays_all.take(keep)
     if run_robust:
         # thresholds in pixels: the pixel-noise model of the rig converts them
+        # the vertical prior is for the minimal solver (the final refinement is free)
+        prior = {k: options.pop(k) for k in ("gravity1", "gravity2") if k in options}
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                            seed=seed, focal=pixels_per_radian(rig, rays),
-                           motion_focal=sampson_pixel_scale(rig), **options)
+                           motion_focal=sampson_pixel_scale(rig),
+                           solver_options=prior or None, **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:
@@ -155,7 +191,8 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
 def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
                       method: str = RIG_5P1_RANSAC, prob: float = 0.999,
                       threshold: float = 1.0, maxIters: int = 1000,
-                      mask: Any = None) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+                      mask: Any = None, gravity1: Any = None, gravity2: Any = None
+                      ) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
     """OpenCV-style rig motion: ``retval, R, t, mask`` (see the module docstring).
 
     Same arguments as :func:`estimate`. ``R`` (3x3) and ``t`` (3x1, metres) map
@@ -165,6 +202,7 @@ def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     observable: call :func:`estimate` for the verdict.
     """
     m = estimate(points1, points2, cameraIds1, cameraIds2, rig, method=method, prob=prob,
-                 threshold=threshold, maxIters=maxIters, mask=mask)
+                 threshold=threshold, maxIters=maxIters, mask=mask, gravity1=gravity1,
+                 gravity2=gravity2)
     out_mask = m.inliers.astype(np.uint8).reshape(-1, 1)
     return int(out_mask.sum()), np.array(m.R), np.array(m.t).reshape(3, 1), out_mask

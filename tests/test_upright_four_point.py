@@ -127,3 +127,23 @@ def test_minimal_sample_size():
     p = make("most-general", 0, n=5)
     with pytest.raises(ValueError, match="4 correspondences"):
         minimal_solutions(p.rays, gravity1=G1, gravity2=G1)
+
+
+def test_facade_takes_the_vertical():
+    """cv.estimate with gravity1/gravity2 runs the upright 4-point search; one
+    without the other, or a method that ignores them, is a ValueError."""
+    from mcgeom import cv
+    rng = np.random.default_rng(7)
+    rig = synth.vehicle8()
+    R = synth.rotation_about([0.0, 0.0, 1.0], 0.15)
+    t = np.array([0.8, 0.1, 0.02])
+    p = synth.make_problem(rig, R, t, 320, rng, pixel_noise=0.5, outlier_fraction=0.3)
+    g1 = np.array([0.0, 0.0, -1.0])
+    m = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, gravity1=g1, gravity2=R @ g1)
+    assert m.method == "ransac[upright_four_point]"
+    assert np.degrees(rot_err(m.R, R)) < 0.1
+    with pytest.raises(ValueError, match="gravity2 is missing"):
+        cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, gravity1=g1)
+    with pytest.raises(ValueError, match="does not use a vertical prior"):
+        cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, method=cv.RIG_LINEAR17,
+                    gravity1=g1, gravity2=g1)
