@@ -22,15 +22,18 @@ from ._common import travel_direction
 __all__ = ["refine_and_report"]
 
 
-def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool) -> dict:
+def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool,
+            iterate: bool = True) -> dict:
     # converged to rounding: the result must not depend on the start's rounding
-    # (ray order, rig frame), as five_plus_one's refinement
-    return refine_centred(rays, R, t, loss="none", fix_scale=fix_scale, max_iterations=100,
+    # (ray order, rig frame), as five_plus_one's refinement; without iterations
+    # the covariance of (R, t) as given
+    return refine_centred(rays, R, t, loss="none", fix_scale=fix_scale,
+                          max_iterations=100 if iterate else 0,
                           cost_tolerance=1e-15, step_tolerance=1e-13)
 
 
 def refine_and_report(rays: RayPairs, starts: list, method: str,
-                      max_scale_rel_std: float, info: dict) -> RigMotion:
+                      max_scale_rel_std: float, info: dict, iterate: bool = True) -> RigMotion:
     """Refine each start ``(R, t)`` (rig2_from_rig1, metres) on all ``rays`` and
     report the one of least final cost.
 
@@ -45,15 +48,17 @@ def refine_and_report(rays: RayPairs, starts: list, method: str,
     travelled distance at most ``max_scale_rel_std`` and its profile excluding
     ``1 +- 3 max_scale_rel_std`` at 3 sigma. ``info`` is completed with the
     refinement's iterations and ``t_metric`` (the metric estimate whatever the
-    verdict).
+    verdict). With ``iterate=False`` no start is moved: the least Sampson cost
+    among them is kept and the verdict rests on the covariance and profile
+    there.
     """
     best = None
     for R, t in starts:
         fixed = False
         try:
-            out = _refine(rays, R, t, False)
+            out = _refine(rays, R, t, False, iterate)
         except DegenerateError:
-            out = _refine(rays, R, t, True)
+            out = _refine(rays, R, t, True, iterate)
             fixed = True
         if best is None or out["final_cost"] < best[0]["final_cost"] * (1.0 - 1e-9):
             best = (out, fixed)

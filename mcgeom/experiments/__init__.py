@@ -41,6 +41,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
     "odometry_real": ("odometry_real", "the whole sequence pipeline on the real image "
                                        "recordings (KITTI raw, DDAD, EuRoC) against their "
                                        "ground truth"),
+    "peer_solvers": ("peer_solvers", "the upright 4-point solver next to PoseLib's: noise-free "
+                                     "minimal configurations, then RANSAC from pixels with a "
+                                     "known vertical (needs poselib)"),
     "batch_scaling": ("batch_scaling", "mcgeom batch on Dask: sequences per minute with 1 "
                                        "and 2 workers, scheduler overhead per task, and the "
                                        "extrapolation to 10,000 sequences (needs dask)"),

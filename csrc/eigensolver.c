@@ -1,0 +1,305 @@
+/*
+ * eigensolver.c -- generalized relative pose by minimising the smallest
+ * eigenvalue of the generalized-epipolar matrix over the rotation (Kneip and
+ * Li, "Efficient computation of relative pose for multi-camera systems",
+ * CVPR 2014). Our own formulation and minimiser, written from the paper's idea.
+ *
+ * 1. For a rotation R, the generalized epipolar constraint of correspondence
+ *    k (thesis eq. 8.16 in this library's convention) is linear in (t, 1),
+ *    since d2^T [t]x R d1 = t . (R d1 x d2):
+ *        v_k(R) . (t, 1) = 0,
+ *        v_k(R) = ( R d1 x d2 ,  d2 . R m1 + m2 . R d1 ).                   (E1)
+ *    With M(R) = sum_k v_k v_k^T (4 x 4, symmetric, positive semi-definite)
+ *    the least-squares (t, 1) for R is the eigenvector u of the smallest
+ *    eigenvalue lambda(R), and lambda(R) = sum_k (u . v_k)^2 is the algebraic
+ *    cost left: the rotation minimises lambda(R) (the paper's objective,
+ *    there written with the translation eliminated the same way).
+ *
+ * 2. Minimisation: Levenberg-Marquardt on the residuals r_k = u . v_k(R) over
+ *    a left increment R <- exp([w]x) R (three parameters, like the paper's
+ *    Cayley parameters: a local chart of SO(3)), u held at the current
+ *    eigenvector (variable projection: the derivative of lambda with respect
+ *    to R is that of sum r_k^2 with u fixed, since u minimises it for each R).
+ *    With d(R x)/dw_j = e_j x (R x):
+ *        dr_k/dw_j = u . ( (e_j x R d1) x d2 ,
+ *                          d2 . (e_j x R m1) + m2 . (e_j x R d1) ).          (E2)
+ *    A step is kept only if lambda decreases by more than its rounding (the
+ *    damping grows otherwise); it stops when the step or the relative
+ *    decrease is at rounding level.
+ *
+ *    Trap: with rays that each stay in one camera, R = I, t = 0 (no motion)
+ *    satisfies every constraint (v_k[3] = 0 at R = I), so lambda has a
+ *    global minimum 0 there whatever the true motion; a start near a small
+ *    true rotation can slide into it. The caller compares the travel of the
+ *    result with that of the start (mcgeom.estimators.eigensolver).
+ *
+ * 3. Conditioning and invariance: the directions are normalised, the origins
+ *    centred on their mean c and divided by their RMS distance s from it
+ *    (both invariant to a change of the rig frame and to a global scale), so
+ *    the minimiser and its optimum do not depend on where the user put the
+ *    rig origin; t = s t_u + c - R c maps back.
+ *
+ * 4. The translation: t_u = u[0:3] / u[3]. When the smallest two eigenvalues
+ *    both vanish and their eigenspace holds (0, 0, 0, 1) -- every row has
+ *    v[3] = 0: no rotation and rays that each stay in one camera, the
+ *    critical motion of thesis ch. 7.3.2 -- or u[3] ~ 0, |t| is not
+ *    determined: t is returned as the unit direction of the null space with
+ *    u[3] = 0 and *has_scale = 0. Rays from one centre (s = 0: every moment
+ *    vanishes) use the 3 x 3 block: the direction of travel only.
+ */
+#include "mcgeom.h"
+#include "internal.h"
+#include "so3.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#define DIR2_MIN 1e-100 /* smallest squared length of a direction */
+#define MAX_PAIRS (1 << 26)
+
+size_t mcg_eigensolver_work_size(int n)
+{
+    int ok = 1;
+    size_t s;
+    if (n < 1 || n > MAX_PAIRS)
+        return 0;
+    s = mul_sz((size_t)n, 12, &ok);
+    return ok ? s : 0;
+}
+
+/* rows v_k of (E1) accumulated into M (dim x dim, dim = 4, or 3 when the
+ * moments vanish); also the residuals' normal equations (A = J^T J, g = J^T r)
+ * for the eigenvector u when A != NULL */
+static void accumulate(int n, const double *w, const double R[9], int dim, const double *u,
+                       double *M, double *A, double *g)
+{
+    int k, i, j;
+    memset(M, 0, sizeof(double) * 16);
+    if (A) {
+        memset(A, 0, sizeof(double) * 9);
+        memset(g, 0, sizeof(double) * 3);
+    }
+    for (k = 0; k < n; ++k) {
+        const double *a = w + 12 * k, *m1 = a + 3, *b = a + 6, *m2 = a + 9;
+        double ra[3], rm[3], v[4];
+        mat_vec(R, a, ra);
+        mat_vec(R, m1, rm);
+        cross3(ra, b, v);
+        v[3] = dot3(b, rm) + dot3(m2, ra);
+        for (i = 0; i < dim; ++i)
+            for (j = 0; j < dim; ++j)
+                M[dim * i + j] += v[i] * v[j];
+        if (A) {
+            double r = 0.0, J[3];
+            for (i = 0; i < dim; ++i)
+                r += u[i] * v[i];
+            for (j = 0; j < 3; ++j) {
+                double e[3] = {0.0, 0.0, 0.0}, era[3], erm[3], dv[4];
+                e[j] = 1.0;
+                cross3(e, ra, era);
+                cross3(e, rm, erm);
+                cross3(era, b, dv);
+                dv[3] = dot3(b, erm) + dot3(m2, era);
+                J[j] = 0.0;
+                for (i = 0; i < dim; ++i)
+                    J[j] += u[i] * dv[i];
+            }
+            for (i = 0; i < 3; ++i) {
+                g[i] += J[i] * r;
+                for (j = 0; j < 3; ++j)
+                    A[3 * i + j] += J[i] * J[j];
+            }
+        }
+    }
+}
+
+/* smallest eigenvalue and its eigenvector (and the second smallest) of M */
+static int smallest(int dim, const double *M, double *lam, double *lam2, double *u,
+                    double *top)
+{
+    double a[16], wv[4], V[16];
+    int i, st;
+    memcpy(a, M, sizeof(double) * (size_t)(dim * dim));
+    st = mcg_sym_eig(dim, a, wv, V);
+    if (st != MCG_OK)
+        return st;
+    *lam = wv[0];
+    *lam2 = wv[1];
+    *top = wv[dim - 1];
+    for (i = 0; i < dim; ++i)
+        u[i] = V[dim * i];
+    return MCG_OK;
+}
+
+/* solve the 3 x 3 SPD system (A + mu diag(A)) x = -g by Cholesky; 0 if it fails */
+static int damped_step(const double A[9], const double g[3], double mu, double x[3])
+{
+    double L[9] = {0}, y[3];
+    int i, j, k;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j <= i; ++j) {
+            double s = A[3 * i + j] + (i == j ? mu * (A[3 * i + i] + 1e-300) : 0.0);
+            for (k = 0; k < j; ++k)
+                s -= L[3 * i + k] * L[3 * j + k];
+            if (i == j) {
+                if (!(s > 0.0))
+                    return 0;
+                L[3 * i + i] = sqrt(s);
+            } else {
+                L[3 * i + j] = s / L[3 * j + j];
+            }
+        }
+    for (i = 0; i < 3; ++i) {
+        double s = -g[i];
+        for (k = 0; k < i; ++k)
+            s -= L[3 * i + k] * y[k];
+        y[i] = s / L[3 * i + i];
+    }
+    for (i = 2; i >= 0; --i) {
+        double s = y[i];
+        for (k = i + 1; k < 3; ++k)
+            s -= L[3 * k + i] * x[k];
+        x[i] = s / L[3 * i + i];
+    }
+    return all_finite(x, 3);
+}
+
+int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
+                    const double *d2, const double R0[9], int max_iterations, double R[9],
+                    double t[3], double *lambda_min, int *has_scale, int *iterations,
+                    double *work, size_t lwork)
+{
+    double c[3] = {0.0, 0.0, 0.0}, s = 0.0, M[16], A[9], g[3], u[4], lam, lam2, top, mu = 1e-3;
+    int k, i, dim, it, st;
+    if (!o1 || !d1 || !o2 || !d2 || !R0 || !R || !t || !lambda_min || !has_scale ||
+        !iterations || !work)
+        return MCG_EINVAL;
+    if (n < 1 || n > MAX_PAIRS || max_iterations < 0 || max_iterations > 100000)
+        return MCG_EINVAL;
+    if (lwork < mcg_eigensolver_work_size(n))
+        return MCG_ENOMEM;
+    if (!all_finite(R0, 9) || !is_rotation(R0))
+        return MCG_EINVAL;
+    for (k = 0; k < n; ++k) {
+        if (!all_finite(o1 + 3 * k, 3) || !all_finite(d1 + 3 * k, 3) ||
+            !all_finite(o2 + 3 * k, 3) || !all_finite(d2 + 3 * k, 3))
+            return MCG_EINVAL;
+        for (i = 0; i < 3; ++i)
+            c[i] += (o1[3 * k + i] + o2[3 * k + i]) / (2.0 * n);
+    }
+    for (k = 0; k < n; ++k)
+        for (i = 0; i < 3; ++i) {
+            double x = o1[3 * k + i] - c[i], y = o2[3 * k + i] - c[i];
+            s += (x * x + y * y) / (2.0 * n);
+        }
+    s = sqrt(s);
+    if (!isfinite(s) || !all_finite(c, 3))
+        return MCG_EINVAL;
+    dim = s > 1e-12 * (1.0 + fabs(c[0]) + fabs(c[1]) + fabs(c[2])) ? 4 : 3;
+    if (dim == 3)
+        s = 1.0;
+    for (k = 0; k < n; ++k) {
+        double *wk = work + 12 * k, x = dot3(d1 + 3 * k, d1 + 3 * k),
+               y = dot3(d2 + 3 * k, d2 + 3 * k), p[3];
+        if (!(x >= DIR2_MIN && y >= DIR2_MIN && isfinite(x) && isfinite(y)))
+            return MCG_EINVAL;
+        x = 1.0 / sqrt(x);
+        y = 1.0 / sqrt(y);
+        for (i = 0; i < 3; ++i) {
+            wk[i] = d1[3 * k + i] * x;
+            wk[6 + i] = d2[3 * k + i] * y;
+            p[i] = (o1[3 * k + i] - c[i]) / s;
+        }
+        cross3(p, wk, wk + 3);
+        for (i = 0; i < 3; ++i)
+            p[i] = (o2[3 * k + i] - c[i]) / s;
+        cross3(p, wk + 6, wk + 9);
+        if (dim == 3)
+            for (i = 0; i < 3; ++i)
+                wk[3 + i] = wk[9 + i] = 0.0;
+    }
+    memcpy(R, R0, sizeof(double) * 9);
+    accumulate(n, work, R, dim, NULL, M, NULL, NULL);
+    if (!all_finite(M, 16))
+        return MCG_EINVAL; /* magnitudes that overflow */
+    if ((st = smallest(dim, M, &lam, &lam2, u, &top)) != MCG_OK)
+        return st;
+    for (it = 0; it < max_iterations; ++it) {
+        double x[3], Rn[9], Rx[9], un[4], ln, l2n, tn;
+        int improved = 0;
+        accumulate(n, work, R, dim, u, M, A, g);
+        while (mu < 1e12) {
+            if (!damped_step(A, g, mu, x)) {
+                mu *= 10.0;
+                continue;
+            }
+            if (mcg_rot_from_angle_axis(x, Rx) != MCG_OK)
+                break;
+            mul33(Rx, R, Rn);
+            accumulate(n, work, Rn, dim, NULL, M, NULL, NULL);
+            if (smallest(dim, M, &ln, &l2n, un, &tn) != MCG_OK)
+                break;
+            /* a decrease above the rounding of the eigenvalues (Jacobi's
+             * accuracy is relative to the largest): steps within it only
+             * wander (measured: 1e-11 rad away from an exact start) */
+            if (ln < lam - 16.0 * DBL_EPSILON * top) {
+                double step = sqrt(dot3(x, x)), dec = lam - ln;
+                memcpy(R, Rn, sizeof Rn);
+                memcpy(u, un, sizeof un);
+                lam = ln;
+                lam2 = l2n;
+                top = tn;
+                mu = fmax(mu / 10.0, 1e-12);
+                improved = 1 + (step < 1e-14 || dec <= 1e-15 * ln);
+                break;
+            }
+            mu *= 10.0;
+        }
+        if (improved != 1)
+            break; /* no decrease left, or the last one at rounding level */
+    }
+    *iterations = it;
+    *lambda_min = lam;
+    /* re-orthonormalise the product of the increments */
+    if (mcg_project_so3(R, A) == MCG_OK)
+        memcpy(R, A, sizeof A);
+    {
+        double tu[3], Rc[3];
+        int scale = 0;
+        if (dim == 4) {
+            double un2 = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (lam2 <= 1e-10 * top || !(fabs(u[3]) > 1e-12)) {
+                /* |t| free: the null-space direction with no homogeneous part */
+                double a[16], wv[4], V[16];
+                accumulate(n, work, R, dim, NULL, M, NULL, NULL);
+                memcpy(a, M, sizeof a);
+                if (mcg_sym_eig(4, a, wv, V) != MCG_OK)
+                    return MCG_ENUMERIC;
+                for (i = 0; i < 3; ++i)
+                    tu[i] = V[4 * i] * V[4 * 3 + 1] - V[4 * i + 1] * V[4 * 3 + 0];
+                un2 = sqrt(dot3(tu, tu));
+                if (!(un2 > 0.0))
+                    for (i = 0; i < 3; ++i)
+                        tu[i] = V[4 * i];
+                un2 = sqrt(dot3(tu, tu));
+                for (i = 0; i < 3; ++i)
+                    tu[i] /= un2;
+            } else {
+                for (i = 0; i < 3; ++i)
+                    tu[i] = u[i] / u[3];
+                scale = 1;
+            }
+        } else {
+            for (i = 0; i < 3; ++i)
+                tu[i] = u[i];
+        }
+        mat_vec(R, c, Rc);
+        for (i = 0; i < 3; ++i)
+            t[i] = s * tu[i] + c[i] - Rc[i];
+        *has_scale = scale;
+    }
+    if (!all_finite(R, 9) || !all_finite(t, 3))
+        return MCG_ENUMERIC;
+    return MCG_OK;
+}
