@@ -45,7 +45,7 @@ from mcgeom.estimators.upright_four_point import upright_rotation
 from mcgeom.rig import Rig
 
 from .common import Progress, add_count_and_seed, import_peer, no_progress, positive_int
-from .robust_vs_poselib import CASES as ROBUST_CASES, _poselib
+from .robust_vs_poselib import CASES as ROBUST_CASES, poselib_motion
 
 #: e_z -> e_y: PoseLib's upright solvers rotate about y
 _Z_TO_Y = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -225,7 +225,7 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                 f"mcgeom upright ({gravity_error_deg:g} deg)":
                     lambda: _facade(rig, p, gravity1=g1, gravity2=g2),
                 "mcgeom 17-pt": lambda: _facade(rig, p, method=RIG_LINEAR17_RANSAC),
-                "poselib": lambda: _poselib(rig, p),
+                "poselib": lambda: poselib_motion(rig, p),
             }
             for meth, fn in runs.items():
                 t0 = time.perf_counter()

@@ -49,7 +49,9 @@ CASES: dict[str, tuple[Callable[[], Rig], int, float, float]] = {
 }
 
 
-def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
+def poselib_motion(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
+    """PoseLib's robust generalized relative pose of problem ``p`` (pixels of ``rig``),
+    its default RANSAC and bundle options, 1 px threshold: ``(R, t)`` rig2_from_rig1."""
     poselib = import_peer("poselib", "robust_vs_poselib")
     exts, cams = [], []
     for c in rig.cameras:
@@ -100,7 +102,7 @@ def run(trials: int = 50, seed: int = 0, cases=None, progress: Progress = no_pro
             t = rng.normal(size=3)
             t /= np.linalg.norm(t)
             p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
-            for meth, fn in (("mcgeom", _mcgeom), ("poselib", _poselib)):
+            for meth, fn in (("mcgeom", _mcgeom), ("poselib", poselib_motion)):
                 t0, c0 = time.perf_counter(), time.process_time()
                 Re, te = fn(rig, p)
                 res[meth][2].append(time.process_time() - c0)
