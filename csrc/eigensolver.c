@@ -228,8 +228,8 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
 {
     double c[3] = {0.0, 0.0, 0.0}, s = 0.0, M[16], A[9], g[3], u[4], u2[4], ev[3], Vb[16];
     double mu = 1e-3;
-    double *vbuf = work + 12 * (size_t)n, *swork = vbuf + 4 * (size_t)n;
-    size_t lsw = lwork - 16 * (size_t)n;
+    double *vbuf, *swork; /* carved from work once n is checked */
+    size_t lsw;
     int k, i, dim, it, st;
     if (!o1 || !d1 || !o2 || !d2 || !R0 || !R || !t || !lambda_min || !has_scale ||
         !iterations || !work)
@@ -238,6 +238,9 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
         return MCG_EINVAL;
     if (lwork < mcg_eigensolver_work_size(n))
         return MCG_ENOMEM;
+    vbuf = work + 12 * (size_t)n;
+    swork = vbuf + 4 * (size_t)n;
+    lsw = lwork - 16 * (size_t)n;
     if (!all_finite(R0, 9) || !is_rotation(R0))
         return MCG_EINVAL;
     for (k = 0; k < n; ++k) {
