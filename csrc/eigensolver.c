@@ -70,6 +70,34 @@ size_t mcg_eigensolver_work_size(int n)
     return ok && sv > 0 ? s : 0;
 }
 
+/* The row v (E1) of correspondence a (a, m1, b, m2: 12 doubles) at R, and,
+ * when J != NULL, the derivatives (E2) of u . v along the three rotation
+ * increments. */
+static void row_at(const double *a, const double R[9], const double *u, int dim, double v[4],
+                   double *J)
+{
+    const double *m1 = a + 3, *b = a + 6, *m2 = a + 9;
+    double ra[3], rm[3];
+    int i, j;
+    mat_vec(R, a, ra);
+    mat_vec(R, m1, rm);
+    cross3(ra, b, v);
+    v[3] = dot3(b, rm) + dot3(m2, ra);
+    if (!J)
+        return;
+    for (j = 0; j < 3; ++j) {
+        double e[3] = {0.0, 0.0, 0.0}, era[3], erm[3], dv[4];
+        e[j] = 1.0;
+        cross3(e, ra, era);
+        cross3(e, rm, erm);
+        cross3(era, b, dv);
+        dv[3] = dot3(b, erm) + dot3(m2, era);
+        J[j] = 0.0;
+        for (i = 0; i < dim; ++i)
+            J[j] += u[i] * dv[i];
+    }
+}
+
 /* rows v_k of (E1) accumulated into M (dim x dim, dim = 4, or 3 when the
  * moments vanish); also the residuals' normal equations (A = J^T J, g = J^T r)
  * for the eigenvector u when A != NULL */
@@ -83,30 +111,15 @@ static void accumulate(int n, const double *w, const double R[9], int dim, const
         memset(g, 0, sizeof(double) * 3);
     }
     for (k = 0; k < n; ++k) {
-        const double *a = w + 12 * k, *m1 = a + 3, *b = a + 6, *m2 = a + 9;
-        double ra[3], rm[3], v[4];
-        mat_vec(R, a, ra);
-        mat_vec(R, m1, rm);
-        cross3(ra, b, v);
-        v[3] = dot3(b, rm) + dot3(m2, ra);
+        double v[4], J[3];
+        row_at(w + 12 * k, R, u, dim, v, A ? J : NULL);
         for (i = 0; i < dim; ++i)
             for (j = 0; j < dim; ++j)
                 M[dim * i + j] += v[i] * v[j];
         if (A) {
-            double r = 0.0, J[3];
+            double r = 0.0;
             for (i = 0; i < dim; ++i)
                 r += u[i] * v[i];
-            for (j = 0; j < 3; ++j) {
-                double e[3] = {0.0, 0.0, 0.0}, era[3], erm[3], dv[4];
-                e[j] = 1.0;
-                cross3(e, ra, era);
-                cross3(e, rm, erm);
-                cross3(era, b, dv);
-                dv[3] = dot3(b, erm) + dot3(m2, era);
-                J[j] = 0.0;
-                for (i = 0; i < dim; ++i)
-                    J[j] += u[i] * dv[i];
-            }
             for (i = 0; i < 3; ++i) {
                 g[i] += J[i] * r;
                 for (j = 0; j < 3; ++j)
@@ -129,12 +142,8 @@ static int smallest(int n, const double *w, const double R[9], int dim, double *
     double sv[4], V[16];
     int k, i, st;
     for (k = 0; k < n; ++k) {
-        const double *a = w + 12 * k, *m1 = a + 3, *b = a + 6, *m2 = a + 9;
-        double ra[3], rm[3], v[4];
-        mat_vec(R, a, ra);
-        mat_vec(R, m1, rm);
-        cross3(ra, b, v);
-        v[3] = dot3(b, rm) + dot3(m2, ra);
+        double v[4];
+        row_at(w + 12 * k, R, NULL, dim, v, NULL);
         for (i = 0; i < dim; ++i)
             vbuf[dim * k + i] = v[i];
     }
@@ -335,26 +344,11 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
             memset(N6, 0, sizeof N6);
             memset(b6, 0, sizeof b6);
             for (k = 0; k < n; ++k) {
-                const double *a = work + 12 * k, *m1 = a + 3, *b = a + 6, *m2 = a + 9;
-                double ra[3], rm[3], v[4], row[6], r = 0.0;
+                double v[4], row[6], r = 0.0;
                 int j;
-                mat_vec(R, a, ra);
-                mat_vec(R, m1, rm);
-                cross3(ra, b, v);
-                v[3] = dot3(b, rm) + dot3(m2, ra);
+                row_at(work + 12 * k, R, u, dim, v, row); /* (E1), (E2) */
                 for (i = 0; i < dim; ++i)
                     r += u[i] * v[i];
-                for (j = 0; j < 3; ++j) { /* (E2) */
-                    double e[3] = {0.0, 0.0, 0.0}, era[3], erm[3], dv[4];
-                    e[j] = 1.0;
-                    cross3(e, ra, era);
-                    cross3(e, rm, erm);
-                    cross3(era, b, dv);
-                    dv[3] = dot3(b, erm) + dot3(m2, era);
-                    row[j] = 0.0;
-                    for (i = 0; i < dim; ++i)
-                        row[j] += u[i] * dv[i];
-                }
                 for (j = 0; j < dim - 1; ++j) { /* d r / d (basis coordinate j) */
                     row[3 + j] = 0.0;
                     for (i = 0; i < dim; ++i)

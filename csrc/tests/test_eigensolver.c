@@ -17,42 +17,13 @@
 
 #define TEST_SEED 0xe16e5017e3ULL
 #include "testutil.h"
+#include "../so3.h" /* dot3, cross3, mat_vec, mul33 */
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #define N 40
-
-static void cross(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double dot(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void mv(const double R[9], const double x[3], double y[3])
-{
-    int i;
-    for (i = 0; i < 3; i++)
-        y[i] = R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2];
-}
-
-static void mm(const double *a, const double *b, double *c)
-{
-    int i, j, k;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++) {
-            c[3 * i + j] = 0.0;
-            for (k = 0; k < 3; k++)
-                c[3 * i + j] += a[3 * i + k] * b[3 * k + j];
-        }
-}
 
 static void make(int head, double noise, const double R[9], const double t[3], double *o1,
                  double *d1, double *o2, double *d2)
@@ -66,10 +37,10 @@ static void make(int head, double noise, const double R[9], const double t[3], d
         int c1 = head ? k % 2 : k % 4, c2 = k % 3 == 0 ? (head ? 1 - c1 : (c1 + 1) % 4) : c1;
         double X[3], X2[3], dir[3], n;
         randn(dir, 3);
-        n = sqrt(dot(dir, dir));
+        n = sqrt(dot3(dir, dir));
         for (i = 0; i < 3; i++)
             X[i] = cen[c1][i] + (2.0 + 8.0 * urand()) * dir[i] / n;
-        mv(R, X, X2);
+        mat_vec(R, X, X2);
         for (i = 0; i < 3; i++) {
             X2[i] += t[i];
             o1[3 * k + i] = cen[c1][i];
@@ -95,19 +66,19 @@ static double lambda_ref(const double R[9], const double *o1, const double *d1,
     s = sqrt(s);
     for (k = 0; k < N; k++) {
         double a[3], b[3], p[3], q[3], m1[3], m2[3], ra[3], rm[3], v[4];
-        double na = sqrt(dot(d1 + 3 * k, d1 + 3 * k)), nb = sqrt(dot(d2 + 3 * k, d2 + 3 * k));
+        double na = sqrt(dot3(d1 + 3 * k, d1 + 3 * k)), nb = sqrt(dot3(d2 + 3 * k, d2 + 3 * k));
         for (i = 0; i < 3; i++) {
             a[i] = d1[3 * k + i] / na;
             b[i] = d2[3 * k + i] / nb;
             p[i] = (o1[3 * k + i] - c[i]) / s;
             q[i] = (o2[3 * k + i] - c[i]) / s;
         }
-        cross(p, a, m1);
-        cross(q, b, m2);
-        mv(R, a, ra);
-        mv(R, m1, rm);
-        cross(ra, b, v);
-        v[3] = dot(b, rm) + dot(m2, ra);
+        cross3(p, a, m1);
+        cross3(q, b, m2);
+        mat_vec(R, a, ra);
+        mat_vec(R, m1, rm);
+        cross3(ra, b, v);
+        v[3] = dot3(b, rm) + dot3(m2, ra);
         for (i = 0; i < 4; i++)
             for (j = 0; j < 4; j++)
                 M[4 * i + j] += v[i] * v[j];
@@ -135,7 +106,7 @@ static void run(int head, double noise, int trials, const char *label)
         for (i = 0; i < 3; i++)
             w[i] *= 0.087 / sqrt(3.0);  /* ~5 degrees */
         mcg_rot_from_angle_axis(w, P);
-        mm(P, R, R0);
+        mul33(P, R, R0);
         st = mcg_eigensolver(N, o1, d1, o2, d2, R0, 100, Re, te, &lam, &has, &its, work,
                              mcg_eigensolver_work_size(N));
         if (st != MCG_OK || !has) {
@@ -146,7 +117,7 @@ static void run(int head, double noise, int trials, const char *label)
             for (i = 0; i < 9; i++)
                 e = fmax(e, fabs(Re[i] - R[i]));
             for (i = 0; i < 3; i++)
-                e = fmax(e, fabs(te[i] - t[i]) / sqrt(dot(t, t)));
+                e = fmax(e, fabs(te[i] - t[i]) / sqrt(dot3(t, t)));
             worst_exact = fmax(worst_exact, e);
         } else {
             double l0 = lambda_ref(Re, o1, d1, o2, d2), ls = lambda_ref(R0, o1, d1, o2, d2);
@@ -154,7 +125,7 @@ static void run(int head, double noise, int trials, const char *label)
                 double dw[3] = {0, 0, 0}, D[9], Rp[9];
                 dw[j % 3] = j < 3 ? 1e-4 : -1e-4;
                 mcg_rot_from_angle_axis(dw, D);
-                mm(D, Re, Rp);
+                mul33(D, Re, Rp);
                 worst_min = fmax(worst_min, (l0 - lambda_ref(Rp, o1, d1, o2, d2)) / l0);
             }
             worst_start = fmax(worst_start, (l0 - ls) / ls);

@@ -16,36 +16,18 @@
 
 #define TEST_SEED 0x0b417f4a11ULL
 #include "testutil.h"
+#include "../so3.h" /* dot3, cross3, mat_vec, mul33 */
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-static void cross(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double dot(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void mv(const double R[9], const double x[3], double y[3])
-{
-    int i;
-    for (i = 0; i < 3; i++)
-        y[i] = R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2];
-}
 
 static void random_rotation(double R[9], double max_angle)
 {
     double w[3], n;
     int i;
     randn(w, 3);
-    n = sqrt(dot(w, w));
+    n = sqrt(dot3(w, w));
     for (i = 0; i < 3; i++)
         w[i] *= max_angle * (2.0 * urand() - 1.0) / n;
     mcg_rot_from_angle_axis(w, R);
@@ -66,10 +48,10 @@ static void make_problem(int head, int cross, const double R[9], const double t[
         int c1 = head ? k & 1 : k, c2 = cross ? (head ? (k + 1) & 1 : (k + 1) % 4) : c1;
         double X[3], X2[3], dir[3], n;
         randn(dir, 3);
-        n = sqrt(dot(dir, dir));
+        n = sqrt(dot3(dir, dir));
         for (i = 0; i < 3; i++)
             X[i] = cen[c1][i] + (2.0 + 8.0 * urand()) * dir[i] / n;
-        mv(R, X, X2);
+        mat_vec(R, X, X2);
         for (i = 0; i < 3; i++) {
             X2[i] += t[i];
             o1[3 * k + i] = cen[c1][i];
@@ -84,19 +66,19 @@ static void make_problem(int head, int cross, const double R[9], const double t[
 static double gec(const double R[9], const double t[3], const double *o1, const double *d1,
                   const double *o2, const double *d2)
 {
-    double a[3], b[3], m1[3], m2[3], Rd[3], Rm[3], x[3], n1 = sqrt(dot(d1, d1)),
-        n2 = sqrt(dot(d2, d2));
+    double a[3], b[3], m1[3], m2[3], Rd[3], Rm[3], x[3], n1 = sqrt(dot3(d1, d1)),
+        n2 = sqrt(dot3(d2, d2));
     int i;
     for (i = 0; i < 3; i++) {
         a[i] = d1[i] / n1;
         b[i] = d2[i] / n2;
     }
-    cross(o1, a, m1);
-    cross(o2, b, m2);
-    mv(R, a, Rd);
-    mv(R, m1, Rm);
-    cross(Rd, b, x);
-    return dot(t, x) + dot(b, Rm) + dot(m2, Rd);
+    cross3(o1, a, m1);
+    cross3(o2, b, m2);
+    mat_vec(R, a, Rd);
+    mat_vec(R, m1, Rm);
+    cross3(Rd, b, x);
+    return dot3(t, x) + dot3(b, Rm) + dot3(m2, Rd);
 }
 
 /* The rotation with R g1 = g2 and yaw theta: Rodrigues' rotation taking g1
@@ -105,9 +87,9 @@ static void yaw_rotation(const double g1[3], const double g2[3], double th, doub
 {
     double w[3], A[9], B[9], s, c;
     int i, j, k;
-    cross(g1, g2, w);
-    s = sqrt(dot(w, w));
-    c = dot(g1, g2);
+    cross3(g1, g2, w);
+    s = sqrt(dot3(w, w));
+    c = dot3(g1, g2);
     for (i = 0; i < 3; i++)
         w[i] = s > 0 ? w[i] / s * atan2(s, c) : 0.0;
     mcg_rot_from_angle_axis(w, A);
@@ -158,15 +140,15 @@ static double det_at(const double g1[3], const double g2[3], double th, const do
     int k;
     yaw_rotation(g1, g2, th, R);
     for (k = 0; k < 4; k++) {
-        double a[3], Ra[3], x[3], n = sqrt(dot(d1 + 3 * k, d1 + 3 * k)),
-                                  nb = sqrt(dot(d2 + 3 * k, d2 + 3 * k)), b[3];
+        double a[3], Ra[3], x[3], n = sqrt(dot3(d1 + 3 * k, d1 + 3 * k)),
+                                  nb = sqrt(dot3(d2 + 3 * k, d2 + 3 * k)), b[3];
         int i;
         for (i = 0; i < 3; i++) {
             a[i] = d1[3 * k + i] / n;
             b[i] = d2[3 * k + i] / nb;
         }
-        mv(R, a, Ra);
-        cross(Ra, b, x);
+        mat_vec(R, a, Ra);
+        cross3(Ra, b, x);
         memcpy(M + 4 * k, x, sizeof x);
         M[4 * k + 3] = gec(R, z, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k);
     }
@@ -184,7 +166,7 @@ static void test_random(int head, int cross, int trials, const char *label)
         random_rotation(R, 3.14159);
         randn(t, 3);
         randn(g1, 3);
-        mv(R, g1, g2);
+        mat_vec(R, g1, g2);
         make_problem(head, cross, R, t, o1, d1, o2, d2);
         st = mcg_upright4(o1, d1, o2, d2, g1, g2, Rs, ts, &n);
         if (st != MCG_OK) {
@@ -192,17 +174,17 @@ static void test_random(int head, int cross, int trials, const char *label)
             continue;
         }
         for (s = 0; s < n; s++) {
-            double e = 0.0, Rg[3], gn = sqrt(dot(g1, g1)), g2n = sqrt(dot(g2, g2));
+            double e = 0.0, Rg[3], gn = sqrt(dot3(g1, g1)), g2n = sqrt(dot3(g2, g2));
             for (i = 0; i < 9; i++)
                 e = fmax(e, fabs(Rs[9 * s + i] - R[i]));
             for (i = 0; i < 3; i++)
-                e = fmax(e, fabs(ts[3 * s + i] - t[i]) / sqrt(dot(t, t)));
+                e = fmax(e, fabs(ts[3 * s + i] - t[i]) / sqrt(dot3(t, t)));
             hit |= e < 1e-8;
             for (k = 0; k < 4; k++)
                 worst_gec = fmax(worst_gec, fabs(gec(Rs + 9 * s, ts + 3 * s, o1 + 3 * k,
                                                      d1 + 3 * k, o2 + 3 * k, d2 + 3 * k)) /
-                                                (1.0 + sqrt(dot(ts + 3 * s, ts + 3 * s))));
-            mv(Rs + 9 * s, g1, Rg);
+                                                (1.0 + sqrt(dot3(ts + 3 * s, ts + 3 * s))));
+            mat_vec(Rs + 9 * s, g1, Rg);
             for (i = 0; i < 3; i++)
                 worst_g = fmax(worst_g, fabs(Rg[i] / gn - g2[i] / g2n));
         }
@@ -211,8 +193,8 @@ static void test_random(int head, int cross, int trials, const char *label)
             double g1u[3], g2u[3], prev, th;
             int changes = 0, j;
             for (i = 0; i < 3; i++) {
-                g1u[i] = g1[i] / sqrt(dot(g1, g1));
-                g2u[i] = g2[i] / sqrt(dot(g2, g2));
+                g1u[i] = g1[i] / sqrt(dot3(g1, g1));
+                g2u[i] = g2[i] / sqrt(dot3(g2, g2));
             }
             prev = det_at(g1u, g2u, -3.14159265358979, o1, d1, o2, d2);
             for (j = 1; j <= 4000; j++) {
