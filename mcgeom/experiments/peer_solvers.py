@@ -1,10 +1,10 @@
 """The peers' generalized relative-pose solvers, mcgeom's and PoseLib's, on the same problems.
 
-Part ``minimal``: noise-free random minimal configurations per family (generic
-4-camera rigs with intra- and cross-camera rays, 2-camera heads; the four
-rays start from at least two cameras, as four rays of one camera are a
-central camera without metric scale; and the
-degenerate cases of the upright problem: no yaw with intra-camera rays only
+Part ``minimal``: noise-free random minimal configurations per family
+(generic 4-camera rigs with intra- and cross-camera rays, 2-camera heads; the
+four rays start from at least two cameras, as four rays of one camera are a
+central camera without metric scale; and the degenerate cases of the
+upright problem: no yaw with intra-camera rays only
 -- the critical motion of thesis ch. 7.3.2, where |t| is not observable and
 no solver can return the truth --, cameras stacked along the vertical with
 intra-camera rays -- an axial rig rotating about its axis, critical too --
