@@ -395,25 +395,20 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
         poly[i] = 0.0;
     for (j = 0; j < 6; ++j) {
         int a = pairs[j][0], b = pairs[j][1], cc = pairs[5 - j][0], dd = pairs[5 - j][1];
-        double m01[5], m23[5], p0a[3], p1b[3], p0b[3], p1a[3], p2c[3], p3d[3], p2d[3], p3c[3],
-            x[5], y[5], prod[9];
+        /* entries (row, column) of the two 2 x 2 minors, each a quadratic in q */
+        const int rc[8][2] = {{0, a}, {1, b}, {0, b}, {1, a}, {2, cc}, {3, dd}, {2, dd}, {3, cc}};
+        double e[8][3], m01[5], m23[5], x[5], y[5], prod[9];
         double sign = ((a + b + 1) & 1) ? -1.0 : 1.0;
-        for (i = 0; i < 3; ++i) {
-            p0a[i] = Mq[i][0 * 4 + a];
-            p0b[i] = Mq[i][0 * 4 + b];
-            p1a[i] = Mq[i][1 * 4 + a];
-            p1b[i] = Mq[i][1 * 4 + b];
-            p2c[i] = Mq[i][2 * 4 + cc];
-            p2d[i] = Mq[i][2 * 4 + dd];
-            p3c[i] = Mq[i][3 * 4 + cc];
-            p3d[i] = Mq[i][3 * 4 + dd];
-        }
-        poly_mul(p0a, 2, p1b, 2, x);
-        poly_mul(p0b, 2, p1a, 2, y);
+        int q;
+        for (q = 0; q < 8; ++q)
+            for (i = 0; i < 3; ++i)
+                e[q][i] = Mq[i][4 * rc[q][0] + rc[q][1]];
+        poly_mul(e[0], 2, e[1], 2, x);
+        poly_mul(e[2], 2, e[3], 2, y);
         for (i = 0; i < 5; ++i)
             m01[i] = x[i] - y[i];
-        poly_mul(p2c, 2, p3d, 2, x);
-        poly_mul(p2d, 2, p3c, 2, y);
+        poly_mul(e[4], 2, e[5], 2, x);
+        poly_mul(e[6], 2, e[7], 2, y);
         for (i = 0; i < 5; ++i)
             m23[i] = x[i] - y[i];
         poly_mul(m01, 4, m23, 4, prod);
