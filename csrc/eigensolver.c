@@ -57,7 +57,7 @@
 #include <string.h>
 
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction */
-#define MAX_PAIRS (1 << 26)
+#define MAX_PAIRS (1 << 20) /* the rows mcg_svd takes */
 
 size_t mcg_eigensolver_work_size(int n)
 {
@@ -244,6 +244,8 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
         !iterations || !work)
         return MCG_EINVAL;
     if (n < 1 || n > MAX_PAIRS || max_iterations < 0 || max_iterations > 100000)
+        return MCG_EINVAL;
+    if (mcg_eigensolver_work_size(n) == 0)
         return MCG_EINVAL;
     if (lwork < mcg_eigensolver_work_size(n))
         return MCG_ENOMEM;

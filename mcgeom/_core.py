@@ -1125,6 +1125,8 @@ def eigensolver(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
     """
     rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 1)
     n = rays[0].shape[0]
+    if n > 1 << 20:
+        raise ValueError(f"eigensolver: at most 2^20 correspondences supported, got {n}")
     R0 = _f64("R0", R0, (3, 3))
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
             or not 0 <= int(max_iterations) <= 100000:

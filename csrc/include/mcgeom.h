@@ -930,7 +930,7 @@ size_t mcg_eigensolver_work_size(int n);
  * increments of R from R0 (a rotation, e.g. of linear17) for at most
  * max_iterations steps (0..100000; 0 evaluates at R0). Pairs (o1, d1) <->
  * (o2, d2) as for mcg_gec_residuals (n x 3 each, rig frames at times 1 and 2,
- * metres, directions of any non-zero length), n in [1, 2^26]. Outputs: R and
+ * metres, directions of any non-zero length), n in [1, 2^20]. Outputs: R and
  * t (rig2_from_rig1, X2 = R X1 + t; t metric when *has_scale = 1, else t =
  * u + c - R c with u the unit direction of travel of the centroid c of the
  * origins: no rotation and intra-camera rays only, or all rays from one
