@@ -30,6 +30,7 @@ __all__ = [
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
     "skyline_eig",
     "essential5", "essential_decompose",
+    "upright4", "eigensolver",
 ]
 
 GC_CASE_NAMES = {
@@ -1278,3 +1279,68 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         "scale_profile": res.scale_profile,
         "refinement": _refine_dict(res.refinement, R, t) if res.refined else None,
     }
+# ------------------------------------------------------------- upright4.c
+
+def upright4(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, gravity1: Any,
+             gravity2: Any) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Every motion of 4 correspondences with a known vertical (``mcg_upright4``).
+
+    Rays (4, 3) each as for :func:`gec_residuals` (rig frames at times 1 and 2,
+    metres); ``gravity1``/``gravity2`` (3,) the vertical direction in rig
+    frame 1 / rig frame 2 (any non-zero length, the same physical direction).
+    Returns the real solutions ``(R, t)`` rig2_from_rig1 (``X2 = R X1 + t``,
+    ``R gravity1 = gravity2`` up to their lengths, ``t`` metric), up to 8.
+    ValueError names a bad argument; DegenerateError when the four rays fix no
+    yaw (e.g. all from one centre).
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 4)
+    if rays[0].shape[0] != 4:
+        raise ValueError(f"upright4: exactly 4 correspondences needed, got {rays[0].shape[0]}")
+    g1 = _f64("gravity1", gravity1, (3,))
+    g2 = _f64("gravity2", gravity2, (3,))
+    R = np.empty((lib.MCG_UPRIGHT4_MAX_SOLUTIONS, 3, 3))
+    t = np.empty((lib.MCG_UPRIGHT4_MAX_SOLUTIONS, 3))
+    n = ffi.new("int *")
+    st = lib.mcg_upright4(_p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]), _p(g1), _p(g2),
+                          _p(R), _p(t), n)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL:
+            for name, g in (("gravity1", g1), ("gravity2", g2)):
+                if np.isfinite(g).all() and not g @ g >= 1e-100:
+                    raise ValueError(f"upright4: {name} has zero length")
+        _ray_error(st, "upright4", rays, (("gravity1", g1), ("gravity2", g2)))
+    return [(R[k], t[k]) for k in range(n[0])]
+
+
+# ---------------------------------------------------------- eigensolver.c
+
+def eigensolver(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
+                max_iterations: int = 100) -> dict:
+    """Kneip and Li's eigensolver from the start rotation ``R0`` (``mcg_eigensolver``).
+
+    Rays (N, 3) each as for :func:`gec_residuals` (rig frames, metres). Returns
+    ``R`` (3, 3), ``t`` (3,) rig2_from_rig1 (metric when ``has_scale``, else
+    ``u + c - R c`` with ``u`` the unit travel direction of the origins'
+    centroid ``c``), ``lambda_min`` (the smallest eigenvalue left, the
+    algebraic cost) and ``iterations``. ValueError names a bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 1)
+    n = rays[0].shape[0]
+    if n > 1 << 20:
+        raise ValueError(f"eigensolver: at most 2^20 correspondences supported, got {n}")
+    R0 = _f64("R0", R0, (3, 3))
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
+            or not 0 <= int(max_iterations) <= 100000:
+        raise ValueError(f"max_iterations must be an integer in 0..100000, got {max_iterations!r}")
+    work = _work(lib.mcg_eigensolver_work_size(n))
+    R, t = np.empty((3, 3)), np.empty(3)
+    lam, has, its = ffi.new("double *"), ffi.new("int *"), ffi.new("int *")
+    st = lib.mcg_eigensolver(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]), _p(R0),
+                             int(max_iterations), _p(R), _p(t), lam, has, its, _p(work),
+                             work.size)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL and np.isfinite(R0).all() and _not_rotation(R0):
+            raise ValueError("eigensolver: R0 is not a rotation")
+        _ray_error(st, "eigensolver", rays, (("R0", R0),))
+    return {"R": R, "t": t, "lambda_min": float(lam[0]), "has_scale": bool(has[0]),
+            "iterations": int(its[0])}

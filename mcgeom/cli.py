@@ -51,6 +51,11 @@ def _cmd_methods(args: argparse.Namespace) -> int:
         print(f"    camera kinds: {', '.join(e.camera_kinds)}")
         for k, v in e.options.items():
             print(f"    option {k}: {v}")
+    print("\nThe facade (mcgeom.cv.estimate, estimateRigMotion) by default runs five_plus_one "
+          "inside LO-RANSAC (5 correspondences of one camera + 1 of another); with a vertical "
+          "prior (gravity1=, gravity2=: the gravity direction in the rig frame at each time, "
+          "e.g. from an IMU) upright_four_point (4-samples, the yaw about the vertical); any "
+          "registered name, 'ransac:NAME' or 'direct:NAME' may be passed as method.")
     # the LP backends of bnb_lp: the available ones, and why GLPK is not (with
     # the command that brings it) when it is not
     print(f"\nLP backends (bnb_lp, default {registry.default_lp_backend()}):")

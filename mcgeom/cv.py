@@ -39,7 +39,7 @@ from .validation import integral_camera_ids
 
 __all__ = [
     "RIG_5P1_RANSAC", "RIG_LINEAR17", "RIG_LINEAR17_RANSAC", "RIG_5P1_DIRECT",
-    "estimateRigMotion", "estimate",
+    "RIG_UPRIGHT_RANSAC", "estimateRigMotion", "estimate",
 ]
 
 #: 5+1 method (thesis ch. 7) inside LO-RANSAC: the default
@@ -50,6 +50,32 @@ RIG_LINEAR17 = "linear17"
 RIG_LINEAR17_RANSAC = "ransac:linear17"
 #: 5+1 on all correspondences (no outlier rejection)
 RIG_5P1_DIRECT = "direct:five_plus_one"
+#: upright 4-point with a known vertical inside LO-RANSAC (chosen by itself when
+#: ``gravity1``/``gravity2`` are passed with the default method)
+RIG_UPRIGHT_RANSAC = "upright_four_point"
+
+
+def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) -> str:
+    """The method to run when a vertical prior may be given: the default 5+1
+    becomes the upright 4-point (4-samples instead of 6: fewer iterations at
+    a given outlier rate); the prior goes into ``options``. ValueError when
+    only one of the two is given, or the named method does not take it."""
+    if gravity1 is None and gravity2 is None:
+        return method
+    if gravity1 is None or gravity2 is None:
+        missing = "gravity1" if gravity1 is None else "gravity2"
+        raise ValueError(f"{missing} is missing: a vertical prior needs the gravity direction "
+                         "in the rig frame at both times (gravity1=, gravity2=)")
+    if not isinstance(method, str):
+        return method           # _resolve names the problem
+    if method == RIG_5P1_RANSAC:
+        method = RIG_UPRIGHT_RANSAC
+    base = method.split(":", 1)[1] if method.startswith(("ransac:", "direct:")) else method
+    if "gravity1" not in registry.get(base).options:
+        raise ValueError(f"gravity1/gravity2 are given but method {method!r} does not use a "
+                         f"vertical prior; use {RIG_UPRIGHT_RANSAC!r} (or the default method)")
+    options["gravity1"], options["gravity2"] = gravity1, gravity2
+    return method
 
 
 def _points(name: str, p: Any) -> np.ndarray:
@@ -121,6 +147,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
              method: str = RIG_5P1_RANSAC, prob: float = 0.999, threshold: float = 1.0,
              maxIters: int = 1000, mask: Any = None, seed: Optional[int] = 0,
              robust: Optional[bool] = None, calibration_std: Any = None,
+             gravity1: Any = None, gravity2: Any = None,
              **options: Any) -> RigMotion:
     """Full :class:`RigMotion` rig2_from_rig1 from pixel correspondences of ``rig``.
 
@@ -142,6 +169,11 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     metres, rotation std in radians) for every camera, or one per camera.
     ``scale.rel_std`` (and ``info['covariance']``) include its effect on the
     metric scale, and the verdict is decided on that total.
+
+    ``gravity1``/``gravity2`` (3-vectors, e.g. an IMU's gravity in the rig frame
+    at time 1 and at time 2) are a vertical prior: with the default method the
+    search then runs the upright 4-point solver (``RIG_UPRIGHT_RANSAC``); the
+    final refinement frees all six degrees of freedom.
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
@@ -161,6 +193,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
                              f"got dtype {m.dtype}" + (" with NaN or inf" if m.dtype.kind == "f"
                                                        else ""))
         use = m != 0
+    method = _gravity_method(method, gravity1, gravity2, options)
     name, run_robust = _resolve(method, robust)
     if not run_robust:
         _no_ransac_options(name, prob=prob, threshold=threshold, maxIters=maxIters, seed=seed)
@@ -174,10 +207,13 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     rays = rays_all if keep is None else rays_all.take(keep)
     if run_robust:
         # thresholds in pixels: the pixel-noise model of the rig converts them
+        # the vertical prior is for the minimal solver (the final refinement is free)
+        prior = {k: options.pop(k) for k in ("gravity1", "gravity2") if k in options}
         m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
                            seed=seed, focal=pixels_per_radian(rig, rays),
                            motion_focal=sampson_pixel_scale(rig), calibration_std=cal,
-                           pixel_cameras=camera_table(rig), **options)
+                           pixel_cameras=camera_table(rig), solver_options=prior or None,
+                           **options)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:
@@ -194,7 +230,8 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
 def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
                       method: str = RIG_5P1_RANSAC, prob: float = 0.999,
                       threshold: float = 1.0, maxIters: int = 1000,
-                      mask: Any = None) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+                      mask: Any = None, gravity1: Any = None, gravity2: Any = None
+                      ) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
     """OpenCV-style rig motion: ``retval, R, t, mask`` (see the module docstring).
 
     Same arguments as :func:`estimate`. ``R`` (3x3) and ``t`` (3x1, metres) map
@@ -213,7 +250,8 @@ def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     :func:`estimate` for the full verdict.
     """
     m = estimate(points1, points2, cameraIds1, cameraIds2, rig, method=method, prob=prob,
-                 threshold=threshold, maxIters=maxIters, mask=mask)
+                 threshold=threshold, maxIters=maxIters, mask=mask, gravity1=gravity1,
+                 gravity2=gravity2)
     if not m.scale.observable and np.any(m.t != 0):
         if m.info.get("scale_determined", False):
             what = (f"t is the maximum-likelihood metric estimate, but its relative standard "

@@ -83,10 +83,12 @@ class MinimalSolver(Protocol):
     epipolar constraints to rounding. A degenerate sample returns ``[]`` or
     raises :class:`mcgeom.errors.DegenerateError` (the robust layer skips it).
     The robust layer scores each solution on all correspondences (cf. PoseLib's
-    ``generate_models``).
+    ``generate_models``). Keyword options (e.g. the gravity directions of
+    ``upright_four_point``) come from ``mcgeom.robust.ransac(solver_options=...)``.
     """
 
-    def __call__(self, sample: RayPairs, /) -> list[tuple[np.ndarray, np.ndarray]]: ...
+    def __call__(self, sample: RayPairs, /, **options: Any
+                 ) -> list[tuple[np.ndarray, np.ndarray]]: ...
 
 
 class Sampler(Protocol):

@@ -272,7 +272,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
            options: Optional[RansacOptions] = None,
            motion_focal: Optional[MotionFocal] = None, calibration_std: Any = None,
            pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]] = None,
-           **kw: Any) -> RigMotion:
+           solver_options: Optional[dict] = None, **kw: Any) -> RigMotion:
     """Robust rig motion rig2_from_rig1 from correspondences with outliers.
 
     ``method`` is a registered estimator with a minimal solver or a proposer.
@@ -288,7 +288,9 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     (:attr:`mcgeom.rig.Rig.extrinsic_std`; :func:`mcgeom.cv.estimate` passes
     the rig's): the relative std of ``|t|`` and the verdict include its
     effect (:func:`mcgeom.observability.calibration_scale_std`); None = rays
-    known exactly. Further ``RansacOptions`` fields may be passed as keywords.
+    known exactly. ``solver_options`` are keyword options of the estimator's
+    minimal solver (e.g. ``gravity1``/``gravity2`` of ``upright_four_point``).
+    Further ``RansacOptions`` fields may be passed as keywords.
 
     ``five_plus_one`` with ``strategy="auto"`` runs as one call of the C
     entry point ``mcg_robust_rig_motion`` (csrc/robust.c: 5+1 sampling,
@@ -342,7 +344,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         # proposer's own search): fall back to minimal samples where possible
         use_proposer = scorer.best is not None or info_est.minimal_solver is None
     if not use_proposer:
-        iterations += _run_minimal(info_est, rays, scorer, options, rng)
+        iterations += _run_minimal(info_est, rays, scorer, options, rng, solver_options or {})
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
         return _nothing_found(rays, scorer, options, method, t_start, max(6, info_est.min_sample),
                               f" ({scorer.n_hyp} hypotheses from {iterations} samples)")
@@ -454,7 +456,7 @@ def _ratio(mask: np.ndarray) -> float:
 
 
 def _run_minimal(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptions,
-                 rng: np.random.Generator) -> int:
+                 rng: np.random.Generator, solver_options: dict) -> int:
     """Classic LO-RANSAC loop over minimal samples with the adaptive stop."""
     sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
     k_needed = options.max_iters
@@ -463,7 +465,7 @@ def _run_minimal(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptio
         iterations += 1
         try:
             idx = sampler(rays, rng)
-            sols = info_est.minimal_solver(rays.take(idx))
+            sols = info_est.minimal_solver(rays.take(idx), **solver_options)
         except DegenerateError:
             continue
         for R, t in sols:

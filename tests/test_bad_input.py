@@ -50,6 +50,8 @@ def row(rid: str, given: str, gets: str) -> Callable:
 R_TOL = np.radians(0.5)
 DIR_TOL = np.radians(10.0)   # 15 rays of one camera at 0.3 px: e_socp is 5 deg off
 MOTION = (synth.rotation_about([0, 0, 1], 0.2), np.array([0.3, 0.1, 0.05]))
+#: the vertical in rig frame 1 given to estimators that take it (``gravity1``)
+GRAVITY1 = np.array([0.0, -1.0, 0.1]) / np.linalg.norm([0.0, -1.0, 0.1])
 
 
 def names() -> list[str]:
@@ -59,9 +61,15 @@ def names() -> list[str]:
 def est(rp, name: str, R=None, **kw):
     """``mcgeom.estimate(rp, name)``; an estimator that declares it needs the
     rotation (registry ``needs_rotation``) is given the row's true rotation
-    ``R`` (default: that of ``MOTION``), as its users would."""
-    if mcgeom.registry.get(name).needs_rotation:
-        kw.setdefault("rotation", MOTION[0] if R is None else R)
+    ``R`` (default: that of ``MOTION``), as its users would; one that takes the
+    vertical (``gravity1``/``gravity2``) gets ``GRAVITY1`` and ``R GRAVITY1``."""
+    info = mcgeom.registry.get(name)
+    R_true = MOTION[0] if R is None else R
+    if info.needs_rotation:
+        kw.setdefault("rotation", R_true)
+    if "gravity1" in info.options:   # the vertical of an IMU, consistent with R
+        kw.setdefault("gravity1", GRAVITY1)
+        kw.setdefault("gravity2", R_true @ GRAVITY1)
     return mcgeom.estimate(rp, name, **kw)
 
 

@@ -25,10 +25,20 @@ def _n(name):
     return max(60, 3 * registry.get(name).min_sample)
 
 
-def _given(name, R):
+#: the vertical of the test problems in rig frame 1 (any direction serves)
+G1 = np.array([0.3, -0.9, 0.2]) / np.linalg.norm([0.3, -0.9, 0.2])
+
+
+def _given(name, R, g1=G1):
     """Options of an estimator that needs the rotation: the true one, expressed
-    as the test's transformed data require (conjugated, inverted)."""
-    return {"rotation": R} if registry.get(name).needs_rotation else {}
+    as the test's transformed data require (conjugated, inverted); of one that
+    takes the vertical (``gravity1``/``gravity2``, e.g. an IMU's): ``g1`` in rig
+    frame 1 (re-expressed likewise) and ``R g1`` in rig frame 2."""
+    info = registry.get(name)
+    out = {"rotation": R} if info.needs_rotation else {}
+    if "gravity1" in info.options:
+        out.update(gravity1=g1, gravity2=R @ g1)
+    return out
 
 
 def test_every_estimator_is_covered():
@@ -71,7 +81,8 @@ def test_invariant_to_rig_frame(name, kind, seed):
     p = make(kind, seed, n=_n(name), angular_noise=3e-4)
     Rf, tf = rigid(np.random.default_rng(seed + 1))
     m = mcgeom.estimate(p.rays, name, **_given(name, p.R))
-    mf = mcgeom.estimate(p.rays.in_frame(Rf, tf), name, **_given(name, Rf @ p.R @ Rf.T))
+    mf = mcgeom.estimate(p.rays.in_frame(Rf, tf), name,
+                         **_given(name, Rf @ p.R @ Rf.T, Rf @ G1))
     F = np.eye(4)
     F[:3, :3], F[:3, 3] = Rf, tf
     expect = F @ m.T @ np.linalg.inv(F)
@@ -110,7 +121,7 @@ def test_invariant_to_permutation(name, kind, seed):
 def test_swapping_frames_inverts_motion(name, kind, seed):
     p = make(kind, seed, n=_n(name))
     a = mcgeom.estimate(p.rays, name, **_given(name, p.R))
-    b = mcgeom.estimate(p.rays.swapped(), name, **_given(name, p.R.T))
+    b = mcgeom.estimate(p.rays.swapped(), name, **_given(name, p.R.T, p.R @ G1))
     inv = a.inverse()
     assert rot_err(b.R, inv.R) < 1e-8
     assert np.linalg.norm(b.t - inv.t) < 1e-8 * (1 + np.linalg.norm(inv.t))

@@ -1026,6 +1026,58 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                           const double *cam_focal, const mcg_robust_options *opt,
                           mcg_robust_result *res, unsigned char *mask, double *weights,
                           double *work, size_t lwork);
+/* ------------------------------------------------------------- upright4.c */
+
+/* Upper bound on the solutions of mcg_upright4 (the degree of its polynomial). */
+enum { MCG_UPRIGHT4_MAX_SOLUTIONS = 8 };
+
+/* Minimal generalized relative pose with a known vertical direction (the
+ * "upright" 4-point problem; Sweeney et al. 3DV 2014, Lee et al. CVPR 2014):
+ * every motion rig2_from_rig1 (R, t), X2 = R X1 + t, with R g1 = g2 that
+ * satisfies the generalized epipolar constraint of the four correspondences
+ * (o1[k], d1[k]) <-> (o2[k], d2[k]) (4 x 3 each, rig frames at times 1 and 2,
+ * metres; directions of any non-zero length). g1, g2: the vertical (gravity)
+ * direction in rig frame 1 and rig frame 2 (any non-zero length; the same
+ * physical direction, so R g1 = g2). Writes *n_solutions (0..8) real
+ * solutions: R (row-major 3 x 3 each, 8 x 9 doubles) and t (8 x 3 doubles,
+ * metric). The yaw about the vertical is a root of a degree-8 polynomial in
+ * the tangent half-angle (derivation in csrc/upright4.c); a yaw of exactly
+ * 180 degrees is not represented. MCG_EINVAL: NULL pointers, NaN/inf, a
+ * zero-length direction or gravity (|v| < 1e-50), magnitudes whose products
+ * overflow. MCG_EDEGENERATE: the four determine no yaw (e.g. every ray from
+ * one centre: a central camera has no metric scale). No solution (*n_solutions = 0) is MCG_OK. */
+int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
+                 const double d2[12], const double g1[3], const double g2[3], double R[72],
+                 double t[24], int *n_solutions);
+
+/* ---------------------------------------------------------- eigensolver.c */
+
+/* Workspace (doubles) of mcg_eigensolver for n pairs; 0 for invalid n. */
+size_t mcg_eigensolver_work_size(int n);
+
+/* Generalized relative pose by minimising the smallest eigenvalue of the
+ * generalized-epipolar matrix over the rotation (Kneip and Li, CVPR 2014):
+ * M(R) = sum_k v_k v_k^T with v_k = (R d1 x d2, d2 . R m1 + m2 . R d1) (the
+ * constraint on (t, 1), origins centred on their mean and scaled by their RMS
+ * spread, unit directions), minimised by Levenberg-Marquardt over left
+ * increments of R from R0 (a rotation, e.g. of linear17) for at most
+ * max_iterations steps (0..100000; 0 evaluates at R0). Pairs (o1, d1) <->
+ * (o2, d2) as for mcg_gec_residuals (n x 3 each, rig frames at times 1 and 2,
+ * metres, directions of any non-zero length), n in [1, 2^20]. Outputs: R and
+ * t (rig2_from_rig1, X2 = R X1 + t; t metric when *has_scale = 1, else t =
+ * u + c - R c with u the unit direction of travel of the centroid c of the
+ * origins: no rotation and intra-camera rays only, or all rays from one
+ * centre, leave |t| free); *lambda_min the smallest eigenvalue at R
+ * (dimensionless, the algebraic cost left), *iterations the steps taken.
+ * A local minimiser: the result is the minimum of the basin of R0. Workspace
+ * lwork >= mcg_eigensolver_work_size(n). MCG_EINVAL: NULL pointers, n,
+ * max_iterations, NaN/inf, R0 not a rotation, a zero-length direction,
+ * magnitudes that overflow; MCG_ENOMEM; MCG_ENUMERIC: the eigen-solver did
+ * not converge. */
+int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
+                    const double *d2, const double R0[9], int max_iterations, double R[9],
+                    double t[3], double *lambda_min, int *has_scale, int *iterations,
+                    double *work, size_t lwork);
 
 /* MCG_CDEF_END */
 

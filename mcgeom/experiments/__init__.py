@@ -55,6 +55,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
                                                  "from the real recordings that "
                                                  "tests/test_real_data_estimators.py runs "
                                                  "every estimator on"),
+    "peer_solvers": ("peer_solvers", "the upright 4-point solver next to PoseLib's: noise-free "
+                                     "minimal configurations, then RANSAC from pixels with a "
+                                     "known vertical (needs poselib)"),
     "batch_scaling": ("batch_scaling", "mcgeom batch on Dask: sequences per minute with 1 "
                                        "and 2 workers, scheduler overhead per task, and the "
                                        "extrapolation to 10,000 sequences (needs dask)"),

@@ -103,7 +103,9 @@ def poselib_estimate(setup: tuple, p, ransac_options: dict) -> tuple[np.ndarray,
     return np.asarray(pose.R), np.asarray(pose.t)
 
 
-def _poselib(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
+def poselib_motion(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
+    """PoseLib's robust generalized relative pose of problem ``p`` (pixels of ``rig``),
+    its default RANSAC and bundle options, 1 px threshold: ``(R, t)`` rig2_from_rig1."""
     return poselib_estimate(poselib_setup(rig), p, {"max_epipolar_error": 1.0})
 
 
@@ -130,7 +132,7 @@ def run(trials: int = 50, seed: int = 0, cases=None, progress: Progress = no_pro
         for _ in progress(range(trials), total=trials, desc=name):
             R, t = draw(rng)
             p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
-            for meth, fn in (("mcgeom", _mcgeom), ("poselib", _poselib)):
+            for meth, fn in (("mcgeom", _mcgeom), ("poselib", poselib_motion)):
                 t0, c0 = time.perf_counter(), time.process_time()
                 Re, te, *tm = fn(rig, p)
                 res[meth][2].append(time.process_time() - c0)

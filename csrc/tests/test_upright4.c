@@ -1,0 +1,254 @@
+/*
+ * test_upright4.c -- plain-C checks of csrc/upright4.c (mcg_upright4), the
+ * minimal generalized relative pose with a known vertical.
+ *
+ * Independent references: (1) the true motion of random noise-free
+ * configurations (generic rigs with cross-camera rays, 2-camera heads) must
+ * be among the solutions to 1e-8; (2) every returned solution satisfies the
+ * four generalized epipolar constraints and R g1 = g2; (3) the number of
+ * solutions equals the number of sign changes of det M(theta), computed by
+ * direct LU of the 4 x 4 matrix of rows [ (R d1 x d2)^T, d2.R m1 + m2.R d1 ]
+ * on a fine grid of yaws (no polynomial, no upright frames: the rotations
+ * with R g1 = g2 are built by Rodrigues' formula, yaw_rotation()); (4) status codes of
+ * invalid and degenerate input. Exit status 0 iff every check passes.
+ */
+#include "mcgeom.h"
+
+#define TEST_SEED 0x0b417f4a11ULL
+#include "testutil.h"
+#include "../so3.h" /* dot3, cross3, mat_vec, mul33 */
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static void random_rotation(double R[9], double max_angle)
+{
+    double w[3], n;
+    int i;
+    randn(w, 3);
+    n = sqrt(dot3(w, w));
+    for (i = 0; i < 3; i++)
+        w[i] *= max_angle * (2.0 * urand() - 1.0) / n;
+    mcg_rot_from_angle_axis(w, R);
+}
+
+/* A noise-free problem: 4 correspondences of a rig with ncam cameras
+ * (centres random within 0.5 m, or a 2-camera head with baseline 0.3 m),
+ * cross-camera pairs when cross != 0, points 2..10 m away. */
+static void make_problem(int head, int cross, const double R[9], const double t[3],
+                         double o1[12], double d1[12], double o2[12], double d2[12])
+{
+    double cen[4][3];
+    int k, i;
+    for (k = 0; k < 4; k++)
+        for (i = 0; i < 3; i++)
+            cen[k][i] = head ? (i == 0 ? (k & 1 ? 0.15 : -0.15) : 0.0) : 0.5 * nrand();
+    for (k = 0; k < 4; k++) {
+        int c1 = head ? k & 1 : k, c2 = cross ? (head ? (k + 1) & 1 : (k + 1) % 4) : c1;
+        double X[3], X2[3], dir[3], n;
+        randn(dir, 3);
+        n = sqrt(dot3(dir, dir));
+        for (i = 0; i < 3; i++)
+            X[i] = cen[c1][i] + (2.0 + 8.0 * urand()) * dir[i] / n;
+        mat_vec(R, X, X2);
+        for (i = 0; i < 3; i++) {
+            X2[i] += t[i];
+            o1[3 * k + i] = cen[c1][i];
+            d1[3 * k + i] = X[i] - cen[c1][i];
+            o2[3 * k + i] = cen[c2][i];
+            d2[3 * k + i] = X2[i] - cen[c2][i];
+        }
+    }
+}
+
+/* generalized epipolar residual of correspondence k (unit directions) */
+static double gec(const double R[9], const double t[3], const double *o1, const double *d1,
+                  const double *o2, const double *d2)
+{
+    double a[3], b[3], m1[3], m2[3], Rd[3], Rm[3], x[3], n1 = sqrt(dot3(d1, d1)),
+        n2 = sqrt(dot3(d2, d2));
+    int i;
+    for (i = 0; i < 3; i++) {
+        a[i] = d1[i] / n1;
+        b[i] = d2[i] / n2;
+    }
+    cross3(o1, a, m1);
+    cross3(o2, b, m2);
+    mat_vec(R, a, Rd);
+    mat_vec(R, m1, Rm);
+    cross3(Rd, b, x);
+    return dot3(t, x) + dot3(b, Rm) + dot3(m2, Rd);
+}
+
+/* The rotation with R g1 = g2 and yaw theta: Rodrigues' rotation taking g1
+ * to g2 (about g1 x g2), preceded by theta about g1. */
+static void yaw_rotation(const double g1[3], const double g2[3], double th, double R[9])
+{
+    double w[3], A[9], B[9], s, c;
+    int i, j, k;
+    cross3(g1, g2, w);
+    s = sqrt(dot3(w, w));
+    c = dot3(g1, g2);
+    for (i = 0; i < 3; i++)
+        w[i] = s > 0 ? w[i] / s * atan2(s, c) : 0.0;
+    mcg_rot_from_angle_axis(w, A);
+    for (i = 0; i < 3; i++)
+        w[i] = th * g1[i];
+    mcg_rot_from_angle_axis(w, B);
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) {
+            R[3 * i + j] = 0.0;
+            for (k = 0; k < 3; k++)
+                R[3 * i + j] += A[3 * i + k] * B[3 * k + j];
+        }
+}
+
+static double det4(double M[16])
+{
+    double d = 1.0;
+    int i, j, k;
+    for (k = 0; k < 4; k++) {
+        int p = k;
+        for (i = k + 1; i < 4; i++)
+            if (fabs(M[4 * i + k]) > fabs(M[4 * p + k]))
+                p = i;
+        if (M[4 * p + k] == 0.0)
+            return 0.0;
+        if (p != k) {
+            for (j = 0; j < 4; j++) {
+                double s = M[4 * k + j];
+                M[4 * k + j] = M[4 * p + j];
+                M[4 * p + j] = s;
+            }
+            d = -d;
+        }
+        d *= M[4 * k + k];
+        for (i = k + 1; i < 4; i++) {
+            double f = M[4 * i + k] / M[4 * k + k];
+            for (j = k; j < 4; j++)
+                M[4 * i + j] -= f * M[4 * k + j];
+        }
+    }
+    return d;
+}
+
+static double det_at(const double g1[3], const double g2[3], double th, const double *o1,
+                     const double *d1, const double *o2, const double *d2)
+{
+    double R[9], M[16], z[3] = {0, 0, 0};
+    int k;
+    yaw_rotation(g1, g2, th, R);
+    for (k = 0; k < 4; k++) {
+        double a[3], Ra[3], x[3], n = sqrt(dot3(d1 + 3 * k, d1 + 3 * k)),
+                                  nb = sqrt(dot3(d2 + 3 * k, d2 + 3 * k)), b[3];
+        int i;
+        for (i = 0; i < 3; i++) {
+            a[i] = d1[3 * k + i] / n;
+            b[i] = d2[3 * k + i] / nb;
+        }
+        mat_vec(R, a, Ra);
+        cross3(Ra, b, x);
+        memcpy(M + 4 * k, x, sizeof x);
+        M[4 * k + 3] = gec(R, z, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k);
+    }
+    return det4(M);
+}
+
+static void test_random(int head, int cross, int trials, const char *label)
+{
+    int trial, found = 0, count_ok = 0, counted = 0;
+    double worst_gec = 0.0, worst_g = 0.0;
+    char what[128];
+    for (trial = 0; trial < trials; trial++) {
+        double R[9], t[3], o1[12], d1[12], o2[12], d2[12], g1[3], g2[3], Rs[72], ts[24];
+        int n = -1, st, s, k, i, hit = 0;
+        random_rotation(R, 3.14159);
+        randn(t, 3);
+        randn(g1, 3);
+        mat_vec(R, g1, g2);
+        make_problem(head, cross, R, t, o1, d1, o2, d2);
+        st = mcg_upright4(o1, d1, o2, d2, g1, g2, Rs, ts, &n);
+        if (st != MCG_OK) {
+            check_status(st, MCG_OK, label);
+            continue;
+        }
+        for (s = 0; s < n; s++) {
+            double e = 0.0, Rg[3], gn = sqrt(dot3(g1, g1)), g2n = sqrt(dot3(g2, g2));
+            for (i = 0; i < 9; i++)
+                e = fmax(e, fabs(Rs[9 * s + i] - R[i]));
+            for (i = 0; i < 3; i++)
+                e = fmax(e, fabs(ts[3 * s + i] - t[i]) / sqrt(dot3(t, t)));
+            hit |= e < 1e-8;
+            for (k = 0; k < 4; k++)
+                worst_gec = fmax(worst_gec, fabs(gec(Rs + 9 * s, ts + 3 * s, o1 + 3 * k,
+                                                     d1 + 3 * k, o2 + 3 * k, d2 + 3 * k)) /
+                                                (1.0 + sqrt(dot3(ts + 3 * s, ts + 3 * s))));
+            mat_vec(Rs + 9 * s, g1, Rg);
+            for (i = 0; i < 3; i++)
+                worst_g = fmax(worst_g, fabs(Rg[i] / gn - g2[i] / g2n));
+        }
+        found += hit;
+        if (trial < trials / 20) { /* the sign changes of det M(theta) on a grid */
+            double g1u[3], g2u[3], prev, th;
+            int changes = 0, j;
+            for (i = 0; i < 3; i++) {
+                g1u[i] = g1[i] / sqrt(dot3(g1, g1));
+                g2u[i] = g2[i] / sqrt(dot3(g2, g2));
+            }
+            prev = det_at(g1u, g2u, -3.14159265358979, o1, d1, o2, d2);
+            for (j = 1; j <= 4000; j++) {
+                double cur;
+                th = -3.14159265358979 + 6.28318530717958 * j / 4000.0;
+                cur = det_at(g1u, g2u, th, o1, d1, o2, d2);
+                changes += (cur < 0.0) != (prev < 0.0);
+                prev = cur;
+            }
+            count_ok += changes == n;
+            counted++;
+        }
+    }
+    snprintf(what, sizeof what, "%s: true motion among the solutions (fraction)", label);
+    check(found >= 0.995 * trials, what, (double)found / trials, 0.995);
+    snprintf(what, sizeof what, "%s: every solution satisfies the 4 constraints", label);
+    check(worst_gec < 1e-9, what, worst_gec, 1e-9);
+    snprintf(what, sizeof what, "%s: every solution maps g1 to g2", label);
+    check(worst_g < 1e-12, what, worst_g, 1e-12);
+    snprintf(what, sizeof what, "%s: solution count = sign changes of det M(yaw)", label);
+    check(count_ok >= 0.98 * counted, what, (double)count_ok / counted, 0.98);
+}
+
+static void test_status(void)
+{
+    double o[12] = {0}, d[12], g[3] = {0, 0, 1}, R[72], t[24], zero[3] = {0, 0, 0};
+    int n, i, st;
+    for (i = 0; i < 12; i++)
+        d[i] = (i % 3 == 2) ? 1.0 : 0.1 * (i % 5);
+    check_status(mcg_upright4(NULL, d, o, d, g, g, R, t, &n), MCG_EINVAL, "NULL o1");
+    check_status(mcg_upright4(o, d, o, d, g, g, R, t, NULL), MCG_EINVAL, "NULL n_solutions");
+    check_status(mcg_upright4(o, d, o, d, zero, g, R, t, &n), MCG_EINVAL, "zero gravity g1");
+    {
+        double dn[12];
+        memcpy(dn, d, sizeof d);
+        dn[4] = NAN;
+        check_status(mcg_upright4(o, dn, o, d, g, g, R, t, &n), MCG_EINVAL, "NaN in d1");
+        dn[4] = 0.0;
+        dn[3] = dn[5] = 0.0;
+        check_status(mcg_upright4(o, dn, o, d, g, g, R, t, &n), MCG_EINVAL,
+                     "zero-length direction");
+    }
+    /* every ray from one centre: no metric scale, det M = 0 for every yaw */
+    st = mcg_upright4(o, d, o, d, g, g, R, t, &n);
+    check_status(st, MCG_EDEGENERATE, "central rays (one centre)");
+}
+
+int main(void)
+{
+    test_random(0, 1, scaled(3000), "generic 4-camera rig, cross-camera");
+    test_random(0, 0, scaled(3000), "generic 4-camera rig, intra-camera");
+    test_random(1, 0, scaled(3000), "2-camera head, intra-camera");
+    test_random(1, 1, scaled(3000), "2-camera head, cross-camera");
+    test_status();
+    printf("%d checks, %d failed\n", n_checks, n_failed);
+    return n_failed != 0;
+}

@@ -1,0 +1,79 @@
+/*
+ * fuzz_upright4.c -- libFuzzer harness of mcg_upright4, the minimal
+ * generalized relative pose with a known vertical direction.
+ *
+ * Inputs: mode 0 a synthetic rig scene of 4 pairs (1-4 cameras, intra- or
+ * cross-camera, fz_scene's noise and replaced entries) with the gravity of
+ * frame 2 consistent with the motion (R g1) or perturbed; mode 1 arbitrary
+ * rays and gravity vectors. Invariants: NaN/inf or zero-length inputs give
+ * MCG_EINVAL, the status is always a known one; on MCG_OK 0 <= n <= 8 and
+ * every solution is finite, a rotation (orthonormal, det +1) and maps the
+ * unit g1 onto the unit g2 (the constraint that defines the solver).
+ */
+#include "fuzz_input.h"
+#include "mcgeom.h"
+
+/* routines selected by the first input byte (fuzz/make_corpus.py writes
+ * seeds for each) */
+#define FUZZ_MODES 2
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_in in = fz_make(data, size);
+    int mode = fz_u8(&in) % FUZZ_MODES, st, n = -1, s, i;
+    double o1[12], d1[12], o2[12], d2[12], g1[3], g2[3], Rm[9], t[3], Rs[72], ts[24];
+    double n1, n2;
+    if (mode == 0) {
+        fz_rotation(&in, Rm);
+        for (i = 0; i < 3; ++i)
+            t[i] = fz_range(&in, -2.0, 2.0);
+        {   /* decoded in this order (not as arguments of one call) */
+            const int ncams = fz_int(&in, 1, 4), cross = fz_u8(&in) & 1;
+            fz_scene(&in, 4, ncams, cross, Rm, t, o1, d1, o2, d2, NULL);
+        }
+        for (i = 0; i < 3; ++i)
+            g1[i] = fz_range(&in, -1.0, 1.0);
+        for (i = 0; i < 3; ++i)
+            g2[i] = Rm[3 * i] * g1[0] + Rm[3 * i + 1] * g1[1] + Rm[3 * i + 2] * g1[2];
+        if (fz_u8(&in) % 4 == 0)
+            g2[fz_u8(&in) % 3] += fz_double(&in);
+    } else {
+        fz_rays(&in, 4, o1, d1, o2, d2);
+        fz_doubles(&in, g1, 3);
+        fz_doubles(&in, g2, 3);
+    }
+    st = mcg_upright4(o1, d1, o2, d2, g1, g2, Rs, ts, &n);
+    FZ_CHECK(fz_status_known(st), "upright4 status %d", st);
+    if (!fz_all_finite(o1, 12) || !fz_all_finite(d1, 12) || !fz_all_finite(o2, 12) ||
+        !fz_all_finite(d2, 12) || !fz_all_finite(g1, 3) || !fz_all_finite(g2, 3)) {
+        FZ_CHECK(st == MCG_EINVAL, "upright4 of non-finite input: %d", st);
+        return 0;
+    }
+    n1 = fz_dot3(g1, g1);
+    n2 = fz_dot3(g2, g2);
+    if (!(n1 >= 1e-100 && n2 >= 1e-100)) {
+        FZ_CHECK(st == MCG_EINVAL, "upright4 with zero gravity: %d", st);
+        return 0;
+    }
+    if (st != MCG_OK)
+        return 0;
+    FZ_CHECK(n >= 0 && n <= MCG_UPRIGHT4_MAX_SOLUTIONS, "upright4: %d solutions", n);
+    if (!isfinite(n1) || !isfinite(n2))
+        return 0; /* overflowing |g|^2: the unit vectors below would be 0 */
+    n1 = sqrt(n1);
+    n2 = sqrt(n2);
+    for (s = 0; s < n; ++s) {
+        const double *R = Rs + 9 * s;
+        double Rg[3], e = 0.0;
+        FZ_CHECK(fz_all_finite(R, 9) && fz_all_finite(ts + 3 * s, 3),
+                 "upright4: solution %d not finite", s);
+        FZ_CHECK(fz_is_rotation(R, 1e-9), "upright4: solution %d not a rotation (%g)", s,
+                 fz_orth_err3(R));
+        for (i = 0; i < 3; ++i)
+            Rg[i] = (R[3 * i] * g1[0] + R[3 * i + 1] * g1[1] + R[3 * i + 2] * g1[2]) / n1;
+        for (i = 0; i < 3; ++i)
+            e = fmax(e, fabs(Rg[i] - g2[i] / n2));
+        FZ_CHECK(e < 1e-9, "upright4: solution %d maps g1 off g2 by %g", s, e);
+    }
+    return 0;
+}

@@ -1,0 +1,85 @@
+"""The last step shared by the estimators that start from an algebraic solution
+(``upright_four_point``, ``eigensolver``): the joint refinement of (R, t) on
+all correspondences (Sampson angular error, thesis eq. 8.15), the scale verdict
+from its covariance and profile, and the :class:`RigMotion` (the unit travel
+direction when ``|t|`` is not observable, as every estimator reports it).
+
+Frames and units (docs/architecture.md §3): rays in the rig frame (metres),
+``X2 = R X1 + t`` with ``t`` in metres; residuals in radians.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _core
+from ..errors import DegenerateError
+from ..geometry import refine_centred
+from ..observability import scale_profile, scale_verdict
+from ..types import RayPairs, RigMotion
+from ._common import travel_direction
+
+__all__ = ["refine_and_report"]
+
+
+def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool,
+            iterate: bool = True) -> dict:
+    # converged to rounding: the result must not depend on the start's rounding
+    # (ray order, rig frame), as five_plus_one's refinement; without iterations
+    # the covariance of (R, t) as given
+    return refine_centred(rays, R, t, loss="none", fix_scale=fix_scale,
+                          max_iterations=100 if iterate else 0,
+                          cost_tolerance=1e-15, step_tolerance=1e-13)
+
+
+def refine_and_report(rays: RayPairs, starts: list, method: str,
+                      max_scale_rel_std: float, info: dict, iterate: bool = True) -> RigMotion:
+    """Refine each start ``(R, t)`` (rig2_from_rig1, metres) on all ``rays`` and
+    report the one of least final cost.
+
+    Several starts (e.g. the local minima of an algebraic cost, which noise can
+    reorder) make the result independent of which of them the algebraic cost
+    happened to rank first: the refinement of each ends in a minimum of the
+    Sampson cost and the lowest is kept (ties within 1e-9: the first start).
+    All six degrees of freedom are refined; where the refinement cannot move
+    ``|t|`` (critical motion: a singular normal matrix) it is held and the
+    scale reported unobservable. The verdict is that of the other estimators
+    (:func:`mcgeom.observability.scale_verdict`): the relative std of the
+    travelled distance at most ``max_scale_rel_std`` and its profile excluding
+    ``1 +- 3 max_scale_rel_std`` at 3 sigma. ``info`` is completed with the
+    refinement's iterations and ``t_metric`` (the metric estimate whatever the
+    verdict). With ``iterate=False`` no start is moved: the least Sampson cost
+    among them is kept and the verdict rests on the covariance and profile
+    there.
+    """
+    best = None
+    for R, t in starts:
+        fixed = False
+        try:
+            out = _refine(rays, R, t, False, iterate)
+        except DegenerateError:
+            out = _refine(rays, R, t, True, iterate)
+            fixed = True
+        if best is None or out["final_cost"] < best[0]["final_cost"] * (1.0 - 1e-9):
+            best = (out, fixed)
+    if best is None:
+        raise DegenerateError(f"{method}: no start to refine")
+    out, fixed = best
+    R, t = out["R"], out["t"]
+    rel = float("inf") if fixed else float(out["scale_rel_std"])
+    info["refinement"] = {k: out[k] for k in ("iterations", "converged") if k in out}
+    if rel <= max_scale_rel_std:
+        k = 1.0 + 3.0 * max_scale_rel_std
+        info["scale_profile"] = scale_profile(rays, R, t, out["final_cost"], out["sigma2"],
+                                              (1.0 / k, k))
+        if info["scale_profile"] < 9.0:
+            rel = float("inf")
+    everything = np.ones(len(rays), bool)
+    verdict = scale_verdict(rays, everything, R, t, rel, max_scale_rel_std, fixed)
+    info["t_metric"] = np.array(t)
+    if not verdict.observable:
+        nt = np.linalg.norm(t)
+        t = travel_direction(rays, everything, R, t)
+        info["t_metric"] = nt * t
+    r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
+    return RigMotion(R, t, verdict, method, float(np.sqrt(np.mean(r ** 2))), None, info)

@@ -1,0 +1,125 @@
+"""``eigensolver``: Kneip and Li's eigensolver for multi-camera relative pose (CVPR 2014).
+
+For a rotation ``R`` the generalized epipolar constraints are linear in
+``(t, 1)``; the rotation minimises the smallest eigenvalue of their 4 x 4
+moment matrix ``M(R)`` and ``t`` is its eigenvector (``csrc/eigensolver.c``,
+equations E1-E2 there). A local minimiser of an algebraic cost on all
+correspondences: more accurate than the linear 17-point solution it starts
+from (it enforces ``R`` in SO(3) and ``E = [t]x R`` exactly), cheaper than the
+Sampson refinement, which ``refine=True`` runs after it.
+
+Frames and units (docs/architecture.md §3): rays in the rig frame (metres),
+``X2 = R X1 + t`` with ``t`` in metres.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from .. import _core
+from ..errors import DegenerateError
+from ..registry import register
+from ..types import RayPairs, RigMotion
+from ..validation import check_rotation
+from ._finish import refine_and_report
+from .linear17 import linear17
+
+__all__ = ["eigensolver", "minimal_solutions"]
+
+
+def _start(rays: RayPairs, rotation_start: Any) -> np.ndarray:
+    """The start rotation: the given one, else linear17's."""
+    if rotation_start is not None:
+        return check_rotation("rotation_start", rotation_start)
+    return linear17(rays, refine=False).R
+
+
+def _travel(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
+    """Length of the travel of the origins' centroid c, |t + R c - c| (metres)."""
+    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    return float(np.linalg.norm(t + R @ c - c))
+
+
+def _solve(rays: RayPairs, rotation_start: Any, max_iterations: int) -> dict:
+    R0 = _start(rays, rotation_start)
+    args = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
+    r = _core.eigensolver(*args, R0, max_iterations)
+    r["trivial_avoided"] = False
+    if max_iterations > 0 and r["has_scale"]:
+        # The no-motion trap of intra-camera rays (csrc/eigensolver.c): a
+        # result whose centroid hardly travels, from a start that clearly did,
+        # is that trivial solution, not the motion: keep the start.
+        r0 = _core.eigensolver(*args, R0, 0)
+        if r0["has_scale"] and _travel(rays, r["R"], r["t"]) < 1e-2 * _travel(rays, r0["R"],
+                                                                               r0["t"]):
+            r0["trivial_avoided"] = True
+            return r0
+    return r
+
+
+def minimal_solutions(sample: RayPairs) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The motion of a 17-correspondence sample for RANSAC: the eigensolver from
+    the linear 17-point rotation (none if the sample is degenerate)."""
+    try:
+        r = _solve(sample, None, 100)
+    except (DegenerateError, ValueError):
+        return []
+    return [(r["R"], r["t"])] if r["has_scale"] else []
+
+
+@register(
+    "eigensolver",
+    min_sample=17,
+    camera_kinds=("most-general", "locally-central", "axial", "locally-central-and-axial"),
+    family="linear",
+    needs_rotation=False,
+    recovers_scale=True,
+    description="Kneip-Li eigensolver: the rotation minimising the smallest eigenvalue of the "
+                "generalized-epipolar matrix (LM from linear17 or a given start), t from its "
+                "eigenvector",
+    options={"rotation_start": "start rotation (default: linear17's)",
+             "refine": "joint Sampson refinement after it (default False)",
+             "max_iterations": "cap on the Levenberg-Marquardt steps (100)",
+             "max_scale_rel_std": "relative std of |t| above which the scale is reported "
+                                  "unobservable (0.1)"},
+    minimal_solver=minimal_solutions,
+)
+def eigensolver(rays: RayPairs, *, rotation_start: Any = None, refine: bool = False,
+                max_iterations: Optional[int] = None,
+                max_scale_rel_std: float = 0.1) -> RigMotion:
+    """Rig motion rig2_from_rig1 (R, t in metres) by Kneip and Li's eigensolver.
+
+    ``rays`` in the rig frame (origins at the camera centres, metres). The
+    rotation minimises the smallest eigenvalue of ``M(R) = sum v v^T``, ``v =
+    (R d1 x d2, d2 . R m1 + m2 . R d1)`` (origins centred and scaled, unit
+    directions), by Levenberg-Marquardt from ``rotation_start`` or from
+    linear17's rotation (at least 17 correspondences then, 14 for some camera
+    kinds); ``t`` comes from the eigenvector. With intra-camera rays only the
+    cost has a trivial minimum at no motion: a result that slid into it is
+    replaced by the start (``info["trivial_avoided"]``). ``refine`` then
+    refines all six degrees of freedom on the Sampson angular error. The
+    verdict rests on the covariance of the Sampson cost at the result.
+    ``info``: ``lambda_min`` (the algebraic cost left), ``iterations``.
+    Raises ValueError for bad input, DegenerateError when no start is found.
+    """
+    if not isinstance(rays, RayPairs):
+        raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
+    n = len(rays)
+    if rotation_start is None and n < 14:
+        raise ValueError(f"too few correspondences: eigensolver starts from linear17, which "
+                         f"needs at least 17 (14-16 for some camera kinds), got {n}; or pass "
+                         "rotation_start=")
+    if n < 6:
+        raise ValueError(f"too few correspondences: eigensolver needs at least 6, got {n}")
+    if max_iterations is None:
+        max_iterations = 100
+    if not (np.isfinite(max_scale_rel_std) and max_scale_rel_std > 0):
+        raise ValueError(f"max_scale_rel_std must be a positive number, got {max_scale_rel_std}")
+    rays.check_finite()
+    r = _solve(rays, rotation_start, max_iterations)
+    info: dict = {"lambda_min": r["lambda_min"], "iterations": r["iterations"],
+                  "has_scale": r["has_scale"], "trivial_avoided": r["trivial_avoided"]}
+    return refine_and_report(rays, [(r["R"], r["t"])], "eigensolver", max_scale_rel_std, info,
+                             iterate=bool(refine))

@@ -1,0 +1,285 @@
+"""The peers' generalized relative-pose solvers, mcgeom's and PoseLib's, on the same problems.
+
+Part ``minimal``: noise-free random minimal configurations per family
+(generic 4-camera rigs with intra- and cross-camera rays, 2-camera heads; the
+four rays start from at least two cameras, as four rays of one camera are a
+central camera without metric scale; and the degenerate cases of the
+upright problem: no yaw with intra-camera rays only
+-- the critical motion of thesis ch. 7.3.2, where |t| is not observable and
+no solver can return the truth --, cameras stacked along the vertical with
+intra-camera rays -- an axial rig rotating about its axis, critical too --
+and a yaw within 1e-4 rad of 180 degrees, where the half-angle tangent that
+mcgeom's polynomial uses is large). Printed per family and solver: the
+fraction of configurations where some returned solution matches the truth to
+1e-8 (max |R - R_true| and |t - t_true| / |t_true|), the mean number of real
+solutions and the time per call (median over batches). Both are called
+through their Python bindings on prepared arrays; PoseLib's
+``gen_relpose_upright_4pt`` assumes the vertical along y, so its rays are
+re-expressed in such frames first (outside the timing).
+
+Part ``ransac``: the robust estimate from pixels with 1 px threshold, median
+rotation error (deg), scale error ``| |t| / |t_true| - 1 |`` (the metric
+estimate, whatever the verdict) and time per problem (ms): mcgeom's default
+façade (5+1), the upright 4-point façade with the vertical known to 0.2 deg
+(each gravity vector turned by 0.2 deg about a random axis), 17-point RANSAC
+(``ransac:linear17``) and PoseLib's ``estimate_generalized_relative_pose``;
+on the cases of :mod:`mcgeom.experiments.robust_vs_poselib`, a 12-camera rig
+with 8 correspondences per camera (half cross-camera, 40 % outliers) and the
+8-camera car rig (forward motion).
+
+``mcgeom experiment peer_solvers [--part minimal|ransac|all] [--configs 10000]
+[--problems 50] [--seed 0]`` (needs poselib)
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from typing import Callable, Optional
+
+import numpy as np
+
+from mcgeom import _core, metrics, synth
+from mcgeom.cv import RIG_LINEAR17_RANSAC, estimate
+from mcgeom.estimators.upright_four_point import upright_rotation
+from mcgeom.rig import Rig
+
+from .common import Progress, add_count_and_seed, import_peer, no_progress, positive_int
+from .robust_vs_poselib import CASES as ROBUST_CASES, poselib_motion
+
+#: e_z -> e_y: PoseLib's upright solvers rotate about y
+_Z_TO_Y = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
+
+# ------------------------------------------------------------- minimal part
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _config(family: str, rng: np.random.Generator):
+    """One noise-free minimal configuration: rays (4 x 3 each), g1, g2, R, t."""
+    g1 = _unit(rng.normal(size=3))
+    if family == "no yaw, intra (critical)":
+        R = np.eye(3)
+    elif family == "yaw pi - 1e-4":
+        R = synth.rotation_about(g1, np.pi - 1e-4 * rng.choice([-1.0, 1.0]))
+    else:
+        R = synth.random_rotation(rng)
+    t = rng.normal(size=3)
+    if family.startswith("2-camera head"):
+        centres = np.array([[-0.15, 0.0, 0.0], [0.15, 0.0, 0.0]])
+    elif family.startswith("vertical stack"):
+        centres = np.outer(np.arange(4) * 0.3, g1)
+        R = synth.rotation_about(g1, rng.uniform(-np.pi, np.pi))
+    else:
+        centres = 0.5 * rng.normal(size=(4, 3))
+    m = len(centres)
+    c1 = rng.integers(0, m, 4)
+    if np.all(c1 == c1[0]):   # at least two cameras: four rays of one are a central camera
+        c1[0] = (c1[0] + 1) % m
+    cross = "cross" in family or (family.startswith("generic") and "intra" not in family)
+    c2 = (c1 + rng.integers(1, m, 4)) % m if cross else c1
+    if family.startswith("generic") and "intra" not in family:
+        c2 = np.where(rng.random(4) < 0.5, c1, c2)   # mixed intra- and cross-camera
+    X = centres[c1] + rng.uniform(2.0, 10.0, (4, 1)) * _unit(rng.normal(size=(4, 3)))
+    o1, o2 = centres[c1], centres[c2]
+    return (o1, X - o1, o2, X @ R.T + t - o2), g1, R @ g1, R, t
+
+
+FAMILIES = ("generic 4-cam, mixed", "generic 4-cam, intra", "2-camera head, intra",
+            "2-camera head, cross", "no yaw, intra (critical)", "vertical stack, intra (critical)",
+            "yaw pi - 1e-4")
+
+
+def _hit(sols, R: np.ndarray, t: np.ndarray) -> bool:
+    return any(np.abs(Rs - R).max() < 1e-8 and np.linalg.norm(ts - t) < 1e-8 * np.linalg.norm(t)
+               for Rs, ts in sols)
+
+
+def _timed(fn: Callable, args: list, batch: int = 200) -> float:
+    """Median seconds per call of ``fn(*a)`` over batches of ``batch`` argument tuples."""
+    per = []
+    for k in range(0, len(args), batch):
+        chunk = args[k:k + batch]
+        t0 = time.perf_counter()
+        for a in chunk:
+            fn(*a)
+        per.append((time.perf_counter() - t0) / len(chunk))
+    return float(np.median(per))
+
+
+def run_minimal(configs: int = 10000, seed: int = 0, families=FAMILIES,
+                progress: Progress = no_progress) -> dict:
+    """{family: {solver: (success fraction, mean real solutions, seconds per call)}}."""
+    poselib = import_peer("poselib", "peer_solvers")
+    out = {}
+    for fam in progress(families, total=len(families), desc="families"):
+        rng = np.random.default_rng(seed)
+        ours_args, theirs_args, truth, frames = [], [], [], []
+        for _ in range(configs):
+            (o1, d1, o2, d2), g1, g2, R, t = _config(fam, rng)
+            ours_args.append((o1, d1, o2, d2, g1, g2))
+            Q1, Q2 = _Z_TO_Y @ upright_rotation(g1), _Z_TO_Y @ upright_rotation(_unit(g2))
+            theirs_args.append((list(o1 @ Q1.T), list(_unit(d1) @ Q1.T), list(o2 @ Q2.T),
+                                list(_unit(d2) @ Q2.T)))
+            truth.append((R, t))
+            frames.append((Q1, Q2))
+        res = {}
+        hits, counts = 0, 0
+        for a, (R, t) in zip(ours_args, truth):
+            try:
+                sols = _core.upright4(*a)
+            except Exception:       # DegenerateError: no yaw determined
+                sols = []
+            hits += _hit(sols, R, t)
+            counts += len(sols)
+        res["mcgeom upright4"] = (hits / configs, counts / configs,
+                                  _timed(_safe(_core.upright4), ours_args))
+        hits, counts = 0, 0
+        for a, (R, t), (Q1, Q2) in zip(theirs_args, truth, frames):
+            sols = [(Q2.T @ np.asarray(p.R) @ Q1, Q2.T @ np.asarray(p.t))
+                    for p in poselib.gen_relpose_upright_4pt(*a)]
+            hits += _hit(sols, R, t)
+            counts += len(sols)
+        res["poselib upright_4pt"] = (hits / configs, counts / configs,
+                                      _timed(poselib.gen_relpose_upright_4pt, theirs_args))
+        out[fam] = res
+    return out
+
+
+def _safe(fn: Callable) -> Callable:
+    def call(*a):
+        try:
+            return fn(*a)
+        except Exception:
+            return []
+    return call
+
+
+def minimal_table(res: dict) -> str:
+    lines = [f"{'family':<34} {'solver':<22} {'found 1e-8':>10} {'mean sols':>9} "
+             f"{'us/call':>8}"]
+    for fam, solvers in res.items():
+        for name, (frac, nsol, secs) in solvers.items():
+            lines.append(f"{fam:<34} {name:<22} {100 * frac:9.2f}% {nsol:9.2f} "
+                         f"{1e6 * secs:8.2f}")
+    return "\n".join(lines)
+
+
+# -------------------------------------------------------------- RANSAC part
+
+def rig12(radius: float = 0.6, f: float = 500.0) -> Rig:
+    """12 cameras on a ring, looking outward every 30 deg (neighbours overlap)."""
+    return synth.ring_rig(12, radius, f, name="ring12")
+
+
+#: name: (rig, correspondences, outlier fraction, pixel noise, cross fraction, motion)
+RANSAC_CASES: dict = {name: (mk, n, outl, noise, 0.0, "random")
+                      for name, (mk, n, outl, noise) in ROBUST_CASES.items()}
+RANSAC_CASES["ring12 12x8 half-cross 40%out"] = (rig12, 96, 0.4, 0.5, 0.5, "random")
+RANSAC_CASES["car8 320c 0.5px forward"] = (synth.vehicle8, 320, 0.0, 0.5, 0.0, "forward")
+
+_GRAVITY = np.array([0.0, 0.0, -1.0])   # the vertical of the rig frame (rigs' z is up)
+
+
+def _tilted(g: np.ndarray, deg: float, rng: np.random.Generator) -> np.ndarray:
+    axis = np.cross(g, rng.normal(size=3))
+    return synth.rotation_about(axis, np.radians(deg)) @ g
+
+
+def _motion(kind: str, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    if kind == "forward":   # a car: yaw up to 10 deg, a little pitch/roll, forward travel
+        R = (synth.rotation_about([0, 0, 1], rng.uniform(-0.17, 0.17))
+             @ synth.rotation_about(rng.normal(size=3), rng.uniform(0.0, 0.01)))
+        t = np.array([1.0, 0.0, 0.0]) + 0.05 * rng.normal(size=3)
+        return R, t
+    R = synth.random_rotation(rng, 0.3)
+    while metrics.rotation_error(R, np.eye(3)) < 0.05:
+        R = synth.random_rotation(rng, 0.3)
+    t = rng.normal(size=3)
+    return R, t / np.linalg.norm(t)
+
+
+def _errors(R, t, Rt, tt) -> tuple[float, float]:
+    return (float(np.degrees(metrics.rotation_error(R, Rt))),
+            abs(np.linalg.norm(t) / np.linalg.norm(tt) - 1.0))
+
+
+def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
+               gravity_error_deg: float = 0.2, progress: Progress = no_progress) -> dict:
+    """{case: {method: (errors problems x 2, seconds per problem)}}."""
+    out = {}
+    for name, (make_rig, n, outl, noise, cross, kind) in (cases or RANSAC_CASES).items():
+        rng = np.random.default_rng(seed)
+        rig = make_rig()
+        res: dict = {}
+        for _ in progress(range(problems), total=problems, desc=name):
+            R, t = _motion(kind, rng)
+            p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl,
+                                   cross_fraction=cross, require_visible=cross == 0.0)
+            g1 = _tilted(_GRAVITY, gravity_error_deg, rng)
+            g2 = _tilted(R @ _GRAVITY, gravity_error_deg, rng)
+            runs = {
+                "mcgeom 5+1": lambda: _facade(rig, p),
+                f"mcgeom upright ({gravity_error_deg:g} deg)":
+                    lambda: _facade(rig, p, gravity1=g1, gravity2=g2),
+                "mcgeom 17-pt": lambda: _facade(rig, p, method=RIG_LINEAR17_RANSAC),
+                "poselib": lambda: poselib_motion(rig, p),
+            }
+            for meth, fn in runs.items():
+                t0 = time.perf_counter()
+                try:
+                    Re, te = fn()
+                    err = _errors(Re, te, R, t)
+                except (ValueError, ArithmeticError):
+                    err = (np.nan, np.nan)       # the method could not sample these data
+                secs = time.perf_counter() - t0
+                res.setdefault(meth, ([], []))
+                res[meth][0].append(err)
+                res[meth][1].append(secs)
+        out[name] = {k: (np.array(e), np.array(s)) for k, (e, s) in res.items()}
+    return out
+
+
+def _facade(rig: Rig, p, **kw) -> tuple[np.ndarray, np.ndarray]:
+    m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
+    return m.R, m.info["t_metric"]
+
+
+def ransac_table(res: dict) -> str:
+    lines = [f"{'case':<32} {'method':<24} {'rot med deg':>11} {'scale med':>9} "
+             f"{'failed':>6} {'ms med':>8} {'vs 5+1':>7}"]
+    for case, methods in res.items():
+        base = np.median(methods["mcgeom 5+1"][1])
+        for meth, (e, secs) in methods.items():
+            ok = np.isfinite(e[:, 0])
+            med = np.median(e[ok], axis=0) if ok.any() else (np.nan, np.nan)
+            lines.append(f"{case:<32} {meth:<24} {med[0]:11.4f} {med[1]:9.4f} "
+                         f"{np.mean(~ok):6.2f} {1e3 * np.median(secs):8.2f} "
+                         f"{base / np.median(secs):6.2f}x")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------- CLI
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of ``mcgeom experiment peer_solvers``."""
+    ap.add_argument("--part", choices=("minimal", "ransac", "all"), default="all",
+                    help="minimal solvers on noise-free configurations, RANSAC from "
+                         "pixels, or both")
+    ap.add_argument("--configs", type=positive_int, default=10000,
+                    help="noise-free configurations per family (minimal part)")
+    add_count_and_seed(ap, "--problems", 50, "problems per case (RANSAC part)")
+
+
+def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
+    """Print the tables of the requested parts."""
+    import_peer("poselib", "peer_solvers")
+    if args.part in ("minimal", "all"):
+        print(minimal_table(run_minimal(args.configs, args.seed, progress=progress)))
+    if args.part in ("ransac", "all"):
+        if args.part == "all":
+            print()
+        print(ransac_table(run_ransac(args.problems, args.seed, progress=progress)))
+    return 0
