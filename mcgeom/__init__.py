@@ -10,6 +10,7 @@ from __future__ import annotations
 from . import registry
 from .errors import (DegenerateError, InfeasibleError, McgeomError, NumericalError,
                      ScaleNotObservableWarning)
+from .observability import with_calibration
 from .types import RayPairs, RigMotion, ScaleVerdict
 from . import estimators as _estimators  # noqa: F401  (registers the built-ins)
 from . import robust
@@ -20,13 +21,25 @@ from .cv import (RIG_5P1_DIRECT, RIG_5P1_RANSAC, RIG_LINEAR17, RIG_LINEAR17_RANS
 __version__ = "0.1.0"
 
 
-def estimate(rays: RayPairs, method: str = "linear17", **options) -> RigMotion:
+def estimate(rays: RayPairs, method: str = "linear17", *, calibration_std=None,
+             **options) -> RigMotion:
     """Estimate the rig motion from ray correspondences with a registered method.
 
     ``method`` is any name of :func:`mcgeom.registry.names`; ``options`` are the
-    method's keyword options (see ``mcgeom methods``).
+    method's keyword options (see ``mcgeom methods``). ``calibration_std``: the
+    rig's extrinsic calibration error (``rig.extrinsic_std``: (M, 2) metres and
+    radians per camera id, or one pair); when given, ``scale.rel_std`` of every
+    estimator includes it and the verdict is decided on that total
+    (:func:`mcgeom.observability.with_calibration`); None = the rays are exact.
     """
-    return registry.get(method)(rays, **options)
+    est = registry.get(method)
+    if calibration_std is not None and "calibration_std" in est.options:
+        return est(rays, calibration_std=calibration_std, **options)   # propagates it itself
+    motion = est(rays, **options)
+    if calibration_std is None:
+        return motion
+    return with_calibration(motion, rays, calibration_std,
+                            float(options.get("max_scale_rel_std", 0.1)))
 
 
 __all__ = [

@@ -23,6 +23,8 @@ The verdict is "observable" when the statistics say so (relative std at most
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from . import _core
@@ -32,7 +34,7 @@ from .types import RayPairs, ScaleVerdict
 
 __all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
            "scale_determined", "UNDETERMINED_REL_STD", "ZERO_FACTOR", "calibration_scale_std",
-           "combine_rel_std", "total_scale_std", "no_parallax"]
+           "combine_rel_std", "total_scale_std", "no_parallax", "with_calibration"]
 
 #: relative std of ``|t|`` above which the data define no metric scale at all:
 #: a one-sigma interval that reaches zero bounds neither the length nor (with
@@ -411,3 +413,40 @@ def total_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray, refined: dict,
     return combine_rel_std(rel_noise, rel_cal), {
         "scale_rel_std_noise": rel_noise, "scale_rel_std_calibration": rel_cal,
         "covariance": cov}
+
+
+def with_calibration(motion, rays: RayPairs, calibration_std,
+                     max_scale_rel_std: float = 0.1):
+    """``motion`` (a :class:`mcgeom.types.RigMotion` of any estimator on ``rays``)
+    with the rig's extrinsic calibration error in its scale uncertainty.
+
+    For the estimators that do not propagate it themselves (no
+    ``info['scale_rel_std_calibration']``): a metric ``t`` (observable, or
+    determined) gets :func:`calibration_scale_std` at (R, t) added in
+    quadrature to its ``rel_std`` (:func:`combine_rel_std`), and the verdict
+    is decided again on the total against ``max_scale_rel_std``: an estimate
+    whose scale the calibration leaves loose is no longer called observable
+    (thesis ch. 7's verdict, with the uncertainty of the rig itself).
+    ``calibration_std`` as :attr:`mcgeom.rig.Rig.extrinsic_std` ((M, 2):
+    metres, radians per camera id, or one pair). Static answers (``t = 0``)
+    and direction-only ones are returned unchanged.
+    """
+    info = motion.info if isinstance(motion.info, dict) else {}
+    t = np.asarray(motion.t, dtype=np.float64)
+    if calibration_std is None or "scale_rel_std_calibration" in info or \
+            not np.any(t != 0) or not np.isfinite(motion.scale.rel_std) or \
+            not (motion.scale.observable or info.get("scale_determined", False)):
+        return motion
+    cal, _ = calibration_scale_std(rays, motion.R, t, calibration_std)
+    total = combine_rel_std(float(motion.scale.rel_std), cal)
+    v = motion.scale
+    observable = bool(v.observable and total <= max_scale_rel_std)
+    reason = v.reason
+    if v.observable and not observable:
+        reason = (f"scale too uncertain with the rig's calibration error: relative std of "
+                  f"|t| {total:.3g} (noise {v.rel_std:.3g}, calibration {cal:.3g}) above "
+                  f"{max_scale_rel_std:g}; {v.reason}")
+    verdict = ScaleVerdict(observable, reason, v.conditioning, total, v.critical_angle)
+    new_info = {**info, "scale_rel_std_noise": float(v.rel_std),
+                "scale_rel_std_calibration": float(cal)}
+    return replace(motion, scale=verdict, info=new_info)

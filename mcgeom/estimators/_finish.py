@@ -16,6 +16,7 @@ from .. import _core
 from ..errors import DegenerateError
 from ..geometry import refine_centred
 from ..observability import scale_profile, scale_verdict
+from ._static import check_static
 from ..types import RayPairs, RigMotion
 from ._common import travel_direction
 
@@ -82,4 +83,7 @@ def refine_and_report(rays: RayPairs, starts: list, method: str,
         t = travel_direction(rays, everything, R, t)
         info["t_metric"] = nt * t
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
-    return RigMotion(R, t, verdict, method, float(np.sqrt(np.mean(r ** 2))), None, info)
+    m = RigMotion(R, t, verdict, method, float(np.sqrt(np.mean(r ** 2))), None, info)
+    # a rig that did not translate measurably: the shared static answer (R,
+    # t = 0, "no translation detected"), as every estimator gives it
+    return check_static(rays, method, m) or m

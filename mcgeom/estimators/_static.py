@@ -219,7 +219,11 @@ def static_test(rays: RayPairs, noise_level: float, *, rotation: Optional[np.nda
         cross_median = float(np.median(rc))
     explained = (float(np.count_nonzero(ang < NO_PARALLAX_FACTOR * noise_level)) / ang.size
                  if ang.size else 0.0)
-    return StaticTest(static=no_parallax(ang, noise_level), R=R, noise_level=float(noise_level),
+    # a rotation from fewer than 5 distinct correspondences is not determined
+    # (repeats of one correspondence "explain" any rotation-only model)
+    static = bool(no_parallax(ang, noise_level)) and \
+        rays.take(np.flatnonzero(same)).n_distinct(at_least=5) >= 5
+    return StaticTest(static=static, R=R, noise_level=float(noise_level),
                       noise_source=noise_source, explained=explained, n_intra=int(ang.size),
                       median_angle=float(np.median(ang)) if ang.size else float("nan"),
                       cross_median=cross_median)
