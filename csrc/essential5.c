@@ -37,6 +37,7 @@
  */
 #include "mcgeom.h"
 #include "internal.h"
+#include "poly.h"
 
 #include <float.h>
 #include <math.h>
@@ -109,26 +110,6 @@ static void row_times_col(const double q0[10], const double q1[10], const double
             c[CUB_OF[i][j]] += s[i][j];
 }
 
-/* c = a * b for polynomials in z of degrees na, nb (coefficients by rising
- * powers); c has na + nb + 1 coefficients */
-static void zpoly_mul(const double *a, int na, const double *b, int nb, double *c)
-{
-    int i, j;
-    for (i = 0; i <= na + nb; ++i)
-        c[i] = 0.0;
-    for (i = 0; i <= na; ++i)
-        for (j = 0; j <= nb; ++j)
-            c[i + j] += a[i] * b[j];
-}
-
-static double horner(const double *p, int n, double x)
-{
-    double v = p[n];
-    int i;
-    for (i = n - 1; i >= 0; --i)
-        v = v * x + p[i];
-    return v;
-}
 
 /* ------------------------------------------------- step 1: the null space */
 
@@ -336,11 +317,11 @@ static void add_cofactor_term(const double *f, int nf, const double *a, int na, 
 {
     double ab[DEG + 1], cd[DEG + 1], s[DEG + 1];
     int i;
-    zpoly_mul(a, na, b, nb, ab);
-    zpoly_mul(c, nc, d, nd, cd);
+    poly_mul(a, na, b, nb, ab);
+    poly_mul(c, nc, d, nd, cd);
     for (i = 0; i <= na + nb; ++i)
         ab[i] -= cd[i];
-    zpoly_mul(f, nf, ab, na + nb, s);
+    poly_mul(f, nf, ab, na + nb, s);
     for (i = 0; i <= DEG; ++i)
         p[i] += sign * s[i];
 }
@@ -420,7 +401,7 @@ static int sturm_changes(const sturm_chain *sc, double z)
     double last = 0.0;
     int k, changes = 0;
     for (k = 0; k < sc->len; ++k) {
-        double v = horner(sc->s[k], sc->deg[k], z);
+        double v = poly_eval(sc->s[k], sc->deg[k], z);
         if (v != 0.0) {
             if (last != 0.0 && (last < 0.0) != (v < 0.0))
                 ++changes;
@@ -435,7 +416,7 @@ static int sturm_changes(const sturm_chain *sc, double z)
  * step leaves it or does not halve the bracket. */
 static double polish_root(const sturm_chain *sc, double lo, double hi)
 {
-    double flo = horner(sc->s[0], sc->deg[0], lo), fhi = horner(sc->s[0], sc->deg[0], hi), x, dxold;
+    double flo = poly_eval(sc->s[0], sc->deg[0], lo), fhi = poly_eval(sc->s[0], sc->deg[0], hi), x, dxold;
     int it, newton;
     if (flo == 0.0)
         return lo;
@@ -451,7 +432,7 @@ static double polish_root(const sturm_chain *sc, double lo, double hi)
     x = 0.5 * (lo + hi);
     dxold = fabs(hi - lo);
     for (it = 0; it < MAX_POLISH; ++it) {
-        double f = horner(sc->s[0], sc->deg[0], x), df = horner(sc->s[1], sc->deg[1], x), dx, xn;
+        double f = poly_eval(sc->s[0], sc->deg[0], x), df = poly_eval(sc->s[1], sc->deg[1], x), dx, xn;
         if (f == 0.0)
             return x;
         if (f < 0.0)

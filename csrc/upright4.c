@@ -52,6 +52,7 @@
  */
 #include "mcgeom.h"
 #include "internal.h"
+#include "poly.h"
 #include "so3.h"
 
 #include <math.h>
@@ -59,27 +60,8 @@
 
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction or gravity */
 
-/* ---------------------------------------------------------- polynomials */
-
-/* c = a * b, a of degree na, b of degree nb (coefficients ascending) */
-static void poly_mul(const double *a, int na, const double *b, int nb, double *c)
-{
-    int i, j;
-    for (i = 0; i <= na + nb; ++i)
-        c[i] = 0.0;
-    for (i = 0; i <= na; ++i)
-        for (j = 0; j <= nb; ++j)
-            c[i + j] += a[i] * b[j];
-}
-
-static double poly_eval(const double *a, int n, double x)
-{
-    double y = a[n];
-    int i;
-    for (i = n - 1; i >= 0; --i)
-        y = y * x + a[i];
-    return y;
-}
+/* ---------------------------------------------------------- polynomials
+ * (poly_mul, poly_eval: poly.h) */
 
 /* A root of a (degree n) in [lo, hi] where a(lo), a(hi) differ in sign:
  * Newton steps that stay inside the shrinking bracket, bisection otherwise. */
