@@ -175,8 +175,11 @@ def rig12(radius: float = 0.6, f: float = 500.0) -> Rig:
 
 
 #: name: (rig, correspondences, outlier fraction, pixel noise, cross fraction, motion)
+#: (robust_vs_poselib's cases with a motion of their own, e.g. its car8 forward
+#: case, are covered by the forward car case below)
 RANSAC_CASES: dict = {name: (mk, n, outl, noise, 0.0, "random")
-                      for name, (mk, n, outl, noise) in ROBUST_CASES.items()}
+                      for name, (mk, n, outl, noise, *motion) in ROBUST_CASES.items()
+                      if not motion}
 RANSAC_CASES["ring12 12x8 half-cross 40%out"] = (rig12, 96, 0.4, 0.5, 0.5, "random")
 RANSAC_CASES["car8 320c 0.5px forward"] = (synth.vehicle8, 320, 0.0, 0.5, 0.0, "forward")
 
