@@ -46,19 +46,8 @@ static void make_problem(int head, int cross, const double R[9], const double t[
             cen[k][i] = head ? (i == 0 ? (k & 1 ? 0.15 : -0.15) : 0.0) : 0.5 * nrand();
     for (k = 0; k < 4; k++) {
         int c1 = head ? k & 1 : k, c2 = cross ? (head ? (k + 1) & 1 : (k + 1) % 4) : c1;
-        double X[3], X2[3], dir[3], n;
-        randn(dir, 3);
-        n = sqrt(dot3(dir, dir));
-        for (i = 0; i < 3; i++)
-            X[i] = cen[c1][i] + (2.0 + 8.0 * urand()) * dir[i] / n;
-        mat_vec(R, X, X2);
-        for (i = 0; i < 3; i++) {
-            X2[i] += t[i];
-            o1[3 * k + i] = cen[c1][i];
-            d1[3 * k + i] = X[i] - cen[c1][i];
-            o2[3 * k + i] = cen[c2][i];
-            d2[3 * k + i] = X2[i] - cen[c2][i];
-        }
+        scene_correspondence(cen[c1], cen[c2], R, t, 0.0, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k,
+                             d2 + 3 * k);
     }
 }
 

@@ -85,4 +85,35 @@ static inline void matmul(int m, int k, int n, const double *a, const double *b,
         }
 }
 
+/* One correspondence of a synthetic rig scene: a point 2..10 m from the
+ * camera centre c1 in a uniformly random direction, seen from c1 at time 1
+ * and, after the motion X2 = R X + t (rig2_from_rig1, R row-major), from the
+ * camera centre c2 at time 2. Outputs the origins and the (unnormalised)
+ * directions, each direction coordinate perturbed by noise * N(0, 1) when
+ * noise > 0. Shared by the minimal- and non-minimal-solver tests. */
+static inline void scene_correspondence(const double c1[3], const double c2[3], const double R[9],
+                                        const double t[3], double noise, double o1[3],
+                                        double d1[3], double o2[3], double d2[3])
+{
+    double dir[3], X[3], depth, n;
+    int i;
+    randn(dir, 3);
+    n = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    depth = 2.0 + 8.0 * urand();
+    for (i = 0; i < 3; ++i)
+        X[i] = c1[i] + depth * dir[i] / n;
+    for (i = 0; i < 3; ++i) {
+        double X2 = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+        o1[i] = c1[i];
+        o2[i] = c2[i];
+        d1[i] = X[i] - c1[i];
+        d2[i] = X2 - c2[i];
+    }
+    if (noise > 0.0)
+        for (i = 0; i < 3; ++i) {
+            d1[i] += noise * nrand();
+            d2[i] += noise * nrand();
+        }
+}
+
 #endif /* MCGEOM_TESTUTIL_H */
