@@ -58,6 +58,39 @@ def test_static_test_needs_a_positive_noise_level():
         _static.static_test(p.rays, 0.0)
 
 
+def _euroc_near_static():
+    """The EuRoC hovering pair (0.9 mm between the frames): its rays and 5+1's
+    full estimate before the static test."""
+    from pathlib import Path
+
+    from mcgeom.estimators.five_plus_one import _five_plus_one
+    from mcgeom.experiments.make_real_fixtures import load_fixture
+    f = load_fixture(Path(__file__).parent / "data" / "real" / "euroc_static.npz")
+    rays = f["rig"].ray_pairs(f["pixels1"], f["pixels2"], f["cam1"], f["cam2"])
+    return rays, _five_plus_one(rays, None, True, 0.1)
+
+
+def test_a_translation_that_cannot_be_told_from_zero_is_none():
+    """Issue 18, EuRoC: the full estimate's |t| is within 3 sigma of 0 and its
+    rotation's per-camera fit understates the noise; the noise level at the
+    pure rotation decides, and the answer is t = 0. The same estimate with a
+    scale it is sure of keeps the stricter level and stays a translation."""
+    from dataclasses import replace
+
+    rays, full = _euroc_near_static()
+    assert not full.scale.observable and 3 * full.scale.rel_std >= 1
+    from mcgeom.geometry import rotation_fit, same_camera
+    levels = _static._noise_levels(rays, (full.R, rotation_fit(rays, same_camera(rays))[0]))
+    assert levels[0] < levels[1]          # the overfit rotation's level is the smaller
+    m = _static.check_static(rays, "x", full)
+    assert m is not None and np.array_equal(m.t, np.zeros(3))
+    assert "pure rotation" in m.info["static_test"]["noise_source"]
+    sure = replace(full, scale=replace(full.scale, observable=True, rel_std=0.05))
+    assert _static.check_static(rays, "x", sure) is None
+    loose = replace(full, scale=replace(full.scale, rel_std=0.2))   # 3 sigma = 0.6 < 1
+    assert _static.check_static(rays, "x", loose) is None
+
+
 def test_linear17_on_a_static_rig_does_not_raise():
     """E = 0 used to raise DegenerateError ("matches no generalized-camera
     kind"); docs/bad_input.md promises R = I with an unobservable scale."""
