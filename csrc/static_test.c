@@ -162,6 +162,9 @@ static int camera_direction(const double *d1, const double *d2, const double R[9
         mat_vec(R, p, rd);
         nr = sqrt(dot3(rd, rd));
         nb = sqrt(dot3(q, q));
+        /* R maps a bearing to zero or beyond the doubles: not a rotation */
+        if (!(nr > 0.0 && isfinite(nr)))
+            return MCG_EINVAL;
         for (r = 0; r < 3; r++) {
             rd[r] /= nr;
             b[r] = q[r] / nb;

@@ -1095,7 +1095,9 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
  * convention for an even count; 0 when none) and *n_used their number.
  * Workspace lwork >= mcg_static_noise_work_size(n). MCG_EINVAL: NULL
  * pointers, n outside [0, 2^20], min_rows < 1, samples, group < -1, NaN/inf,
- * a zero or overflowing direction of a used pair; MCG_ENOMEM. */
+ * a zero or overflowing direction of a used pair, R mapping a bearing to
+ * zero or beyond the doubles; MCG_ENOMEM; MCG_ENUMERIC: the 3 x 3
+ * eigen-solver did not converge. */
 size_t mcg_static_noise_work_size(int n);
 int mcg_static_noise(int n, const double *o1, const double *d1, const double *o2,
                      const double *d2, const int *group, const double R[9], int min_rows,
