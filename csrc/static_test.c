@@ -17,6 +17,16 @@
  * of mcg_gec_residuals with t = u + c - R c (c the camera centre): the
  * camera's centre moves by u. Outliers handed to a direct estimator then do
  * not swing the direction and inflate the noise level.
+ *
+ * mcg_static_check runs the whole test of one estimate in one call (issue
+ * 22: it runs on every estimator call): the best pure rotation of the
+ * intra-camera bearings (Wahba's problem, the rotation nearest to
+ * sum d2 d1^T), the noise level (the smaller of those at the estimate's and
+ * at the pure rotation), then the no-parallax statistic of
+ * mcgeom.observability.no_parallax (a fraction of the rotation-only angles
+ * within a factor of the level) at the pure rotation and, failing that, at
+ * the estimate's own rotation; and at least min_distinct distinct
+ * intra-camera pairs (repeats of one pair explain any rotation).
  */
 #include "mcgeom.h"
 #include "internal.h"
@@ -230,37 +240,37 @@ static int camera_direction(const double *d1, const double *d2, const double R[9
     return st;
 }
 
-int mcg_static_noise(int n, const double *o1, const double *d1, const double *o2,
-                     const double *d2, const int *group, const double R[9], int min_rows,
-                     int samples, double *res, double *median, int *n_used, double *work,
-                     size_t lwork)
+/* the checks shared by both entry points (sizes and workspace aside) */
+static int check_rays(int n, const double *o1, const double *d1, const double *o2,
+                      const double *d2, const int *group, int min_rows, int samples)
 {
-    size_t need;
-    int *idx, *tmp, i, m = 0, used = 0;
-    double *ahat, *prod;
-    if (!o1 || !d1 || !o2 || !d2 || !group || !R || !res || !median || !n_used ||
-        (!work && lwork))
+    int i;
+    if (min_rows < 1 || samples < 0 || samples > MAX_SAMPLES)
         return MCG_EINVAL;
-    need = mcg_static_noise_work_size(n);
-    if (need == 0 || min_rows < 1 || samples < 0 || samples > MAX_SAMPLES)
-        return MCG_EINVAL;
-    if (!all_finite(R, 9) || !all_finite(o1, 3 * (size_t)n) || !all_finite(d1, 3 * (size_t)n) ||
+    if (!all_finite(o1, 3 * (size_t)n) || !all_finite(d1, 3 * (size_t)n) ||
         !all_finite(o2, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
         return MCG_EINVAL;
     for (i = 0; i < n; i++) {
         if (group[i] < -1)
             return MCG_EINVAL;
-        /* a zero direction has no bearing (as mcg_gec_residuals) */
+        /* a zero direction has no bearing (as mcg_gec_residuals); mat_vec(R,
+         * .) of a direction must not overflow */
         if (group[i] >= 0 && !(dot3(d1 + 3 * i, d1 + 3 * i) > 0.0 &&
-                               dot3(d2 + 3 * i, d2 + 3 * i) > 0.0))
-            return MCG_EINVAL;
-        /* mat_vec(R, .) of a direction must not overflow */
-        if (group[i] >= 0 && !(isfinite(dot3(d1 + 3 * i, d1 + 3 * i)) &&
+                               dot3(d2 + 3 * i, d2 + 3 * i) > 0.0 &&
+                               isfinite(dot3(d1 + 3 * i, d1 + 3 * i)) &&
                                isfinite(dot3(d2 + 3 * i, d2 + 3 * i))))
             return MCG_EINVAL;
     }
-    if (lwork < need)
-        return MCG_ENOMEM;
+    return MCG_OK;
+}
+
+/* mcg_static_noise on checked arguments */
+static int static_noise(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const int *group, const double R[9], int min_rows,
+                        int samples, double *res, double *median, int *n_used, double *work)
+{
+    int *idx, *tmp, i, m = 0, used = 0;
+    double *ahat, *prod;
     idx = (int *)work;
     tmp = idx + n;
     ahat = work + 2 * ints_as_doubles((size_t)n);
@@ -303,5 +313,216 @@ int mcg_static_noise(int n, const double *o1, const double *d1, const double *o2
             prod[used++] = res[i];
     *n_used = used;
     *median = used ? median_inplace(prod, used) : 0.0;
+    return MCG_OK;
+}
+
+int mcg_static_noise(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const int *group, const double R[9], int min_rows,
+                     int samples, double *res, double *median, int *n_used, double *work,
+                     size_t lwork)
+{
+    size_t need;
+    int st;
+    if (!o1 || !d1 || !o2 || !d2 || !group || !R || !res || !median || !n_used ||
+        (!work && lwork))
+        return MCG_EINVAL;
+    need = mcg_static_noise_work_size(n);
+    if (need == 0 || !all_finite(R, 9))
+        return MCG_EINVAL;
+    st = check_rays(n, o1, d1, o2, d2, group, min_rows, samples);
+    if (st != MCG_OK)
+        return st;
+    if (lwork < need)
+        return MCG_ENOMEM;
+    return static_noise(n, o1, d1, o2, d2, group, R, min_rows, samples, res, median, n_used,
+                        work);
+}
+
+void mcg_static_default_options(mcg_static_options *opt)
+{
+    if (!opt)
+        return;
+    opt->noise_factor = 10.0;
+    opt->noise_floor = 1e-9;
+    opt->default_level = 1e-3;
+    opt->parallax_factor = 1.5;
+    opt->fraction = 0.9;
+    opt->min_pairs = 5;
+    opt->min_distinct = 5;
+    opt->min_rows = 12;
+    opt->samples = 32;
+}
+
+size_t mcg_static_check_work_size(int n)
+{
+    int ok = 1;
+    size_t w = mcg_static_noise_work_size(n);
+    if (w == 0)
+        return 0;
+    w = add_sz(w, mul_sz(2, (size_t)n, &ok), &ok); /* residuals, angles */
+    return ok ? w : 0;
+}
+
+/* unit copy of v */
+static void unit3(const double *v, double u[3])
+{
+    double s = 1.0 / sqrt(dot3(v, v));
+    u[0] = v[0] * s;
+    u[1] = v[1] * s;
+    u[2] = v[2] * s;
+}
+
+/* the rotation-only statistic at R: the fraction of the intra-camera pairs
+ * whose angle between d2 and R d1 is below lim, and their median angle
+ * (ang: scratch of n doubles) */
+static void rotation_statistic(int n, const double *d1, const double *d2, const int *group,
+                               const double R[9], double lim, double *ang, int *n_intra,
+                               double *explained, double *median_angle)
+{
+    int i, m = 0, inside = 0;
+    for (i = 0; i < n; i++) {
+        double a[3], b[3], ra[3], x[3];
+        if (group[i] < 0)
+            continue;
+        unit3(d1 + 3 * i, a);
+        unit3(d2 + 3 * i, b);
+        mat_vec(R, a, ra);
+        cross3(ra, b, x);
+        /* as numpy's arctan2(|R d1 x d2|, R d1 . d2) of geometry.rotation_fit */
+        ang[m] = atan2(sqrt(dot3(x, x)), dot3(ra, b));
+        inside += ang[m] < lim;
+        m++;
+    }
+    *n_intra = m;
+    *explained = m ? (double)inside / m : 0.0;
+    *median_angle = m ? median_inplace(ang, m) : NAN;
+}
+
+/* at least k distinct intra-camera pairs (all four rows and the camera
+ * compared exactly)? O(k n) */
+static int distinct_at_least(int n, const double *o1, const double *d1, const double *o2,
+                             const double *d2, const int *group, int k, int *seen)
+{
+    int i, j, found = 0;
+    if (k <= 0)
+        return 1;
+    for (i = 0; i < n && found < k; i++) {
+        int same = 0;
+        if (group[i] < 0)
+            continue;
+        for (j = 0; j < found && !same; j++) {
+            int p = seen[j], c;
+            same = group[p] == group[i];
+            for (c = 0; c < 3 && same; c++)
+                same = o1[3 * p + c] == o1[3 * i + c] && d1[3 * p + c] == d1[3 * i + c] &&
+                       o2[3 * p + c] == o2[3 * i + c] && d2[3 * p + c] == d2[3 * i + c];
+        }
+        if (!same)
+            seen[found++] = i;
+    }
+    return found >= k;
+}
+
+int mcg_static_check(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const int *group, const double *R_est,
+                     const double *R_given, double noise_level, const mcg_static_options *opt,
+                     mcg_static_result *out, double *work, size_t lwork)
+{
+    mcg_static_options o;
+    size_t need;
+    double B[9] = {0}, *res, *ang, med, levels[2], lim;
+    const double *R_test;
+    int i, r, c, st, used, n_intra = 0, n_rot = 0, distinct, seen[64];
+    if (!o1 || !d1 || !o2 || !d2 || !group || !out || (!work && lwork))
+        return MCG_EINVAL;
+    if (opt)
+        o = *opt;
+    else
+        mcg_static_default_options(&o);
+    need = mcg_static_check_work_size(n);
+    if (need == 0 || !(isfinite(o.noise_factor) && o.noise_factor > 0.0) ||
+        !(isfinite(o.noise_floor) && o.noise_floor >= 0.0) ||
+        !(isfinite(o.default_level) && o.default_level > 0.0) ||
+        !(isfinite(o.parallax_factor) && o.parallax_factor > 0.0) ||
+        !(o.fraction >= 0.0 && o.fraction <= 1.0) || o.min_pairs < 0 || o.min_distinct < 0 ||
+        o.min_distinct > 64)
+        return MCG_EINVAL;
+    /* noise_level: > 0 given (radians), 0 = estimate it */
+    if (!(isfinite(noise_level) && noise_level >= 0.0))
+        return MCG_EINVAL;
+    if ((R_est && !all_finite(R_est, 9)) || (R_given && !all_finite(R_given, 9)))
+        return MCG_EINVAL;
+    st = check_rays(n, o1, d1, o2, d2, group, o.min_rows, o.samples);
+    if (st != MCG_OK)
+        return st;
+    if (lwork < need)
+        return MCG_ENOMEM;
+    res = work + mcg_static_noise_work_size(n);
+    ang = res + n;
+    /* the best pure rotation: nearest rotation to sum d2 d1^T (identity
+     * with fewer than two intra-camera pairs) */
+    for (i = 0; i < n; i++) {
+        double a[3], b[3];
+        if (group[i] < 0)
+            continue;
+        unit3(d1 + 3 * i, a);
+        unit3(d2 + 3 * i, b);
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++)
+                B[3 * r + c] += b[r] * a[c];
+        n_intra++;
+    }
+    /* rank < 2 (one bearing repeated): no rotation is determined, the
+     * identity stands in and the distinct-pairs condition decides */
+    if (n_intra < 2 || mcg_project_so3(B, out->R_fit) != MCG_OK) {
+        for (i = 0; i < 9; i++)
+            out->R_fit[i] = (i % 4 == 0) ? 1.0 : 0.0;
+    }
+    /* the noise level: the smaller of those at the first rotation (the
+     * estimate's, else the given one) and at the pure rotation */
+    out->noise_from_default = 0;
+    if (noise_level > 0.0) {
+        out->noise_level = noise_level;
+    } else {
+        const double *rots[2];
+        rots[n_rot++] = R_est ? R_est : R_given;
+        if (!rots[0])
+            n_rot = 0;
+        rots[n_rot++] = out->R_fit;
+        out->noise_level = HUGE_VAL;
+        for (i = 0; i < n_rot; i++) {
+            st = static_noise(n, o1, d1, o2, d2, group, rots[i], o.min_rows, o.samples, res,
+                              &med, &used, work);
+            if (st != MCG_OK)
+                return st;
+            if (!used)
+                break;
+            levels[i] = o.noise_factor * MAD_TO_STD * med;
+            if (levels[i] < o.noise_floor)
+                levels[i] = o.noise_floor;
+            if (levels[i] < out->noise_level)
+                out->noise_level = levels[i];
+        }
+        if (!used) {
+            out->noise_level = o.default_level;
+            out->noise_from_default = 1;
+        }
+    }
+    lim = o.parallax_factor * out->noise_level;
+    distinct = distinct_at_least(n, o1, d1, o2, d2, group, o.min_distinct, seen);
+    /* the pure rotation (given or fitted), then the estimate's own */
+    out->is_static = 0;
+    for (i = 0; i < 2 && !out->is_static; i++) {
+        R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
+        if (i == 1 && (!R_est || R_given))
+            break;
+        rotation_statistic(n, d1, d2, group, R_test, lim, ang, &out->n_intra, &out->explained,
+                           &out->median_angle);
+        out->decided_at = i;
+        for (r = 0; r < 9; r++)
+            out->R[r] = R_test[r];
+        out->is_static = distinct && out->n_intra >= o.min_pairs && out->n_intra > 0 &&
+                         out->explained >= o.fraction;
+    }
     return MCG_OK;
 }

@@ -31,7 +31,7 @@ __all__ = [
     "skyline_eig",
     "essential5", "essential_decompose",
     "upright4", "eigensolver",
-    "static_noise",
+    "static_noise", "static_check",
 ]
 
 GC_CASE_NAMES = {
@@ -1384,3 +1384,65 @@ def static_noise(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
     if st != lib.MCG_OK:
         _ray_error(st, "static_noise", rays, (("R", R),))
     return res, float(med[0]), int(used[0])
+
+
+def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: Any,
+                 R_est: Any = None, R_given: Any = None, noise_level: float = 0.0, *,
+                 noise_factor: float, noise_floor: float, default_level: float,
+                 parallax_factor: float, fraction: float, min_pairs: int, min_distinct: int,
+                 min_rows: int, samples: int) -> dict:
+    """The static-rig test of one estimate in one C call (``mcg_static_check``).
+
+    Rays and ``group`` as for :func:`static_noise`; ``R_est`` the estimate's
+    rotation, ``R_given`` a known one (3x3 or None); ``noise_level`` radians
+    (0 = estimate it); the options are the constants of
+    :mod:`mcgeom.estimators._static` and :func:`mcgeom.observability.no_parallax`
+    (see ``mcg_static_options`` in mcgeom.h). Returns a dict: ``static``,
+    ``decided_at`` (0 the pure rotation, 1 the estimate's), ``R`` (that
+    rotation), ``R_fit`` (the best pure rotation), ``noise_level`` (radians),
+    ``noise_from_default``, ``explained``, ``n_intra``, ``median_angle``
+    (radians). Raises ValueError naming the bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    n = rays[0].shape[0]
+    if n > 1 << 20:
+        raise ValueError(f"static_check: at most 2^20 correspondences supported, got {n}")
+    g = np.asarray(group)
+    if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
+        raise ValueError(f"group must be {n} integer camera ids, got shape {g.shape} "
+                         f"and dtype {g.dtype}")
+    if n and (g.min() < -1 or g.max() > np.iinfo(np.int32).max):
+        raise ValueError("group holds ids below -1 or beyond int32")
+    g = np.ascontiguousarray(g, dtype=np.int32)
+    mats = [None if M is None else _f64(name, M, (3, 3))
+            for name, M in (("R_est", R_est), ("R_given", R_given))]
+    if not (np.isfinite(noise_level) and noise_level >= 0):
+        raise ValueError(f"noise_level must be >= 0 radians (0: estimate it), got {noise_level}")
+    opt = ffi.new("mcg_static_options *")
+    for name, v in (("noise_factor", noise_factor), ("noise_floor", noise_floor),
+                    ("default_level", default_level), ("parallax_factor", parallax_factor),
+                    ("fraction", fraction), ("min_pairs", min_pairs),
+                    ("min_distinct", min_distinct), ("min_rows", min_rows),
+                    ("samples", samples)):
+        setattr(opt, name, v)
+    out = ffi.new("mcg_static_result *")
+    work = _work(lib.mcg_static_check_work_size(n))
+    st = lib.mcg_static_check(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
+                              ffi.from_buffer("int[]", g),
+                              ffi.NULL if mats[0] is None else _p(mats[0]),
+                              ffi.NULL if mats[1] is None else _p(mats[1]),
+                              float(noise_level), opt, out, _p(work), work.size)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL and not (1 <= min_rows and 0 <= samples <= 65536
+                                         and 0 <= min_distinct <= 64):
+            raise ValueError("static_check: min_rows, samples or min_distinct out of range")
+        _ray_error(st, "static_check", rays, tuple((k, M) for k, M in
+                                                   (("R_est", mats[0]), ("R_given", mats[1]))
+                                                   if M is not None))
+    return {"static": bool(out.is_static), "decided_at": int(out.decided_at),
+            "R": np.frombuffer(ffi.buffer(out.R), dtype=np.float64).reshape(3, 3).copy(),
+            "R_fit": np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy(),
+            "noise_level": float(out.noise_level),
+            "noise_from_default": bool(out.noise_from_default),
+            "explained": float(out.explained), "n_intra": int(out.n_intra),
+            "median_angle": float(out.median_angle)}

@@ -144,3 +144,73 @@ def test_noise_level_is_the_kernel_median():
     r = _static.camera_residuals(p.rays, p.R)
     level = _static.noise_level_of(p.rays, p.R)
     assert level <= _static.NOISE_FACTOR * 1.4826 * float(np.median(r)) * (1 + 1e-12)
+
+
+def _reference_decision(rays, full_R, rotation):
+    """check_static's rule composed from the Python pieces (static_test at the
+    pure or given rotation, then at the estimate's; the noise level the smaller
+    of the estimate's or given rotation's and the pure rotation's)."""
+    from mcgeom.geometry import rotation_fit, same_camera
+    R0 = rotation_fit(rays, same_camera(rays))[0]
+    first = full_R if full_R is not None else rotation
+    level = min(_static._noise_levels(rays, (R0,) if first is None else (first, R0)))
+    test = _static.static_test(rays, level, rotation=rotation, _fit=R0)
+    if not test.static and full_R is not None and rotation is None:
+        test = _static.static_test(rays, level, rotation=full_R)
+    return test
+
+
+def _cases():
+    """Static, slowly and fast moving rigs, with and without noise, outliers and
+    cross-camera rays; an estimate's rotation slightly off or none."""
+    out = []
+    for seed in range(12):
+        rng = np.random.default_rng(100 + seed)
+        t = [0.0, 1e-4, 3e-3, 0.3][seed % 4] * rng.normal(size=3)
+        R = synth.random_rotation(rng, 0.2)
+        p = synth.make_problem(synth.generic_rig(4, rng), R, t, [17, 60, 200][seed % 3], rng,
+                               cross_fraction=0.3 * (seed % 2), angular_noise=3e-4,
+                               outlier_fraction=0.1 * (seed % 3 == 2), require_visible=False)
+        R_est = synth.random_rotation(rng, 3e-4) @ R
+        out += [(p.rays, None, None), (p.rays, R_est, None), (p.rays, R_est, R)]
+    return out
+
+
+@pytest.mark.parametrize("case", range(36))
+def test_check_static_in_c_decides_as_the_python_rule(case):
+    rays, R_est, rotation = _cases()[case]
+    ref = _reference_decision(rays, R_est, rotation)
+    got = _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                             _static._intra_groups(rays), R_est, rotation, 0.0,
+                             **_static._C_OPTIONS)
+    assert got["static"] == ref.static
+    assert got["noise_level"] == pytest.approx(ref.noise_level, rel=1e-9)
+    assert got["explained"] == pytest.approx(ref.explained, abs=1e-12)
+    assert got["n_intra"] == ref.n_intra
+    np.testing.assert_allclose(got["R"], ref.R, atol=1e-12)
+    assert got["median_angle"] == pytest.approx(ref.median_angle, rel=1e-9)
+
+
+def test_check_static_cases_cover_both_answers():
+    answers = {_reference_decision(*c).static for c in _cases()}
+    assert answers == {True, False}
+
+
+def test_check_static_given_noise_level_and_repeats():
+    p = make("locally-central", 2, n=40, angular_noise=3e-4, t_norm=0.0)
+    rays = p.rays
+    g = _static._intra_groups(rays)
+    big = _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, g,
+                             noise_level=1.0, **_static._C_OPTIONS)
+    assert big["static"] and big["noise_level"] == 1.0
+    # one correspondence repeated explains any rotation: not static
+    one = rays.take(np.zeros(40, dtype=int))
+    rep = _core.static_check(one.origins1, one.dirs1, one.origins2, one.dirs2,
+                             _static._intra_groups(one), noise_level=1.0, **_static._C_OPTIONS)
+    assert not rep["static"]
+    with pytest.raises(ValueError, match="noise_level"):
+        _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, g,
+                           noise_level=-1.0, **_static._C_OPTIONS)
+    with pytest.raises(ValueError, match="R_est"):
+        _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, g,
+                           R_est=np.full((3, 3), np.nan), **_static._C_OPTIONS)

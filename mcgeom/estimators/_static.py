@@ -48,7 +48,8 @@ import numpy as np
 from .. import _core
 from ..errors import DegenerateError
 from ..geometry import rotation_fit, rotation_only_residuals, same_camera
-from ..observability import NO_PARALLAX_FACTOR, no_parallax
+from ..observability import (NO_PARALLAX_FACTOR, NO_PARALLAX_FRACTION, NO_PARALLAX_MIN,
+                             no_parallax)
 from ..types import RayPairs, RigMotion, ScaleVerdict
 from ._common import camera_ids
 
@@ -69,6 +70,9 @@ _FLOOR = 1e-9
 #: fewest intra-camera correspondences of a camera whose residuals measure the
 #: noise (a static rig with 7 per camera and 3e-4 rad noise read as moving)
 _MIN_PER_CAMERA = 12
+#: fewest distinct intra-camera correspondences of a static answer (repeats of
+#: one correspondence "explain" any rotation-only model)
+_MIN_DISTINCT = 5
 #: 1 / the median of |N(0, 1)|: the standard deviation from the median absolute residual
 _MAD_TO_STD = 1.4826
 
@@ -192,19 +196,13 @@ def static_test(rays: RayPairs, noise_level: float, *, rotation: Optional[np.nda
         R = np.asarray(rotation if rotation is not None else _fit, dtype=np.float64)
         ang = rotation_only_residuals(rays.take(np.flatnonzero(same)), R) if same.any() \
             else np.zeros(0)
-    cross = np.flatnonzero(~same)
-    cross_median = float("nan")
-    if cross.size:
-        rc = np.abs(_core.gec_residuals(rays.origins1[cross], rays.dirs1[cross],
-                                        rays.origins2[cross], rays.dirs2[cross], R,
-                                        np.zeros(3)))
-        cross_median = float(np.median(rc))
+    cross_median = _cross_median(rays, R)
     explained = (float(np.count_nonzero(ang < NO_PARALLAX_FACTOR * noise_level)) / ang.size
                  if ang.size else 0.0)
     # a rotation from fewer than 5 distinct correspondences is not determined
     # (repeats of one correspondence "explain" any rotation-only model)
     static = bool(no_parallax(ang, noise_level)) and \
-        rays.take(np.flatnonzero(same)).n_distinct(at_least=5) >= 5
+        rays.take(np.flatnonzero(same)).n_distinct(at_least=_MIN_DISTINCT) >= _MIN_DISTINCT
     return StaticTest(static=static, R=R, noise_level=float(noise_level),
                       noise_source=noise_source, explained=explained, n_intra=int(ang.size),
                       median_angle=float(np.median(ang)) if ang.size else float("nan"),
@@ -242,6 +240,33 @@ def static_motion(rays: RayPairs, method: str, test: StaticTest,
                      None, out)
 
 
+#: the constants of the test, as mcg_static_check takes them
+_C_OPTIONS = dict(noise_factor=NOISE_FACTOR, noise_floor=_FLOOR,
+                  default_level=DEFAULT_NOISE_LEVEL, parallax_factor=NO_PARALLAX_FACTOR,
+                  fraction=NO_PARALLAX_FRACTION, min_pairs=NO_PARALLAX_MIN,
+                  min_distinct=_MIN_DISTINCT, min_rows=_MIN_PER_CAMERA, samples=_LMEDS_SAMPLES)
+
+
+def _intra_groups(rays: RayPairs) -> np.ndarray:
+    """(N,) the camera of each intra-camera correspondence, -1 for cross-camera ones."""
+    if rays.cam1 is not None and rays.cam2 is not None:
+        cam1, cam2 = rays.cam1, rays.cam2
+    else:
+        cam1, cam2, _ = camera_ids(rays)
+    return np.where(cam1 == cam2, cam1, -1)
+
+
+def _cross_median(rays: RayPairs, R: np.ndarray) -> float:
+    """Median Sampson residual (radians) of the cross-camera correspondences under
+    ``(R, t = 0)``; nan without any."""
+    cross = np.flatnonzero(~same_camera(rays))
+    if not cross.size:
+        return float("nan")
+    return float(np.median(np.abs(_core.gec_residuals(
+        rays.origins1[cross], rays.dirs1[cross], rays.origins2[cross], rays.dirs2[cross], R,
+        np.zeros(3)))))
+
+
 def check_static(rays: RayPairs, method: str, full: Optional[RigMotion] = None, *,
                  noise_level: Optional[float] = None,
                  rotation: Optional[np.ndarray] = None) -> Optional[RigMotion]:
@@ -274,20 +299,23 @@ def check_static(rays: RayPairs, method: str, full: Optional[RigMotion] = None, 
     The noise level stays the smaller of the two rotations' (a wrong
     rotation must not inflate it).
     """
-    R0 = rotation_fit(rays, same_camera(rays))[0]     # the best pure rotation
-    if noise_level is not None:
-        level, source = float(noise_level), "given"
-    else:
-        first = full.R if full is not None else rotation
-        rots = (R0,) if first is None else (np.asarray(first, dtype=np.float64), R0)
-        level = min(_noise_levels(rays, rots))
-        source = "per-camera fit" if level != DEFAULT_NOISE_LEVEL else "default"
-    test = static_test(rays, level, rotation=rotation, noise_source=source, _fit=R0)
-    if not test.static and full is not None and rotation is None:
-        test = static_test(rays, level, rotation=full.R,
-                           noise_source=source + "; angles at the estimate's rotation")
-    if not test.static:
+    # one C call (mcg_static_check: the pure-rotation fit, the noise levels,
+    # the statistic at both rotations); its rule and constants are those of
+    # static_test, noise_level_of and observability.no_parallax above
+    if noise_level is not None and not (np.isfinite(noise_level) and noise_level > 0):
+        raise ValueError(f"noise_level must be a positive number of radians, got {noise_level}")
+    r = _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                           _intra_groups(rays), None if full is None else full.R, rotation,
+                           0.0 if noise_level is None else float(noise_level), **_C_OPTIONS)
+    if not r["static"]:
         return None
+    source = "given" if noise_level is not None else \
+        "default" if r["noise_from_default"] else "per-camera fit"
+    if r["decided_at"] == 1:
+        source += "; angles at the estimate's rotation"
+    test = StaticTest(static=True, R=r["R"], noise_level=r["noise_level"], noise_source=source,
+                      explained=r["explained"], n_intra=r["n_intra"],
+                      median_angle=r["median_angle"], cross_median=_cross_median(rays, r["R"]))
     extra = {} if full is None else {"full_estimate": {
         "R": np.array(full.R), "t": np.array(full.t), "reason": full.scale.reason}}
     if full is not None and isinstance(full.info, dict):
