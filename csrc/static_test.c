@@ -423,6 +423,54 @@ static int distinct_at_least(int n, const double *o1, const double *d1, const do
     return found >= k;
 }
 
+/* the noise level at R (noise_factor robust stds of the per-camera
+ * residuals, at least noise_floor), 0 when no camera has min_rows pairs */
+static int level_at(int n, const double *o1, const double *d1, const double *o2,
+                    const double *d2, const int *group, const double R[9],
+                    const mcg_static_options *o, double *res, double *work, double *level)
+{
+    double med;
+    int used, st = static_noise(n, o1, d1, o2, d2, group, R, o->min_rows, o->samples, res,
+                                &med, &used, work);
+    *level = 0.0;
+    if (st == MCG_OK && used) {
+        *level = o->noise_factor * MAD_TO_STD * med;
+        if (*level < o->noise_floor)
+            *level = o->noise_floor;
+    }
+    return st;
+}
+
+/* the statistic at out->noise_level: at R_given (else R_fit), then --
+ * without R_given -- at R_est; out->is_static and the figures of the last
+ * rotation tried */
+static void explained_anywhere(int n, const double *o1, const double *d1, const double *o2,
+                               const double *d2, const int *group, const double *R_est,
+                               const double *R_given, const mcg_static_options *o,
+                               mcg_static_result *out, double *ang)
+{
+    double lim = o->parallax_factor * out->noise_level;
+    int i, r, distinct = -1, seen[64];
+    out->is_static = 0;
+    for (i = 0; i < 2 && !out->is_static; i++) {
+        const double *R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
+        if (i == 1 && (!R_est || R_given))
+            break;
+        rotation_statistic(n, d1, d2, group, R_test, lim, ang, &out->n_intra, &out->explained,
+                           &out->median_angle);
+        out->decided_at = i;
+        for (r = 0; r < 9; r++)
+            out->R[r] = R_test[r];
+        out->is_static = out->n_intra >= o->min_pairs && out->n_intra > 0 &&
+                         out->explained >= o->fraction;
+        if (out->is_static) {
+            if (distinct < 0)
+                distinct = distinct_at_least(n, o1, d1, o2, d2, group, o->min_distinct, seen);
+            out->is_static = distinct;
+        }
+    }
+}
+
 int mcg_static_check(int n, const double *o1, const double *d1, const double *o2,
                      const double *d2, const int *group, const double *R_est,
                      const double *R_given, double noise_level, const mcg_static_options *opt,
@@ -430,9 +478,8 @@ int mcg_static_check(int n, const double *o1, const double *d1, const double *o2
 {
     mcg_static_options o;
     size_t need;
-    double B[9] = {0}, *res, *ang, med, levels[2], lim;
-    const double *R_test;
-    int i, r, c, st, used, n_intra = 0, n_rot = 0, distinct, seen[64];
+    double B[9] = {0}, *res, *ang, levels[2];
+    int i, r, c, st, n_intra = 0;
     if (!o1 || !d1 || !o2 || !d2 || !group || !out || (!work && lwork))
         return MCG_EINVAL;
     if (opt)
@@ -479,50 +526,36 @@ int mcg_static_check(int n, const double *o1, const double *d1, const double *o2
             out->R_fit[i] = (i % 4 == 0) ? 1.0 : 0.0;
     }
     /* the noise level: the smaller of those at the first rotation (the
-     * estimate's, else the given one) and at the pure rotation */
+     * estimate's, else the given one) and at the pure rotation. The pure
+     * rotation's comes first: it bounds the level from above, and a smaller
+     * level only explains fewer angles, so when no rotation explains enough
+     * of them at that bound the rig moved whatever the other level is (the
+     * exact early exit of a moving rig: one noise computation, not two) */
     out->noise_from_default = 0;
     if (noise_level > 0.0) {
         out->noise_level = noise_level;
     } else {
-        const double *rots[2];
-        rots[n_rot++] = R_est ? R_est : R_given;
-        if (!rots[0])
-            n_rot = 0;
-        rots[n_rot++] = out->R_fit;
-        out->noise_level = HUGE_VAL;
-        for (i = 0; i < n_rot; i++) {
-            st = static_noise(n, o1, d1, o2, d2, group, rots[i], o.min_rows, o.samples, res,
-                              &med, &used, work);
-            if (st != MCG_OK)
-                return st;
-            if (!used)
-                break;
-            levels[i] = o.noise_factor * MAD_TO_STD * med;
-            if (levels[i] < o.noise_floor)
-                levels[i] = o.noise_floor;
-            if (levels[i] < out->noise_level)
-                out->noise_level = levels[i];
-        }
-        if (!used) {
+        st = level_at(n, o1, d1, o2, d2, group, out->R_fit, &o, res, work, &levels[1]);
+        if (st != MCG_OK)
+            return st;
+        if (levels[1] == 0.0) { /* no camera with min_rows pairs */
             out->noise_level = o.default_level;
             out->noise_from_default = 1;
+        } else {
+            out->noise_level = levels[1];
+            if (R_est || R_given) {
+                explained_anywhere(n, o1, d1, o2, d2, group, R_est, R_given, &o, out, ang);
+                if (!out->is_static)
+                    return MCG_OK; /* moving at the upper bound of the level */
+                st = level_at(n, o1, d1, o2, d2, group, R_est ? R_est : R_given, &o, res, work,
+                              &levels[0]);
+                if (st != MCG_OK)
+                    return st;
+                if (levels[0] < out->noise_level)
+                    out->noise_level = levels[0];
+            }
         }
     }
-    lim = o.parallax_factor * out->noise_level;
-    distinct = distinct_at_least(n, o1, d1, o2, d2, group, o.min_distinct, seen);
-    /* the pure rotation (given or fitted), then the estimate's own */
-    out->is_static = 0;
-    for (i = 0; i < 2 && !out->is_static; i++) {
-        R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
-        if (i == 1 && (!R_est || R_given))
-            break;
-        rotation_statistic(n, d1, d2, group, R_test, lim, ang, &out->n_intra, &out->explained,
-                           &out->median_angle);
-        out->decided_at = i;
-        for (r = 0; r < 9; r++)
-            out->R[r] = R_test[r];
-        out->is_static = distinct && out->n_intra >= o.min_pairs && out->n_intra > 0 &&
-                         out->explained >= o.fraction;
-    }
+    explained_anywhere(n, o1, d1, o2, d2, group, R_est, R_given, &o, out, ang);
     return MCG_OK;
 }

@@ -184,11 +184,16 @@ def test_check_static_in_c_decides_as_the_python_rule(case):
                              _static._intra_groups(rays), R_est, rotation, 0.0,
                              **_static._C_OPTIONS)
     assert got["static"] == ref.static
-    assert got["noise_level"] == pytest.approx(ref.noise_level, rel=1e-9)
-    assert got["explained"] == pytest.approx(ref.explained, abs=1e-12)
     assert got["n_intra"] == ref.n_intra
-    np.testing.assert_allclose(got["R"], ref.R, atol=1e-12)
-    assert got["median_angle"] == pytest.approx(ref.median_angle, rel=1e-9)
+    if got["static"] or R_est is None and rotation is None:
+        assert got["noise_level"] == pytest.approx(ref.noise_level, rel=1e-9)
+        assert got["explained"] == pytest.approx(ref.explained, abs=1e-12)
+        np.testing.assert_allclose(got["R"], ref.R, atol=1e-12)
+        assert got["median_angle"] == pytest.approx(ref.median_angle, rel=1e-9)
+    else:
+        # stopped early at the pure rotation's level, an upper bound of the level
+        assert got["noise_level"] >= ref.noise_level * (1 - 1e-9)
+        assert got["explained"] < _static.NO_PARALLAX_FRACTION
 
 
 def test_check_static_cases_cover_both_answers():

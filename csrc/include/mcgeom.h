@@ -1128,7 +1128,9 @@ typedef struct {
                                (given or fitted), 1 the estimate's own */
     double R[9];            /* that rotation (rig2_from_rig1, row-major) */
     double R_fit[9];        /* best pure rotation of the intra-camera bearings */
-    double noise_level;     /* radians */
+    double noise_level;     /* radians; when the test stopped early (not
+                               static even at the level of the pure rotation,
+                               the upper bound) that bound */
     int noise_from_default; /* 1: no camera had min_rows pairs */
     double explained;       /* fraction of intra-camera pairs explained at R */
     int n_intra;            /* intra-camera pairs (group >= 0) */
@@ -1150,7 +1152,11 @@ size_t mcg_static_check_work_size(int n);
  * opt->min_pairs rotation-only angles (between d2 and R d1) are below
  * parallax_factor x the level, at R_given (else R_fit) or -- without
  * R_given -- at R_est, and at least min_distinct intra-camera pairs are
- * distinct. Workspace lwork >= mcg_static_check_work_size(n). MCG_EINVAL
+ * distinct. The pure rotation's level is computed first: it bounds the
+ * level from above, and when no rotation explains enough angles at that
+ * bound the answer is "not static" without the second level (exact: a
+ * smaller level explains fewer). Workspace lwork >=
+ * mcg_static_check_work_size(n). MCG_EINVAL
  * as mcg_static_noise, and for bad options, a negative or non-finite
  * noise_level, NaN/inf in R_est or R_given; MCG_ENOMEM; MCG_ENUMERIC. */
 int mcg_static_check(int n, const double *o1, const double *d1, const double *o2,

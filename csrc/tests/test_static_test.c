@@ -220,8 +220,54 @@ static void test_status(void)
     free(work);
 }
 
+/* mcg_static_check: a static rig (R = I, t = 0, ~1e-4 rad noise) is static
+ * with its rotation recovered; a moving rig (rotation up to 0.1 rad, |t| up
+ * to 0.87 m) is not, with the estimate's rotation given; a given noise
+ * level is used as is */
+static void test_check(void)
+{
+    mcg_static_options opt;
+    mcg_static_result res;
+    size_t lw = mcg_static_check_work_size(N);
+    double *work = malloc(sizeof(double) * lw), err = 0.0;
+    int i, st, ok_static = 1, ok_moving = 1, trial;
+    mcg_static_default_options(&opt);
+    for (trial = 0; trial < scaled(10); trial++) {
+        scene(0.0);
+        /* static (R = I, t = 0: a rig that rotates moves its off-centre
+         * cameras): time 2 sees each point along the same bearing, with noise */
+        for (i = 0; i < 9; i++)
+            R[i] = (i % 4 == 0) ? 1.0 : 0.0;
+        for (i = 0; i < 3 * N; i++)
+            d2[i] = d1[i] + 5e-4 * gauss();
+        st = mcg_static_check(N, o1, d1, o2, d2, grp, NULL, NULL, 0.0, &opt, &res, work, lw);
+        ok_static &= st == MCG_OK && res.is_static && res.decided_at == 0;
+        for (i = 0; i < 9; i++)
+            err = fmax(err, fabs(res.R_fit[i] - R[i]));
+        scene(1e-4);
+        st = mcg_static_check(N, o1, d1, o2, d2, grp, R, NULL, 0.0, &opt, &res, work, lw);
+        ok_moving &= st == MCG_OK && !res.is_static;
+    }
+    check(ok_static, "static rig: static at the pure rotation", (double)!ok_static, 0.0);
+    check(err < 1e-3, "static rig: R_fit = R (max entry error)", err, 1e-3);
+    check(ok_moving, "moving rig (estimate's R given): not static", (double)!ok_moving, 0.0);
+    st = mcg_static_check(N, o1, d1, o2, d2, grp, R, NULL, 10.0, &opt, &res, work, lw);
+    check(st == MCG_OK && res.is_static && res.noise_level == 10.0,
+          "a given noise level of 10 rad explains every angle", res.noise_level, 0.0);
+    check_status(mcg_static_check(N, o1, d1, o2, d2, grp, NULL, NULL, -1.0, &opt, &res, work,
+                                  lw), MCG_EINVAL, "static_check: noise_level -1");
+    opt.fraction = 1.5;
+    check_status(mcg_static_check(N, o1, d1, o2, d2, grp, NULL, NULL, 0.0, &opt, &res, work,
+                                  lw), MCG_EINVAL, "static_check: fraction 1.5");
+    mcg_static_default_options(&opt);
+    check_status(mcg_static_check(N, o1, d1, o2, d2, grp, NULL, NULL, 0.0, &opt, &res, work,
+                                  lw - 1), MCG_ENOMEM, "static_check: workspace one short");
+    free(work);
+}
+
 int main(void)
 {
+    test_check();
     test_exact_and_outliers();
     test_noisy_median();
     test_selection();

@@ -5,7 +5,11 @@
  *
  * Inputs: mode 0 a synthetic rig scene (cross-camera pairs left out with
  * group -1), mode 1 arbitrary arrays and group ids in -3..8; min_rows and
- * samples valid or not. Invariants: bad sizes, options, group ids below -1
+ * samples valid or not; mode 2 the scene of mode 0 through mcg_static_check
+ * (the whole test: estimate's and given rotation present or not, a given or
+ * estimated noise level) with the invariants: R_fit a rotation, a positive
+ * finite noise level, explained in [0, 1], n_intra the pairs of group >= 0,
+ * a static answer explains at least the fraction of at least min_pairs. Invariants: bad sizes, options, group ids below -1
  * and NaN/inf inputs give MCG_EINVAL; on MCG_OK a pair of group -1 or of a
  * camera with fewer than min_rows pairs has residual -1, every other one a
  * finite residual in [0, pi/2], n_used counts them and the median lies
@@ -16,9 +20,51 @@
 
 /* routines selected by the first input byte (fuzz/make_corpus.py writes
  * seeds for each) */
-#define FUZZ_MODES 2
+#define FUZZ_MODES 3
 
 #define MAXN 96
+
+static int check_whole_test(fz_in *in, int n, const int *group, const double R[9],
+                            const double *o1, const double *d1, const double *o2,
+                            const double *d2, double *work, size_t lw_noise)
+{
+    static double w2[10 * MAXN + 16];
+    mcg_static_options opt;
+    mcg_static_result out;
+    double level = (fz_u8(in) & 1) ? fz_range(in, 0.0, 0.01) : 0.0, r_fit_err;
+    const int with_est = fz_u8(in) & 1, with_given = fz_u8(in) & 1;
+    size_t lw = mcg_static_check_work_size(n);
+    int st, i, n_intra = 0;
+    (void)work;
+    (void)lw_noise;
+    FZ_CHECK(lw > 0 && lw <= sizeof(w2) / sizeof(w2[0]), "check work size %zu", lw);
+    mcg_static_default_options(&opt);
+    opt.min_rows = fz_int(in, 1, 20);
+    opt.samples = fz_int(in, 0, 64);
+    st = mcg_static_check(n, o1, d1, o2, d2, group, with_est ? R : NULL, with_given ? R : NULL,
+                          level, &opt, &out, w2, lw);
+    FZ_CHECK(fz_status_known(st), "static_check status %d", st);
+    if (!fz_all_finite(o1, 3 * (size_t)n) || !fz_all_finite(d1, 3 * (size_t)n) ||
+        !fz_all_finite(o2, 3 * (size_t)n) || !fz_all_finite(d2, 3 * (size_t)n)) {
+        FZ_CHECK(st == MCG_EINVAL, "static_check of non-finite input: %d", st);
+        return 0;
+    }
+    if (st != MCG_OK)
+        return 0;
+    for (i = 0; i < n; ++i)
+        n_intra += group[i] >= 0;
+    r_fit_err = fz_orth_err3(out.R_fit);
+    FZ_CHECK(r_fit_err < 1e-9 && fz_det3(out.R_fit) > 0.0, "R_fit not a rotation: %g",
+             r_fit_err);
+    FZ_CHECK(isfinite(out.noise_level) && out.noise_level > 0.0, "noise level %g",
+             out.noise_level);
+    FZ_CHECK(out.n_intra == n_intra, "n_intra %d, counted %d", out.n_intra, n_intra);
+    FZ_CHECK(out.explained >= 0.0 && out.explained <= 1.0, "explained %g", out.explained);
+    if (out.is_static)
+        FZ_CHECK(out.explained >= opt.fraction && out.n_intra >= opt.min_pairs,
+                 "static with %g explained of %d", out.explained, out.n_intra);
+    return 0;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -38,7 +84,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     lw = mcg_static_noise_work_size(n);
     FZ_CHECK(lw > 0 && lw <= sizeof(work) / sizeof(work[0]), "work size %zu for n = %d", lw, n);
-    if (mode == 0) {
+    if (mode == 0 || mode == 2) {
         fz_rotation(&in, R);
         for (i = 0; i < 3; ++i)
             t[i] = fz_range(&in, -2.0, 2.0);
@@ -55,6 +101,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             group[i] = fz_int(&in, -3, 8);
         fz_rotation_or_any(&in, R);
     }
+    if (mode == 2)
+        return check_whole_test(&in, n, group, R, o1, d1, o2, d2, work, lw);
     min_rows = (fz_u8(&in) % 8 == 0) ? fz_int(&in, -2, 2) : fz_int(&in, 1, 20);
     samples = (fz_u8(&in) % 8 == 0) ? fz_int(&in, -2, 70000) : fz_int(&in, 0, 64);
     st = mcg_static_noise(n, o1, d1, o2, d2, group, R, min_rows, samples, res, &med, &used,
