@@ -66,53 +66,6 @@ static uint64_t splitmix64(uint64_t *state)
     return z ^ (z >> 31);
 }
 
-/* the k-th smallest of x[0..m) (x is reordered; Hoare's selection) */
-static double select_kth(double *x, int m, int k)
-{
-    int lo = 0, hi = m - 1;
-    while (lo < hi) {
-        double pivot = x[lo + (hi - lo) / 2];
-        int i = lo, j = hi;
-        while (i <= j) {
-            while (x[i] < pivot)
-                i++;
-            while (x[j] > pivot)
-                j--;
-            if (i <= j) {
-                double s = x[i];
-                x[i] = x[j];
-                x[j] = s;
-                i++;
-                j--;
-            }
-        }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            break;
-    }
-    return x[k];
-}
-
-/* median of x[0..m), m >= 1, as numpy.median (the mean of the two middle
- * values when m is even); x is reordered */
-static double median_inplace(double *x, int m)
-{
-    double hi = select_kth(x, m, m / 2);
-    double lo;
-    int i;
-    if (m % 2)
-        return hi;
-    /* the largest of the lower half (all <= hi after the selection) */
-    lo = x[0];
-    for (i = 1; i < m / 2; i++)
-        if (x[i] > lo)
-            lo = x[i];
-    return 0.5 * (lo + hi);
-}
-
 /* stable merge sort of idx[0..m) by group[idx] (tmp: m ints) */
 static void sort_by_group(int *idx, int *tmp, int m, const int *group)
 {
@@ -157,6 +110,29 @@ static double median_abs_dot(const double *ahat, int m, const double v[3], doubl
     return median_inplace(prod, m);
 }
 
+/* the row a = (R d1) x d2 of unit bearings, added to the scatter s += a a^T;
+ * 0 when R maps the bearing to zero or beyond the doubles (not a rotation) */
+static int add_row(const double *p, const double *q, const double R[9], double s[9],
+                   double a[3])
+{
+    double rd[3], b[3], nr, nb;
+    int r, c;
+    mat_vec(R, p, rd);
+    nr = sqrt(dot3(rd, rd));
+    nb = sqrt(dot3(q, q));
+    if (!(nr > 0.0 && isfinite(nr)))
+        return 0;
+    for (r = 0; r < 3; r++) {
+        rd[r] /= nr;
+        b[r] = q[r] / nb;
+    }
+    cross3(rd, b, a);
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++)
+            s[3 * r + c] += a[r] * a[c];
+    return 1;
+}
+
 /* the robust null vector u of camera rows rows[0..m) (see the file comment) */
 static int camera_direction(const double *d1, const double *d2, const double R[9],
                             const int *rows, int m, int samples, double *ahat, double *prod,
@@ -166,23 +142,10 @@ static int camera_direction(const double *d1, const double *d2, const double R[9
     int i, k, n_ok = 0, st;
     uint64_t state = (uint64_t)m;
     for (i = 0; i < m; i++) {
-        const double *p = d1 + 3 * rows[i], *q = d2 + 3 * rows[i];
-        double rd[3], b[3], a[3], nr, nb, na;
-        int r, c;
-        mat_vec(R, p, rd);
-        nr = sqrt(dot3(rd, rd));
-        nb = sqrt(dot3(q, q));
-        /* R maps a bearing to zero or beyond the doubles: not a rotation */
-        if (!(nr > 0.0 && isfinite(nr)))
+        double a[3], na;
+        int r;
+        if (!add_row(d1 + 3 * rows[i], d2 + 3 * rows[i], R, s, a))
             return MCG_EINVAL;
-        for (r = 0; r < 3; r++) {
-            rd[r] /= nr;
-            b[r] = q[r] / nb;
-        }
-        cross3(rd, b, a);
-        for (r = 0; r < 3; r++)
-            for (c = 0; c < 3; c++)
-                s[3 * r + c] += a[r] * a[c];
         na = sqrt(dot3(a, a));
         if (na > 0.0) {
             for (r = 0; r < 3; r++)
@@ -215,22 +178,11 @@ static int camera_direction(const double *d1, const double *d2, const double R[9
         /* least squares on the rows within KEEP_SIGMAS robust stds (the
          * scatter of the unnormalised rows, as the first estimate) */
         double lim = KEEP_SIGMAS * MAD_TO_STD * best, s2[9] = {0};
-        int kept = 0, r, c;
+        int kept = 0;
         for (i = 0; i < n_ok; i++) {
+            double a[3];
             if (fabs(dot3(ahat + 3 * i, u)) <= lim) {
-                const double *p = d1 + 3 * rows[okrow[i]], *q = d2 + 3 * rows[okrow[i]];
-                double rd[3], b[3], a[3], nr, nb;
-                mat_vec(R, p, rd);
-                nr = sqrt(dot3(rd, rd));
-                nb = sqrt(dot3(q, q));
-                for (r = 0; r < 3; r++) {
-                    rd[r] /= nr;
-                    b[r] = q[r] / nb;
-                }
-                cross3(rd, b, a);
-                for (r = 0; r < 3; r++)
-                    for (c = 0; c < 3; c++)
-                        s2[3 * r + c] += a[r] * a[c];
+                add_row(d1 + 3 * rows[okrow[i]], d2 + 3 * rows[okrow[i]], R, s2, a);
                 kept++;
             }
         }

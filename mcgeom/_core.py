@@ -1347,6 +1347,17 @@ def eigensolver(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
             "iterations": int(its[0])}
 
 
+def _group_ids(group: Any, n: int) -> np.ndarray:
+    """``group`` of :func:`static_noise` as (n,) int32: camera ids >= 0, -1 = left out."""
+    g = np.asarray(group)
+    if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
+        raise ValueError(f"group must be {n} integer camera ids, got shape {g.shape} "
+                         f"and dtype {g.dtype}")
+    if n and (g.min() < -1 or g.max() > np.iinfo(np.int32).max):
+        raise ValueError("group holds ids below -1 or beyond int32")
+    return np.ascontiguousarray(g, dtype=np.int32)
+
+
 def static_noise(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: Any, R: Any,
                  min_rows: int = 12, samples: int = 32) -> tuple[np.ndarray, float, int]:
     """Per-camera free-direction Sampson residuals of the static-rig test (``mcg_static_noise``).
@@ -1363,13 +1374,7 @@ def static_noise(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
     n = rays[0].shape[0]
     if n > 1 << 20:
         raise ValueError(f"static_noise: at most 2^20 correspondences supported, got {n}")
-    g = np.asarray(group)
-    if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
-        raise ValueError(f"group must be {n} integer camera ids, got shape {g.shape} "
-                         f"and dtype {g.dtype}")
-    if n and (g.min() < -1 or g.max() > np.iinfo(np.int32).max):
-        raise ValueError("group holds ids below -1 or beyond int32")
-    g = np.ascontiguousarray(g, dtype=np.int32)
+    g = _group_ids(group, n)
     R = _f64("R", R, (3, 3))
     for name, v, lo in (("min_rows", min_rows, 1), ("samples", samples, 0)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= 65536:
@@ -1407,13 +1412,7 @@ def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
     n = rays[0].shape[0]
     if n > 1 << 20:
         raise ValueError(f"static_check: at most 2^20 correspondences supported, got {n}")
-    g = np.asarray(group)
-    if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
-        raise ValueError(f"group must be {n} integer camera ids, got shape {g.shape} "
-                         f"and dtype {g.dtype}")
-    if n and (g.min() < -1 or g.max() > np.iinfo(np.int32).max):
-        raise ValueError("group holds ids below -1 or beyond int32")
-    g = np.ascontiguousarray(g, dtype=np.int32)
+    g = _group_ids(group, n)
     mats = [None if M is None else _f64(name, M, (3, 3))
             for name, M in (("R_est", R_est), ("R_given", R_given))]
     if not (np.isfinite(noise_level) and noise_level >= 0):
