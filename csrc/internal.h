@@ -110,4 +110,51 @@ int mcg_linf_local(int n, const double *u1, const double *a1, const double *u2,
                    double delta_min, int max_steps, double *work, double *f_out,
                    int *steps_out);
 
+/* The k-th smallest of x[0..m) (x is reordered; Hoare's selection), and the
+ * median as numpy.median (the mean of the two middle values for even m,
+ * m >= 1; x is reordered). For the robust statistics of the kernels
+ * (static_test.c). */
+static inline double select_kth_inplace(double *x, int m, int k)
+{
+    int lo = 0, hi = m - 1;
+    while (lo < hi) {
+        double pivot = x[lo + (hi - lo) / 2];
+        int i = lo, j = hi;
+        while (i <= j) {
+            while (x[i] < pivot)
+                i++;
+            while (x[j] > pivot)
+                j--;
+            if (i <= j) {
+                double s = x[i];
+                x[i] = x[j];
+                x[j] = s;
+                i++;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            break;
+    }
+    return x[k];
+}
+
+static inline double median_inplace(double *x, int m)
+{
+    double hi = select_kth_inplace(x, m, m / 2), lo;
+    int i;
+    if (m % 2)
+        return hi;
+    /* the largest of the lower half (all <= hi after the selection) */
+    lo = x[0];
+    for (i = 1; i < m / 2; i++)
+        if (x[i] > lo)
+            lo = x[i];
+    return 0.5 * (lo + hi);
+}
+
 #endif /* MCGEOM_INTERNAL_H */

@@ -31,6 +31,7 @@ __all__ = [
     "skyline_eig",
     "essential5", "essential_decompose",
     "upright4", "eigensolver",
+    "static_noise", "static_check",
 ]
 
 GC_CASE_NAMES = {
@@ -1344,3 +1345,103 @@ def eigensolver(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
         _ray_error(st, "eigensolver", rays, (("R0", R0),))
     return {"R": R, "t": t, "lambda_min": float(lam[0]), "has_scale": bool(has[0]),
             "iterations": int(its[0])}
+
+
+def _group_ids(group: Any, n: int) -> np.ndarray:
+    """``group`` of :func:`static_noise` as (n,) int32: camera ids >= 0, -1 = left out."""
+    g = np.asarray(group)
+    if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
+        raise ValueError(f"group must be {n} integer camera ids, got shape {g.shape} "
+                         f"and dtype {g.dtype}")
+    if n and (g.min() < -1 or g.max() > np.iinfo(np.int32).max):
+        raise ValueError("group holds ids below -1 or beyond int32")
+    return np.ascontiguousarray(g, dtype=np.int32)
+
+
+def static_noise(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: Any, R: Any,
+                 min_rows: int = 12, samples: int = 32) -> tuple[np.ndarray, float, int]:
+    """Per-camera free-direction Sampson residuals of the static-rig test (``mcg_static_noise``).
+
+    Rays as for :func:`gec_residuals` (rig frames, metres); ``group`` (N,)
+    integer: the camera of an intra-camera pair (>= 0) or -1 to leave the pair
+    out; ``R`` (3x3) rig2_from_rig1. Each camera with at least ``min_rows``
+    pairs translates in its own least-median-of-squares direction (``samples``
+    pairs of rows from a fixed stream). Returns ``(res, median, n_used)``:
+    (N,) absolute residuals in radians (-1 for pairs not used), their median
+    and number. Raises ValueError naming the bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    n = rays[0].shape[0]
+    if n > 1 << 20:
+        raise ValueError(f"static_noise: at most 2^20 correspondences supported, got {n}")
+    g = _group_ids(group, n)
+    R = _f64("R", R, (3, 3))
+    for name, v, lo in (("min_rows", min_rows, 1), ("samples", samples, 0)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= 65536:
+            raise ValueError(f"{name} must be an integer in {lo}..65536, got {v!r}")
+    res = np.empty(n)
+    med = ffi.new("double *")
+    used = ffi.new("int *")
+    work = _work(lib.mcg_static_noise_work_size(n))
+    st = lib.mcg_static_noise(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
+                              ffi.from_buffer("int[]", g), _p(R), int(min_rows), int(samples),
+                              _p(res), med, used, _p(work), work.size)
+    if st != lib.MCG_OK:
+        _ray_error(st, "static_noise", rays, (("R", R),))
+    return res, float(med[0]), int(used[0])
+
+
+def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: Any,
+                 R_est: Any = None, R_given: Any = None, noise_level: float = 0.0, *,
+                 noise_factor: float, noise_floor: float, default_level: float,
+                 parallax_factor: float, fraction: float, min_pairs: int, min_distinct: int,
+                 min_rows: int, samples: int) -> dict:
+    """The static-rig test of one estimate in one C call (``mcg_static_check``).
+
+    Rays and ``group`` as for :func:`static_noise`; ``R_est`` the estimate's
+    rotation, ``R_given`` a known one (3x3 or None); ``noise_level`` radians
+    (0 = estimate it); the options are the constants of
+    :mod:`mcgeom.estimators._static` and :func:`mcgeom.observability.no_parallax`
+    (see ``mcg_static_options`` in mcgeom.h). Returns a dict: ``static``,
+    ``decided_at`` (0 the pure rotation, 1 the estimate's), ``R`` (that
+    rotation), ``R_fit`` (the best pure rotation), ``noise_level`` (radians),
+    ``noise_from_default``, ``explained``, ``n_intra``, ``median_angle``
+    (radians). Raises ValueError naming the bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    n = rays[0].shape[0]
+    if n > 1 << 20:
+        raise ValueError(f"static_check: at most 2^20 correspondences supported, got {n}")
+    g = _group_ids(group, n)
+    mats = [None if M is None else _f64(name, M, (3, 3))
+            for name, M in (("R_est", R_est), ("R_given", R_given))]
+    if not (np.isfinite(noise_level) and noise_level >= 0):
+        raise ValueError(f"noise_level must be >= 0 radians (0: estimate it), got {noise_level}")
+    opt = ffi.new("mcg_static_options *")
+    for name, v in (("noise_factor", noise_factor), ("noise_floor", noise_floor),
+                    ("default_level", default_level), ("parallax_factor", parallax_factor),
+                    ("fraction", fraction), ("min_pairs", min_pairs),
+                    ("min_distinct", min_distinct), ("min_rows", min_rows),
+                    ("samples", samples)):
+        setattr(opt, name, v)
+    out = ffi.new("mcg_static_result *")
+    work = _work(lib.mcg_static_check_work_size(n))
+    st = lib.mcg_static_check(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
+                              ffi.from_buffer("int[]", g),
+                              ffi.NULL if mats[0] is None else _p(mats[0]),
+                              ffi.NULL if mats[1] is None else _p(mats[1]),
+                              float(noise_level), opt, out, _p(work), work.size)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL and not (1 <= min_rows and 0 <= samples <= 65536
+                                         and 0 <= min_distinct <= 64):
+            raise ValueError("static_check: min_rows, samples or min_distinct out of range")
+        _ray_error(st, "static_check", rays, tuple((k, M) for k, M in
+                                                   (("R_est", mats[0]), ("R_given", mats[1]))
+                                                   if M is not None))
+    return {"static": bool(out.is_static), "decided_at": int(out.decided_at),
+            "R": np.frombuffer(ffi.buffer(out.R), dtype=np.float64).reshape(3, 3).copy(),
+            "R_fit": np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy(),
+            "noise_level": float(out.noise_level),
+            "noise_from_default": bool(out.noise_from_default),
+            "explained": float(out.explained), "n_intra": int(out.n_intra),
+            "median_angle": float(out.median_angle)}

@@ -1079,6 +1079,91 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
                     double t[3], double *lambda_min, int *has_scale, int *iterations,
                     double *work, size_t lwork);
 
+/* Noise level of the static-rig test (mcgeom/estimators/_static.py): the
+ * absolute Sampson angular residuals (radians, as mcg_gec_residuals) of the
+ * intra-camera pairs of each camera when it translates in its own robust
+ * best direction under the rotation R (rig2_from_rig1). Pairs (o1, d1) <->
+ * (o2, d2) as for mcg_gec_residuals (n x 3, rig frames, metres, directions
+ * of any non-zero length); group[k] >= 0 the camera of an intra-camera pair
+ * (its rows form one camera), -1 for a pair to leave out. Per camera with at
+ * least min_rows pairs: the direction u is the least-median-of-squares null
+ * vector of the rows (R d1) x d2 (samples pairs of rows from a splitmix64
+ * stream seeded by the camera's pair count, 0..65536), refined by least
+ * squares on the rows within 2.5 robust stds; the residuals are those of
+ * t = u + c - R c, c = o1 of the camera's first pair. Outputs: res[k] (n;
+ * -1 for pairs not used), *median the median of the used residuals (numpy's
+ * convention for an even count; 0 when none) and *n_used their number.
+ * Workspace lwork >= mcg_static_noise_work_size(n). MCG_EINVAL: NULL
+ * pointers, n outside [0, 2^20], min_rows < 1, samples, group < -1, NaN/inf,
+ * a zero or overflowing direction of a used pair, R mapping a bearing to
+ * zero or beyond the doubles; MCG_ENOMEM; MCG_ENUMERIC: the 3 x 3
+ * eigen-solver did not converge. */
+size_t mcg_static_noise_work_size(int n);
+int mcg_static_noise(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const int *group, const double R[9], int min_rows,
+                     int samples, double *res, double *median, int *n_used, double *work,
+                     size_t lwork);
+
+/* Options of mcg_static_check (mcg_static_default_options in brackets): the
+ * constants of mcgeom/estimators/_static.py and observability.no_parallax. */
+typedef struct {
+    double noise_factor;    /* noise level = noise_factor x 1.4826 x the median
+                               per-camera residual (mcg_static_noise) [10] */
+    double noise_floor;     /* smallest estimated noise level, radians [1e-9] */
+    double default_level;   /* level when no camera has min_rows pairs [1e-3] */
+    double parallax_factor; /* an angle is explained below parallax_factor x
+                               the level [1.5] */
+    double fraction;        /* static: at least this fraction explained [0.9] */
+    int min_pairs;          /* fewest intra-camera pairs decided on [5] */
+    int min_distinct;       /* fewest distinct intra-camera pairs, 0..64 [5] */
+    int min_rows;           /* per camera, for the noise level [12] */
+    int samples;            /* least-median-of-squares samples [32] */
+} mcg_static_options;
+
+/* Result of mcg_static_check. */
+typedef struct {
+    int is_static;          /* 1: a pure rotation explains the intra-camera
+                               pairs (no translation detected) */
+    int decided_at;         /* rotation of the last statistic: 0 the pure one
+                               (given or fitted), 1 the estimate's own */
+    double R[9];            /* that rotation (rig2_from_rig1, row-major) */
+    double R_fit[9];        /* best pure rotation of the intra-camera bearings */
+    double noise_level;     /* radians; when the test stopped early (not
+                               static even at the level of the pure rotation,
+                               the upper bound) that bound */
+    int noise_from_default; /* 1: no camera had min_rows pairs */
+    double explained;       /* fraction of intra-camera pairs explained at R */
+    int n_intra;            /* intra-camera pairs (group >= 0) */
+    double median_angle;    /* their median rotation-only angle at R, radians */
+} mcg_static_result;
+
+/* Fill *opt with the defaults (no-op for NULL). */
+void mcg_static_default_options(mcg_static_options *opt);
+size_t mcg_static_check_work_size(int n);
+
+/* The static-rig test of one estimate (mcgeom/estimators/_static.py,
+ * check_static) in one call. Pairs and group as for mcg_static_noise (group
+ * >= 0: the camera of an intra-camera pair). R_est: the estimate's rotation
+ * (NULL: none); R_given: a known rotation (NULL: none); noise_level > 0 a
+ * given level (radians), 0 to estimate it: the smaller of the levels of
+ * mcg_static_noise at R_est (else R_given) and at the best pure rotation
+ * R_fit (the rotation nearest to sum d2 d1^T of the unit intra-camera
+ * bearings). Static when at least opt->fraction of the n_intra >=
+ * opt->min_pairs rotation-only angles (between d2 and R d1) are below
+ * parallax_factor x the level, at R_given (else R_fit) or -- without
+ * R_given -- at R_est, and at least min_distinct intra-camera pairs are
+ * distinct. The pure rotation's level is computed first: it bounds the
+ * level from above, and when no rotation explains enough angles at that
+ * bound the answer is "not static" without the second level (exact: a
+ * smaller level explains fewer). Workspace lwork >=
+ * mcg_static_check_work_size(n). MCG_EINVAL
+ * as mcg_static_noise, and for bad options, a negative or non-finite
+ * noise_level, NaN/inf in R_est or R_given; MCG_ENOMEM; MCG_ENUMERIC. */
+int mcg_static_check(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const int *group, const double *R_est,
+                     const double *R_given, double noise_level, const mcg_static_options *opt,
+                     mcg_static_result *out, double *work, size_t lwork);
+
 /* MCG_CDEF_END */
 
 #if defined(__GNUC__) && __GNUC__ >= 4

@@ -1,0 +1,513 @@
+/*
+ * static_test.c -- the noise level of the shared static-rig test
+ * (mcgeom/estimators/_static.py, issue 18): per camera, the Sampson angular
+ * residuals of its intra-camera correspondences when the camera translates
+ * in its own best direction under a given rotation R.
+ *
+ * For camera i the generalized epipolar constraint (thesis eq. 8.16) of an
+ * intra-camera pair reduces to the essential matrix about the camera centre
+ * (thesis ch. 2.3): with a = (R d1) x d2 (unit bearings) it reads u . a = 0,
+ * u the translation of the camera centre. u is the null vector of the rows
+ * a, found robustly: least median of squares (Rousseeuw 1984) over the
+ * directions that two rows fix (their cross product), scored by the median
+ * of |ahat . v| (the sine of the angle between v and each row's plane), then
+ * least squares on the rows within 2.5 robust standard deviations. The
+ * samples come from a fixed stream (splitmix64 seeded by the camera's row
+ * count), so the result is a function of the data. The residuals are those
+ * of mcg_gec_residuals with t = u + c - R c (c the camera centre): the
+ * camera's centre moves by u. Outliers handed to a direct estimator then do
+ * not swing the direction and inflate the noise level.
+ *
+ * mcg_static_check runs the whole test of one estimate in one call (issue
+ * 22: it runs on every estimator call): the best pure rotation of the
+ * intra-camera bearings (Wahba's problem, the rotation nearest to
+ * sum d2 d1^T), the noise level (the smaller of those at the estimate's and
+ * at the pure rotation), then the no-parallax statistic of
+ * mcgeom.observability.no_parallax (a fraction of the rotation-only angles
+ * within a factor of the level) at the pure rotation and, failing that, at
+ * the estimate's own rotation; and at least min_distinct distinct
+ * intra-camera pairs (repeats of one pair explain any rotation).
+ */
+#include "mcgeom.h"
+#include "internal.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define MAX_SAMPLES 65536
+#define MAD_TO_STD 1.4826 /* 1 / the median of |N(0, 1)| */
+#define KEEP_SIGMAS 2.5   /* rows kept for the least-squares step */
+#define MIN_SINE 1e-12    /* two rows closer than this fix no direction */
+
+/* doubles holding n ints (the index arrays live in the double workspace) */
+static size_t ints_as_doubles(size_t n)
+{
+    return (n * sizeof(int) + sizeof(double) - 1) / sizeof(double);
+}
+
+size_t mcg_static_noise_work_size(int n)
+{
+    int ok = 1;
+    size_t w;
+    if (n < 0 || (size_t)n > MAX_ROWS)
+        return 0;
+    /* two index arrays, the unit rows (3 n), their absolute products (n) */
+    w = add_sz(mul_sz(2, ints_as_doubles((size_t)n), &ok), mul_sz(4, (size_t)n, &ok), &ok);
+    w = add_sz(w, 1, &ok);
+    return ok ? w : 0;
+}
+
+static uint64_t splitmix64(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+
+/* stable merge sort of idx[0..m) by group[idx] (tmp: m ints) */
+static void sort_by_group(int *idx, int *tmp, int m, const int *group)
+{
+    int width, i;
+    for (width = 1; width < m; width *= 2) {
+        for (i = 0; i < m; i += 2 * width) {
+            int a = i, mid = i + width < m ? i + width : m;
+            int end = i + 2 * width < m ? i + 2 * width : m, b = mid, k = i;
+            while (a < mid && b < end)
+                tmp[k++] = group[idx[b]] < group[idx[a]] ? idx[b++] : idx[a++];
+            while (a < mid)
+                tmp[k++] = idx[a++];
+            while (b < end)
+                tmp[k++] = idx[b++];
+        }
+        for (i = 0; i < m; i++)
+            idx[i] = tmp[i];
+    }
+}
+
+/* eigenvector of the smallest eigenvalue of the 3 x 3 scatter s (row-major) */
+static int smallest_eigvec(const double s[9], double u[3])
+{
+    double a[9], w[3], v[9];
+    int i, st;
+    for (i = 0; i < 9; i++)
+        a[i] = s[i];
+    st = mcg_sym_eig(3, a, w, v);
+    if (st != MCG_OK)
+        return st;
+    for (i = 0; i < 3; i++)
+        u[i] = v[3 * i];
+    return MCG_OK;
+}
+
+/* median of |ahat . v| over the m rows, scratch prod (m doubles) */
+static double median_abs_dot(const double *ahat, int m, const double v[3], double *prod)
+{
+    int i;
+    for (i = 0; i < m; i++)
+        prod[i] = fabs(dot3(ahat + 3 * i, v));
+    return median_inplace(prod, m);
+}
+
+/* the row a = (R d1) x d2 of unit bearings, added to the scatter s += a a^T;
+ * 0 when R maps the bearing to zero or beyond the doubles (not a rotation) */
+static int add_row(const double *p, const double *q, const double R[9], double s[9],
+                   double a[3])
+{
+    double rd[3], b[3], nr, nb;
+    int r, c;
+    mat_vec(R, p, rd);
+    nr = sqrt(dot3(rd, rd));
+    nb = sqrt(dot3(q, q));
+    if (!(nr > 0.0 && isfinite(nr)))
+        return 0;
+    for (r = 0; r < 3; r++) {
+        rd[r] /= nr;
+        b[r] = q[r] / nb;
+    }
+    cross3(rd, b, a);
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++)
+            s[3 * r + c] += a[r] * a[c];
+    return 1;
+}
+
+/* the robust null vector u of camera rows rows[0..m) (see the file comment) */
+static int camera_direction(const double *d1, const double *d2, const double R[9],
+                            const int *rows, int m, int samples, double *ahat, double *prod,
+                            int *okrow, double u[3])
+{
+    double s[9] = {0}, best;
+    int i, k, n_ok = 0, st;
+    uint64_t state = (uint64_t)m;
+    for (i = 0; i < m; i++) {
+        double a[3], na;
+        int r;
+        if (!add_row(d1 + 3 * rows[i], d2 + 3 * rows[i], R, s, a))
+            return MCG_EINVAL;
+        na = sqrt(dot3(a, a));
+        if (na > 0.0) {
+            for (r = 0; r < 3; r++)
+                ahat[3 * n_ok + r] = a[r] / na;
+            okrow[n_ok++] = i;
+        }
+    }
+    st = smallest_eigvec(s, u);
+    if (st != MCG_OK || n_ok < 3)
+        return st;
+    best = median_abs_dot(ahat, n_ok, u, prod);
+    for (k = 0; k < samples; k++) {
+        int a = (int)(splitmix64(&state) % (uint64_t)n_ok);
+        int b = (int)(splitmix64(&state) % (uint64_t)(n_ok - 1));
+        double v[3], nv, med;
+        if (b >= a)
+            b++;
+        cross3(ahat + 3 * a, ahat + 3 * b, v);
+        nv = sqrt(dot3(v, v));
+        if (!(nv > MIN_SINE))
+            continue;
+        med = median_abs_dot(ahat, n_ok, v, prod) / nv;
+        if (med < best) {
+            best = med;
+            for (i = 0; i < 3; i++)
+                u[i] = v[i] / nv;
+        }
+    }
+    {
+        /* least squares on the rows within KEEP_SIGMAS robust stds (the
+         * scatter of the unnormalised rows, as the first estimate) */
+        double lim = KEEP_SIGMAS * MAD_TO_STD * best, s2[9] = {0};
+        int kept = 0;
+        for (i = 0; i < n_ok; i++) {
+            double a[3];
+            if (fabs(dot3(ahat + 3 * i, u)) <= lim) {
+                add_row(d1 + 3 * rows[okrow[i]], d2 + 3 * rows[okrow[i]], R, s2, a);
+                kept++;
+            }
+        }
+        if (kept >= 2)
+            st = smallest_eigvec(s2, u);
+    }
+    return st;
+}
+
+/* the checks shared by both entry points (sizes and workspace aside) */
+static int check_rays(int n, const double *o1, const double *d1, const double *o2,
+                      const double *d2, const int *group, int min_rows, int samples)
+{
+    int i;
+    if (min_rows < 1 || samples < 0 || samples > MAX_SAMPLES)
+        return MCG_EINVAL;
+    if (!all_finite(o1, 3 * (size_t)n) || !all_finite(d1, 3 * (size_t)n) ||
+        !all_finite(o2, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
+        return MCG_EINVAL;
+    for (i = 0; i < n; i++) {
+        if (group[i] < -1)
+            return MCG_EINVAL;
+        /* a zero direction has no bearing (as mcg_gec_residuals); mat_vec(R,
+         * .) of a direction must not overflow */
+        if (group[i] >= 0 && !(dot3(d1 + 3 * i, d1 + 3 * i) > 0.0 &&
+                               dot3(d2 + 3 * i, d2 + 3 * i) > 0.0 &&
+                               isfinite(dot3(d1 + 3 * i, d1 + 3 * i)) &&
+                               isfinite(dot3(d2 + 3 * i, d2 + 3 * i))))
+            return MCG_EINVAL;
+    }
+    return MCG_OK;
+}
+
+/* mcg_static_noise on checked arguments */
+static int static_noise(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const int *group, const double R[9], int min_rows,
+                        int samples, double *res, double *median, int *n_used, double *work)
+{
+    int *idx, *tmp, i, m = 0, used = 0;
+    double *ahat, *prod;
+    idx = (int *)work;
+    tmp = idx + n;
+    ahat = work + 2 * ints_as_doubles((size_t)n);
+    prod = ahat + 3 * (size_t)n;
+    for (i = 0; i < n; i++) {
+        res[i] = -1.0;
+        if (group[i] >= 0)
+            idx[m++] = i;
+    }
+    sort_by_group(idx, tmp, m, group);
+    for (i = 0; i < m;) {
+        int j = i, k, st;
+        double u[3], c[3], rc[3], t[3];
+        while (j < m && group[idx[j]] == group[idx[i]])
+            j++;
+        if (j - i >= min_rows) {
+            /* tmp serves as the row list of the camera's usable rows */
+            st = camera_direction(d1, d2, R, idx + i, j - i, samples, ahat, prod, tmp, u);
+            if (st != MCG_OK)
+                return st;
+            for (k = 0; k < 3; k++)
+                c[k] = o1[3 * idx[i] + k];
+            mat_vec(R, c, rc);
+            for (k = 0; k < 3; k++)
+                t[k] = u[k] + c[k] - rc[k];
+            for (k = i; k < j; k++) {
+                int r = idx[k];
+                double e;
+                st = mcg_gec_residuals(1, o1 + 3 * r, d1 + 3 * r, o2 + 3 * r, d2 + 3 * r, R, t,
+                                       &e);
+                if (st != MCG_OK)
+                    return st;
+                res[r] = fabs(e);
+            }
+        }
+        i = j;
+    }
+    for (i = 0; i < n; i++)
+        if (res[i] >= 0.0)
+            prod[used++] = res[i];
+    *n_used = used;
+    *median = used ? median_inplace(prod, used) : 0.0;
+    return MCG_OK;
+}
+
+int mcg_static_noise(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const int *group, const double R[9], int min_rows,
+                     int samples, double *res, double *median, int *n_used, double *work,
+                     size_t lwork)
+{
+    size_t need;
+    int st;
+    if (!o1 || !d1 || !o2 || !d2 || !group || !R || !res || !median || !n_used ||
+        (!work && lwork))
+        return MCG_EINVAL;
+    need = mcg_static_noise_work_size(n);
+    if (need == 0 || !all_finite(R, 9))
+        return MCG_EINVAL;
+    st = check_rays(n, o1, d1, o2, d2, group, min_rows, samples);
+    if (st != MCG_OK)
+        return st;
+    if (lwork < need)
+        return MCG_ENOMEM;
+    return static_noise(n, o1, d1, o2, d2, group, R, min_rows, samples, res, median, n_used,
+                        work);
+}
+
+void mcg_static_default_options(mcg_static_options *opt)
+{
+    if (!opt)
+        return;
+    opt->noise_factor = 10.0;
+    opt->noise_floor = 1e-9;
+    opt->default_level = 1e-3;
+    opt->parallax_factor = 1.5;
+    opt->fraction = 0.9;
+    opt->min_pairs = 5;
+    opt->min_distinct = 5;
+    opt->min_rows = 12;
+    opt->samples = 32;
+}
+
+size_t mcg_static_check_work_size(int n)
+{
+    int ok = 1;
+    size_t w = mcg_static_noise_work_size(n);
+    if (w == 0)
+        return 0;
+    w = add_sz(w, mul_sz(2, (size_t)n, &ok), &ok); /* residuals, angles */
+    return ok ? w : 0;
+}
+
+/* unit copy of v */
+static void unit3(const double *v, double u[3])
+{
+    double s = 1.0 / sqrt(dot3(v, v));
+    u[0] = v[0] * s;
+    u[1] = v[1] * s;
+    u[2] = v[2] * s;
+}
+
+/* the rotation-only statistic at R: the fraction of the intra-camera pairs
+ * whose angle between d2 and R d1 is below lim, and their median angle
+ * (ang: scratch of n doubles) */
+static void rotation_statistic(int n, const double *d1, const double *d2, const int *group,
+                               const double R[9], double lim, double *ang, int *n_intra,
+                               double *explained, double *median_angle)
+{
+    int i, m = 0, inside = 0;
+    for (i = 0; i < n; i++) {
+        double a[3], b[3], ra[3], x[3];
+        if (group[i] < 0)
+            continue;
+        unit3(d1 + 3 * i, a);
+        unit3(d2 + 3 * i, b);
+        mat_vec(R, a, ra);
+        cross3(ra, b, x);
+        /* as numpy's arctan2(|R d1 x d2|, R d1 . d2) of geometry.rotation_fit */
+        ang[m] = atan2(sqrt(dot3(x, x)), dot3(ra, b));
+        inside += ang[m] < lim;
+        m++;
+    }
+    *n_intra = m;
+    *explained = m ? (double)inside / m : 0.0;
+    *median_angle = m ? median_inplace(ang, m) : NAN;
+}
+
+/* at least k distinct intra-camera pairs (all four rows and the camera
+ * compared exactly)? O(k n) */
+static int distinct_at_least(int n, const double *o1, const double *d1, const double *o2,
+                             const double *d2, const int *group, int k, int *seen)
+{
+    int i, j, found = 0;
+    if (k <= 0)
+        return 1;
+    for (i = 0; i < n && found < k; i++) {
+        int same = 0;
+        if (group[i] < 0)
+            continue;
+        for (j = 0; j < found && !same; j++) {
+            int p = seen[j], c;
+            same = group[p] == group[i];
+            for (c = 0; c < 3 && same; c++)
+                same = o1[3 * p + c] == o1[3 * i + c] && d1[3 * p + c] == d1[3 * i + c] &&
+                       o2[3 * p + c] == o2[3 * i + c] && d2[3 * p + c] == d2[3 * i + c];
+        }
+        if (!same)
+            seen[found++] = i;
+    }
+    return found >= k;
+}
+
+/* the noise level at R (noise_factor robust stds of the per-camera
+ * residuals, at least noise_floor), 0 when no camera has min_rows pairs */
+static int level_at(int n, const double *o1, const double *d1, const double *o2,
+                    const double *d2, const int *group, const double R[9],
+                    const mcg_static_options *o, double *res, double *work, double *level)
+{
+    double med;
+    int used, st = static_noise(n, o1, d1, o2, d2, group, R, o->min_rows, o->samples, res,
+                                &med, &used, work);
+    *level = 0.0;
+    if (st == MCG_OK && used) {
+        *level = o->noise_factor * MAD_TO_STD * med;
+        if (*level < o->noise_floor)
+            *level = o->noise_floor;
+    }
+    return st;
+}
+
+/* the statistic at out->noise_level: at R_given (else R_fit), then --
+ * without R_given -- at R_est; out->is_static and the figures of the last
+ * rotation tried */
+static void explained_anywhere(int n, const double *o1, const double *d1, const double *o2,
+                               const double *d2, const int *group, const double *R_est,
+                               const double *R_given, const mcg_static_options *o,
+                               mcg_static_result *out, double *ang)
+{
+    double lim = o->parallax_factor * out->noise_level;
+    int i, r, distinct = -1, seen[64];
+    out->is_static = 0;
+    for (i = 0; i < 2 && !out->is_static; i++) {
+        const double *R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
+        if (i == 1 && (!R_est || R_given))
+            break;
+        rotation_statistic(n, d1, d2, group, R_test, lim, ang, &out->n_intra, &out->explained,
+                           &out->median_angle);
+        out->decided_at = i;
+        for (r = 0; r < 9; r++)
+            out->R[r] = R_test[r];
+        out->is_static = out->n_intra >= o->min_pairs && out->n_intra > 0 &&
+                         out->explained >= o->fraction;
+        if (out->is_static) {
+            if (distinct < 0)
+                distinct = distinct_at_least(n, o1, d1, o2, d2, group, o->min_distinct, seen);
+            out->is_static = distinct;
+        }
+    }
+}
+
+int mcg_static_check(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const int *group, const double *R_est,
+                     const double *R_given, double noise_level, const mcg_static_options *opt,
+                     mcg_static_result *out, double *work, size_t lwork)
+{
+    mcg_static_options o;
+    size_t need;
+    double B[9] = {0}, *res, *ang, levels[2];
+    int i, r, c, st, n_intra = 0;
+    if (!o1 || !d1 || !o2 || !d2 || !group || !out || (!work && lwork))
+        return MCG_EINVAL;
+    if (opt)
+        o = *opt;
+    else
+        mcg_static_default_options(&o);
+    need = mcg_static_check_work_size(n);
+    if (need == 0 || !(isfinite(o.noise_factor) && o.noise_factor > 0.0) ||
+        !(isfinite(o.noise_floor) && o.noise_floor >= 0.0) ||
+        !(isfinite(o.default_level) && o.default_level > 0.0) ||
+        !(isfinite(o.parallax_factor) && o.parallax_factor > 0.0) ||
+        !(o.fraction >= 0.0 && o.fraction <= 1.0) || o.min_pairs < 0 || o.min_distinct < 0 ||
+        o.min_distinct > 64)
+        return MCG_EINVAL;
+    /* noise_level: > 0 given (radians), 0 = estimate it */
+    if (!(isfinite(noise_level) && noise_level >= 0.0))
+        return MCG_EINVAL;
+    if ((R_est && !all_finite(R_est, 9)) || (R_given && !all_finite(R_given, 9)))
+        return MCG_EINVAL;
+    st = check_rays(n, o1, d1, o2, d2, group, o.min_rows, o.samples);
+    if (st != MCG_OK)
+        return st;
+    if (lwork < need)
+        return MCG_ENOMEM;
+    res = work + mcg_static_noise_work_size(n);
+    ang = res + n;
+    /* the best pure rotation: nearest rotation to sum d2 d1^T (identity
+     * with fewer than two intra-camera pairs) */
+    for (i = 0; i < n; i++) {
+        double a[3], b[3];
+        if (group[i] < 0)
+            continue;
+        unit3(d1 + 3 * i, a);
+        unit3(d2 + 3 * i, b);
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++)
+                B[3 * r + c] += b[r] * a[c];
+        n_intra++;
+    }
+    /* rank < 2 (one bearing repeated): no rotation is determined, the
+     * identity stands in and the distinct-pairs condition decides */
+    if (n_intra < 2 || mcg_project_so3(B, out->R_fit) != MCG_OK) {
+        for (i = 0; i < 9; i++)
+            out->R_fit[i] = (i % 4 == 0) ? 1.0 : 0.0;
+    }
+    /* the noise level: the smaller of those at the first rotation (the
+     * estimate's, else the given one) and at the pure rotation. The pure
+     * rotation's comes first: it bounds the level from above, and a smaller
+     * level only explains fewer angles, so when no rotation explains enough
+     * of them at that bound the rig moved whatever the other level is (the
+     * exact early exit of a moving rig: one noise computation, not two) */
+    out->noise_from_default = 0;
+    if (noise_level > 0.0) {
+        out->noise_level = noise_level;
+    } else {
+        st = level_at(n, o1, d1, o2, d2, group, out->R_fit, &o, res, work, &levels[1]);
+        if (st != MCG_OK)
+            return st;
+        if (levels[1] == 0.0) { /* no camera with min_rows pairs */
+            out->noise_level = o.default_level;
+            out->noise_from_default = 1;
+        } else {
+            out->noise_level = levels[1];
+            if (R_est || R_given) {
+                explained_anywhere(n, o1, d1, o2, d2, group, R_est, R_given, &o, out, ang);
+                if (!out->is_static)
+                    return MCG_OK; /* moving at the upper bound of the level */
+                st = level_at(n, o1, d1, o2, d2, group, R_est ? R_est : R_given, &o, res, work,
+                              &levels[0]);
+                if (st != MCG_OK)
+                    return st;
+                if (levels[0] < out->noise_level)
+                    out->noise_level = levels[0];
+            }
+        }
+    }
+    explained_anywhere(n, o1, d1, o2, d2, group, R_est, R_given, &o, out, ang);
+    return MCG_OK;
+}
