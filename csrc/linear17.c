@@ -513,6 +513,11 @@ static double sampson_pass(const raydata *rd, const double r[9], const double t[
  * smaller by about m^2: 0.1 -> 4e-4 on the cases of issue 22): it is taken
  * and checked by a pass that computes the cost only (no Jacobian), and the
  * iteration stops; if the cost rose instead, the step is rejected as usual.
+ * The step must also be local in absolute terms (LOCAL_STEP: 0.01 rad and
+ * 1 % of |t|): where |t| is only weakly determined (near-critical motion,
+ * relative std of |t| above 1) a fraction of a standard deviation is a
+ * long way along a cost that is far from quadratic in |t|, and the estimate
+ * slides over many steps (bad_input's pure translation: 33 steps, |t| x 30).
  * The information h is then that of the previous point, at most STEP_STD
  * standard deviations away (it only feeds the relative std of |t|). From
  * the linear step this takes two full passes and one cost pass on the
@@ -523,6 +528,7 @@ static double sampson_pass(const raydata *rd, const double r[9], const double t[
  * the start (the linear estimate); on return h holds J^T J at (R, t) (for
  * the scale evidence) and *cost the Sampson cost there. */
 #define STEP_STD 0.3
+#define LOCAL_STEP 1e-2
 static int geometric_refine(const raydata *rd, const mcg_linear17_options *o,
                             double r[9], double t[3], double *cost, double h[36],
                             int *converged, double *cost0)
@@ -577,7 +583,8 @@ static int geometric_refine(const raydata *rd, const mcg_linear17_options *o,
             for (i = 0; i < 6; i++)
                 pred -= g[i] * d[i] + 0.5 * d[i] * hd[i];
             small = !(pred > o->tolerance * *cost);
-            if (!small && lambda <= 1e-4 && pred <= negligible * *cost) {
+            if (!small && lambda <= 1e-4 && pred <= negligible * *cost &&
+                nw * sc <= LOCAL_STEP && nt * sc <= LOCAL_STEP * sqrt(dot3(t, t))) {
                 /* shorter than STEP_STD standard deviations: the last step */
                 cn = sampson_pass(rd, rn, tn, NULL, NULL);
                 if (cn <= *cost) {
