@@ -32,6 +32,7 @@ __all__ = [
     "skyline_eig",
     "essential5", "essential_decompose",
     "upright4", "eigensolver",
+    "static_noise",
 ]
 
 GC_CASE_NAMES = {
@@ -1373,3 +1374,42 @@ def eigensolver(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
         _ray_error(st, "eigensolver", rays, (("R0", R0),))
     return {"R": R, "t": t, "lambda_min": float(lam[0]), "has_scale": bool(has[0]),
             "iterations": int(its[0])}
+
+
+def static_noise(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: Any, R: Any,
+                 min_rows: int = 12, samples: int = 32) -> tuple[np.ndarray, float, int]:
+    """Per-camera free-direction Sampson residuals of the static-rig test (``mcg_static_noise``).
+
+    Rays as for :func:`gec_residuals` (rig frames, metres); ``group`` (N,)
+    integer: the camera of an intra-camera pair (>= 0) or -1 to leave the pair
+    out; ``R`` (3x3) rig2_from_rig1. Each camera with at least ``min_rows``
+    pairs translates in its own least-median-of-squares direction (``samples``
+    pairs of rows from a fixed stream). Returns ``(res, median, n_used)``:
+    (N,) absolute residuals in radians (-1 for pairs not used), their median
+    and number. Raises ValueError naming the bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    n = rays[0].shape[0]
+    if n > 1 << 20:
+        raise ValueError(f"static_noise: at most 2^20 correspondences supported, got {n}")
+    g = np.asarray(group)
+    if g.shape != (n,) or (n and g.dtype.kind not in "iu"):
+        raise ValueError(f"group must be {n} integer camera ids, got shape {g.shape} "
+                         f"and dtype {g.dtype}")
+    if n and (g.min() < -1 or g.max() > np.iinfo(np.int32).max):
+        raise ValueError("group holds ids below -1 or beyond int32")
+    g = np.ascontiguousarray(g, dtype=np.int32)
+    R = _f64("R", R, (3, 3))
+    for name, v, lo in (("min_rows", min_rows, 1), ("samples", samples, 0)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= 65536:
+            raise ValueError(f"{name} must be an integer in {lo}..65536, got {v!r}")
+    res = np.empty(n)
+    med = ffi.new("double *")
+    used = ffi.new("int *")
+    work = _work(lib.mcg_static_noise_work_size(n))
+    st = lib.mcg_static_noise(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
+                              ffi.from_buffer("int[]", g), _p(R), int(min_rows), int(samples),
+                              _p(res), med, used, _p(work), work.size)
+    if st != lib.MCG_OK:
+        _ray_error(st, "static_noise", rays, (("R", R),))
+    return res, float(med[0]), int(used[0])

@@ -98,13 +98,6 @@ def _describe(m, f) -> str:
 #: (check, method, fixture) -> diagnosis: the open failures of issue 18, strict
 #: xfails so that they stay visible (-ra) and a fix (XPASS) fails until the marker goes
 KNOWN_FAILURES = {
-    **{("verdict", m, "euroc_static"): (
-        "EuRoC's 'static' pair moved 0.9 mm (ground truth): the shared static test, at "
-        "the estimate's rotation, finds the per-camera translation model ~10x better "
-        "than a pure rotation (noise 5.5e-4 rad against a 6e-4 rad median rotation-only "
-        "angle), so it reports a translation whose scale it cannot measure (unit t, "
-        "'scale too uncertain') instead of 't = 0'")
-       for m in ("bnb_lp", "five_plus_one", "linear17", "refine")},
     ("rotation", "eigensolver", "kitti_raw_straight_intra"): (
         "the eigensolver stops 0.119 deg from the truth on this near-critical straight "
         "pair (5+1: 0.002 deg): the smallest eigenvalue is flat along the rotation that "

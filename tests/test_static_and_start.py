@@ -58,6 +58,36 @@ def test_static_test_needs_a_positive_noise_level():
         _static.static_test(p.rays, 0.0)
 
 
+def _euroc_near_static():
+    """The EuRoC hovering pair (0.9 mm between the frames): its rays and 5+1's
+    full estimate before the static test."""
+    from pathlib import Path
+
+    from mcgeom.estimators.five_plus_one import _five_plus_one
+    from mcgeom.experiments.make_real_fixtures import load_fixture
+    f = load_fixture(Path(__file__).parent / "data" / "real" / "euroc_static.npz")
+    rays = f["rig"].ray_pairs(f["pixels1"], f["pixels2"], f["cam1"], f["cam2"])
+    return rays, _five_plus_one(rays, None, True, 0.1)
+
+
+def test_near_static_rig_is_judged_at_the_estimates_own_rotation():
+    """Issue 18, EuRoC hovering: the full estimate's tiny t trades against its
+    rotation, whose per-camera fit gives the (smaller) noise level; the
+    rotation-only angles at the best pure rotation exceed 1.5 levels, those at
+    the estimate's own rotation do not: no translation detected, t = 0."""
+    rays, full = _euroc_near_static()
+    from mcgeom.geometry import rotation_fit, same_camera
+    R0 = rotation_fit(rays, same_camera(rays))[0]
+    levels = _static._noise_levels(rays, (full.R, R0))
+    assert levels[0] < levels[1]
+    assert not _static.static_test(rays, levels[0]).static          # angles at R0
+    assert _static.static_test(rays, levels[0], rotation=full.R).static
+    m = _static.check_static(rays, "x", full)
+    assert m is not None and np.array_equal(m.t, np.zeros(3))
+    assert "estimate's rotation" in m.info["static_test"]["noise_source"]
+    assert rot_err(m.R, full.R) < 1e-15
+
+
 def test_linear17_on_a_static_rig_does_not_raise():
     """E = 0 used to raise DegenerateError ("matches no generalized-camera
     kind"); docs/bad_input.md promises R = I with an unobservable scale."""

@@ -1079,6 +1079,31 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
                     double t[3], double *lambda_min, int *has_scale, int *iterations,
                     double *work, size_t lwork);
 
+/* Noise level of the static-rig test (mcgeom/estimators/_static.py): the
+ * absolute Sampson angular residuals (radians, as mcg_gec_residuals) of the
+ * intra-camera pairs of each camera when it translates in its own robust
+ * best direction under the rotation R (rig2_from_rig1). Pairs (o1, d1) <->
+ * (o2, d2) as for mcg_gec_residuals (n x 3, rig frames, metres, directions
+ * of any non-zero length); group[k] >= 0 the camera of an intra-camera pair
+ * (its rows form one camera), -1 for a pair to leave out. Per camera with at
+ * least min_rows pairs: the direction u is the least-median-of-squares null
+ * vector of the rows (R d1) x d2 (samples pairs of rows from a splitmix64
+ * stream seeded by the camera's pair count, 0..65536), refined by least
+ * squares on the rows within 2.5 robust stds; the residuals are those of
+ * t = u + c - R c, c = o1 of the camera's first pair. Outputs: res[k] (n;
+ * -1 for pairs not used), *median the median of the used residuals (numpy's
+ * convention for an even count; 0 when none) and *n_used their number.
+ * Workspace lwork >= mcg_static_noise_work_size(n). MCG_EINVAL: NULL
+ * pointers, n outside [0, 2^20], min_rows < 1, samples, group < -1, NaN/inf,
+ * a zero or overflowing direction of a used pair, R mapping a bearing to
+ * zero or beyond the doubles; MCG_ENOMEM; MCG_ENUMERIC: the 3 x 3
+ * eigen-solver did not converge. */
+size_t mcg_static_noise_work_size(int n);
+int mcg_static_noise(int n, const double *o1, const double *d1, const double *o2,
+                     const double *d2, const int *group, const double R[9], int min_rows,
+                     int samples, double *res, double *median, int *n_used, double *work,
+                     size_t lwork);
+
 /* MCG_CDEF_END */
 
 #if defined(__GNUC__) && __GNUC__ >= 4

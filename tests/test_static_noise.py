@@ -1,0 +1,146 @@
+"""mcg_static_noise (csrc/static_test.c), the noise level of the shared static test,
+against a numpy reference written from its definition (issue 18 and 22: the test
+runs on every estimator call, so it is one C call)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mcgeom import _core, synth
+from mcgeom.estimators import _static
+from problems import make
+
+_MASK = (1 << 64) - 1
+
+
+def _splitmix64(state: int) -> tuple[int, int]:
+    state = (state + 0x9E3779B97F4A7C15) & _MASK
+    z = state
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
+    return state, z ^ (z >> 31)
+
+
+def _null_vector(a: np.ndarray, samples: int) -> np.ndarray:
+    """Least median of squares over the cross products of two rows, then least
+    squares on the rows within 2.5 robust stds (the definition in mcgeom.h)."""
+    norms = np.linalg.norm(a, axis=1)
+    ok = norms > 0
+    ahat = a[ok] / norms[ok, None]
+    u = np.linalg.eigh(a.T @ a)[1][:, 0]
+    if len(ahat) < 3:
+        return u
+    best = float(np.median(np.abs(ahat @ u)))
+    state = len(a)
+    for _ in range(samples):
+        state, x = _splitmix64(state)
+        state, y = _splitmix64(state)
+        i, j = x % len(ahat), y % (len(ahat) - 1)
+        j += j >= i
+        v = np.cross(ahat[i], ahat[j])
+        nv = np.linalg.norm(v)
+        if not nv > 1e-12:
+            continue
+        med = float(np.median(np.abs(ahat @ v))) / nv
+        if med < best:
+            best, u = med, v / nv
+    keep = np.abs(ahat @ u) <= 2.5 * 1.4826 * best
+    if np.count_nonzero(keep) >= 2:
+        sub = a[ok][keep]
+        u = np.linalg.eigh(sub.T @ sub)[1][:, 0]
+    return u
+
+
+def _reference(rays, group, R, min_rows, samples):
+    res = np.full(len(rays), -1.0)
+    for g in np.unique(group[group >= 0]):
+        idx = np.flatnonzero(group == g)
+        if idx.size < min_rows:
+            continue
+        d1 = rays.dirs1[idx] / np.linalg.norm(rays.dirs1[idx], axis=1, keepdims=True)
+        d2 = rays.dirs2[idx] / np.linalg.norm(rays.dirs2[idx], axis=1, keepdims=True)
+        u = _null_vector(np.cross(d1 @ R.T, d2), samples)
+        c = rays.origins1[idx[0]]
+        res[idx] = np.abs(_core.gec_residuals(rays.origins1[idx], d1, rays.origins2[idx], d2,
+                                              R, u + c - R @ c))
+    return res
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("outliers", [0.0, 0.2])
+def test_static_noise_matches_the_numpy_reference(seed, outliers):
+    rng = np.random.default_rng(seed)
+    p = synth.make_problem(synth.generic_rig(4, rng), synth.random_rotation(rng, 0.3),
+                           0.3 * rng.normal(size=3), 120, rng, cross_fraction=0.3,
+                           angular_noise=3e-4, outlier_fraction=outliers,
+                           require_visible=False)
+    rays = p.rays
+    group = np.where(rays.cam1 == rays.cam2, rays.cam1, -1)
+    R = synth.random_rotation(np.random.default_rng(seed), 0.01) @ p.R
+    res, med, used = _core.static_noise(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                        group, R, 12, 32)
+    ref = _reference(rays, group, R, 12, 32)
+    assert np.array_equal(res < 0, ref < 0)
+    assert used == int(np.count_nonzero(ref >= 0)) > 0
+    np.testing.assert_allclose(res, ref, rtol=1e-6, atol=1e-12)
+    assert med == pytest.approx(float(np.median(ref[ref >= 0])), rel=1e-6)
+
+
+def test_static_noise_exact_data_and_a_planted_outlier():
+    """Noise-free moving rig at the true rotation: every camera's direction is
+    exact, the residuals vanish; an outlier leaves the others at zero."""
+    p = make("locally-central", 3, n=80, angular_noise=0.0, t_norm=0.5)
+    rays = p.rays
+    d2 = rays.dirs2.copy()
+    d2[0] = rays.dirs2[0] + np.array([0.05, -0.03, 0.02])
+    group = rays.cam1.copy()
+    res, med, used = _core.static_noise(rays.origins1, rays.dirs1, rays.origins2, d2, group,
+                                        p.R, 5, 32)
+    assert used == len(rays)
+    assert res[0] > 1e-3
+    assert np.max(res[1:]) < 1e-9 and med < 1e-9
+
+
+def test_static_noise_leaves_out_small_cameras_and_cross_pairs():
+    p = make("most-general", 1, n=60, angular_noise=1e-4)
+    rays = p.rays
+    group = np.where(rays.cam1 == rays.cam2, rays.cam1, -1)
+    sizes = {g: int(np.count_nonzero(group == g)) for g in np.unique(group[group >= 0])}
+    min_rows = sorted(sizes.values())[len(sizes) // 2]
+    res, _, used = _core.static_noise(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                      group, p.R, min_rows, 8)
+    expect = np.array([g >= 0 and sizes[g] >= min_rows for g in group])
+    assert np.array_equal(res >= 0, expect) and used == int(expect.sum())
+    none, med, used = _core.static_noise(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                         np.full(len(rays), -1), p.R, 1, 8)
+    assert used == 0 and med == 0.0 and np.all(none == -1.0)
+
+
+def test_static_noise_bad_arguments_name_themselves():
+    p = make("locally-central", 0, n=30)
+    r = p.rays
+    g = r.cam1
+    with pytest.raises(ValueError, match="group"):
+        _core.static_noise(r.origins1, r.dirs1, r.origins2, r.dirs2, g[:-1], p.R)
+    with pytest.raises(ValueError, match="group"):
+        _core.static_noise(r.origins1, r.dirs1, r.origins2, r.dirs2, g - 2, p.R)
+    with pytest.raises(ValueError, match="min_rows"):
+        _core.static_noise(r.origins1, r.dirs1, r.origins2, r.dirs2, g, p.R, min_rows=0)
+    with pytest.raises(ValueError, match="samples"):
+        _core.static_noise(r.origins1, r.dirs1, r.origins2, r.dirs2, g, p.R, samples=-1)
+    bad = r.dirs2.copy()
+    bad[3] = np.nan
+    with pytest.raises(ValueError, match="dirs2"):
+        _core.static_noise(r.origins1, r.dirs1, r.origins2, bad, g, p.R)
+    bad[3] = 0.0
+    with pytest.raises(ValueError, match="dirs2"):
+        _core.static_noise(r.origins1, r.dirs1, r.origins2, bad, g, p.R)
+
+
+def test_noise_level_is_the_kernel_median():
+    """The library's noise level is NOISE_FACTOR robust stds of the kernel's residuals."""
+    p = make("locally-central", 5, n=80, angular_noise=3e-4)
+    r = _static.camera_residuals(p.rays, p.R)
+    level = _static.noise_level_of(p.rays, p.R)
+    assert level <= _static.NOISE_FACTOR * 1.4826 * float(np.median(r)) * (1 + 1e-12)
