@@ -68,7 +68,9 @@ def _verdict(observable: bool, gc_case: str, conditioning: float,
     options={"refine": "run the refinement of ch. 8.4.3 to the Sampson-error optimum "
                        "(default True)",
              "max_iterations": "cap on refinement iterations (default 100)",
-             "tolerance": "relative cost decrease that stops the alternation (1e-10)",
+             "tolerance": "relative cost decrease that stops the alternation (1e-10); the "
+                          "refinement also stops after a step below 0.3 standard "
+                          "deviations of the estimate (csrc/linear17.c)",
              "max_scale_rel_std": "relative std of |t| above which the scale is "
                                   "reported unobservable (0.1)"},
     minimal_solver=lambda sample: _minimal(sample),
