@@ -40,6 +40,7 @@
 
 #define NX 18
 #define MAX_RAYS (1 << 26)
+#define DIR2_MIN 1e-100 /* smallest squared length of a direction (|d| >= 1e-50) */
 
 /* ---------------------------------------------------------- small helpers */
 
@@ -86,12 +87,15 @@ static int make_row(const double *o1, const double *d1, const double *o2,
         p[i] = s * (o1[i] - o[i]);
         q[i] = s * (o2[i] - o[i]);
     }
-    na = sqrt(dot3(a, a));
-    nb = sqrt(dot3(b, b));
-    if (!(na > 0.0) || !(nb > 0.0) || !isfinite(na) || !isfinite(nb))
+    na = dot3(a, a);
+    nb = dot3(b, b);
+    /* |d| < 1e-50 is a zero-length direction, the one rule of every kernel
+     * and of mcgeom.validation.check_directions (the wrapper then need not
+     * look at the directions before the call) */
+    if (!(na >= DIR2_MIN) || !(nb >= DIR2_MIN) || !isfinite(na) || !isfinite(nb))
         return 0;
-    na = 1.0 / na;
-    nb = 1.0 / nb;
+    na = 1.0 / sqrt(na);
+    nb = 1.0 / sqrt(nb);
     for (i = 0; i < 3; i++) {
         a[i] *= na;
         b[i] *= nb;
@@ -498,17 +502,43 @@ static double sampson_pass(const raydata *rd, const double r[9], const double t[
  * its first-order sensitivity, which vanishes there, and has no such
  * minimum. A step turns R by at most 0.5 rad and moves t by at most half of
  * max(|t|, 1) (the rig size is 1 in this frame), so that a weakly observable
- * |t| does not overshoot. Returns the iterations (trial steps) taken; on
- * return h holds J^T J at (R, t) (for the scale evidence) and *cost the
- * Sampson cost there. */
+ * |t| does not overshoot.
+ * Stopping rule: each pass over the rays costs as much as the linear step,
+ * so the last step is taken without its own Gauss-Newton pass. The model
+ * predicts the decrease pred = -g.d - d^T H d / 2 of the step d; near the
+ * optimum pred = m^2 sigma^2 / 2, with m the length of d in standard
+ * deviations of the estimate (covariance sigma^2 H^-1, sigma^2 =
+ * cost / (n - 6)). A step shorter than STEP_STD standard deviations is in
+ * the region where the Gauss-Newton model is accurate (the next step is
+ * smaller by about m^2: 0.1 -> 4e-4 on the cases of issue 22): it is taken
+ * and checked by a pass that computes the cost only (no Jacobian), and the
+ * iteration stops; if the cost rose instead, the step is rejected as usual.
+ * The step must also be local in absolute terms (LOCAL_STEP: 0.01 rad and
+ * 1 % of |t|): where |t| is only weakly determined (near-critical motion,
+ * relative std of |t| above 1) a fraction of a standard deviation is a
+ * long way along a cost that is far from quadratic in |t|, and the estimate
+ * slides over many steps (bad_input's pure translation: 33 steps, |t| x 30).
+ * The information h is then that of the previous point, at most STEP_STD
+ * standard deviations away (it only feeds the relative std of |t|). From
+ * the linear step this takes two full passes and one cost pass on the
+ * cases of issue 22 (five full passes before). A step whose decrease is
+ * below `tolerance` of the cost is taken without any pass (it corrects the
+ * last digits: exact data).
+ * Returns the iterations (trial steps) taken; *cost0 is the Sampson cost at
+ * the start (the linear estimate); on return h holds J^T J at (R, t) (for
+ * the scale evidence) and *cost the Sampson cost there. */
+#define STEP_STD 0.3
+#define LOCAL_STEP 1e-2
 static int geometric_refine(const raydata *rd, const mcg_linear17_options *o,
                             double r[9], double t[3], double *cost, double h[36],
-                            int *converged)
+                            int *converged, double *cost0)
 {
     double g[6], lambda = 1e-8, hn[36], gn[6];
+    double negligible = 0.5 * STEP_STD * STEP_STD / (rd->n > 6 ? rd->n - 6 : 1);
     int it, i, j;
     *converged = 0;
     *cost = sampson_pass(rd, r, t, h, g);
+    *cost0 = *cost;
     for (it = 0; it < o->max_iterations; it++) {
         double a[36], rhs[6], d[6], dr[9], rn[9], tn[3], cn, nw, nt, lim, sc;
         int small;
@@ -553,6 +583,21 @@ static int geometric_refine(const raydata *rd, const mcg_linear17_options *o,
             for (i = 0; i < 6; i++)
                 pred -= g[i] * d[i] + 0.5 * d[i] * hd[i];
             small = !(pred > o->tolerance * *cost);
+            if (!small && lambda <= 1e-4 && pred <= negligible * *cost &&
+                nw * sc <= LOCAL_STEP && nt * sc <= LOCAL_STEP * sqrt(dot3(t, t))) {
+                /* shorter than STEP_STD standard deviations: the last step */
+                cn = sampson_pass(rd, rn, tn, NULL, NULL);
+                if (cn <= *cost) {
+                    memcpy(r, rn, sizeof rn);
+                    memcpy(t, tn, sizeof tn);
+                    *cost = cn;
+                    *converged = 1;
+                    it++;
+                    break;
+                }
+                lambda = lambda < 1e-6 ? 1e-6 : 10.0 * lambda;
+                continue;
+            }
         }
         if (small) {
             /* the step would lower the cost by less than the tolerance: take
@@ -940,14 +985,14 @@ static int choose_candidate(const double *m, const raydata *rays,
  * zero once |t| = 1 is fixed. */
 static int refine_motion(const double *m, const raydata *rd,
                          const mcg_linear17_options *o, double tiny,
-                         mcg_linear17_result *res, motion *mo)
+                         mcg_linear17_result *res, motion *mo, double *cost0)
 {
     int k;
     tsolve ts;
     if (!mo->unit_mode) {
         double x[NX];
         res->iterations = geometric_refine(rd, o, mo->r, mo->t, &mo->geo_cost, mo->h,
-                                           &res->converged);
+                                           &res->converged, cost0);
         mo->have_h = 1;
         motion_vector(mo->r, mo->t, x);
         mo->cost = quad18(m, x);
@@ -1131,16 +1176,26 @@ static int solve_case(int n, const double *origins1, const double *dirs1,
         mo.cost = 0.0;
     /* reported costs: RMS Sampson angular error (radians), the same
      * measure before and after the refinement and in every frame */
-    res->cost_linear = sqrt(sampson_pass(&rays, mo.r, mo.t, NULL, NULL) / n);
-    res->cost_final = res->cost_linear;
-
     res->converged = 0;
-    if (opt->refine) {
-        st = refine_motion(m, &rays, opt, tiny, res, &mo);
+    if (opt->refine && !mo.unit_mode) {
+        /* the geometric refinement's first pass is at the linear estimate:
+         * its cost is cost_linear (one pass over the rays fewer) */
+        double cost0;
+        st = refine_motion(m, &rays, opt, tiny, res, &mo, &cost0);
         if (st != MCG_OK)
             return st;
-        res->cost_final = sqrt((mo.have_h ? mo.geo_cost
-                                : sampson_pass(&rays, mo.r, mo.t, NULL, NULL)) / n);
+        res->cost_linear = sqrt(cost0 / n);
+        res->cost_final = sqrt(mo.geo_cost / n);
+    } else {
+        res->cost_linear = sqrt(sampson_pass(&rays, mo.r, mo.t, NULL, NULL) / n);
+        res->cost_final = res->cost_linear;
+        if (opt->refine) {
+            double unused;
+            st = refine_motion(m, &rays, opt, tiny, res, &mo, &unused);
+            if (st != MCG_OK)
+                return st;
+            res->cost_final = sqrt(sampson_pass(&rays, mo.r, mo.t, NULL, NULL) / n);
+        }
     }
     if (mo.cost < 0.0)
         mo.cost = 0.0; /* rounding of x^T M x, as above */

@@ -25,7 +25,8 @@ __all__ = [
     "rot_from_angle_axis", "angle_axis_from_rot", "rot_from_quat", "quat_from_rot",
     "project_so3", "plucker_from_points", "gec_rows",
     "cls_general", "cls_partial", "cls_range",
-    "Linear17Options", "linear17", "GC_CASE_NAMES",
+    "Linear17Options", "linear17", "linear17_raw", "linear17_dict", "L17_OFFSETS",
+    "GC_CASE_NAMES",
     "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
     "skyline_eig",
@@ -329,8 +330,36 @@ _DEFAULT_L17 = Linear17Options()
 _L17_DOUBLES = {name: ffi.offsetof("mcg_linear17_result", name) // 8
                 for name in ("R", "t", "t_metric", "E", "ar_eig", "schur_eig", "candidate_cost",
                              "norm_origin")}
+#: offsets (in doubles) of the array fields of mcg_linear17_result in the
+#: buffer of :func:`linear17_raw`
+L17_OFFSETS = _L17_DOUBLES
 # the struct holds only doubles and ints, so it is 8-byte aligned
 _L17_NDOUBLES = -(-ffi.sizeof("mcg_linear17_result") // 8)
+
+
+def linear17_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
+                 dirs2: np.ndarray, options: Optional[Linear17Options] = None
+                 ) -> tuple[int, np.ndarray, Any]:
+    """Run ``mcg_linear17``; returns (status, buffer, result) without raising.
+
+    The lean path of the estimator (issue 22: the public call at 100 rays
+    costs about as much as the kernel): no dict is built. ``result`` is the
+    ``mcg_linear17_result *`` living in ``buffer`` (float64, owned by the
+    caller); its array fields are at the offsets ``_L17_DOUBLES`` of the
+    buffer. Arrays as in :func:`linear17` (float64 C-contiguous (N, 3), rig
+    frame); NaN/inf and zero-length directions (|d| < 1e-50) give
+    ``STATUS_EINVAL``.
+    """
+    # The result struct lives in a fresh numpy buffer: array fields are views
+    # of it (no per-field copies; the buffer is owned by the result).
+    f64 = np.empty(_L17_NDOUBLES, dtype=np.float64)
+    res = ffi.cast("mcg_linear17_result *", ffi.from_buffer(f64))
+    opt = (options or _DEFAULT_L17)._c
+    st = lib.mcg_linear17(origins1.shape[0], ffi.from_buffer("double[]", origins1),
+                          ffi.from_buffer("double[]", dirs1),
+                          ffi.from_buffer("double[]", origins2),
+                          ffi.from_buffer("double[]", dirs2), opt, res)
+    return st, f64, res
 
 
 def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
@@ -341,13 +370,13 @@ def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
     :func:`mcgeom.validation.as_vectors`); finiteness is checked by the kernel.
     The caller decides how to report a non-OK status (``raise_for``).
     """
-    n = origins1.shape[0]
-    # The result struct lives in a fresh numpy buffer: the array fields below
-    # are views of it (no per-field copies; the buffer is owned by the result).
-    f64 = np.empty(_L17_NDOUBLES, dtype=np.float64)
-    res = ffi.cast("mcg_linear17_result *", ffi.from_buffer(f64))
-    opt = (options or _DEFAULT_L17)._c
-    st = lib.mcg_linear17(n, _p(origins1), _p(dirs1), _p(origins2), _p(dirs2), opt, res)
+    st, f64, res = linear17_raw(origins1, dirs1, origins2, dirs2, options)
+    return st, linear17_dict(f64, res)
+
+
+def linear17_dict(f64: np.ndarray, res: Any) -> dict:
+    """The result of :func:`linear17_raw` as the dict :func:`linear17` returns
+    (array fields are views of ``f64``)."""
     d = _L17_DOUBLES
     out = {
         "R": f64[d["R"]:d["R"] + 9].reshape(3, 3),
@@ -372,7 +401,7 @@ def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
         "norm_origin": f64[d["norm_origin"]:d["norm_origin"] + 3],
         "norm_scale": res.norm_scale,
     }
-    return st, out
+    return out
 
 
 def raise_for(status: int, what: str) -> None:

@@ -38,8 +38,13 @@ def test_matches_numpy_reference(kind):
     R, t, _ = linear17_numpy(p.rays.origins1, p.rays.dirs1, p.rays.origins2, p.rays.dirs2)
     assert rot_err(m.R, R) < 1e-6
     # compare the metric estimates (m.t is a unit direction when the verdict
-    # says the scale is not trustworthy)
-    assert np.linalg.norm(m.info["t_metric"] - t) < 1e-5 * np.linalg.norm(t)
+    # says the scale is not trustworthy). The kernel stops once its last
+    # Gauss-Newton step is below 0.3 standard deviations (csrc/linear17.c,
+    # geometric_refine), the reference at a relative cost decrease of 1e-10:
+    # where |t| is weakly determined (the 2-camera head, rel_std 0.29) the two
+    # may differ by a thousandth of the estimate's own standard deviation
+    tol = max(1e-5, 1e-3 * m.scale.rel_std)
+    assert np.linalg.norm(m.info["t_metric"] - t) < tol * np.linalg.norm(t)
 
 
 @pytest.mark.parametrize("kind", ["locally-central", "axial", "locally-central-and-axial"])

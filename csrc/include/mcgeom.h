@@ -262,7 +262,11 @@ typedef struct {
                                algebraic cost when only the direction of t
                                is determined) */
     int max_iterations;     /* cap on refinement iterations (0..10000) */
-    double tolerance;       /* stop when the relative cost decrease < tol */
+    double tolerance;       /* stop when the relative cost decrease < tol;
+                               the geometric refinement also stops after a
+                               step shorter than 0.3 standard deviations of
+                               the estimate (and 0.01 rad, 1 % of |t|),
+                               checked by a cost-only pass */
     double rank_rtol;       /* relative eigenvalue tolerance for null(A_R) */
     double min_scale_conditioning; /* below: scale reported unobservable */
     double max_scale_rel_std;      /* above: scale reported unobservable */
@@ -289,7 +293,7 @@ typedef struct {
                                mcg_gec_residuals) after the linear step */
     double cost_final;      /* RMS Sampson angular error at return */
     int iterations;         /* refinement iterations performed */
-    int converged;          /* 1 if the refinement met the tolerance */
+    int converged;          /* 1 if the refinement met its stopping rule */
     int n_distinct;         /* distinct correspondences, counted up to 17
                                (a pair repeating an earlier one exactly adds
                                no constraint) */
@@ -326,9 +330,10 @@ void mcg_linear17_default_options(mcg_linear17_options *opt);
  * MCG_EDEGENERATE if the most-general reading is not unique either.
  * The result is in the caller's rig frame (R, t: rig2_from_rig1, t in the
  * unit of the origins). n in [14, 2^26]. MCG_EINVAL: NULL, n, bad options,
- * NaN/inf, a zero direction; MCG_ENUMERIC: an inner decomposition failed.
- * The refinement runs at most opt->max_iterations steps (res->iterations),
- * each one O(n) pass over the rays. No workspace. */
+ * NaN/inf, a zero-length direction (|d| < 1e-50); MCG_ENUMERIC: an inner
+ * decomposition failed. The refinement runs at most opt->max_iterations
+ * steps (res->iterations), each one O(n) pass over the rays (typically two,
+ * plus a cost-only pass for the last step). No workspace. */
 int mcg_linear17(int n, const double *origins1, const double *dirs1,
                  const double *origins2, const double *dirs2,
                  const mcg_linear17_options *opt, mcg_linear17_result *res);

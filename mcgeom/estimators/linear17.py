@@ -28,26 +28,32 @@ from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
 from ._static import with_static_check
 
-__all__ = ["linear17"]
+__all__ = ["linear17", "linear17_no_static_check"]
 
 _NEEDED = {"most-general": 17, "locally-central": 16, "axial": 16,
            "locally-central-and-axial": 14, "central": 8}
 
 
-def _verdict(r: dict) -> ScaleVerdict:
-    if r["scale_observable"]:
-        reason = "scale fixed by the data (rotation or cross-camera rays)"
-    elif r["gc_case"] == "central":
-        reason = "central camera: all rays share one centre, the scale is not observable"
-    elif r["scale_conditioning"] < 1e-6:
-        reason = ("critical motion: the data leave |t| free (no rotation and only "
-                  "intra-camera correspondences, thesis ch. 7.3.2)")
+_OBSERVABLE = "scale fixed by the data (rotation or cross-camera rays)"
+_CENTRAL = "central camera: all rays share one centre, the scale is not observable"
+_CRITICAL = ("critical motion: the data leave |t| free (no rotation and only "
+             "intra-camera correspondences, thesis ch. 7.3.2)")
+
+
+def _verdict(observable: bool, gc_case: str, conditioning: float,
+             rel_std: float) -> ScaleVerdict:
+    """The scale verdict from the kernel's O(N) evidence (scale_evidence in
+    csrc/linear17.c: conditioning of eq. 8.15, relative std of |t|)."""
+    if observable:
+        reason = _OBSERVABLE
+    elif gc_case == "central":
+        reason = _CENTRAL
+    elif conditioning < 1e-6:
+        reason = _CRITICAL
     else:
-        reason = (f"scale too uncertain: relative std {r['scale_rel_std']:.3g} "
+        reason = (f"scale too uncertain: relative std {rel_std:.3g} "
                   "(near-critical motion, too little rotation for the noise level)")
-    return ScaleVerdict(bool(r["scale_observable"]), reason,
-                        conditioning=float(r["scale_conditioning"]),
-                        rel_std=float(r["scale_rel_std"]))
+    return ScaleVerdict(observable, reason, conditioning=conditioning, rel_std=rel_std)
 
 
 @register(
@@ -62,7 +68,9 @@ def _verdict(r: dict) -> ScaleVerdict:
     options={"refine": "run the refinement of ch. 8.4.3 to the Sampson-error optimum "
                        "(default True)",
              "max_iterations": "cap on refinement iterations (default 100)",
-             "tolerance": "relative cost decrease that stops the alternation (1e-10)",
+             "tolerance": "relative cost decrease that stops the alternation (1e-10); the "
+                          "refinement also stops after a step below 0.3 standard "
+                          "deviations of the estimate (csrc/linear17.c)",
              "max_scale_rel_std": "relative std of |t| above which the scale is "
                                   "reported unobservable (0.1)"},
     minimal_solver=lambda sample: _minimal(sample),
@@ -88,54 +96,63 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     """
     # E = 0 has no null space of the right dimension: a static rig raises
     # DegenerateError in the kernel (thesis ch. 8.3's kinds all assume t != 0)
-    return with_static_check(rays, "linear17", lambda: _linear17(
+    return with_static_check(rays, "linear17", lambda: linear17_no_static_check(
         rays, refine=refine, max_iterations=max_iterations, tolerance=tolerance,
         max_scale_rel_std=max_scale_rel_std, options=options))
 
 
-def _linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[int] = None,
-              tolerance: Optional[float] = None, max_scale_rel_std: Optional[float] = None,
-              options: Optional[_core.Linear17Options] = None) -> RigMotion:
-    """:func:`linear17` without the static-rig test (RANSAC's minimal solver)."""
+def linear17_no_static_check(rays: RayPairs, *, refine: bool = True,
+                             max_iterations: Optional[int] = None,
+                             tolerance: Optional[float] = None,
+                             max_scale_rel_std: Optional[float] = None,
+                             options: Optional[_core.Linear17Options] = None) -> RigMotion:
+    """:func:`linear17` without the shared static-rig test (RANSAC's minimal
+    solver, and ``mcgeom bench linear17``'s plugin timing): same frames, units,
+    options and errors; a static rig raises DegenerateError here."""
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
     n = len(rays)
     if n < 14:
         raise ValueError(f"too few correspondences: linear17 needs at least 17 "
                          f"(16 locally-central or axial, 14 locally-central-and-axial), got {n}")
-    # NaN/inf, then zero-length directions by the one rule of every estimator
-    # (mcgeom.validation.check_directions: the kernel would normalise a 1e-150
-    # direction that the others refuse)
-    rays.check_finite()
     if options is None and (not refine or max_iterations is not None or tolerance is not None
                             or max_scale_rel_std is not None):
         options = _core.Linear17Options(refine=refine, max_iterations=max_iterations,
                                         tolerance=tolerance, max_scale_rel_std=max_scale_rel_std)
-    st, r = _core.linear17(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, options)
+    # NaN/inf and zero-length directions (|d| < 1e-50, the one rule of every
+    # estimator: mcgeom.validation.check_directions) are rejected by the
+    # kernel in its one pass over the rays; _raise then names the array
+    st, f, r = _core.linear17_raw(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, options)
     if st != _core.STATUS_OK:
-        _raise(st, r, rays, n)
+        _raise(st, _core.linear17_dict(f, r), rays, n)
+    d = _core.L17_OFFSETS
+    gc_case = _core.GC_CASE_NAMES.get(r.gc_case, "degenerate")
+    t_metric = f[d["t_metric"]:d["t_metric"] + 3]
     info = {
-        "camera_kind": r["gc_case"],
-        "rank_A_R": r["rank_ar"],
-        "rank_A": r["rank_a"],
-        "iterations": r["iterations"],
-        "converged": r["converged"],
-        "cost_linear": r["cost_linear"],
-        "t_metric": r["t_metric"],
-        "candidate_cost": r["candidate_cost"],
-        "n_in_front": r["n_in_front"],
-        "E_normalised": r["E"],
-        "schur_eig": r["schur_eig"],
-        "A_R_eig": r["ar_eig"],
-        "normalisation": (r["norm_origin"], r["norm_scale"]),
+        "camera_kind": gc_case,
+        "rank_A_R": r.rank_ar,
+        "rank_A": r.rank_a,
+        "iterations": r.iterations,
+        "converged": bool(r.converged),
+        "cost_linear": r.cost_linear,
+        "t_metric": t_metric,
+        "candidate_cost": f[d["candidate_cost"]:d["candidate_cost"] + r.n_candidates],
+        "n_in_front": r.n_in_front,
+        "E_normalised": f[d["E"]:d["E"] + 9].reshape(3, 3),
+        "schur_eig": f[d["schur_eig"]:d["schur_eig"] + 9],
+        "A_R_eig": f[d["ar_eig"]:d["ar_eig"] + 9],
+        "normalisation": (f[d["norm_origin"]:d["norm_origin"] + 3], r.norm_scale),
     }
-    return RigMotion(r["R"], r["t"], _verdict(r), "linear17", r["cost_final"], None, info)
+    verdict = _verdict(bool(r.scale_observable), gc_case, r.scale_conditioning,
+                       r.scale_rel_std)
+    return RigMotion(f[d["R"]:d["R"] + 9].reshape(3, 3), f[d["t"]:d["t"] + 3], verdict,
+                     "linear17", r.cost_final, None, info)
 
 
 def _minimal(sample: RayPairs) -> list:
     """The motion of a 17-ray sample for RANSAC (none if the sample is degenerate)."""
     try:
-        m = _linear17(sample, refine=False)
+        m = linear17_no_static_check(sample, refine=False)
     except DegenerateError:
         return []
     return [(m.R, m.t if m.scale.observable else m.info["t_metric"])]

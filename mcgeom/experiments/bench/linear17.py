@@ -6,6 +6,11 @@ intra-camera correspondences, 0.05 deg angular noise), the best mean time of:
 - ``public``: ``mcgeom.estimate(rays, "linear17")``, what a user calls
   (RayPairs in, RigMotion with its scale verdict out: the registry, the
   plugin, the cffi wrapper and the kernel);
+- ``plugin``: the estimator without the shared static-rig test
+  (``mcgeom.estimators.linear17.linear17_no_static_check``: input checks, the kernel, the
+  info dict and the verdict); ``static`` = public - plugin is what the test
+  of :mod:`mcgeom.estimators._static` costs (issue 18's, shared by every
+  estimator);
 - ``wrapper``: ``mcgeom._core.linear17`` (the cffi wrapper: buffers in, the
   result struct as a dict of numpy views out);
 - ``C``: the kernel ``mcg_linear17`` alone through cffi, its pointers made
@@ -22,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mcgeom import _core, estimate, synth
+from mcgeom.estimators.linear17 import linear17_no_static_check
 from ..common import Progress, no_progress
 from .linear17_numpy import linear17_numpy
 from .timing import best_of
@@ -35,6 +41,7 @@ class Linear17Timing:
 
     n: int
     public_us: float
+    plugin_us: float
     wrapper_us: float
     c_us: float
     numpy_us: float
@@ -44,6 +51,11 @@ class Linear17Timing:
     def python_us(self) -> float:
         """Time spent above the kernel: public call minus C."""
         return self.public_us - self.c_us
+
+    @property
+    def static_us(self) -> float:
+        """Time of the shared static-rig test: public call minus plugin."""
+        return self.public_us - self.plugin_us
 
     @property
     def ratio(self) -> float:
@@ -59,7 +71,7 @@ def _timed(fn, budget_s: float) -> float:
 
 def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float = 0.5,
                    progress: Progress = no_progress) -> list[Linear17Timing]:
-    """Time linear17 through the public call, the wrapper and the bare kernel,
+    """Time linear17 through the public call, the plugin, the wrapper and the bare kernel,
     and the numpy reference, for each N (microseconds per call, best of
     batches; ``budget_s`` seconds per timing)."""
     rng = np.random.default_rng(seed)
@@ -76,9 +88,10 @@ def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float 
         res = _core.ffi.new("mcg_linear17_result *")
         kernel = _core.lib.mcg_linear17
         public_t = _timed(lambda: estimate(rays, "linear17"), budget_s)
+        plugin_t = _timed(lambda: linear17_no_static_check(rays), budget_s)
         wrapper_t = _timed(lambda: _core.linear17(*args), budget_s)
         c_t = _timed(lambda: kernel(n, *ptrs, _core.ffi.NULL, res), budget_s)
         np_t = _timed(lambda: linear17_numpy(*args), budget_s)
-        out.append(Linear17Timing(n, public_t * 1e6, wrapper_t * 1e6, c_t * 1e6, np_t * 1e6,
+        out.append(Linear17Timing(n, public_t * 1e6, plugin_t * 1e6, wrapper_t * 1e6, c_t * 1e6, np_t * 1e6,
                                   m.info["iterations"]))
     return out
