@@ -105,10 +105,6 @@ KNOWN_FAILURES = {
         "angle), so it reports a translation whose scale it cannot measure (unit t, "
         "'scale too uncertain') instead of 't = 0'")
        for m in ("bnb_lp", "five_plus_one", "linear17", "refine")},
-    ("rotation", "eigensolver", "kitti_raw_straight_intra"): (
-        "the eigensolver stops 0.119 deg from the truth on this near-critical straight "
-        "pair (5+1: 0.002 deg): the smallest eigenvalue is flat along the rotation that "
-        "trades against the translation direction"),
 }
 
 
