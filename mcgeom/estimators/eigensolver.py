@@ -52,21 +52,20 @@ def _default_starts(rays: RayPairs) -> list[np.ndarray]:
     0.119 deg off on KITTI raw 0023 driving straight, 5+1's 0.002 deg. The
     Sampson cost of :func:`refine_and_report` decides between the results.
     """
-    R_lin = None
+    R_lin, failure = None, None
     try:
         R_lin = linear17(rays, refine=False).R
-    except (DegenerateError, ValueError):
-        pass
+    except (DegenerateError, ValueError) as e:
+        failure = e
     try:
         R_best = best_start(rays)[0].R
     except DegenerateError:
         R_best = None
     starts = [R for R in (R_lin, R_best) if R is not None]
+    if failure is not None and not starts:
+        raise failure   # linear17's own diagnosis (e.g. the degenerate geometry it met)
     if len(starts) == 2 and np.allclose(starts[0], starts[1], rtol=0.0, atol=1e-12):
         starts = starts[:1]
-    if not starts:
-        raise DegenerateError("eigensolver: no start rotation (linear17 and 5+1 both failed); "
-                              "pass rotation_start=")
     return starts
 
 
