@@ -95,8 +95,9 @@ def minimal_answer(rays: RayPairs, method: str = "five_plus_one",
     info = {"candidates": cands, "ambiguous": k > 1, "primary_rule": PRIMARY_RULE,
             "t_metric": np.array(t), "scale_determined": False, "translation_detected": True,
             "t_direction": travel_direction(rays, every, R, t), "inlier_ratio": 1.0}
-    return RigMotion(np.array(R), info["t_direction"], verdict, method, 0.0,
-                     every if with_inliers else None, info)
+    r = _core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t)
+    return RigMotion(np.array(R), info["t_direction"], verdict, method,
+                     float(np.sqrt(np.mean(r ** 2))), every if with_inliers else None, info)
 
 
 # -------------------------------------------------------------- estimator
@@ -258,6 +259,9 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     A rig that did not translate measurably gives the rotation, ``t = 0`` and
     the verdict "no translation detected" (the shared test of
     :mod:`mcgeom.estimators._static`, the robust layer's statistic).
+    On exactly 6 correspondences (5 of one camera, 1 other) every motion that
+    fits them exactly with all points in front is in ``info["candidates"]``
+    and the verdict says when they are ambiguous (:func:`minimal_answer`).
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
