@@ -83,7 +83,13 @@
 #define SQRT3 1.7320508075688772
 #define PI 3.14159265358979323846
 #define EPS_MAX 1.5         /* a bound beyond this (rad) constrains nothing */
-#define SUBSET 8            /* widest-angle correspondences tested first */
+#define SUBSET 32           /* widest-angle correspondences tested first: a
+                               subset's infeasibility proves the group's, and
+                               most blocks of a search are discarded by one;
+                               measured on 300 KITTI raw inliers (two groups
+                               of ~150, gap 1e-4): 8 -> 32 took the 2-variable
+                               LPs from 190k to 100k and the search from 1.05
+                               to 0.84 s CPU (16: 0.96, 64: 0.88 s) */
 #define ROWS_PER 4          /* rows of a correspondence: its wedge and its cap */
 #define CAP_MAX 1.5         /* caps only of radius below this (rad, ~75 deg) */
 #define BLOCK_DOUBLES 5     /* centre (3), half-side, lower bound */

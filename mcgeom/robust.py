@@ -36,6 +36,7 @@ from .errors import DegenerateError
 # observable; the robust layer finishes any estimator's motion and must report
 # the same (see mcgeom.estimators._common: no estimator imports this module)
 from .estimators._common import camera_ids, travel_direction
+from .estimators.five_plus_one import minimal_answer
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
                             total_scale_std)
@@ -325,6 +326,13 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     f = _focal_array(focal, n)
     if motion_focal is not None and f is None:
         raise ValueError("motion_focal needs focal (thresholds in pixels)")
+    if method == "five_plus_one" and n == 6:
+        # exactly minimal input: every motion that fits it exactly, the ambiguity
+        # in the verdict (issue 18; mcgeom.estimators.five_plus_one.minimal_answer)
+        thr = options.threshold / (1.0 if f is None else float(np.median(f)))
+        m = minimal_answer(rays, f"ransac[{method}]", thr, with_inliers=True)
+        if m is not None:
+            return m
     if method == "five_plus_one" and options.strategy == "auto" and \
             (motion_focal is None or pixel_cameras is not None):
         return _ransac_c(rays, f, options, pixel_cameras, t_start, calibration_std)

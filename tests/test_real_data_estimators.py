@@ -98,10 +98,6 @@ def _describe(m, f) -> str:
 #: (check, method, fixture) -> diagnosis: the open failures of issue 18, strict
 #: xfails so that they stay visible (-ra) and a fix (XPASS) fails until the marker goes
 KNOWN_FAILURES = {
-    ("rotation", "eigensolver", "kitti_raw_straight_intra"): (
-        "the eigensolver stops 0.119 deg from the truth on this near-critical straight "
-        "pair (5+1: 0.002 deg): the smallest eigenvalue is flat along the rotation that "
-        "trades against the translation direction"),
 }
 
 

@@ -478,7 +478,12 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
                          mask_out, {**static.info, "domain": "static", "n_used": len(sub),
                                     "pruned": 0, "pruned_index": np.zeros(0, np.int64)})
     R0, t0, source = start.R, start.t, start.source   # not None: _static_answer raised
-    kw = dict(resolution=resolution, gap=gap, tol=tol, preemptive=preemptive,
+    # bound_steps=0: a split block's children inherit its bound instead of one
+    # more relaxed test each to order the heap; with the start's incumbent
+    # (best_start) the search examines the same blocks (KITTI raw, 300
+    # inliers, gap 1e-4: 48050 either way) and saves those tests (1.54 ->
+    # 1.17 s CPU on pair 0-1 intra-only)
+    kw = dict(bound_steps=0, resolution=resolution, gap=gap, tol=tol, preemptive=preemptive,
               working_sets=working_sets, max_blocks=int(max_blocks), lp_backend=backend,
               polish_tol=1e-9 if polish else 0.0, max_seconds=float(max_seconds))
     keep = np.ones(len(sub), bool)

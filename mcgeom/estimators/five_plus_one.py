@@ -35,15 +35,69 @@ from ..geometry import count_in_front, rcross, refine_centred
 from ..observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
                               total_scale_std)
 from ..registry import register
-from ..types import RayPairs, RigMotion
+from ..types import RayPairs, RigMotion, ScaleVerdict
 from ..validation import integral_camera_ids
 from ._common import camera_ids, intra_counts, travel_direction
 from ._static import with_static_check
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
-from .five_plus_one_minimal import (critical_angles, minimal_solutions, sample_five_plus_one,
-                                    scale_terms)
+from .five_plus_one_minimal import (PRIMARY_RULE, critical_angles, exact_candidates,
+                                    minimal_solutions, sample_five_plus_one, scale_terms)
 
-__all__ = ["five_plus_one", "solve", "propose", "scale_one_point_ransac"]
+__all__ = ["five_plus_one", "solve", "propose", "scale_one_point_ransac", "minimal_answer"]
+
+
+# ------------------------------------------------ exactly minimal input (6)
+
+def minimal_answer(rays: RayPairs, method: str = "five_plus_one",
+                   noise_level: float = float("nan"),
+                   with_inliers: bool = False) -> Optional[RigMotion]:
+    """The answer on exactly minimal input: 6 correspondences, 5 of one camera
+    and 1 other (issue 18); None when ``rays`` is not such a set, no exact
+    solution puts all six points in front, or the rig did not translate
+    measurably (the caller's usual path then answers).
+
+    Six correspondences fit up to ten motions exactly, and several of them can
+    put every point in front of the cameras (~45 % of noise-free
+    configurations: ``mcgeom experiment minimal_5p1``); nothing in the data
+    tells the physical one. So every such motion is returned in
+    ``info["candidates"]`` (dicts with ``R``, ``t`` in metres, ``min_depth``,
+    ``max_residual`` and ``why``; :func:`exact_candidates`), ``R`` and ``t``
+    are those of the primary, chosen by :data:`PRIMARY_RULE`
+    (``info["primary_rule"]``), and the verdict is never observable: it says
+    "ambiguous: k motions fit the 6 correspondences exactly" when k > 1, "no
+    redundancy" otherwise. ``t`` is the primary's unit travel direction (no
+    redundancy supports a metric scale); its metric value is
+    ``info["t_metric"]``. ``method`` names the motion; ``noise_level``
+    (radians) enables the no-parallax test of :func:`scale_verdict`;
+    ``with_inliers``: the motion's ``inliers`` mask (all six) as a robust
+    search reports it, else None as the direct estimators.
+    """
+    if len(rays) != 6:
+        return None
+    cands = exact_candidates(rays)
+    if not cands:
+        return None
+    R, t = cands[0]["R"], cands[0]["t"]
+    every = np.ones(6, bool)
+    base = scale_verdict(rays, every, R, t, float("inf"), 0.1, noise_level=noise_level)
+    if base.reason.startswith("no translation"):
+        return None
+    k = len(cands)
+    what = (f"ambiguous: {k} motions fit the 6 correspondences exactly and put all 6 points "
+            "in front of the cameras (info['candidates']); nothing in the data tells the "
+            f"physical one; the one returned has the {PRIMARY_RULE}" if k > 1 else
+            "no redundancy: one motion fits the 6 correspondences exactly with all 6 points "
+            "in front of the cameras (the other exact solutions put points behind)")
+    verdict = ScaleVerdict(False, f"{what}; 6 correspondences for the 6 unknowns of the "
+                                  "motion: no uncertainty can be estimated, the scale is "
+                                  "not checked", base.conditioning, float("inf"),
+                           base.critical_angle)
+    info = {"candidates": cands, "ambiguous": k > 1, "primary_rule": PRIMARY_RULE,
+            "t_metric": np.array(t), "scale_determined": False, "translation_detected": True,
+            "t_direction": travel_direction(rays, every, R, t), "inlier_ratio": 1.0}
+    r = _core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t)
+    return RigMotion(np.array(R), info["t_direction"], verdict, method,
+                     float(np.sqrt(np.mean(r ** 2))), every if with_inliers else None, info)
 
 
 # -------------------------------------------------------------- estimator
@@ -73,6 +127,12 @@ def _choose_camera(rays: RayPairs, five_camera: Optional[int]):
         raise ValueError(f"too few correspondences: five_plus_one needs 5 intra-camera "
                          f"correspondences in camera {a}, got {counts[a]}")
     return a, cam1, cam2, centres, np.flatnonzero(intra & (cam1 == a))
+
+
+def _five_of(rays: RayPairs) -> int:
+    """The camera with the most intra-camera correspondences (the 5-point one
+    of a 5+1 set)."""
+    return int(np.argmax(intra_counts(rays)[4]))
 
 
 def _scale_ls(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
@@ -199,6 +259,9 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
     A rig that did not translate measurably gives the rotation, ``t = 0`` and
     the verdict "no translation detected" (the shared test of
     :mod:`mcgeom.estimators._static`, the robust layer's statistic).
+    On exactly 6 correspondences (5 of one camera, 1 other) every motion that
+    fits them exactly with all points in front is in ``info["candidates"]``
+    and the verdict says when they are ambiguous (:func:`minimal_answer`).
     """
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
@@ -214,6 +277,12 @@ def five_plus_one(rays: RayPairs, *, five_camera: Optional[int] = None, refine: 
 def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
                    max_scale_rel_std: float, calibration_std: Any = None) -> RigMotion:
     """:func:`five_plus_one` on checked rays, without the static-rig test."""
+    if len(rays) == 6:
+        # exactly minimal: every exact motion with all points in front
+        # (minimal_answer), unless the set is not 5 + 1 or none passes
+        m = minimal_answer(rays)
+        if m is not None and five_camera in (None, _five_of(rays)):
+            return m
     if five_camera is None:
         # every camera that can be the 5-point camera, best final cost wins: the
         # refinement from a single camera's start can stop in a local minimum,
