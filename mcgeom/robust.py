@@ -678,15 +678,39 @@ def _verdict_sample(rays: RayPairs, inl: np.ndarray, seed: Optional[int]
     return sub, np.ones(len(sub), bool)
 
 
+def _camera_count(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, int]:
+    """``(cam1, cam2, number of cameras)`` for the C search, with the check of
+    :func:`camera_ids` that every camera id has one origin at both times (the
+    C search takes a camera's centre from any of its rays).
+
+    With camera ids the check compares every origin with its camera's first
+    one (a gather and a maximum: at 1e6 rays a fifth of the time of
+    :func:`camera_ids`, which scatters every origin into its table first).
+    """
+    if rays.cam1 is None or rays.cam2 is None:
+        cam1, cam2, centres = camera_ids(rays)
+        return cam1, cam2, len(centres)
+    cam1, cam2 = rays.cam1, rays.cam2
+    m = int(max(cam1.max(initial=-1), cam2.max(initial=-1))) + 1
+    table = np.full((m, 3), np.nan)
+    for cam, o in ((cam2, rays.origins2), (cam1, rays.origins1)):   # time 1 wins
+        for k in np.flatnonzero(np.bincount(cam, minlength=m)):
+            table[k] = o[int(np.argmax(cam == k))]
+    for cam, o in ((cam1, rays.origins1), (cam2, rays.origins2)):
+        if np.abs(table[cam] - o).max(initial=0.0) > 1e-9 * (1.0 + np.abs(o).max(initial=0.0)):
+            raise ValueError("rays: one camera id has several different origins; origins must "
+                             "be the camera centres (rig frame) for five_plus_one")
+    return cam1, cam2, m
+
+
 def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions,
               pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
               t_start: float, calibration_std: Any = None) -> RigMotion:
     """five_plus_one: the search and the final refinement in one C call
     (``_core.robust_rig_motion``, csrc/robust.c), the verdict here."""
     method = "five_plus_one"
-    cam1, cam2, centres = camera_ids(rays)
+    cam1, cam2, n_cameras = _camera_count(rays)
     cam_focal = cam_axes = None
-    n_cameras = len(centres)
     if pixel_cameras is not None:
         cam_focal, cam_axes = pixel_cameras
         if focal is None:
@@ -733,15 +757,10 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             scorer.n_hyp = int(probe["hypotheses"])
         return _nothing_found(rays, scorer, options, method, t_start, 6, "")
     R, t, inl = out["R"], out["t"], out["inliers"]
-    # the RMS residual of the inliers: their residuals only (not all N), in
-    # chunks (a copy of all inliers' rays would add ~0.8x the input to the
-    # peak memory)
-    idx = np.flatnonzero(inl)
-    ss = 0.0
-    for k in range(0, idx.size, _CHUNK):
-        j = idx[k:k + _CHUNK]
-        r_in = _residuals(rays.take(j), R, t, None if focal is None else focal[j])
-        ss += float(np.dot(r_in, r_in))
+    # the RMS residual of the inliers: one C pass over the rays in place (a
+    # copy of the inliers' rays costs more than the residuals of all, and
+    # ~0.8x the input in memory)
+    r = _residuals(rays, R, t, focal)[inl]
     info = {k: out[k] for k in ("iterations", "hypotheses", "local_optimizations", "score",
                                 "stop")}
     info["c_seconds"] = out["seconds"]
@@ -754,8 +773,4 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     return _conclude(rays, R, t, None, inl, fit, out["loss_scale"],
                      float(np.linalg.norm(out["t_hypothesis"])), options, method, info, t_start,
                      out["scale_profile"], calibration_std,
-                     rms=float(np.sqrt(ss / idx.size)) if idx.size else float("nan"))
-
-
-#: correspondences per chunk of the C path's O(N) numpy passes (bounded memory)
-_CHUNK = 1 << 16
+                     rms=float(np.sqrt(np.dot(r, r) / r.size)) if r.size else float("nan"))
