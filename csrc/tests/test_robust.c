@@ -131,6 +131,39 @@ static int orthonormal(const double R[9])
                                R[2] * (R[3] * R[7] - R[4] * R[6]) > 0.0;
 }
 
+/* The checks of a robust result on scene(n, n_out, ...) with the true (R, t):
+ * rotation (deg) and relative translation errors within the tolerances, R a
+ * rotation, mask bit 0 == (|r| < thr) by residuals recomputed here; the
+ * outliers caught and inliers kept are counted into *caught, *kept. */
+static void check_found(const char *tag, int n, int n_out, double thr, const double R[9],
+                        const double t[3], const mcg_robust_result *res, double rot_tol,
+                        double t_tol, int *caught, int *kept)
+{
+    char what[96];
+    double err;
+    int k, agree = 1;
+    rot_err(res->R, R, &err);
+    snprintf(what, sizeof what, "%s: rotation error (deg)", tag);
+    check(err < rot_tol, what, err, rot_tol);
+    err = rel_err3(res->t, t);
+    snprintf(what, sizeof what, "%s: metric translation, relative error", tag);
+    check(err < t_tol, what, err, t_tol);
+    snprintf(what, sizeof what, "%s: R orthonormal, det +1", tag);
+    check(orthonormal(res->R), what, 0.0, 1e-9);
+    /* the mask against residuals recomputed here */
+    mcg_gec_residuals(n, o1, d1, o2, d2, res->R, res->t, res_chk);
+    *caught = *kept = 0;
+    for (k = 0; k < n; k++) {
+        agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) < thr);
+        *caught += is_out[k] && !(mask[k] & 1);
+        *kept += !is_out[k] && (mask[k] & 1);
+    }
+    snprintf(what, sizeof what, "%s: mask bit 0 == (|r| < threshold)", tag);
+    check(agree, what, 0.0, 0.0);
+    snprintf(what, sizeof what, "%s: outliers flagged", tag);
+    check(*caught >= n_out * 95 / 100, what, *caught, n_out * 95 / 100);
+}
+
 static void outliers_case(void)
 {
     const int n = 300, n_out = 90;
@@ -145,20 +178,7 @@ static void outliers_case(void)
     st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, wts, work, lwork);
     check_status(st, MCG_OK, "30 % outliers: status");
-    rot_err(res.R, R, &err);
-    check(err < 0.2, "30 % outliers: rotation error (deg)", err, 0.2);
-    err = rel_err3(res.t, t);
-    check(err < 0.05, "30 % outliers: metric translation, relative error", err, 0.05);
-    check(orthonormal(res.R), "R orthonormal, det +1", 0.0, 1e-9);
-    /* the mask against residuals recomputed here */
-    mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
-    for (k = 0; k < n; k++) {
-        agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) < thr);
-        caught += is_out[k] && !(mask[k] & 1);
-        kept += !is_out[k] && (mask[k] & 1);
-    }
-    check(agree, "mask bit 0 == (|r| < threshold) at the returned motion", 0.0, 0.0);
-    check(caught >= n_out * 95 / 100, "outliers flagged (count of 90)", caught, 86);
+    check_found("30 % outliers", n, n_out, thr, R, t, &res, 0.2, 0.05, &caught, &kept);
     check(kept >= (n - n_out) * 90 / 100, "inliers kept (count of 210)", kept, 189);
     check(res.n_inliers == kept + (n_out - caught), "n_inliers counts mask bit 0",
           res.n_inliers, 0.0);
@@ -333,7 +353,7 @@ static void large_case(void)
     mcg_robust_result res;
     mcg_refine_options ro;
     mcg_refine_result rr;
-    int k, i, m = 0, st, agree = 1, caught = 0;
+    int k, i, m = 0, st, caught, kept;
     scene(n, n_out, 1e-3, R, t);
     mcg_robust_default_options(&opt);
     opt.threshold = thr;
@@ -342,18 +362,7 @@ static void large_case(void)
     st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, wts, work, lwork);
     check_status(st, MCG_OK, "20000 pairs: status");
-    rot_err(res.R, R, &err);
-    check(err < 0.02, "20000 pairs: rotation error (deg)", err, 0.02);
-    err = rel_err3(res.t, t);
-    check(err < 0.01, "20000 pairs: metric translation, relative error", err, 0.01);
-    check(orthonormal(res.R), "20000 pairs: R orthonormal, det +1", 0.0, 1e-9);
-    mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
-    for (k = 0; k < n; k++) {
-        agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) < thr);
-        caught += is_out[k] && !(mask[k] & 1);
-    }
-    check(agree, "20000 pairs: mask bit 0 == (|r| < threshold)", 0.0, 0.0);
-    check(caught >= n_out * 95 / 100, "20000 pairs: outliers flagged", caught, n_out * 95 / 100);
+    check_found("20000 pairs", n, n_out, thr, R, t, &res, 0.02, 0.01, &caught, &kept);
     check(res.scale_profile > 25.0, "20000 pairs: scale profile excludes |t| x/ 1.3",
           res.scale_profile, 25.0);
     /* the reference: a full refinement of every used pair (mask bit 1), same
