@@ -125,3 +125,29 @@ def test_c_path_agrees_with_the_python_drivers():
         assert rot_err(a.R, b.R) < np.radians(0.1)
         assert abs(np.count_nonzero(a.inliers) - np.count_nonzero(b.inliers)) <= 0.05 * len(p.rays)
         assert a.scale.observable == b.scale.observable
+
+
+def test_verdict_on_a_sample_of_the_inliers_agrees(monkeypatch):
+    """Beyond VERDICT_SAMPLE intra-camera inliers the verdict runs on a sample of
+    them (issue 19): forced here on 800 rays, it agrees with the verdict on all."""
+    rig, p, R, t = _problem(3, n=800, outliers=0.2)
+    f = pixels_per_radian(rig, p.rays)
+    full = robust.ransac(p.rays, threshold=1.0, focal=f)
+    monkeypatch.setattr(robust, "VERDICT_SAMPLE", 100)
+    sampled = robust.ransac(p.rays, threshold=1.0, focal=f)
+    assert np.count_nonzero(full.inliers & (p.rays.cam1 == p.rays.cam2)) > 100
+    assert sampled.scale.observable == full.scale.observable
+    # the same cameras and cross-camera inliers: the same critical angle and evidence
+    assert sampled.scale.critical_angle == full.scale.critical_angle
+    assert sampled.scale.reason == full.scale.reason
+    np.testing.assert_array_equal(sampled.t, full.t)
+
+
+def test_c_path_names_a_camera_with_two_origins():
+    rig, p, R, t = _problem(4)
+    o2 = p.rays.origins2.copy()
+    o2[np.flatnonzero(p.rays.cam2 == 2)[3]] += 1e-3
+    bad = type(p.rays)(p.rays.origins1, p.rays.dirs1, o2, p.rays.dirs2, p.rays.cam1,
+                       p.rays.cam2)
+    with pytest.raises(ValueError, match="several different origins"):
+        robust.ransac(bad, threshold=1.0, focal=pixels_per_radian(rig, p.rays))

@@ -1023,8 +1023,15 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * directions, focal <= 0, bad options), MCG_ENOMEM (lwork below
  * mcg_robust_work_size). Budgets: opt->max_iterations samples and
  * opt->max_seconds for the search; each refinement is capped by
- * mcg_refine_motion's defaults. Cost O(n) per hypothesis scored (early
- * exit once its score exceeds the best) and per refinement iteration. */
+ * mcg_refine_motion's defaults (a local optimisation by 8 steps). Cost
+ * O(n) per hypothesis scored (early exit once its score exceeds the best)
+ * and per refinement iteration. Large n (issue 19): from 16384 pairs a
+ * hypothesis is first scored on a fixed random subset of 2048 pairs and on
+ * all of them only if it beats the best there too; a final refinement or
+ * scale profile on more than 4096 pairs converges on a random 4096 of them
+ * and then takes at most 3 steps on all (the profile's fits stay on the
+ * subset, the cost increase scaled to all pairs): the time per pair is
+ * about constant in n. */
 int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const double *o2,
                           const double *d2, const int *cam1, const int *cam2, int n_cameras,
                           const double *focal, const double *cam_axes,

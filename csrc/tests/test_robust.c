@@ -10,8 +10,12 @@
  * (issue 18: candidates are chosen by cheirality), the true one in at least
  * 90 % of the trials; pixel units (focal) and the camera table;
  * the status codes of invalid arguments, a too small workspace and data
- * without 5 intra-camera pairs in any camera. Exit status 0 iff every
- * check passes.
+ * without 5 intra-camera pairs in any camera; on 20000 pairs (preemptive
+ * scoring on a subset, the final refinement converged on a subset and
+ * polished on all pairs, the scale profile on a subset: issue 19) the
+ * motion agrees with an independent full refinement (mcg_refine_motion on
+ * all the pairs the result says it used, from the true motion) within a
+ * fraction of its noise. Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
@@ -23,7 +27,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NMAX 400
+/* NMAX: the large case runs past the preemptive scoring's and the capped
+ * final refinement's thresholds of robust.c (16384 and 4096 pairs) */
+#define NMAX 20000
 #define NCAM 4
 
 static double o1[3 * NMAX], d1[3 * NMAX], o2[3 * NMAX], d2[3 * NMAX], focal[NMAX];
@@ -125,6 +131,39 @@ static int orthonormal(const double R[9])
                                R[2] * (R[3] * R[7] - R[4] * R[6]) > 0.0;
 }
 
+/* The checks of a robust result on scene(n, n_out, ...) with the true (R, t):
+ * rotation (deg) and relative translation errors within the tolerances, R a
+ * rotation, mask bit 0 == (|r| < thr) by residuals recomputed here; the
+ * outliers caught and inliers kept are counted into *caught, *kept. */
+static void check_found(const char *tag, int n, int n_out, double thr, const double R[9],
+                        const double t[3], const mcg_robust_result *res, double rot_tol,
+                        double t_tol, int *caught, int *kept)
+{
+    char what[96];
+    double err;
+    int k, agree = 1;
+    rot_err(res->R, R, &err);
+    snprintf(what, sizeof what, "%s: rotation error (deg)", tag);
+    check(err < rot_tol, what, err, rot_tol);
+    err = rel_err3(res->t, t);
+    snprintf(what, sizeof what, "%s: metric translation, relative error", tag);
+    check(err < t_tol, what, err, t_tol);
+    snprintf(what, sizeof what, "%s: R orthonormal, det +1", tag);
+    check(orthonormal(res->R), what, 0.0, 1e-9);
+    /* the mask against residuals recomputed here */
+    mcg_gec_residuals(n, o1, d1, o2, d2, res->R, res->t, res_chk);
+    *caught = *kept = 0;
+    for (k = 0; k < n; k++) {
+        agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) < thr);
+        *caught += is_out[k] && !(mask[k] & 1);
+        *kept += !is_out[k] && (mask[k] & 1);
+    }
+    snprintf(what, sizeof what, "%s: mask bit 0 == (|r| < threshold)", tag);
+    check(agree, what, 0.0, 0.0);
+    snprintf(what, sizeof what, "%s: outliers flagged", tag);
+    check(*caught >= n_out * 95 / 100, what, *caught, n_out * 95 / 100);
+}
+
 static void outliers_case(void)
 {
     const int n = 300, n_out = 90;
@@ -139,20 +178,7 @@ static void outliers_case(void)
     st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, wts, work, lwork);
     check_status(st, MCG_OK, "30 % outliers: status");
-    rot_err(res.R, R, &err);
-    check(err < 0.2, "30 % outliers: rotation error (deg)", err, 0.2);
-    err = rel_err3(res.t, t);
-    check(err < 0.05, "30 % outliers: metric translation, relative error", err, 0.05);
-    check(orthonormal(res.R), "R orthonormal, det +1", 0.0, 1e-9);
-    /* the mask against residuals recomputed here */
-    mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
-    for (k = 0; k < n; k++) {
-        agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) < thr);
-        caught += is_out[k] && !(mask[k] & 1);
-        kept += !is_out[k] && (mask[k] & 1);
-    }
-    check(agree, "mask bit 0 == (|r| < threshold) at the returned motion", 0.0, 0.0);
-    check(caught >= n_out * 95 / 100, "outliers flagged (count of 90)", caught, 86);
+    check_found("30 % outliers", n, n_out, thr, R, t, &res, 0.2, 0.05, &caught, &kept);
     check(kept >= (n - n_out) * 90 / 100, "inliers kept (count of 210)", kept, 189);
     check(res.n_inliers == kept + (n_out - caught), "n_inliers counts mask bit 0",
           res.n_inliers, 0.0);
@@ -317,6 +343,61 @@ static void status_case(void)
           "work size 0 for n < 6 or no camera", 0.0, 0.0);
 }
 
+/* 20000 pairs, 30 % outliers: the paths of robust.c for large N. */
+static void large_case(void)
+{
+    const int n = NMAX, n_out = 3 * NMAX / 10;
+    static double a1[3 * NMAX], b1[3 * NMAX], a2[3 * NMAX], b2[3 * NMAX];
+    double R[9], t[3], err, thr = 3e-3, Rr[9], tr[3];
+    mcg_robust_options opt;
+    mcg_robust_result res;
+    mcg_refine_options ro;
+    mcg_refine_result rr;
+    int k, i, m = 0, st, caught, kept;
+    scene(n, n_out, 1e-3, R, t);
+    mcg_robust_default_options(&opt);
+    opt.threshold = thr;
+    opt.seed = 11;
+    opt.max_scale_rel_std = 0.1;
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, wts, work, lwork);
+    check_status(st, MCG_OK, "20000 pairs: status");
+    check_found("20000 pairs", n, n_out, thr, R, t, &res, 0.02, 0.01, &caught, &kept);
+    check(res.scale_profile > 25.0, "20000 pairs: scale profile excludes |t| x/ 1.3",
+          res.scale_profile, 25.0);
+    /* the reference: a full refinement of every used pair (mask bit 1), same
+     * loss, from the true motion */
+    for (k = 0; k < n; k++) {
+        if (!(mask[k] & 2))
+            continue;
+        for (i = 0; i < 3; i++) {
+            a1[3 * m + i] = o1[3 * k + i];
+            b1[3 * m + i] = d1[3 * k + i];
+            a2[3 * m + i] = o2[3 * k + i];
+            b2[3 * m + i] = d2[3 * k + i];
+        }
+        m++;
+    }
+    check(m == res.n_used, "20000 pairs: mask bit 1 counts n_used", m, res.n_used);
+    mcg_refine_default_options(&ro);
+    ro.loss = opt.loss;
+    ro.loss_scale = thr;
+    ro.max_iterations = 100;
+    memcpy(Rr, R, sizeof Rr);
+    memcpy(tr, t, sizeof tr);
+    st = mcg_refine_motion(m, a1, b1, a2, b2, NULL, &ro, Rr, tr, &rr);
+    check_status(st, MCG_OK, "20000 pairs: reference refinement");
+    /* its noise: ~1e-3 rad / sqrt(14000) ~ 5e-4 deg; the polish must be far closer
+     * (measured: 0.9e-5 to 1.9e-5 deg, ~2e-6 relative) */
+    rot_err(res.R, Rr, &err);
+    check(err < 1e-4, "20000 pairs: rotation vs the full refinement (deg)", err, 1e-4);
+    err = rel_err3(res.t, tr);
+    check(err < 1e-4, "20000 pairs: t vs the full refinement, relative", err, 1e-4);
+    check(fabs(res.refinement.final_cost - rr.final_cost) <= 1e-6 * rr.final_cost,
+          "20000 pairs: final cost = the full refinement's", res.refinement.final_cost,
+          rr.final_cost);
+}
+
 int main(void)
 {
     lwork = mcg_robust_work_size(NMAX, NCAM);
@@ -326,6 +407,7 @@ int main(void)
     outliers_case();
     minimal_case();
     status_case();
+    large_case();
     free(work);
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed != 0;
