@@ -74,6 +74,10 @@
  * the cap keeps its cost independent of N (Lebeda, Matas & Chum 2012 cap
  * the inner sample of LO-RANSAC likewise). The final refinement uses all. */
 #define LO_MAX 4096
+/* doubles of the solutions of one upright or 6-point sample (R and t) */
+#define MINIMAL_SOLUTIONS_SIZE (12 * MCG_SIXPT_MAX_SOLUTIONS)
+/* draws of a 6-point sample before one with two cameras is given up */
+#define SAMPLE_TRIES 16
 
 static double now_seconds(void)
 {
@@ -112,7 +116,12 @@ void mcg_robust_default_options(mcg_robust_options *opt)
     opt->refine = 1;
     opt->loss = MCG_LOSS_CAUCHY;
     opt->max_scale_rel_std = 0.0;
+    opt->sampler = MCG_SAMPLER_5P1;
+    opt->g1[0] = opt->g1[1] = opt->g1[2] = 0.0;
+    opt->g2[0] = opt->g2[1] = opt->g2[2] = 0.0;
 }
+
+static int check_sampler(const mcg_robust_options *o);
 
 static int check_options(const mcg_robust_options *o)
 {
@@ -135,7 +144,7 @@ static int check_options(const mcg_robust_options *o)
     if (!(isfinite(o->max_scale_rel_std) && o->max_scale_rel_std >= 0.0 &&
           o->max_scale_rel_std <= 10.0))
         return 0;
-    return 1;
+    return check_sampler(o);
 }
 
 /* ------------------------------------------------------------ workspace */
@@ -158,6 +167,8 @@ size_t mcg_robust_work_size(int n, int n_cameras)
     /* the scale search: its pairs (12 m), its workspace and order, m <= SCALE_PAIRS */
     nn = min_sz(nn, SCALE_PAIRS);
     s = add_sz(s, 12 * nn + mcg_scale_ransac_work_size((int)nn) + ints_as_doubles(nn), &ok);
+    /* the solutions of one minimal sample (the 6-point solver's are the most) */
+    s = add_sz(s, MINIMAL_SOLUTIONS_SIZE, &ok);
     return ok ? s : 0;
 }
 
@@ -176,6 +187,8 @@ typedef struct {
     double *xs;      /* the scale search's cross-camera pairs: o1 d1 o2 d2 */
     double *xwork;   /* its mcg_scale_ransac workspace */
     int *xorder;     /* its proposal order */
+    double *msol;    /* the solutions of an upright / 6-point sample */
+    int sample_size; /* pairs per sample (adaptive stop) */
     int nx;          /* its pairs (0: no scale search) */
     int nx_others;   /* 1: they are another camera's (gather_others) */
     size_t lxwork;
@@ -723,6 +736,138 @@ static int sample(ctx *c, const double *w)
     return offered;
 }
 
+/* ---------------------------------------- the upright and 6-point samples */
+
+/* Score a motion with a metric t of its own (an upright or 6-point
+ * solution); keep and locally optimise it if it is the best. */
+static int offer_motion(ctx *c, const double R[9], const double t[3], const double *w)
+{
+    double sc;
+    int n_inl = 0, n_wide = 0;
+    c->n_hyp++;
+    sc = msac2(c, R, t, c->have ? c->score : INFINITY, &n_inl, &n_wide);
+    if (!(sc < (c->have ? c->score : INFINITY)))
+        return 0;
+    take_best(c, R, t, sc, n_inl, n_wide);
+    if (c->lo_rounds > 0)
+        local_optimise(c, w);
+    return 1;
+}
+
+/* The options of the samplers: a known sampler, and for the upright one a
+ * finite vertical of non-zero length at both times. */
+static int check_sampler(const mcg_robust_options *o)
+{
+    if (o->sampler == MCG_SAMPLER_5P1 || o->sampler == MCG_SAMPLER_6PT)
+        return 1;
+    if (o->sampler != MCG_SAMPLER_UPRIGHT4)
+        return 0;
+    return all_finite(o->g1, 3) && all_finite(o->g2, 3) && dot3(o->g1, o->g1) >= 1e-100 &&
+           dot3(o->g2, o->g2) >= 1e-100;
+}
+
+/* m distinct pairs drawn uniformly into idx (m <= 6 < n). `central`: 1 when
+ * all of them are intra-camera pairs of one camera (rays from one centre:
+ * no metric scale, the minimal solvers are degenerate there). */
+static void draw_distinct(ctx *c, int m, int idx[6], int *central)
+{
+    int j, i;
+    for (j = 0; j < m; j++) {
+        int k, dup;
+        do { /* rejection of repeats: m <= 6 of n >= 6 */
+            k = rng_below(&c->rng, c->n);
+            dup = 0;
+            for (i = 0; i < j; i++)
+                dup |= idx[i] == k;
+        } while (dup);
+        idx[j] = k;
+    }
+    *central = 1;
+    for (j = 0; j < m; j++)
+        *central &= c->cam1[idx[j]] == c->cam2[idx[j]] && c->cam1[idx[j]] == c->cam1[idx[0]];
+}
+
+/* Copy the pairs idx[0..m) into the m x 3 arrays a1, b1, a2, b2. */
+static void copy_pairs(const ctx *c, const int *idx, int m, double *a1, double *b1,
+                       double *a2, double *b2)
+{
+    int j, i;
+    for (j = 0; j < m; j++)
+        for (i = 0; i < 3; i++) {
+            a1[3 * j + i] = c->o1[3 * (size_t)idx[j] + i];
+            b1[3 * j + i] = c->d1[3 * (size_t)idx[j] + i];
+            a2[3 * j + i] = c->o2[3 * (size_t)idx[j] + i];
+            b2[3 * j + i] = c->d2[3 * (size_t)idx[j] + i];
+        }
+}
+
+/* Offer the ns solutions (R: ns x 9, t: ns x 3) of a minimal solver: each
+ * re-orthonormalised (mcg_refine_motion rejects a rotation off by 1e-6)
+ * and skipped when not finite. Returns the count offered. */
+static int offer_solutions(ctx *c, const double *Rs, const double *ts, int ns, const double *w)
+{
+    int j, offered = 0;
+    for (j = 0; j < ns; j++) {
+        double R[9];
+        memcpy(R, Rs + 9 * j, sizeof R);
+        if (!all_finite(R, 9) || !all_finite(ts + 3 * j, 3) || !orthonormalise(R))
+            continue;
+        offer_motion(c, R, ts + 3 * j, w);
+        offered++;
+    }
+    return offered;
+}
+
+/* One upright sample: 4 distinct pairs of any cameras -> mcg_upright4 with
+ * the vertical of the options (Sweeney et al. 2014; Lee et al. 2014). A
+ * central sample (one camera) is redrawn up to SAMPLE_TRIES times: its yaw
+ * is determined but not |t|, which mcg_upright4 reports as degenerate. */
+static int sample_upright(ctx *c, const double *w)
+{
+    int idx[6], central = 1, tries, ns = 0;
+    double a1[12], b1[12], a2[12], b2[12];
+    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
+        draw_distinct(c, 4, idx, &central);
+    if (central)
+        return 0;
+    copy_pairs(c, idx, 4, a1, b1, a2, b2);
+    if (mcg_upright4(a1, b1, a2, b2, c->opt.g1, c->opt.g2, c->msol,
+                     c->msol + 9 * MCG_UPRIGHT4_MAX_SOLUTIONS, &ns) != MCG_OK)
+        return 0;
+    return offer_solutions(c, c->msol, c->msol + 9 * MCG_UPRIGHT4_MAX_SOLUTIONS, ns, w);
+}
+
+/* One 6-point sample: 6 distinct pairs, not all intra-camera pairs of one
+ * camera -> mcg_sixpt, the generic minimal solver (Stewenius et al. 2005).
+ * Uniform draws: with outliers spread evenly an all-inlier sample is as
+ * likely as anywhere, and a rig with few pairs per camera (where 5+1 has
+ * no 5-point camera) is covered as evenly as its pairs are. */
+static int sample_six(ctx *c, const double *w)
+{
+    int idx[6], central = 1, tries, ns = 0;
+    double a1[18], b1[18], a2[18], b2[18];
+    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
+        draw_distinct(c, 6, idx, &central);
+    if (central)
+        return 0;
+    copy_pairs(c, idx, 6, a1, b1, a2, b2);
+    if (mcg_sixpt(a1, b1, a2, b2, c->msol, c->msol + 9 * MCG_SIXPT_MAX_SOLUTIONS, &ns) !=
+        MCG_OK)
+        return 0;
+    return offer_solutions(c, c->msol, c->msol + 9 * MCG_SIXPT_MAX_SOLUTIONS, ns, w);
+}
+
+/* One sample of the options' sampler: the hypotheses offered, or -1 when
+ * the data can never give one (5+1: no camera with 5 intra-camera pairs). */
+static int draw(ctx *c, const double *w)
+{
+    if (c->opt.sampler == MCG_SAMPLER_UPRIGHT4)
+        return sample_upright(c, w);
+    if (c->opt.sampler == MCG_SAMPLER_6PT)
+        return sample_six(c, w);
+    return sample(c, w);
+}
+
 /* ------------------------------------------------------------ phases */
 
 static int check_inputs(int n, const double *o1, const double *d1, const double *o2,
@@ -773,6 +918,7 @@ static void carve(ctx *c, double *work)
         c->xwork = c->xs + 12 * m;
         c->lxwork = mcg_scale_ransac_work_size((int)m);
         c->xorder = (int *)(c->xwork + c->lxwork);
+        c->msol = c->xwork + c->lxwork + ints_as_doubles(m);
     }
 }
 
@@ -1065,6 +1211,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     c.thr2 = c.opt.threshold * c.opt.threshold;
     c.rng = (uint64_t)c.opt.seed;
     c.lo_rounds = c.opt.lo_rounds;
+    c.sample_size = c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4 : 6;
     carve(&c, work);
     group(&c);
     c.med_focal = 1.0;
@@ -1100,7 +1247,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
            (iters < k_needed || iters < c.opt.min_iterations)) {
         int before = c.have ? c.n_wide : -1, got;
         iters++;
-        got = sample(&c, wlo);
+        got = draw(&c, wlo);
         if (got < 0)
             break; /* no camera with 5 intra-camera correspondences */
         if (c.have && c.n_wide != before) {
@@ -1108,7 +1255,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
              * (at 1 threshold the tail of the noise, ~16 % of the inliers at
              * 0.5 px noise and 1 px, would count as outliers and more than
              * double the samples drawn for an all-inlier 6-sample) */
-            nw = pow((double)c.n_wide / n, 6.0);
+            nw = pow((double)c.n_wide / n, (double)c.sample_size);
             if (nw >= 1.0)
                 k_needed = 1;
             else if (nw > 0.0) {
