@@ -801,16 +801,44 @@ static void copy_pairs(const ctx *c, const int *idx, int m, double *a1, double *
         }
 }
 
-/* Offer the ns solutions (R: ns x 9, t: ns x 3) of a minimal solver: each
- * re-orthonormalised (mcg_refine_motion rejects a rotation off by 1e-6)
- * and skipped when not finite. Returns the count offered. */
-static int offer_solutions(ctx *c, const double *Rs, const double *ts, int ns, const double *w)
+/* 1 when (R, t) satisfies the constraint of one of the m sample pairs
+ * (origins a1 -> a2) trivially: the constraint reads d2 . (g x R d1) = 0
+ * with g = R a1 + t - a2 (thesis eq. 8.16 with m = o x d), which holds for
+ * any rays when g = 0 -- that pair's camera only rotated about its centre.
+ * Such a solution used fewer constraints than the sample has: e.g. the
+ * static rig (R = I, t = 0) solves every upright sample of intra-camera
+ * pairs when the vertical did not tilt (a car on flat ground) and explains
+ * every intra-camera pair, outliers too (seen on the car rig: 320 of 320
+ * "inliers" at t = 0). */
+static int trivial(const ctx *c, const double R[9], const double t[3], const double *a1,
+                   const double *a2, int m)
+{
+    const double tol = 1e-7 * (c->size + sqrt(dot3(t, t)));
+    int k, i;
+    for (k = 0; k < m; k++) {
+        double g[3];
+        mat_vec(R, a1 + 3 * k, g);
+        for (i = 0; i < 3; i++)
+            g[i] += t[i] - a2[3 * k + i];
+        if (dot3(g, g) <= tol * tol)
+            return 1;
+    }
+    return 0;
+}
+
+/* Offer the ns solutions (R: ns x 9, t: ns x 3) of a minimal solver on the
+ * m sample pairs with origins a1 -> a2: each re-orthonormalised
+ * (mcg_refine_motion rejects a rotation off by 1e-6), skipped when not
+ * finite or trivial for a pair. Returns the count offered. */
+static int offer_solutions(ctx *c, const double *Rs, const double *ts, int ns,
+                           const double *a1, const double *a2, int m, const double *w)
 {
     int j, offered = 0;
     for (j = 0; j < ns; j++) {
         double R[9];
         memcpy(R, Rs + 9 * j, sizeof R);
-        if (!all_finite(R, 9) || !all_finite(ts + 3 * j, 3) || !orthonormalise(R))
+        if (!all_finite(R, 9) || !all_finite(ts + 3 * j, 3) || !orthonormalise(R) ||
+            trivial(c, R, ts + 3 * j, a1, a2, m))
             continue;
         offer_motion(c, R, ts + 3 * j, w);
         offered++;
@@ -834,7 +862,8 @@ static int sample_upright(ctx *c, const double *w)
     if (mcg_upright4(a1, b1, a2, b2, c->opt.g1, c->opt.g2, c->msol,
                      c->msol + 9 * MCG_UPRIGHT4_MAX_SOLUTIONS, &ns) != MCG_OK)
         return 0;
-    return offer_solutions(c, c->msol, c->msol + 9 * MCG_UPRIGHT4_MAX_SOLUTIONS, ns, w);
+    return offer_solutions(c, c->msol, c->msol + 9 * MCG_UPRIGHT4_MAX_SOLUTIONS, ns, a1, a2, 4,
+                           w);
 }
 
 /* One 6-point sample: 6 distinct pairs, not all intra-camera pairs of one
@@ -854,7 +883,7 @@ static int sample_six(ctx *c, const double *w)
     if (mcg_sixpt(a1, b1, a2, b2, c->msol, c->msol + 9 * MCG_SIXPT_MAX_SOLUTIONS, &ns) !=
         MCG_OK)
         return 0;
-    return offer_solutions(c, c->msol, c->msol + 9 * MCG_SIXPT_MAX_SOLUTIONS, ns, w);
+    return offer_solutions(c, c->msol, c->msol + 9 * MCG_SIXPT_MAX_SOLUTIONS, ns, a1, a2, 6, w);
 }
 
 /* One sample of the options' sampler: the hypotheses offered, or -1 when
