@@ -1079,6 +1079,23 @@ int mcg_eigensolver(int n, const double *o1, const double *d1, const double *o2,
                     double t[3], double *lambda_min, int *has_scale, int *iterations,
                     double *work, size_t lwork);
 
+/* --------------------------------------------------------------- sixpt.c */
+
+/* Upper bound on the solutions of mcg_sixpt (Stewenius, Nister, Oskarsson,
+ * Astrom, OMNIVIS 2005: up to 64 complex solutions). */
+enum { MCG_SIXPT_MAX_SOLUTIONS = 64 };
+
+/* Minimal generalized relative pose from 6 correspondences of any cameras:
+ * rig2_from_rig1 motions (R row-major 3x3, t metres; X2 = R X1 + t)
+ * satisfying the generalized epipolar constraint of the 6 correspondences
+ * (o1,d1)<->(o2,d2) (6x3 each, rig frames at times 1 and 2, metres,
+ * directions of any non-zero length, any camera mix); R:
+ * MCG_SIXPT_MAX_SOLUTIONS x 9, t: x 3; returns MCG_OK (n_solutions may be 0),
+ * MCG_EINVAL (NULL, NaN/inf, zero directions). No malloc: fixed-size stack
+ * work (method and its guarantees: csrc/sixpt.c). */
+int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], const double d2[18],
+              double R[576], double t[192], int *n_solutions);
+
 /* MCG_CDEF_END */
 
 #if defined(__GNUC__) && __GNUC__ >= 4
