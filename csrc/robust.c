@@ -1,6 +1,7 @@
 /*
  * robust.c -- the whole robust estimate of a rig motion in one call:
- * camera-balanced 5+1 sampling (thesis ch. 7), MSAC scoring, adaptive
+ * camera-balanced 5+1 sampling (thesis ch. 7; or upright 4-point / generic
+ * 6-point samples), MSAC scoring, adaptive
  * stopping, local optimisation and the final refinement (LO-RANSAC, Chum,
  * Matas & Kittler 2003; MSAC, Torr & Zisserman 2000).
  *
@@ -33,6 +34,15 @@
  *                  correspondences within 2 thresholds (robust loss of the
  *                  threshold's scale), refitted once if that set moved, and
  *                  the inlier mask.
+ *
+ * Other samplers (opt.sampler, issue 21; "the upright and 6-point samples"
+ * below): MCG_SAMPLER_UPRIGHT4 draws 4 pairs of any cameras and solves them
+ * with the known vertical (mcg_upright4), MCG_SAMPLER_6PT draws 6 and solves
+ * them with the generic minimal solver (mcg_sixpt); each real solution with
+ * its own metric t is scored, locally optimised and finished as above, the
+ * adaptive stop uses w^4 or w^6. Solutions that satisfy a sample pair
+ * trivially (its camera only rotated about its centre, e.g. the static rig)
+ * are dropped.
  *
  * The sixth correspondence is drawn among the cross-camera ones when there
  * are at least MIN_CROSS of them (they fix the scale whatever the motion,
@@ -846,55 +856,38 @@ static int offer_solutions(ctx *c, const double *Rs, const double *ts, int ns,
     return offered;
 }
 
-/* One upright sample: 4 distinct pairs of any cameras -> mcg_upright4 with
- * the vertical of the options (Sweeney et al. 2014; Lee et al. 2014). A
- * central sample (one camera) is redrawn up to SAMPLE_TRIES times: its yaw
- * is determined but not |t|, which mcg_upright4 reports as degenerate. */
-static int sample_upright(ctx *c, const double *w)
+/* One upright or 6-point sample: m distinct pairs (4 with the vertical
+ * known -> mcg_upright4 with opt.g1, opt.g2, Sweeney et al. 2014, Lee et al.
+ * 2014; else 6 -> mcg_sixpt, the generic minimal solver, Stewenius et al.
+ * 2005), drawn uniformly: with outliers spread evenly an all-inlier sample
+ * is as likely as anywhere, and a rig with few pairs per camera (where 5+1
+ * has no 5-point camera) is covered as evenly as its pairs are. A central
+ * sample (pairs of one camera) is redrawn up to SAMPLE_TRIES times: its
+ * rotation may be determined but not |t|, the solvers find it degenerate. */
+static int sample_minimal(ctx *c, const double *w)
 {
-    int idx[6], central = 1, tries, ns = 0;
-    double a1[12], b1[12], a2[12], b2[12];
-    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
-        draw_distinct(c, 4, idx, &central);
-    if (central)
-        return 0;
-    copy_pairs(c, idx, 4, a1, b1, a2, b2);
-    if (mcg_upright4(a1, b1, a2, b2, c->opt.g1, c->opt.g2, c->msol,
-                     c->msol + 9 * MCG_UPRIGHT4_MAX_SOLUTIONS, &ns) != MCG_OK)
-        return 0;
-    return offer_solutions(c, c->msol, c->msol + 9 * MCG_UPRIGHT4_MAX_SOLUTIONS, ns, a1, a2, 4,
-                           w);
-}
-
-/* One 6-point sample: 6 distinct pairs, not all intra-camera pairs of one
- * camera -> mcg_sixpt, the generic minimal solver (Stewenius et al. 2005).
- * Uniform draws: with outliers spread evenly an all-inlier sample is as
- * likely as anywhere, and a rig with few pairs per camera (where 5+1 has
- * no 5-point camera) is covered as evenly as its pairs are. */
-static int sample_six(ctx *c, const double *w)
-{
-    int idx[6], central = 1, tries, ns = 0;
+    const int upright = c->opt.sampler == MCG_SAMPLER_UPRIGHT4, m = upright ? 4 : 6;
+    const int max_sol = upright ? MCG_UPRIGHT4_MAX_SOLUTIONS : MCG_SIXPT_MAX_SOLUTIONS;
+    int idx[6], central = 1, tries, ns = 0, st;
     double a1[18], b1[18], a2[18], b2[18];
     for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
-        draw_distinct(c, 6, idx, &central);
+        draw_distinct(c, m, idx, &central);
     if (central)
         return 0;
-    copy_pairs(c, idx, 6, a1, b1, a2, b2);
-    if (mcg_sixpt(a1, b1, a2, b2, c->msol, c->msol + 9 * MCG_SIXPT_MAX_SOLUTIONS, &ns) !=
-        MCG_OK)
+    copy_pairs(c, idx, m, a1, b1, a2, b2);
+    st = upright ? mcg_upright4(a1, b1, a2, b2, c->opt.g1, c->opt.g2, c->msol,
+                                c->msol + 9 * max_sol, &ns)
+                 : mcg_sixpt(a1, b1, a2, b2, c->msol, c->msol + 9 * max_sol, &ns);
+    if (st != MCG_OK)
         return 0;
-    return offer_solutions(c, c->msol, c->msol + 9 * MCG_SIXPT_MAX_SOLUTIONS, ns, a1, a2, 6, w);
+    return offer_solutions(c, c->msol, c->msol + 9 * max_sol, ns, a1, a2, m, w);
 }
 
 /* One sample of the options' sampler: the hypotheses offered, or -1 when
  * the data can never give one (5+1: no camera with 5 intra-camera pairs). */
 static int draw(ctx *c, const double *w)
 {
-    if (c->opt.sampler == MCG_SAMPLER_UPRIGHT4)
-        return sample_upright(c, w);
-    if (c->opt.sampler == MCG_SAMPLER_6PT)
-        return sample_six(c, w);
-    return sample(c, w);
+    return c->opt.sampler == MCG_SAMPLER_5P1 ? sample(c, w) : sample_minimal(c, w);
 }
 
 /* ------------------------------------------------------------ phases */
