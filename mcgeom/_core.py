@@ -31,6 +31,7 @@ __all__ = [
     "skyline_eig",
     "essential5", "essential_decompose",
     "upright4", "eigensolver",
+    "sixpt",
 ]
 
 GC_CASE_NAMES = {
@@ -1375,3 +1376,30 @@ def eigensolver(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
         _ray_error(st, "eigensolver", rays, (("R0", R0),))
     return {"R": R, "t": t, "lambda_min": float(lam[0]), "has_scale": bool(has[0]),
             "iterations": int(its[0])}
+
+
+# --------------------------------------------------------------- sixpt.c
+
+def sixpt(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Every motion of 6 generalized correspondences of any cameras (``mcg_sixpt``).
+
+    Rays (6, 3) each as for :func:`gec_residuals` (rig frames at times 1 and
+    2, metres; directions of any non-zero length; any mix of intra- and
+    cross-camera rays). Returns ``(Rs, ts)``: ``Rs`` (k, 3, 3) and ``ts``
+    (k, 3), the k <= 64 real motions rig2_from_rig1 (``X2 = R X1 + t``, ``t``
+    in metres) that satisfy the 6 generalized epipolar constraints (found by
+    the parameter homotopy of csrc/sixpt.c; each checked to 1e-10 on the
+    normalised rays, isolated, so its metric scale is fixed by the data).
+    k = 0 when no motion is found, e.g. all rays from one centre (a central
+    camera has no metric scale). ValueError names a bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+    if rays[0].shape[0] != 6:
+        raise ValueError(f"sixpt: exactly 6 correspondences needed, got {rays[0].shape[0]}")
+    R = np.empty((lib.MCG_SIXPT_MAX_SOLUTIONS, 3, 3))
+    t = np.empty((lib.MCG_SIXPT_MAX_SOLUTIONS, 3))
+    n = ffi.new("int *")
+    st = lib.mcg_sixpt(_p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]), _p(R), _p(t), n)
+    if st != lib.MCG_OK:
+        _ray_error(st, "sixpt", rays)
+    return R[:n[0]].copy(), t[:n[0]].copy()
