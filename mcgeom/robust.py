@@ -328,7 +328,8 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         options = RansacOptions(threshold=thr, prob=prob, max_iters=max_iters, seed=seed, **kw)
     in_c = method in C_SAMPLERS and options.strategy == "auto" and \
         (motion_focal is None or pixel_cameras is not None)
-    info_est = registry.get(method)
+    # (the C search needs no plugin: its samplers are the C solvers)
+    info_est = None if in_c else registry.get(method)
     need = C_SAMPLERS[method] if in_c else info_est.min_sample
     n = len(rays)
     if n < need:
