@@ -54,13 +54,14 @@ RIG_5P1_DIRECT = "direct:five_plus_one"
 #: upright 4-point with a known vertical inside LO-RANSAC (chosen by itself when
 #: ``gravity1``/``gravity2`` are passed with the default method)
 RIG_UPRIGHT_RANSAC = "upright_four_point"
-#: generic minimal 6-point inside LO-RANSAC (chosen by itself when no camera has
-#: the 5 intra-camera correspondences of a 5+1 sample)
-RIG_6PT_RANSAC = "six_point"
+#: generic minimal 6-point inside LO-RANSAC (the C search with mcg_sixpt; chosen by
+#: itself when no camera has the 5 intra-camera correspondences of a 5+1 sample)
+RIG_6PT_RANSAC = "ransac:six_point"
 
 
 def choose_sampler(cam1: np.ndarray, cam2: np.ndarray) -> str:
-    """The minimal solver of the default search for correspondences of
+    """The minimal solver (``"five_plus_one"`` or ``"six_point"``, the names of
+    :data:`mcgeom.robust.C_SAMPLERS`) of the default search for correspondences of
     cameras ``cam1[k]`` -> ``cam2[k]`` (integer ids): 5+1 (thesis ch. 7) when
     some camera has at least 5 intra-camera correspondences (its 5-point
     essential matrix), else the generic 6-point solver, which samples any
@@ -69,7 +70,7 @@ def choose_sampler(cam1: np.ndarray, cam2: np.ndarray) -> str:
     selects the upright 4-point solver before this is asked."""
     intra = np.asarray(cam1) == np.asarray(cam2)
     counts = np.bincount(np.asarray(cam1)[intra], minlength=1)
-    return RIG_5P1_RANSAC if counts.max(initial=0) >= 5 else RIG_6PT_RANSAC
+    return RIG_5P1_RANSAC if counts.max(initial=0) >= 5 else "six_point"
 
 
 def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) -> str:

@@ -79,6 +79,8 @@ def test_facade_takes_six_point_without_a_five_point_camera():
     assert m.method == "ransac[six_point]"
     assert _rot_deg(m.R, R) < 0.2
     assert abs(np.linalg.norm(m.info["t_metric"]) / np.linalg.norm(t) - 1.0) < 0.1
+    forced = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, method=cv.RIG_6PT_RANSAC)
+    assert forced.info["sampler"] == "six_point" and np.allclose(forced.R, m.R)
     # 5+1 cannot sample these data: forced by name it says why
     with pytest.raises(ValueError, match="5 intra-camera"):
         cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, method="ransac:five_plus_one")
