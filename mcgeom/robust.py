@@ -36,6 +36,8 @@ from .errors import DegenerateError
 # observable; the robust layer finishes any estimator's motion and must report
 # the same (see mcgeom.estimators._common: no estimator imports this module)
 from .estimators._common import camera_ids, travel_direction
+# the vertical's checks (the messages name gravity1/gravity2) of the upright solver
+from .estimators.upright_four_point import check_gravity
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
                             total_scale_std)
@@ -306,8 +308,9 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     entry point ``mcg_robust_rig_motion`` (csrc/robust.c: the method's
     minimal samples, MSAC, local optimisation, adaptive stop, final
     refinement of all six degrees of freedom); the verdict stays here;
-    ``info["sampler"]`` names the minimal solver. ``pixel_cameras = (focal, axes)``, the (M,) focal lengths
-    (pixels) and (M, 3) optical axes (rig frame) of the rig's cameras (see
+    ``info["sampler"]`` names the minimal solver. ``pixel_cameras = (focal,
+    axes)``, the (M,) focal lengths (pixels) and (M, 3) optical axes (rig
+    frame) of the rig's cameras (see
     :func:`mcgeom.pixel_noise.camera_table`), is the camera table that
     ``motion_focal`` is computed from: the C search uses it for the final
     refinement (with ``motion_focal`` but without it, the Python drivers run).
@@ -685,7 +688,6 @@ def _solver_gravity(method: str, solver_options: dict) -> dict:
     opts = dict(solver_options)
     out = {}
     if method == "upright_four_point":
-        from .estimators.upright_four_point import check_gravity
         out = {k: check_gravity(k, opts.pop(k, None)) for k in ("gravity1", "gravity2")}
     if opts:
         raise ValueError(f"solver_options {sorted(opts)} are not options of {method}'s "

@@ -1013,8 +1013,11 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * draws 4 distinct pairs uniformly (any cameras) -> mcg_upright4 with
  * opt->g1, opt->g2; MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
  * redrawn when all six are intra-camera pairs of one camera (a central
- * camera: no metric scale) -> mcg_sixpt; every real solution is scored as
- * below (adaptive stop with sample size 4 or 6), and the local optimisation
+ * camera: no metric scale) -> mcg_sixpt; every real solution that puts
+ * its sample in front of the cameras and satisfies no pair trivially (e.g.
+ * the static rig) is scored as below (adaptive stop with sample size 4 or
+ * 6; with an intra-camera pair in the sample, a new best gets the 1-point
+ * scale search of 5+1 on that camera's line), and the local optimisation
  * and final refinement are the same (all six degrees of freedom: an error
  * of the vertical does not bias the result). The default,
  * MCG_SAMPLER_5P1: camera-balanced 5+1 sampling (5 intra-camera
