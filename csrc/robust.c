@@ -1338,7 +1338,9 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                 k_needed = kk < c.opt.max_iterations ? (int)ceil(kk) : c.opt.max_iterations;
             }
         }
-        if (iters % CLOCK_EVERY == 0 && now_seconds() > deadline) {
+        /* (a 6-point sample takes ~0.1 s: the clock after each one) */
+        if ((iters % CLOCK_EVERY == 0 || c.opt.sampler == MCG_SAMPLER_6PT) &&
+            now_seconds() > deadline) {
             res->stop = MCG_ROBUST_STOP_TIME;
             break;
         }
