@@ -66,11 +66,15 @@ def choose_sampler(cam1: np.ndarray, cam2: np.ndarray) -> str:
     some camera has at least 5 intra-camera correspondences (its 5-point
     essential matrix), else the generic 6-point solver, which samples any
     cameras (rigs with many cameras and few matches each, or mostly
-    cross-camera matches). The vertical prior (``gravity1``/``gravity2``)
-    selects the upright 4-point solver before this is asked."""
+    cross-camera matches). Fewer than 6 correspondences sample neither: 5+1
+    then (its checks name what is missing, as before the choice existed).
+    The vertical prior (``gravity1``/``gravity2``) selects the upright
+    4-point solver before this is asked."""
     intra = np.asarray(cam1) == np.asarray(cam2)
     counts = np.bincount(np.asarray(cam1)[intra], minlength=1)
-    return RIG_5P1_RANSAC if counts.max(initial=0) >= 5 else "six_point"
+    if intra.size < 6 or counts.max(initial=0) >= 5:
+        return RIG_5P1_RANSAC
+    return "six_point"
 
 
 def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) -> str:

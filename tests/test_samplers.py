@@ -43,7 +43,9 @@ def test_choose_sampler_counts_intra_camera_correspondences():
     # five of camera 0, but one is cross-camera: four intra-camera only
     assert cv.choose_sampler(np.array([0, 0, 0, 0, 0, 1]), np.array([0, 0, 0, 0, 1, 1])) \
         == "six_point"
-    assert cv.choose_sampler(np.zeros(0, int), np.zeros(0, int)) == "six_point"
+    # too few for any sample: 5+1, whose checks say so
+    assert cv.choose_sampler(np.zeros(0, int), np.zeros(0, int)) == "five_plus_one"
+    assert cv.choose_sampler(np.arange(5), np.arange(5)) == "five_plus_one"
 
 
 def test_facade_reports_the_sampler_it_chose():
