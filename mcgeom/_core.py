@@ -33,6 +33,7 @@ __all__ = [
     "essential5", "essential_decompose",
     "upright4", "eigensolver",
     "static_noise", "static_check",
+    "sixpt",
 ]
 
 GC_CASE_NAMES = {
@@ -1178,7 +1179,15 @@ def essential_decompose(E: Any, d1: Any, d2: Any) -> tuple[np.ndarray, np.ndarra
     return R, t, int(nf[0])
 # ------------------------------------------------------------------ robust.c
 
-__all__ += ["robust_rig_motion", "ROBUST_STOP_NAMES"]
+__all__ += ["robust_rig_motion", "ROBUST_STOP_NAMES", "SAMPLER_NAMES"]
+
+#: the minimal solvers of :func:`robust_rig_motion` (``mcg_robust_options.sampler``),
+#: by the name of their registered estimator
+SAMPLER_NAMES = {
+    "five_plus_one": lib.MCG_SAMPLER_5P1,
+    "upright_four_point": lib.MCG_SAMPLER_UPRIGHT4,
+    "six_point": lib.MCG_SAMPLER_6PT,
+}
 
 #: why the search of :func:`robust_rig_motion` ended
 ROBUST_STOP_NAMES = {
@@ -1194,8 +1203,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                       min_iterations: int = 0, max_iterations: int = 1000,
                       max_seconds: float = 0.0, seed: int = 0, lo_rounds: int = 2,
                       refine: bool = True, loss: str = "cauchy",
-                      max_scale_rel_std: float = 0.0) -> Optional[dict]:
-    """The whole robust 5+1 estimate in C (``mcg_robust_rig_motion``).
+                      max_scale_rel_std: float = 0.0, sampler: str = "five_plus_one",
+                      gravity1: Any = None, gravity2: Any = None) -> Optional[dict]:
+    """The whole robust estimate in C (``mcg_robust_rig_motion``).
 
     Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins the
     camera centres in metres); ``cam1``, ``cam2`` (N,) camera ids in
@@ -1207,6 +1217,12 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     ``max_scale_rel_std`` > 0: when the refinement's ``scale_rel_std`` is at
     most this, the result's ``scale_profile`` is computed (the statistic of
     :func:`mcgeom.observability.scale_profile` at ``1 +- 3 max_scale_rel_std``).
+    ``sampler`` (a name of ``SAMPLER_NAMES``) picks the minimal solver of the
+    hypotheses: 5+1 (5 intra-camera pairs of one camera and a sixth),
+    ``upright_four_point`` (4 pairs of any cameras and the vertical
+    ``gravity1``/``gravity2``: 3-vectors in rig frames 1 and 2, any non-zero
+    length; required for it and refused otherwise) or ``six_point`` (6 pairs,
+    the generic minimal solver).
 
     Returns None when no motion explains 6 correspondences (degenerate data),
     else a dict: ``R`` (3, 3), ``t`` (3,) (metres, metric only if the verdict
@@ -1284,6 +1300,22 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     opt.lo_rounds = int(lo_rounds)
     opt.refine = 1 if refine else 0
     opt.loss = LOSS_NAMES[loss]
+    if not isinstance(sampler, str) or sampler not in SAMPLER_NAMES:
+        raise ValueError(f"sampler must be one of {sorted(SAMPLER_NAMES)}, got {sampler!r}")
+    opt.sampler = SAMPLER_NAMES[sampler]
+    if sampler == "upright_four_point":
+        for name, g, field in (("gravity1", gravity1, opt.g1), ("gravity2", gravity2, opt.g2)):
+            if g is None:
+                raise ValueError(f"{name} is required by the upright_four_point sampler: the "
+                                 "vertical direction in the rig frame, a 3-vector")
+            v = _arr(name, g, (3,))
+            if not float(v @ v) >= 1e-100:
+                raise ValueError(f"{name} has zero length")
+            for i in range(3):
+                field[i] = float(v[i])
+    elif gravity1 is not None or gravity2 is not None:
+        raise ValueError(f"gravity1/gravity2 are for the upright_four_point sampler, not "
+                         f"{sampler!r}")
     work = _work(lib.mcg_robust_work_size(n, int(n_cameras)))
     mask = np.empty(n, dtype=np.uint8)
     weights = np.empty(n)
@@ -1474,3 +1506,28 @@ def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
             "noise_from_default": bool(out.noise_from_default),
             "explained": float(out.explained), "n_intra": int(out.n_intra),
             "median_angle": float(out.median_angle)}
+# --------------------------------------------------------------- sixpt.c
+
+def sixpt(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Every motion of 6 generalized correspondences of any cameras (``mcg_sixpt``).
+
+    Rays (6, 3) each as for :func:`gec_residuals` (rig frames at times 1 and
+    2, metres; directions of any non-zero length; any mix of intra- and
+    cross-camera rays). Returns ``(Rs, ts)``: ``Rs`` (k, 3, 3) and ``ts``
+    (k, 3), the k <= 64 real motions rig2_from_rig1 (``X2 = R X1 + t``, ``t``
+    in metres) that satisfy the 6 generalized epipolar constraints (found by
+    the parameter homotopy of csrc/sixpt.c; each checked to 1e-10 on the
+    normalised rays, isolated, so its metric scale is fixed by the data).
+    k = 0 when no motion is found, e.g. all rays from one centre (a central
+    camera has no metric scale). ValueError names a bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+    if rays[0].shape[0] != 6:
+        raise ValueError(f"sixpt: exactly 6 correspondences needed, got {rays[0].shape[0]}")
+    R = np.empty((lib.MCG_SIXPT_MAX_SOLUTIONS, 3, 3))
+    t = np.empty((lib.MCG_SIXPT_MAX_SOLUTIONS, 3))
+    n = ffi.new("int *")
+    st = lib.mcg_sixpt(_p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]), _p(R), _p(t), n)
+    if st != lib.MCG_OK:
+        _ray_error(st, "sixpt", rays)
+    return R[:n[0]].copy(), t[:n[0]].copy()

@@ -51,11 +51,20 @@ def _cmd_methods(args: argparse.Namespace) -> int:
         print(f"    camera kinds: {', '.join(e.camera_kinds)}")
         for k, v in e.options.items():
             print(f"    option {k}: {v}")
-    print("\nThe facade (mcgeom.cv.estimate, estimateRigMotion) by default runs five_plus_one "
-          "inside LO-RANSAC (5 correspondences of one camera + 1 of another); with a vertical "
-          "prior (gravity1=, gravity2=: the gravity direction in the rig frame at each time, "
-          "e.g. from an IMU) upright_four_point (4-samples, the yaw about the vertical); any "
-          "registered name, 'ransac:NAME' or 'direct:NAME' may be passed as method.")
+    print("\nThe facade (mcgeom.cv.estimate, estimateRigMotion) chooses the minimal solver "
+          "of its LO-RANSAC from the data (info['sampler'] says which ran; all three run in "
+          "the C entry point mcg_robust_rig_motion):\n"
+          "    upright_four_point  when a vertical prior is passed (gravity1=, gravity2=: the "
+          "gravity direction in the rig frame at each time, e.g. from an IMU): 4-samples of "
+          "any cameras, the yaw about the vertical (Sweeney et al. 2014, Lee et al. 2014)\n"
+          "    five_plus_one       else, when some camera has >= 5 intra-camera "
+          "correspondences: 5 of one camera + 1 of another (thesis ch. 7)\n"
+          "    six_point           else: 6-samples of any cameras, the generic minimal "
+          "solver (Stewenius et al. 2005), for rigs with many cameras and few or mostly "
+          "cross-camera matches each\n"
+          "Any registered name, 'ransac:NAME' or 'direct:NAME' may be passed as method "
+          "instead ('ransac:five_plus_one' forces 5+1; 'ransac:linear17' is 17-point "
+          "RANSAC).")
     # the LP backends of bnb_lp: the available ones, and why GLPK is not (with
     # the command that brings it) when it is not
     print(f"\nLP backends (bnb_lp, default {registry.default_lp_backend()}):")

@@ -39,10 +39,11 @@ from .validation import integral_camera_ids
 
 __all__ = [
     "RIG_5P1_RANSAC", "RIG_LINEAR17", "RIG_LINEAR17_RANSAC", "RIG_5P1_DIRECT",
-    "RIG_UPRIGHT_RANSAC", "estimateRigMotion", "estimate",
+    "RIG_UPRIGHT_RANSAC", "RIG_6PT_RANSAC", "estimateRigMotion", "estimate", "choose_sampler",
 ]
 
-#: 5+1 method (thesis ch. 7) inside LO-RANSAC: the default
+#: 5+1 method (thesis ch. 7) inside LO-RANSAC: the default (the generic 6-point
+#: when no camera has 5 intra-camera correspondences, see :func:`choose_sampler`)
 RIG_5P1_RANSAC = "five_plus_one"
 #: linear 17-point generalized essential matrix (thesis ch. 8) on all correspondences
 RIG_LINEAR17 = "linear17"
@@ -53,6 +54,27 @@ RIG_5P1_DIRECT = "direct:five_plus_one"
 #: upright 4-point with a known vertical inside LO-RANSAC (chosen by itself when
 #: ``gravity1``/``gravity2`` are passed with the default method)
 RIG_UPRIGHT_RANSAC = "upright_four_point"
+#: generic minimal 6-point inside LO-RANSAC (the C search with mcg_sixpt; chosen by
+#: itself when no camera has the 5 intra-camera correspondences of a 5+1 sample)
+RIG_6PT_RANSAC = "ransac:six_point"
+
+
+def choose_sampler(cam1: np.ndarray, cam2: np.ndarray) -> str:
+    """The minimal solver (``"five_plus_one"`` or ``"six_point"``, the names of
+    :data:`mcgeom.robust.C_SAMPLERS`) of the default search for correspondences of
+    cameras ``cam1[k]`` -> ``cam2[k]`` (integer ids): 5+1 (thesis ch. 7) when
+    some camera has at least 5 intra-camera correspondences (its 5-point
+    essential matrix), else the generic 6-point solver, which samples any
+    cameras (rigs with many cameras and few matches each, or mostly
+    cross-camera matches). Fewer than 6 correspondences sample neither: 5+1
+    then (its checks name what is missing, as before the choice existed).
+    The vertical prior (``gravity1``/``gravity2``) selects the upright
+    4-point solver before this is asked."""
+    intra = np.asarray(cam1) == np.asarray(cam2)
+    counts = np.bincount(np.asarray(cam1)[intra], minlength=1)
+    if intra.size < 6 or counts.max(initial=0) >= 5:
+        return RIG_5P1_RANSAC
+    return "six_point"
 
 
 def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) -> str:
@@ -173,7 +195,10 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     ``gravity1``/``gravity2`` (3-vectors, e.g. an IMU's gravity in the rig frame
     at time 1 and at time 2) are a vertical prior: with the default method the
     search then runs the upright 4-point solver (``RIG_UPRIGHT_RANSAC``); the
-    final refinement frees all six degrees of freedom.
+    final refinement frees all six degrees of freedom. Without it the default
+    method runs 5+1 when some camera has 5 intra-camera correspondences, else
+    the generic 6-point solver (:func:`choose_sampler`; ``'ransac:five_plus_one'``
+    forces 5+1). ``info["sampler"]`` names the minimal solver the search used.
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
@@ -205,6 +230,8 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     # without a mask every correspondence is used: no copy of the rays
     keep = None if use.all() else np.flatnonzero(use)
     rays = rays_all if keep is None else rays_all.take(keep)
+    if run_robust and method == RIG_5P1_RANSAC:
+        name = choose_sampler(ids1[use], ids2[use])
     if run_robust:
         # thresholds in pixels: the pixel-noise model of the rig converts them
         # the vertical prior is for the minimal solver (the final refinement is free)
@@ -214,6 +241,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
                            motion_focal=sampson_pixel_scale(rig), calibration_std=cal,
                            pixel_cameras=camera_table(rig), solver_options=prior or None,
                            **options)
+        m.info.setdefault("sampler", name)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()
         else:

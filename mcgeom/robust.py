@@ -37,13 +37,22 @@ from .errors import DegenerateError
 # the same (see mcgeom.estimators._common: no estimator imports this module)
 from .estimators._common import camera_ids, travel_direction
 from .estimators.five_plus_one import minimal_answer
+# the vertical's checks (the messages name gravity1/gravity2) of the upright solver
+from .estimators.upright_four_point import check_gravity
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
                             total_scale_std)
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 from .validation import check_seed
 
-__all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras"]
+__all__ = ["RansacOptions", "ransac", "residuals", "adaptive_iterations", "sample_across_cameras",
+           "C_SAMPLERS"]
+
+#: the estimators whose minimal solver the C entry point samples
+#: (``mcg_robust_options.sampler``), with their sample sizes: 5 intra-camera
+#: correspondences of one camera and a sixth; 4 of any cameras with the
+#: vertical known; 6 not all of one camera
+C_SAMPLERS = {"five_plus_one": 6, "upright_four_point": 4, "six_point": 6}
 
 
 
@@ -61,9 +70,10 @@ class RansacOptions:
     refine: bool = True
     loss: str = "cauchy"            # final refinement (scale: the threshold)
     max_scale_rel_std: float = 0.1
-    # "auto": the C entry point (csrc/robust.c) for five_plus_one, else the
-    # estimator's proposer, else its minimal solver; "proposer" and "minimal"
-    # force the Python drivers below
+    # "auto": the C entry point (csrc/robust.c) for the estimators whose
+    # minimal solver it samples (C_SAMPLERS: five_plus_one,
+    # upright_four_point, six_point), else the estimator's proposer, else its
+    # minimal solver; "proposer" and "minimal" force the Python drivers below
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
     max_seconds: float = 0.0        # wall-time budget of the C search (0: none)
 
@@ -293,11 +303,15 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     minimal solver (e.g. ``gravity1``/``gravity2`` of ``upright_four_point``).
     Further ``RansacOptions`` fields may be passed as keywords.
 
-    ``five_plus_one`` with ``strategy="auto"`` runs as one call of the C
-    entry point ``mcg_robust_rig_motion`` (csrc/robust.c: 5+1 sampling,
-    MSAC, local optimisation, adaptive stop, final refinement); the verdict
-    stays here. ``pixel_cameras = (focal, axes)``, the (M,) focal lengths
-    (pixels) and (M, 3) optical axes (rig frame) of the rig's cameras (see
+    The methods of :data:`C_SAMPLERS` (``five_plus_one``,
+    ``upright_four_point`` with ``solver_options={"gravity1": g1, "gravity2":
+    g2}``, ``six_point``) with ``strategy="auto"`` run as one call of the C
+    entry point ``mcg_robust_rig_motion`` (csrc/robust.c: the method's
+    minimal samples, MSAC, local optimisation, adaptive stop, final
+    refinement of all six degrees of freedom); the verdict stays here;
+    ``info["sampler"]`` names the minimal solver. ``pixel_cameras = (focal,
+    axes)``, the (M,) focal lengths (pixels) and (M, 3) optical axes (rig
+    frame) of the rig's cameras (see
     :func:`mcgeom.pixel_noise.camera_table`), is the camera table that
     ``motion_focal`` is computed from: the C search uses it for the final
     refinement (with ``motion_focal`` but without it, the Python drivers run).
@@ -316,13 +330,16 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     if options is None:
         thr = threshold if threshold is not None else (1.0 if focal is not None else 1e-3)
         options = RansacOptions(threshold=thr, prob=prob, max_iters=max_iters, seed=seed, **kw)
-    info_est = registry.get(method)
+    in_c = method in C_SAMPLERS and options.strategy == "auto" and \
+        (motion_focal is None or pixel_cameras is not None)
+    # (the C search needs no plugin: its samplers are the C solvers)
+    info_est = None if in_c else registry.get(method)
+    need = C_SAMPLERS[method] if in_c else info_est.min_sample
     n = len(rays)
-    if n < info_est.min_sample:
-        raise ValueError(f"too few correspondences: {method} needs at least "
-                         f"{info_est.min_sample}, got {n}")
+    if n < need:
+        raise ValueError(f"too few correspondences: {method} needs at least {need}, got {n}")
     rays.check_finite()
-    registry.check_distinct(rays, info_est.min_sample, method)
+    registry.check_distinct(rays, need, method)
     f = _focal_array(focal, n)
     if motion_focal is not None and f is None:
         raise ValueError("motion_focal needs focal (thresholds in pixels)")
@@ -333,9 +350,9 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         m = minimal_answer(rays, f"ransac[{method}]", thr, with_inliers=True)
         if m is not None:
             return m
-    if method == "five_plus_one" and options.strategy == "auto" and \
-            (motion_focal is None or pixel_cameras is not None):
-        return _ransac_c(rays, f, options, pixel_cameras, t_start, calibration_std)
+    if in_c:
+        return _ransac_c(rays, f, options, pixel_cameras, t_start, calibration_std, method,
+                         solver_options or {})
     rng = np.random.default_rng(options.seed)
     scorer = _Scorer(rays, options.threshold, f, options, motion_focal)
     _check_threshold_angle(options.threshold, scorer.loss_scale, f)
@@ -711,13 +728,61 @@ def _camera_count(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, int]:
     return cam1, cam2, m
 
 
+def _sampler_ids(rays: RayPairs, method: str, tabled: bool
+                 ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Camera ids and count for the C search of ``method``.
+
+    5+1 needs the cameras (origins at their centres). The upright and
+    6-point samplers only use the ids to redraw samples from one centre (a
+    central camera, no metric scale): rays whose origins are not camera
+    centres (a generalized camera with a ray-dependent origin) are grouped
+    by origin, folded into the C limit of 4096 ids (a fold may only make a
+    degenerate sample reach the solver, which then finds nothing). With a
+    camera table (``tabled``) the ids index it and must be the rig's.
+    """
+    try:
+        cam1, cam2, centres = camera_ids(rays)
+        if tabled or method == "five_plus_one" or len(centres) <= _MAX_CAMERAS:
+            return cam1, cam2, len(centres)
+    except ValueError:
+        if tabled or method == "five_plus_one":
+            raise
+    allo = np.concatenate([rays.origins1, rays.origins2])
+    _, inv = np.unique(allo, axis=0, return_inverse=True)
+    inv = inv.ravel() % _MAX_CAMERAS
+    n = len(rays)
+    return inv[:n], inv[n:], int(inv.max()) + 1
+
+
+#: camera ids the C entry point accepts (csrc/robust.c MAX_CAMERAS)
+_MAX_CAMERAS = 4096
+
+
+def _solver_gravity(method: str, solver_options: dict) -> dict:
+    """The C search's keywords from ``solver_options``: the vertical of
+    ``upright_four_point`` (checked, named), nothing for the others; an
+    option the sampler does not take is a ValueError naming it."""
+    opts = dict(solver_options)
+    out = {}
+    if method == "upright_four_point":
+        out = {k: check_gravity(k, opts.pop(k, None)) for k in ("gravity1", "gravity2")}
+    if opts:
+        raise ValueError(f"solver_options {sorted(opts)} are not options of {method}'s "
+                         f"minimal solver")
+    return out
+
+
 def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions,
               pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
-              t_start: float, calibration_std: Any = None) -> RigMotion:
-    """five_plus_one: the search and the final refinement in one C call
-    (``_core.robust_rig_motion``, csrc/robust.c), the verdict here."""
-    method = "five_plus_one"
-    cam1, cam2, n_cameras = _camera_count(rays)
+              t_start: float, calibration_std: Any = None, method: str = "five_plus_one",
+              solver_options: Optional[dict] = None) -> RigMotion:
+    """The methods of :data:`C_SAMPLERS`: the search and the final refinement
+    in one C call (``_core.robust_rig_motion``, csrc/robust.c), the verdict here."""
+    gravity = _solver_gravity(method, solver_options or {})
+    if method == "five_plus_one":
+        cam1, cam2, n_cameras = _camera_count(rays)
+    else:
+        cam1, cam2, n_cameras = _sampler_ids(rays, method, pixel_cameras is not None)
     cam_focal = cam_axes = None
     if pixel_cameras is not None:
         cam_focal, cam_axes = pixel_cameras
@@ -728,7 +793,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
                              f"use camera ids up to {n_cameras - 1}")
         n_cameras = len(cam_focal)
     intra = cam1 == cam2
-    if not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
+    if method == "five_plus_one" and not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
         raise ValueError(f"too few correspondences: {method} needs 5 intra-camera "
                          f"correspondences in one camera ({_per_camera(rays)})")
     # the loss scale (radians) as _Scorer computes it; the scorer itself (its
@@ -746,7 +811,8 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             prob=options.prob, min_iterations=min(options.min_iters, options.max_iters),
             max_iterations=int(options.max_iters), max_seconds=options.max_seconds,
             seed=seed, lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
-            refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std)
+            refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
+            sampler=method, **gravity)
 
     out = search(options.threshold, options.refine)
     if out is not None and len(rays) > 6 and np.count_nonzero(out["inliers"]) <= 6:
@@ -772,6 +838,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     info = {k: out[k] for k in ("iterations", "hypotheses", "local_optimizations", "score",
                                 "stop")}
     info["c_seconds"] = out["seconds"]
+    info["sampler"] = method
     fit = None
     if out["refinement"] is not None:
         used = out["used"]

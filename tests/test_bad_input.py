@@ -494,6 +494,8 @@ def test_one_correspondence_repeated():
 
 
 @row("too-few-per-camera", "4 correspondences in each of the 4 cameras, none across cameras",
+     "the façade's default: the generic 6-point sampler instead of 5+1 (`info['sampler']`), "
+     "the motion; `five_plus_one` (direct, or forced by `'ransac:five_plus_one'`): "
      "`ValueError`: too few correspondences: five_plus_one needs 5 intra-camera correspondences "
      "in one camera, most found: 4 (robust: 'no camera has 5 intra-camera correspondences'); "
      "`linear17`, `refine`, `bnb_lp`, `e_socp`: a motion, or `DegenerateError` when 16 rays do "
@@ -501,7 +503,9 @@ def test_one_correspondence_repeated():
 def test_too_few_per_camera():
     p1, p2, c1, c2, rig = pixels()
     sel = np.concatenate([np.flatnonzero((c1 == k) & (c2 == k))[:4] for k in range(4)])
-    for m in (cv.RIG_5P1_RANSAC, cv.RIG_5P1_DIRECT):
+    m = cv.estimate(p1[sel], p2[sel], c1[sel], c2[sel], rig)
+    assert m.info["sampler"] == "six_point" and rot_err(m.R, MOTION[0]) < R_TOL
+    for m in ("ransac:five_plus_one", cv.RIG_5P1_DIRECT):
         with raises(ValueError, "5 intra-camera correspondences"):
             cv.estimate(p1[sel], p2[sel], c1[sel], c2[sel], rig, method=m)
     with raises(ValueError, "five_plus_one needs 5 intra-camera correspondences in one camera, "
@@ -643,7 +647,8 @@ def test_rotation_near_pi():
 
 @row("cross-camera-only-near-pi", "ring rig turned by pi - 1e-3 rad: every correspondence "
      "between opposite cameras, none within a camera",
-     "`five_plus_one`, `e_socp`, pixels: `ValueError` (... needs 5 intra-camera correspondences "
+     "pixels, the façade's default: the 6-point sampler, R right, scale unobservable; "
+     "`five_plus_one`, `e_socp`: `ValueError` (... needs 5 intra-camera correspondences "
      "...); `linear17`, `refine`: `DegenerateError` (degenerate data ...); `bnb_lp`: R right "
      "(its global search starts from a rotation of the cube when the identity is too far), "
      "scale unobservable (the rotated rig nearly maps its cameras onto each other)")
@@ -651,8 +656,11 @@ def test_cross_camera_only_near_pi():
     R = synth.rotation_about([0, 0, 1], np.pi - 1e-3)
     p = synth.make_problem(ring(), R, MOTION[1], 60, rng=2, depth_range=(1.0, 8.0),
                            pixel_noise=0.3, cross_fraction=1.0)
+    m = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    assert m.info["sampler"] == "six_point" and rot_err(m.R, R) < R_TOL
+    assert not m.scale.observable, m.scale.reason
     with raises(ValueError, "5 intra-camera correspondences"):
-        cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+        cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig, method="ransac:five_plus_one")
     for name in ("five_plus_one", "e_socp"):
         with raises(ValueError, "needs 5 intra-camera correspondences"):
             mcgeom.estimate(p.rays, name)

@@ -3,6 +3,7 @@ on every noise-free generic configuration and none on the critical one."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from mcgeom.experiments import peer_solvers
@@ -17,3 +18,34 @@ def test_minimal_part_small():
     assert res["no yaw, intra (critical)"]["mcgeom upright4"][0] == 0.0
     table = peer_solvers.minimal_table(res)
     assert "poselib upright_4pt" in table and "100.00%" in table
+
+
+def test_ransac_part_small():
+    """One problem of ring4: every row present but the 6-point one (run only
+    where the façade chooses it); the façade reports its sampler and the 5+1
+    row reuses its run."""
+    pytest.importorskip("poselib")
+    res = peer_solvers.run_ransac(1, 0, {"ring4 4x50 0.5px":
+                                         peer_solvers.RANSAC_CASES["ring4 4x50 0.5px"]})
+    ring4 = res["ring4 4x50 0.5px"]
+    assert ring4["mcgeom façade (auto)"][2] == ["five_plus_one"]
+    assert "mcgeom 6-pt" not in ring4
+    assert ring4["mcgeom 5+1"][0][0, 0] == ring4["mcgeom façade (auto)"][0][0, 0] < 0.1
+    assert ring4["mcgeom upright (0.2 deg)"][0][0, 0] < 0.2
+    table = peer_solvers.ransac_table(res)
+    assert ring4["mcgeom upright (0.2 deg)"][3][0] > 0 and np.isnan(ring4["poselib defaults"][3][0])
+    assert "vs 17-pt" in table and "C vs 5+1" in table and "upright_four_point" in table
+
+
+def test_poselib_refuses_data_it_cannot_sample():
+    """The 12-camera rig with 8 correspondences per camera: no camera pair has
+    the 5 matches of PoseLib's 5+1 sample, where it would loop forever."""
+    pytest.importorskip("poselib")
+    from mcgeom import synth
+    from mcgeom.experiments.poselib_peer import poselib_motion
+    rng = np.random.default_rng(0)
+    rig = peer_solvers.rig12()
+    p = synth.make_problem(rig, synth.rotation_about([0, 0, 1], 0.2), np.array([0.5, 0, 0]),
+                           96, rng, cross_fraction=0.5, require_visible=False)
+    with pytest.raises(ValueError, match="no camera pair has 5 matches"):
+        poselib_motion(rig, p)

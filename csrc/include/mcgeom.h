@@ -955,7 +955,24 @@ typedef struct {
                             the scale profile at 1/k and k times the
                             centroid's travel, k = 1 + 3 max_scale_rel_std
                             (0 = never), [0, 10] [0] */
+    /* issue 21 (ABI: appended fields; the struct grew by 7 values -- fill
+     * it with mcg_robust_default_options and rebuild callers): */
+    int sampler;         /* MCG_SAMPLER_* minimal solver of the search
+                            [MCG_SAMPLER_5P1] */
+    double g1[3], g2[3]; /* MCG_SAMPLER_UPRIGHT4 only: the vertical (gravity)
+                            direction in rig frame 1 and rig frame 2 (any
+                            non-zero length, finite; R g1 = g2) [0, 0, 0] */
 } mcg_robust_options;
+
+/* mcg_robust_options.sampler: how hypotheses are drawn */
+enum {
+    MCG_SAMPLER_5P1 = 0,      /* 5 intra-camera pairs of one camera (mcg_essential5)
+                                 + a sixth for the metric scale (thesis ch. 7) */
+    MCG_SAMPLER_UPRIGHT4 = 1, /* 4 pairs of any cameras with the vertical known
+                                 (mcg_upright4; opt.g1, opt.g2) */
+    MCG_SAMPLER_6PT = 2       /* 6 pairs not all of one camera, the generic
+                                 minimal solver (mcg_sixpt) */
+};
 
 /* mcg_robust_result.stop: why the search ended */
 enum {
@@ -974,7 +991,7 @@ typedef struct {
     double score;           /* MSAC score of that hypothesis (threshold^2) */
     int n_inliers;          /* |r| < threshold at (R, t) (mask bit 0) */
     int n_used;             /* pairs of the final refinement (mask bit 1) */
-    int iterations;         /* 5+1 samples drawn */
+    int iterations;         /* samples drawn */
     int hypotheses;         /* motions scored */
     int local_optimizations;/* LO refinements run */
     int stop;               /* MCG_ROBUST_STOP_* */
@@ -992,12 +1009,23 @@ typedef struct {
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_robust_default_options(mcg_robust_options *opt);
 
-/* Doubles of workspace for mcg_robust_rig_motion: about 16.5 n (0 for n
- * outside [6, 2^26] or n_cameras outside [1, 4096]). */
+/* Doubles of workspace for mcg_robust_rig_motion: about 16.5 n + 800 (0
+ * for n outside [6, 2^26] or n_cameras outside [1, 4096]). */
 size_t mcg_robust_work_size(int n, int n_cameras);
 
 /* Robust rig motion rig2_from_rig1 from n ray correspondences with
- * outliers, in one call: camera-balanced 5+1 sampling (5 intra-camera
+ * outliers, in one call. Hypotheses by opt->sampler: MCG_SAMPLER_UPRIGHT4
+ * draws 4 distinct pairs uniformly (any cameras) -> mcg_upright4 with
+ * opt->g1, opt->g2; MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
+ * redrawn when all six are intra-camera pairs of one camera (a central
+ * camera: no metric scale) -> mcg_sixpt; every real solution that puts
+ * its sample in front of the cameras and satisfies no pair trivially (e.g.
+ * the static rig) is scored as below (adaptive stop with sample size 4 or
+ * 6; with an intra-camera pair in the sample, a new best gets the 1-point
+ * scale search of 5+1 on that camera's line), and the local optimisation
+ * and final refinement are the same (all six degrees of freedom: an error
+ * of the vertical does not bias the result). The default,
+ * MCG_SAMPLER_5P1: camera-balanced 5+1 sampling (5 intra-camera
  * correspondences of one camera -> mcg_essential5 -> rotation and
  * translation direction by cheirality; the metric scale from a sixth
  * correspondence of another camera pair by thesis eq. 7.4, kept only in
@@ -1020,7 +1048,8 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * explains 6 correspondences (res has the counts; e.g. no camera with 5
  * intra-camera correspondences, a static rig, degenerate scenes),
  * MCG_EINVAL (NULL, sizes, camera ids out of range, NaN/inf, zero
- * directions, focal <= 0, bad options), MCG_ENOMEM (lwork below
+ * directions, focal <= 0, bad options: an unknown sampler, a zero-length or
+ * non-finite g1/g2 with MCG_SAMPLER_UPRIGHT4), MCG_ENOMEM (lwork below
  * mcg_robust_work_size). Budgets: opt->max_iterations samples and
  * opt->max_seconds for the search; each refinement is capped by
  * mcg_refine_motion's defaults (a local optimisation by 8 steps). Cost
@@ -1175,6 +1204,22 @@ int mcg_static_check(int n, const double *o1, const double *d1, const double *o2
                      const double *d2, const int *group, const double *R_est,
                      const double *R_given, double noise_level, const mcg_static_options *opt,
                      mcg_static_result *out, double *work, size_t lwork);
+/* --------------------------------------------------------------- sixpt.c */
+
+/* Upper bound on the solutions of mcg_sixpt (Stewenius, Nister, Oskarsson,
+ * Astrom, OMNIVIS 2005: up to 64 complex solutions). */
+enum { MCG_SIXPT_MAX_SOLUTIONS = 64 };
+
+/* Minimal generalized relative pose from 6 correspondences of any cameras:
+ * rig2_from_rig1 motions (R row-major 3x3, t metres; X2 = R X1 + t)
+ * satisfying the generalized epipolar constraint of the 6 correspondences
+ * (o1,d1)<->(o2,d2) (6x3 each, rig frames at times 1 and 2, metres,
+ * directions of any non-zero length, any camera mix); R:
+ * MCG_SIXPT_MAX_SOLUTIONS x 9, t: x 3; returns MCG_OK (n_solutions may be 0),
+ * MCG_EINVAL (NULL, NaN/inf, zero directions). No malloc: fixed-size stack
+ * work (method and its guarantees: csrc/sixpt.c). */
+int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], const double d2[18],
+              double R[576], double t[192], int *n_solutions);
 
 /* MCG_CDEF_END */
 

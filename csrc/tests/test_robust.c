@@ -15,7 +15,12 @@
  * polished on all pairs, the scale profile on a subset: issue 19) the
  * motion agrees with an independent full refinement (mcg_refine_motion on
  * all the pairs the result says it used, from the true motion) within a
- * fraction of its noise. Exit status 0 iff every check passes.
+ * fraction of its noise. The other samplers (issue
+ * 21): the upright 4-point one with the true vertical on the outlier scene
+ * (same checks, and fewer samples than 5+1: 4-samples), and with a vertical
+ * 0.2 deg off (the free final refinement absorbs it); the 6-point one on the
+ * outlier scene and on a rig where no camera has 5 intra-camera pairs (5+1
+ * fails there); their option checks. Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
@@ -38,6 +43,9 @@ static unsigned char mask[NMAX];
 static double wts[NMAX], res_chk[NMAX];
 static double *work;
 static size_t lwork;
+/* scene() options of the upright checks: a rotation about the z axis only
+ * (the vertical did not tilt), and intra-camera pairs only */
+static int yaw_only, intra_only;
 
 static void rot_err(const double A[9], const double B[9], double *deg)
 {
@@ -81,12 +89,12 @@ static void scene(int n, int n_out, double sigma, double R[9], double t[3])
             c[k][i] = 0.5 * ax[k][i];
     }
     for (i = 0; i < 3; i++)
-        aa[i] = 0.09 * nrand();
+        aa[i] = yaw_only && i < 2 ? 0.0 : 0.09 * nrand();
     mcg_rot_from_angle_axis(aa, R);
     for (i = 0; i < 3; i++)
         t[i] = 0.6 * nrand();
     for (k = 0; k < n; k++) {
-        int g = k % NCAM, h = k % 5 == 4 ? (g + 1) % NCAM : g;
+        int g = k % NCAM, h = k % 5 == 4 && !intra_only ? (g + 1) % NCAM : g;
         double X[3], X2[3], depth = 3.0 + 12.0 * urand();
         for (i = 0; i < 3; i++)
             X[i] = c[g][i] + depth * (ax[g][i] + 0.6 * (urand() - 0.5)) +
@@ -298,6 +306,150 @@ static void minimal_case(void)
     check(solved >= trials * 9 / 10, "minimal: the true motion (of trials)", solved, trials);
 }
 
+/* The motion (R, t) of a robust estimate with opt on the scene's first n
+ * pairs: rotation error (deg) and relative t error; the mask checked
+ * against residuals recomputed here (bit 0 == |r| < threshold) and the
+ * outliers of the scene counted as caught. Returns the status. */
+static int run_checked(int n, const mcg_robust_options *opt, const double R[9],
+                       const double t[3], mcg_robust_result *res, double *rerr, double *terr,
+                       int *agree, int *caught)
+{
+    int k, st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL,
+                                      opt, res, mask, wts, work, lwork);
+    *rerr = *terr = INFINITY;
+    *agree = *caught = 0;
+    if (st != MCG_OK)
+        return st;
+    rot_err(res->R, R, rerr);
+    *terr = rel_err3(res->t, t);
+    mcg_gec_residuals(n, o1, d1, o2, d2, res->R, res->t, res_chk);
+    *agree = 1;
+    for (k = 0; k < n; k++) {
+        *agree &= ((mask[k] & 1) != 0) == (fabs(res_chk[k]) < opt->threshold);
+        *caught += is_out[k] && !(mask[k] & 1);
+    }
+    return st;
+}
+
+/* The checks of a run on the 300-pair outlier scene (90 outliers). */
+static void check_outlier_run(const char *what, int st, const mcg_robust_result *res,
+                              double rerr, double terr, int agree, int caught)
+{
+    char label[96];
+    snprintf(label, sizeof label, "%s: status", what);
+    check_status(st, MCG_OK, label);
+    snprintf(label, sizeof label, "%s, 30 %% outliers: rotation error (deg)", what);
+    check(rerr < 0.2, label, rerr, 0.2);
+    snprintf(label, sizeof label, "%s: metric translation, relative error", what);
+    check(terr < 0.05, label, terr, 0.05);
+    snprintf(label, sizeof label, "%s: R orthonormal, det +1", what);
+    check(st == MCG_OK && orthonormal(res->R), label, 0.0, 1e-9);
+    snprintf(label, sizeof label, "%s: mask bit 0 == (|r| < threshold)", what);
+    check(agree, label, 0.0, 0.0);
+    snprintf(label, sizeof label, "%s: outliers flagged (count of 90)", what);
+    check(caught >= 86, label, caught, 86);
+}
+
+/* The vertical g in frame 1 turned by `deg` about an axis orthogonal to it
+ * (the error of an IMU). */
+static void tilt(const double g[3], double deg, double out[3])
+{
+    double a[3] = {g[1] - g[2], g[2] - g[0], g[0] - g[1]}, s = 0.0, aa[3], Q[9];
+    int i;
+    for (i = 0; i < 3; i++)
+        s += a[i] * a[i];
+    for (i = 0; i < 3; i++)
+        aa[i] = a[i] / sqrt(s) * deg / 57.29577951308232;
+    mcg_rot_from_angle_axis(aa, Q);
+    for (i = 0; i < 3; i++)
+        out[i] = Q[3 * i] * g[0] + Q[3 * i + 1] * g[1] + Q[3 * i + 2] * g[2];
+}
+
+static void upright_case(void)
+{
+    const int n = 300, n_out = 90;
+    double R[9], t[3], rerr, terr, g[3] = {0.1, -0.2, 1.0};
+    mcg_robust_options opt;
+    mcg_robust_result res, r5;
+    int st, agree, caught, i;
+    scene(n, n_out, 1e-3, R, t);
+    mcg_robust_default_options(&opt);
+    opt.threshold = 3e-3;
+    opt.seed = 11;
+    st = run_checked(n, &opt, R, t, &r5, &rerr, &terr, &agree, &caught);
+    check_status(st, MCG_OK, "5+1 reference run: status");
+    opt.sampler = MCG_SAMPLER_UPRIGHT4;
+    for (i = 0; i < 3; i++) {
+        opt.g1[i] = 9.81 * g[i]; /* any length */
+        opt.g2[i] = R[3 * i] * g[0] + R[3 * i + 1] * g[1] + R[3 * i + 2] * g[2];
+    }
+    st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
+    check_outlier_run("upright", st, &res, rerr, terr, agree, caught);
+    check(res.iterations < r5.iterations, "upright: fewer samples than 5+1 (4-samples)",
+          res.iterations, r5.iterations);
+    /* the vertical 0.2 deg off at time 2: the samples' yaw is slightly
+     * wrong, the final refinement (all six degrees of freedom) is not */
+    tilt(opt.g2, 0.2, opt.g2);
+    st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
+    check_status(st, MCG_OK, "upright, vertical 0.2 deg off: status");
+    check(rerr < 0.2, "upright, vertical 0.2 deg off: rotation error (deg)", rerr, 0.2);
+    check(terr < 0.05, "upright, vertical 0.2 deg off: relative t error", terr, 0.05);
+    /* a yaw only (g1 = g2) and intra-camera pairs only: the static rig
+     * (R = I, t = 0) solves every sample exactly and zeroes every residual,
+     * outliers' too; it must not be taken */
+    yaw_only = intra_only = 1;
+    scene(n, n_out, 1e-3, R, t);
+    yaw_only = intra_only = 0;
+    for (i = 0; i < 3; i++)
+        opt.g1[i] = opt.g2[i] = i == 2;
+    st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
+    check_status(st, MCG_OK, "upright, yaw only, intra-camera pairs: status");
+    check(rerr < 0.2, "upright, yaw only: rotation error (deg), not the static rig", rerr, 0.2);
+    /* (intra-camera pairs only: |t| is fixed by the rotation alone, weakly,
+     * and the 1-point scale search on the other cameras' pairs sets it) */
+    check(terr < 0.2, "upright, yaw only: relative t error", terr, 0.2);
+    check(caught >= n_out * 95 / 100, "upright, yaw only: outliers flagged (count of 90)",
+          caught, 86);
+}
+
+static void six_point_case(void)
+{
+    const int n = 300, n_out = 90;
+    double R[9], t[3], rerr, terr;
+    mcg_robust_options opt;
+    mcg_robust_result res;
+    int st, agree, caught, k, c4[NCAM] = {0};
+    scene(n, n_out, 1e-3, R, t);
+    mcg_robust_default_options(&opt);
+    opt.threshold = 3e-3;
+    opt.seed = 5;
+    opt.sampler = MCG_SAMPLER_6PT;
+    /* mcg_sixpt takes ~0.1 s per sample (a homotopy of 64 paths): 40
+     * samples (an all-inlier one among them with probability 0.993 at 30 %
+     * outliers; the seed is fixed) keep this under valgrind bearable */
+    opt.max_iterations = 40;
+    st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
+    check_outlier_run("6-point", st, &res, rerr, terr, agree, caught);
+    /* 20 pairs, 4 intra-camera ones per camera and 4 cross-camera, 2
+     * outliers: no 5-point camera, the 6-point sampler still finds it */
+    scene(20, 2, 1e-4, R, t);
+    for (k = 0; k < 20; k++)
+        c4[cam1[k]] += cam1[k] == cam2[k];
+    check(c4[0] == 4 && c4[1] == 4 && c4[2] == 4 && c4[3] == 4,
+          "few pairs: 4 intra-camera pairs per camera", c4[0], 4);
+    opt.threshold = 1e-3;
+    opt.sampler = MCG_SAMPLER_5P1;
+    st = mcg_robust_rig_motion(20, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EDEGENERATE, "few pairs: 5+1 has no 5-point camera");
+    opt.sampler = MCG_SAMPLER_6PT;
+    st = run_checked(20, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
+    check_status(st, MCG_OK, "few pairs: 6-point status");
+    check(rerr < 0.2, "few pairs, 6-point: rotation error (deg)", rerr, 0.2);
+    check(terr < 0.05, "few pairs, 6-point: relative t error", terr, 0.05);
+    check(caught == 2 && agree, "few pairs, 6-point: both outliers flagged", caught, 2);
+}
+
 static void status_case(void)
 {
     double R[9], t[3];
@@ -339,6 +491,20 @@ static void status_case(void)
     st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, focal, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "focal <= 0");
+    mcg_robust_default_options(&opt);
+    opt.sampler = 3;
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "unknown sampler");
+    opt.sampler = MCG_SAMPLER_UPRIGHT4; /* g1 = g2 = 0 by default: no vertical */
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "upright sampler without a vertical");
+    opt.g1[2] = opt.g2[2] = 1.0;
+    opt.g2[0] = NAN;
+    st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EINVAL, "upright sampler, NaN in the vertical");
     check(mcg_robust_work_size(5, 1) == 0 && mcg_robust_work_size(10, 0) == 0,
           "work size 0 for n < 6 or no camera", 0.0, 0.0);
 }
@@ -406,6 +572,8 @@ int main(void)
         return 2;
     outliers_case();
     minimal_case();
+    upright_case();
+    six_point_case();
     status_case();
     large_case();
     free(work);

@@ -6,16 +6,22 @@
  * cross-camera pairs, a few entries arbitrary), mode 1 arbitrary arrays;
  * camera ids (1 in 16 out of range), optional per-pair focal lengths and
  * camera table, options valid or not (threshold, prob, iteration budgets,
- * LO rounds, loss), and a workspace 1 double short 1 in 16 times.
+ * LO rounds, loss), the sampler (a byte: 5+1, upright 4-point with the
+ * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
+ * huge --, 6-point, or 1 in 16 an unknown one), and a workspace 1 double
+ * short 1 in 16 times.
  * Invariants: the status is known; bad sizes give MCG_EINVAL and a work
  * size of 0, a short workspace MCG_ENOMEM, bad options, ids or focal
- * lengths MCG_EINVAL, NaN/inf inputs never MCG_OK; on MCG_OK R is a
+ * lengths, an unknown sampler or an upright one without a finite non-zero
+ * vertical MCG_EINVAL, NaN/inf inputs never MCG_OK; on MCG_OK R is a
  * rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
  * of the threshold excepted), n_inliers counts it, n_used counts bit 1 and
  * the scale profile is NaN (not asked) or >= 0.
- * Bounded time: max_iterations <= 200 and max_seconds = 0.5 here, and
+ * Bounded time: max_iterations <= 200 (<= 3 with the 6-point sampler,
+ * whose solver takes about a second per sample under the sanitizers) and
+ * max_seconds = 0.5 here, and
  * libFuzzer's timeout catches any loop that ignores them.
  */
 #include "fuzz_input.h"
@@ -99,6 +105,33 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     opt.prob = fz_range(&in, 0.5, 0.9999);
     opt.max_scale_rel_std = fz_u8(&in) & 1 ? fz_range(&in, 0.0, 0.5) : 0.0;
     opt_ok = 1;
+    {
+        const int sb = fz_u8(&in);
+        opt.sampler = sb % 16 == 15 ? 3 + sb % 5 : sb % 3;
+        if (opt.sampler == MCG_SAMPLER_UPRIGHT4) {
+            if (mode == 0) { /* the true vertical: g2 = R g1 */
+                double g[3];
+                fz_doubles(&in, g, 3);
+                for (i = 0; i < 3; ++i) {
+                    opt.g1[i] = g[i];
+                    opt.g2[i] = R[3 * i] * g[0] + R[3 * i + 1] * g[1] + R[3 * i + 2] * g[2];
+                }
+            } else {
+                fz_doubles(&in, opt.g1, 3);
+                fz_doubles(&in, opt.g2, 3);
+            }
+            opt_ok = fz_all_finite(opt.g1, 3) && fz_all_finite(opt.g2, 3) &&
+                     opt.g1[0] * opt.g1[0] + opt.g1[1] * opt.g1[1] + opt.g1[2] * opt.g1[2] >=
+                         1e-100 &&
+                     opt.g2[0] * opt.g2[0] + opt.g2[1] * opt.g2[1] + opt.g2[2] * opt.g2[2] >=
+                         1e-100;
+        }
+        opt_ok &= opt.sampler <= MCG_SAMPLER_6PT;
+        if (opt.sampler == MCG_SAMPLER_6PT) { /* mcg_sixpt: ~1 s a sample here */
+            opt.max_iterations = 1 + opt.max_iterations % 3;
+            opt.min_iterations = opt.min_iterations % (opt.max_iterations + 1);
+        }
+    }
     if (fz_u8(&in) % 16 == 0) {
         switch (fz_u8(&in) % 4) {
         case 0: opt.threshold = fz_double(&in); break;
@@ -106,7 +139,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         case 2: opt.min_iterations = opt.max_iterations + 1; break;
         default: opt.loss = 7; break;
         }
-        opt_ok = isfinite(opt.threshold) && opt.threshold > 0.0 && opt.prob > 0.0 &&
+        opt_ok = opt_ok && isfinite(opt.threshold) && opt.threshold > 0.0 && opt.prob > 0.0 &&
                  opt.prob < 1.0 && opt.min_iterations <= opt.max_iterations && opt.loss <= 3;
     }
     lwork = mcg_robust_work_size(n, ncams);

@@ -19,16 +19,27 @@ re-expressed in such frames first (outside the timing).
 
 Part ``ransac``: the robust estimate from pixels with 1 px threshold, median
 rotation error (deg), scale error ``| |t| / |t_true| - 1 |`` (the metric
-estimate, whatever the verdict) and time per problem (ms): mcgeom's default
-façade (5+1), the upright 4-point façade with the vertical known to 0.2 deg
-(each gravity vector turned by 0.2 deg about a random axis), 17-point RANSAC
-(``ransac:linear17``) and PoseLib's ``estimate_generalized_relative_pose``;
-on the cases of :mod:`mcgeom.experiments.robust_vs_poselib`, a 12-camera rig
-with 8 correspondences per camera (half cross-camera, 40 % outliers) and the
-8-camera car rig (forward motion).
+estimate ``info["t_metric"]``, whatever the verdict) and time per problem
+(ms) of: mcgeom's façade as it chooses its sampler (upright with a vertical
+prior, else 5+1 when a camera has 5 intra-camera correspondences, else
+6-point; the sampler column counts its choices), the C search forced to 5+1,
+to the generic 6-point, and to the upright 4-point with the vertical known
+to 0.2 deg (each gravity vector turned by 0.2 deg about a random axis),
+17-point RANSAC (``ransac:linear17``), and PoseLib's
+``estimate_generalized_relative_pose`` (its 5+1 sampler,
+:mod:`.poselib_peer`) with ``min_iterations=100`` and with its defaults; on
+the cases of ``robust_vs_poselib`` (ring4, ladybug6 with 30 % outliers, car8
+driving forward), a 12-camera rig with 8 correspondences per camera (half
+cross-camera, 40 % outliers) and the 8-camera car rig turning. A method that
+cannot sample a case (5+1 and PoseLib without a 5-point camera pair) counts
+as failed there. Where the façade chose a sampler, the row forcing it reuses
+the façade's run (the same C call with the same seed); the 6-point row runs
+only where the façade chose it: ``mcg_sixpt`` (a homotopy continuation of 64
+paths) takes about 0.1 s per sample on this machine, a minute per RANSAC
+problem, which on the cases with a 5-point camera would only measure that.
 
 ``mcgeom experiment peer_solvers [--part minimal|ransac|all] [--configs 10000]
-[--problems 50] [--seed 0]`` (needs poselib)
+[--problems 50] [--seed 0] [--cases CASE ...]`` (needs poselib)
 """
 
 from __future__ import annotations
@@ -45,7 +56,8 @@ from mcgeom.estimators.upright_four_point import upright_rotation
 from mcgeom.rig import Rig
 
 from .common import Progress, add_count_and_seed, import_peer, no_progress, positive_int
-from .robust_vs_poselib import CASES as ROBUST_CASES, poselib_motion
+from .poselib_peer import poselib_estimate, poselib_setup
+from .robust_vs_poselib import CASES as ROBUST_CASES, car_forward, random_motion
 
 #: e_z -> e_y: PoseLib's upright solvers rotate about y
 _Z_TO_Y = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -174,16 +186,33 @@ def rig12(radius: float = 0.6, f: float = 500.0) -> Rig:
     return synth.ring_rig(12, radius, f, name="ring12")
 
 
-#: name: (rig, correspondences, outlier fraction, pixel noise, cross fraction, motion)
-#: (robust_vs_poselib's cases with a motion of their own, e.g. its car8 forward
-#: case, are covered by the forward car case below)
-RANSAC_CASES: dict = {name: (mk, n, outl, noise, 0.0, "random")
-                      for name, (mk, n, outl, noise, *motion) in ROBUST_CASES.items()
-                      if not motion}
-RANSAC_CASES["ring12 12x8 half-cross 40%out"] = (rig12, 96, 0.4, 0.5, 0.5, "random")
-RANSAC_CASES["car8 320c 0.5px forward"] = (synth.vehicle8, 320, 0.0, 0.5, 0.0, "forward")
+def _car_turning(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A car driving forward about 1 m while yawing up to 10 deg, with a little
+    pitch and roll (the vertical tilts by up to 0.6 deg)."""
+    R = (synth.rotation_about([0, 0, 1], rng.uniform(-0.17, 0.17))
+         @ synth.rotation_about(rng.normal(size=3), rng.uniform(0.0, 0.01)))
+    return R, np.array([1.0, 0.0, 0.0]) + 0.05 * rng.normal(size=3)
+
+
+#: name: (rig, correspondences, outlier fraction, pixel noise, cross fraction, motion):
+#: the cases of robust_vs_poselib / bench robust (ring4, ladybug6 with 30 %
+#: outliers, car8 driving forward with a yaw under 2 deg and 20 % outliers),
+#: the 12-camera rig with 8 correspondences per camera (half cross-camera, 40 %
+#: outliers: no camera has the 5 intra-camera ones of a 5+1 sample) and the car
+#: rig turning (the vertical known to 0.2 deg in the upright rows of every case)
+RANSAC_CASES: dict = {
+    "ring4 4x50 0.5px": ROBUST_CASES["ring4 4x50 0.5px"][:4] + (0.0, random_motion),
+    "ladybug6 300c 30%out": ROBUST_CASES["ladybug6 300c 30%out 0.5px"][:4] + (0.0, random_motion),
+    "car8 fwd<=2deg 20%out": ROBUST_CASES["car8 fwd<=2deg 400c 20%out"][:4] + (0.0, car_forward),
+    "ring12 12x8 half-cross 40%out": (rig12, 96, 0.4, 0.5, 0.5, random_motion),
+    "car8 320c turning <=10deg": (synth.vehicle8, 320, 0.0, 0.5, 0.0, _car_turning),
+}
 
 _GRAVITY = np.array([0.0, 0.0, -1.0])   # the vertical of the rig frame (rigs' z is up)
+
+#: PoseLib's settings: with the iteration floor of issue 19's comparison, and its defaults
+POSELIB_SETTINGS = {"poselib min_it=100": {"max_epipolar_error": 1.0, "min_iterations": 100},
+                    "poselib defaults": {"max_epipolar_error": 1.0}}
 
 
 def _tilted(g: np.ndarray, deg: float, rng: np.random.Generator) -> np.ndarray:
@@ -191,76 +220,121 @@ def _tilted(g: np.ndarray, deg: float, rng: np.random.Generator) -> np.ndarray:
     return synth.rotation_about(axis, np.radians(deg)) @ g
 
 
-def _motion(kind: str, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    if kind == "forward":   # a car: yaw up to 10 deg, a little pitch/roll, forward travel
-        R = (synth.rotation_about([0, 0, 1], rng.uniform(-0.17, 0.17))
-             @ synth.rotation_about(rng.normal(size=3), rng.uniform(0.0, 0.01)))
-        t = np.array([1.0, 0.0, 0.0]) + 0.05 * rng.normal(size=3)
-        return R, t
-    R = synth.random_rotation(rng, 0.3)
-    while metrics.rotation_error(R, np.eye(3)) < 0.05:
-        R = synth.random_rotation(rng, 0.3)
-    t = rng.normal(size=3)
-    return R, t / np.linalg.norm(t)
-
-
 def _errors(R, t, Rt, tt) -> tuple[float, float]:
     return (float(np.degrees(metrics.rotation_error(R, Rt))),
             abs(np.linalg.norm(t) / np.linalg.norm(tt) - 1.0))
 
 
+def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: float) -> dict:
+    """{row: call returning (R, t, sampler, seconds in C)} of one problem."""
+    def facade(**kw):
+        m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
+        return m.R, m.info["t_metric"], m.info.get("sampler", ""), m.info.get("c_seconds", np.nan)
+
+    def peer(opt):
+        return lambda: poselib_estimate(setup, p, opt) + ("5+1", np.nan)
+
+    runs = {"mcgeom façade (auto)": facade,
+            "mcgeom 5+1": lambda: facade(method="ransac:five_plus_one"),
+            "mcgeom 6-pt": lambda: facade(method="ransac:six_point"),
+            f"mcgeom upright ({deg:g} deg)": lambda: facade(gravity1=g1, gravity2=g2),
+            "mcgeom 17-pt": lambda: facade(method=RIG_LINEAR17_RANSAC)}
+    runs.update({name: peer(opt) for name, opt in POSELIB_SETTINGS.items()})
+    return runs
+
+
 def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                gravity_error_deg: float = 0.2, progress: Progress = no_progress) -> dict:
-    """{case: {method: (errors problems x 2, seconds per problem)}}."""
+    """{case: {method: (errors problems x 2, seconds per problem, samplers, seconds
+    in C)}}: the rotation (deg) and scale errors, NaN where the method cannot
+    sample the data (a ValueError, e.g. 5+1 without a 5-point camera) or finds
+    no motion; the samplers the façade chose; the time of mcgeom's C search
+    (``info["c_seconds"]``: sampling, scoring, LO, final refinement; NaN for
+    the Python drivers and PoseLib). Each gravity vector is turned by
+    ``gravity_error_deg`` about a random axis (the IMU's error)."""
     out = {}
-    for name, (make_rig, n, outl, noise, cross, kind) in (cases or RANSAC_CASES).items():
+    for name, (make_rig, n, outl, noise, cross, motion) in (cases or RANSAC_CASES).items():
         rng = np.random.default_rng(seed)
         rig = make_rig()
+        setup = poselib_setup(rig, "peer_solvers")
         res: dict = {}
-        for _ in progress(range(problems), total=problems, desc=name):
-            R, t = _motion(kind, rng)
+        for k in progress(range(problems), total=problems, desc=name):
+            R, t = motion(rng)
             p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl,
                                    cross_fraction=cross, require_visible=cross == 0.0)
             g1 = _tilted(_GRAVITY, gravity_error_deg, rng)
             g2 = _tilted(R @ _GRAVITY, gravity_error_deg, rng)
-            runs = {
-                "mcgeom 5+1": lambda: _facade(rig, p),
-                f"mcgeom upright ({gravity_error_deg:g} deg)":
-                    lambda: _facade(rig, p, gravity1=g1, gravity2=g2),
-                "mcgeom 17-pt": lambda: _facade(rig, p, method=RIG_LINEAR17_RANSAC),
-                "poselib": lambda: poselib_motion(rig, p),
-            }
+            runs = _methods(rig, setup, p, g1, g2, gravity_error_deg)
+            if k == 0:      # untimed warm-up: first calls load plugins and caches
+                for meth, fn in runs.items():
+                    if meth == "mcgeom 6-pt":
+                        continue
+                    try:
+                        fn()
+                    except (ValueError, ArithmeticError):
+                        pass
+            chosen = None
             for meth, fn in runs.items():
-                t0 = time.perf_counter()
-                try:
-                    Re, te = fn()
-                    err = _errors(Re, te, R, t)
-                except (ValueError, ArithmeticError):
-                    err = (np.nan, np.nan)       # the method could not sample these data
-                secs = time.perf_counter() - t0
-                res.setdefault(meth, ([], []))
-                res[meth][0].append(err)
-                res[meth][1].append(secs)
-        out[name] = {k: (np.array(e), np.array(s)) for k, (e, s) in res.items()}
+                forced = _FORCED.get(meth)
+                if forced is not None and forced == chosen:
+                    # the façade ran this very search (same C call, same seed)
+                    e, s, used, cs = res["mcgeom façade (auto)"]
+                    err, secs, sampler, c_secs = e[-1], s[-1], used[-1], cs[-1]
+                elif meth == "mcgeom 6-pt":
+                    continue    # only where the façade chose it (see the module)
+                else:
+                    t0 = time.perf_counter()
+                    try:
+                        Re, te, sampler, c_secs = fn()
+                        err = _errors(Re, te, R, t)
+                    except (ValueError, ArithmeticError):   # cannot sample / nothing found
+                        err, sampler, c_secs = (np.nan, np.nan), "-", np.nan
+                    secs = time.perf_counter() - t0
+                if meth == "mcgeom façade (auto)":
+                    chosen = sampler
+                e, s, used, cs = res.setdefault(meth, ([], [], [], []))
+                e.append(err)
+                s.append(secs)
+                used.append(sampler)
+                cs.append(c_secs)
+        out[name] = {k: (np.array(e), np.array(s), u, np.array(cs))
+                     for k, (e, s, u, cs) in res.items()}
     return out
 
 
-def _facade(rig: Rig, p, **kw) -> tuple[np.ndarray, np.ndarray]:
-    m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
-    return m.R, m.info["t_metric"]
+#: the rows that force one sampler of the façade's choice
+_FORCED = {"mcgeom 5+1": "five_plus_one", "mcgeom 6-pt": "six_point"}
 
 
 def ransac_table(res: dict) -> str:
-    lines = [f"{'case':<32} {'method':<24} {'rot med deg':>11} {'scale med':>9} "
-             f"{'failed':>6} {'ms med':>8} {'vs 5+1':>7}"]
+    """Per case and method: the sampler (the façade's most frequent choice),
+    median rotation error (deg) and scale error of the problems it solved, the
+    fraction it failed, the median time, the speed-up over 5+1 and 17-point
+    RANSAC (their median time / this one's), and the median time of the C
+    search with its speed-up over 5+1's (the search alone, without the
+    façade's Python conversions and verdict)."""
+    lines = [f"{'case':<30} {'method':<23} {'sampler':<18} {'rot med deg':>11} "
+             f"{'scale med':>9} {'failed':>6} {'ms med':>8} {'vs 5+1':>7} {'vs 17-pt':>8} "
+             f"{'C ms med':>8} {'C vs 5+1':>8}"]
     for case, methods in res.items():
-        base = np.median(methods["mcgeom 5+1"][1])
-        for meth, (e, secs) in methods.items():
+        ok5 = np.isfinite(methods["mcgeom 5+1"][0][:, 0])   # (rows not run are absent)
+        base5 = np.median(methods["mcgeom 5+1"][1]) if ok5.any() else np.nan
+        base17 = np.median(methods["mcgeom 17-pt"][1])
+        c5 = methods["mcgeom 5+1"][3]
+        c5 = np.median(c5[np.isfinite(c5)]) if np.isfinite(c5).any() else np.nan
+        for meth, (e, secs, used, c_secs) in methods.items():
             ok = np.isfinite(e[:, 0])
             med = np.median(e[ok], axis=0) if ok.any() else (np.nan, np.nan)
-            lines.append(f"{case:<32} {meth:<24} {med[0]:11.4f} {med[1]:9.4f} "
-                         f"{np.mean(~ok):6.2f} {1e3 * np.median(secs):8.2f} "
-                         f"{base / np.median(secs):6.2f}x")
+            names, counts = np.unique(used, return_counts=True)
+            sampler = ", ".join(f"{k} {c}" if len(names) > 1 else str(k)
+                                for k, c in zip(names, counts))
+            ms = np.median(secs)
+            cms = np.median(c_secs[np.isfinite(c_secs)]) if np.isfinite(c_secs).any() \
+                else np.nan
+            lines.append(f"{case:<30} {meth:<23} {sampler[:18]:<18} {med[0]:11.4f} "
+                         f"{med[1]:9.4f} {np.mean(~ok):6.2f} {1e3 * ms:8.2f} "
+                         f"{base5 / ms:6.2f}x {base17 / ms:7.2f}x {1e3 * cms:8.2f} "
+                         f"{c5 / cms:7.2f}x")
     return "\n".join(lines)
 
 
@@ -274,6 +348,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--configs", type=positive_int, default=10000,
                     help="noise-free configurations per family (minimal part)")
     add_count_and_seed(ap, "--problems", 50, "problems per case (RANSAC part)")
+    ap.add_argument("--cases", nargs="*", default=None, choices=list(RANSAC_CASES),
+                    metavar="CASE", help="cases of the RANSAC part (default: all), of: "
+                    + "; ".join(RANSAC_CASES).replace("%", "%%"))
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
@@ -284,5 +361,6 @@ def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     if args.part in ("ransac", "all"):
         if args.part == "all":
             print()
-        print(ransac_table(run_ransac(args.problems, args.seed, progress=progress)))
+        cases = {k: RANSAC_CASES[k] for k in args.cases or RANSAC_CASES}
+        print(ransac_table(run_ransac(args.problems, args.seed, cases, progress=progress)))
     return 0

@@ -35,6 +35,7 @@ from mcgeom.cv import estimate
 from mcgeom.rig import Rig
 
 from .common import Progress, add_count_and_seed, import_peer, no_progress
+from .poselib_peer import poselib_estimate, poselib_setup
 
 
 def ring4(radius: float = 0.25, f: float = 500.0) -> Rig:
@@ -70,45 +71,6 @@ CASES: dict[str, tuple] = {
 }
 
 
-def poselib_setup(rig: Rig, who: str = "robust_vs_poselib") -> tuple:
-    """PoseLib's module and the rig's camera poses and models, once per rig."""
-    poselib = import_peer("poselib", who)
-    exts, cams = [], []
-    for c in rig.cameras:
-        pose = poselib.CameraPose()
-        pose.R, pose.t = c.R, c.t
-        exts.append(pose)
-        K = c.K
-        cams.append({"model": "PINHOLE", "width": int(c.width), "height": int(c.height),
-                     "params": [K[0, 0], K[1, 1], K[0, 2], K[1, 2]]})
-    return poselib, exts, cams
-
-
-def poselib_estimate(setup: tuple, p, ransac_options: dict) -> tuple[np.ndarray, np.ndarray]:
-    """PoseLib's ``estimate_generalized_relative_pose`` on the pixels of problem ``p``
-    (one match set per camera pair), with ``ransac_options``: (R, t)."""
-    poselib, exts, cams = setup
-    matches = []
-    m = len(cams)
-    for i in range(m):
-        for j in range(m):
-            sel = (p.cam1 == i) & (p.cam2 == j)
-            if sel.any():
-                pm = poselib.PairwiseMatches()
-                pm.cam_id1, pm.cam_id2 = i, j
-                pm.x1, pm.x2 = p.pixels1[sel], p.pixels2[sel]
-                matches.append(pm)
-    pose, _ = poselib.estimate_generalized_relative_pose(matches, exts, cams, exts, cams,
-                                                         ransac_options, {})
-    return np.asarray(pose.R), np.asarray(pose.t)
-
-
-def poselib_motion(rig: Rig, p) -> tuple[np.ndarray, np.ndarray]:
-    """PoseLib's robust generalized relative pose of problem ``p`` (pixels of ``rig``),
-    its default RANSAC and bundle options, 1 px threshold: ``(R, t)`` rig2_from_rig1."""
-    return poselib_estimate(poselib_setup(rig), p, {"max_epipolar_error": 1.0})
-
-
 def _mcgeom(rig: Rig, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0)
     return m.R, m.t, m.info["t_metric"]
@@ -127,12 +89,14 @@ def run(trials: int = 50, seed: int = 0, cases=None, progress: Progress = no_pro
     for name, (make_rig, n, outl, noise, *motion) in (cases or CASES).items():
         rng = np.random.default_rng(seed)
         rig = make_rig()
+        setup = poselib_setup(rig)
         draw = motion[0] if motion else random_motion
         res = {"mcgeom": ([], [], []), "poselib": ([], [], []), "mcgeom t_metric": ([], [], [])}
         for _ in progress(range(trials), total=trials, desc=name):
             R, t = draw(rng)
             p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
-            for meth, fn in (("mcgeom", _mcgeom), ("poselib", poselib_motion)):
+            for meth, fn in (("mcgeom", _mcgeom),
+                             ("poselib", lambda _, q: poselib_estimate(setup, q))):
                 t0, c0 = time.perf_counter(), time.process_time()
                 Re, te, *tm = fn(rig, p)
                 res[meth][2].append(time.process_time() - c0)

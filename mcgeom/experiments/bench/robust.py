@@ -43,7 +43,8 @@ from mcgeom.cv import estimate
 from mcgeom.rig import Rig
 
 from ..common import Progress, no_progress
-from ..robust_vs_poselib import poselib_estimate, poselib_setup, ring4
+from ..poselib_peer import poselib_estimate, poselib_setup
+from ..robust_vs_poselib import ring4
 
 __all__ = ["SpeedRow", "ScaleRow", "bench_speed", "bench_scaling", "CASES"]
 

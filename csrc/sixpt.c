@@ -1,0 +1,504 @@
+/*
+ * sixpt.c -- the generic minimal generalized relative pose from 6
+ * correspondences of any cameras (Stewenius, Nister, Oskarsson, Astrom,
+ * "Solutions to minimal generalized relative pose problems", OMNIVIS 2005:
+ * 64 complex solutions for generic data). Our own formulation and solver:
+ * a parameter homotopy (Morgan and Sommese, "Coefficient-parameter polynomial
+ * continuation", Appl. Math. Comput. 1989) from one generic complex problem
+ * whose 64 solutions are tabulated (csrc/sixpt_start.h, found offline by
+ * monodromy in tools/sixpt_start.py) to the given real problem. No code of
+ * PoseLib, OpenGV or COLMAP is used.
+ *
+ * 1. Unknowns x = (s, t): the Cayley vector s of the rotation,
+ *        R = Rt(s) / (1 + s.s),  Rt(s) = (1 - s.s) I + 2 [s]x + 2 s s^T,
+ *    and the translation t (rig2_from_rig1, X2 = R X1 + t). Rotations by
+ *    exactly 180 degrees (s at infinity) are not represented.
+ *
+ * 2. The generalized epipolar constraint of correspondence i (thesis eq.
+ *    8.16, d2^T [t]x R d1 + d2^T R m1 + m2^T R d1 = 0, m = o x d) times
+ *    1 + s.s is linear in Rt:
+ *        F_i(x) = <Rt(s), G_i>,  G_i = (d2 x t) d1^T + d2 m1^T + m2 d1^T,   (S1)
+ *    with <A, B> = sum_ab A_ab B_ab. Six equations (S1) in the six unknowns:
+ *    for generic data 64 isolated complex solutions (tools/sixpt_start.py
+ *    finds exactly 64 for a random complex problem; 1 + s.s = 0 adds a
+ *    seventh equation, so no spurious root there for generic data). For a
+ *    given R, (S1) is the 6 x 4 system M(R) [t; 1] = 0, so t of a root is
+ *    M(R)'s null vector.
+ *
+ * 3. Homotopy: the problem data p = (o1, d1, o2, d2) of the 6
+ *    correspondences (72 numbers) move on the straight segment p(tau) = p0 +
+ *    tau (p1 - p0), tau in [0, 1], from the complex start p0 to the real,
+ *    normalised problem p1. As p0 is random complex, the segment meets the
+ *    discriminant (where solutions meet or go to infinity) with probability
+ *    zero, and the 64 solution paths x(tau) of H(x, tau) = F(x; p(tau)) = 0
+ *    end at every isolated solution of p1 (Morgan-Sommese). Each path is
+ *    tracked by a fourth-order Runge-Kutta predictor on dx/dtau = -J^-1
+ *    dH/dtau and Newton corrector steps, with step-size control: a step is
+ *    accepted when the corrector converges (first correction below 1e-3 of
+ *    |x|, last below 1e-11) -- the usual guard against jumping between paths.
+ *    Paths whose |x| exceeds 1e7 go to infinity (e.g. a rotation of 180
+ *    degrees, or a degenerate problem) and are dropped.
+ *
+ * 4. At tau = 1 the real endpoints (|Im x| <= 1e-6 (1 + |x|)) are polished by
+ *    Newton steps in real arithmetic and kept when the Jacobian is not
+ *    singular (a singular one means a non-isolated solution, e.g. the metric
+ *    scale of a central camera is free: never reported) and every normalised
+ *    constraint (unit directions, origins centred and scaled by their RMS
+ *    spread) holds to 1e-10 (1 + |t|); duplicates are merged.
+ *
+ * 5. Back to the rig frames: with o = sc u + c, t = sc t_u + c - R c.
+ *
+ * Cost: 64 paths of about 100 steps (a third rejected), each four to seven
+ * evaluations and complex 6 x 6 solves: some 70 ms per call on a 2-core
+ * machine, far slower than an elimination template;
+ * no allocation (all work is on the stack). Every solution returned is
+ * checked (step 4); a miss (a path that failed or jumped) is possible in
+ * ill-conditioned problems and its rate is measured by `mcgeom experiment
+ * peer_solvers --part minimal`.
+ */
+#include "mcgeom.h"
+#include "internal.h"
+#include "sixpt_start.h"
+
+#include <complex.h>
+#include <math.h>
+#include <string.h>
+
+#define DIR2_MIN 1e-100  /* smallest squared length of a direction */
+#define X_MAX 1e7        /* |x| beyond which a path goes to infinity */
+#ifndef H_MAX
+#define H_MAX 0.1        /* largest step in tau */
+#endif
+#ifndef GROW_AFTER
+#define GROW_AFTER 2     /* accepted steps in a row before the step doubles */
+#endif
+#ifndef FIRST_TOL
+#define FIRST_TOL 1e-3   /* largest first corrector step, relative to |x| */
+#endif
+#define H_MIN 1e-9       /* smallest step in tau before a path is given up */
+#define MAX_STEPS 3000   /* steps (accepted or not) per path */
+
+typedef double complex cplx;
+
+/* a b without the C99 Annex G infinity/NaN recovery (a library call per
+ * product otherwise; the values here are finite) */
+static inline cplx cm(cplx a, cplx b)
+{
+    double ar = creal(a), ai = cimag(a), br = creal(b), bi = cimag(b);
+    return (ar * br - ai * bi) + (ar * bi + ai * br) * I;
+}
+
+/* |re| + |im|: a cheap magnitude for pivoting */
+static inline double cabs1(cplx a) { return fabs(creal(a)) + fabs(cimag(a)); }
+
+/* c = a x b (complex) */
+static void ccross(const cplx *a, const cplx *b, cplx *c)
+{
+    c[0] = cm(a[1], b[2]) - cm(a[2], b[1]);
+    c[1] = cm(a[2], b[0]) - cm(a[0], b[2]);
+    c[2] = cm(a[0], b[1]) - cm(a[1], b[0]);
+}
+
+/* Rt(s) (S1) and its derivatives dRt/ds_k (row-major 3 x 3 each) */
+static void cayley(const cplx *s, cplx Rt[9], cplx dR[3][9])
+{
+    cplx ss = cm(s[0], s[0]) + cm(s[1], s[1]) + cm(s[2], s[2]);
+    int a, b, k;
+    for (a = 0; a < 3; ++a)
+        for (b = 0; b < 3; ++b)
+            Rt[3 * a + b] = (a == b ? 1.0 - ss : 0.0) + 2.0 * cm(s[a], s[b]);
+    Rt[1] -= 2.0 * s[2];
+    Rt[2] += 2.0 * s[1];
+    Rt[5] -= 2.0 * s[0];
+    Rt[3] += 2.0 * s[2];
+    Rt[6] -= 2.0 * s[1];
+    Rt[7] += 2.0 * s[0];
+    for (k = 0; k < 3; ++k) {
+        for (a = 0; a < 3; ++a)
+            for (b = 0; b < 3; ++b)
+                dR[k][3 * a + b] = (a == b ? -2.0 * s[k] : 0.0) + (a == k ? 2.0 * s[b] : 0.0) +
+                                   (b == k ? 2.0 * s[a] : 0.0);
+    }
+    /* d[s]x/ds_k = [e_k]x */
+    dR[0][5] -= 2.0;
+    dR[0][7] += 2.0;
+    dR[1][2] += 2.0;
+    dR[1][6] -= 2.0;
+    dR[2][1] -= 2.0;
+    dR[2][3] += 2.0;
+}
+
+/* G += u v^T (3 x 3 complex, row-major) */
+static void outer_add(cplx G[9], const cplx *u, const cplx *v)
+{
+    int a, b;
+    for (a = 0; a < 3; ++a)
+        for (b = 0; b < 3; ++b)
+            G[3 * a + b] += cm(u[a], v[b]);
+}
+
+/* <A, B> = sum_ab A_ab B_ab */
+static cplx frob(const cplx A[9], const cplx B[9])
+{
+    cplx r = 0.0;
+    int a;
+    for (a = 0; a < 9; ++a)
+        r += cm(A[a], B[a]);
+    return r;
+}
+
+/* H(x, tau) (S1) of the problem p = p0 + tau dp (72 complex: per
+ * correspondence o1, d1, o2, d2): Fv (6), J (6 x 6 row-major, d/dx) and, when
+ * Ft is not NULL, dH/dtau (6). */
+static void eval_h(const cplx *x, const cplx *p0, const cplx *dp, double tau, cplx Fv[6],
+                   cplx J[36], cplx *Ft)
+{
+    cplx Rt[9], dR[3][9];
+    const cplx *t = x + 3;
+    int i, k;
+    cayley(x, Rt, dR);
+    for (i = 0; i < 6; ++i) {
+        cplx o1[3], d1[3], o2[3], d2[3], m1[3], m2[3], d2t[3], Rd1[3], w[3], G[9];
+        int a;
+        for (a = 0; a < 3; ++a) {
+            /* real x complex products: no library call */
+            o1[a] = p0[12 * i + a] + tau * dp[12 * i + a];
+            d1[a] = p0[12 * i + 3 + a] + tau * dp[12 * i + 3 + a];
+            o2[a] = p0[12 * i + 6 + a] + tau * dp[12 * i + 6 + a];
+            d2[a] = p0[12 * i + 9 + a] + tau * dp[12 * i + 9 + a];
+        }
+        ccross(o1, d1, m1);
+        ccross(o2, d2, m2);
+        ccross(d2, t, d2t);
+        /* F_i = <Rt, G_i>, G_i = d2t d1^T + d2 m1^T + m2 d1^T (S1) */
+        memset(G, 0, sizeof G);
+        outer_add(G, d2t, d1);
+        outer_add(G, d2, m1);
+        outer_add(G, m2, d1);
+        Fv[i] = frob(Rt, G);
+        for (k = 0; k < 3; ++k)
+            J[6 * i + k] = frob(dR[k], G);
+        for (a = 0; a < 3; ++a)
+            Rd1[a] = cm(Rt[3 * a], d1[0]) + cm(Rt[3 * a + 1], d1[1]) + cm(Rt[3 * a + 2], d1[2]);
+        ccross(Rd1, d2, w); /* dF_i/dt = Rt d1 x d2 */
+        for (k = 0; k < 3; ++k)
+            J[6 * i + 3 + k] = w[k];
+        if (Ft) {
+            /* the derivatives of the data along the segment: o' = dp_o, d' =
+             * dp_d, m' = o' x d + o x d' */
+            const cplx *do1 = dp + 12 * i, *dd1 = dp + 12 * i + 3, *do2 = dp + 12 * i + 6,
+                       *dd2 = dp + 12 * i + 9;
+            cplx dm1[3], dm2[3], u[3], v[3], dd2t[3];
+            ccross(do1, d1, u);
+            ccross(o1, dd1, v);
+            for (a = 0; a < 3; ++a)
+                dm1[a] = u[a] + v[a];
+            ccross(do2, d2, u);
+            ccross(o2, dd2, v);
+            for (a = 0; a < 3; ++a)
+                dm2[a] = u[a] + v[a];
+            ccross(dd2, t, dd2t);
+            memset(G, 0, sizeof G);
+            outer_add(G, dd2t, d1);
+            outer_add(G, d2t, dd1);
+            outer_add(G, dd2, m1);
+            outer_add(G, d2, dm1);
+            outer_add(G, dm2, d1);
+            outer_add(G, m2, dd1);
+            Ft[i] = frob(Rt, G);
+        }
+    }
+}
+
+/* Solve J y = b (6 x 6, partial pivoting; J and b are overwritten, y = b).
+ * Returns 0 when a pivot vanishes relative to the largest entry. */
+static int csolve6(cplx J[36], cplx b[6])
+{
+    int k, i, j;
+    double big = 0.0;
+    for (i = 0; i < 36; ++i)
+        big = fmax(big, cabs1(J[i]));
+    if (!(big > 0.0) || !isfinite(big))
+        return 0;
+    for (k = 0; k < 6; ++k) {
+        int p = k;
+        double best = cabs1(J[6 * k + k]);
+        cplx inv;
+        for (i = k + 1; i < 6; ++i)
+            if (cabs1(J[6 * i + k]) > best) {
+                best = cabs1(J[6 * i + k]);
+                p = i;
+            }
+        if (!(best > 1e-14 * big))
+            return 0;
+        if (p != k) {
+            cplx tmp;
+            for (j = 0; j < 6; ++j) {
+                tmp = J[6 * k + j];
+                J[6 * k + j] = J[6 * p + j];
+                J[6 * p + j] = tmp;
+            }
+            tmp = b[k];
+            b[k] = b[p];
+            b[p] = tmp;
+        }
+        {
+            double pr = creal(J[6 * k + k]), pi = cimag(J[6 * k + k]), q = pr * pr + pi * pi;
+            inv = (pr / q) - (pi / q) * I; /* 1 / pivot */
+            J[6 * k + k] = inv;            /* kept for the back substitution */
+        }
+        for (i = k + 1; i < 6; ++i) {
+            cplx f = cm(J[6 * i + k], inv);
+            if (f == 0.0)
+                continue;
+            for (j = k + 1; j < 6; ++j)
+                J[6 * i + j] -= cm(f, J[6 * k + j]);
+            b[i] -= cm(f, b[k]);
+        }
+    }
+    for (k = 5; k >= 0; --k) {
+        cplx acc = b[k];
+        for (j = k + 1; j < 6; ++j)
+            acc -= cm(J[6 * k + j], b[j]);
+        b[k] = cm(acc, J[6 * k + k]);
+    }
+    return 1;
+}
+
+static double cnorm6(const cplx *x)
+{
+    double s = 0.0;
+    int i;
+    for (i = 0; i < 6; ++i)
+        s += creal(x[i]) * creal(x[i]) + cimag(x[i]) * cimag(x[i]);
+    return sqrt(s);
+}
+
+/* dx/dtau at (x, tau); 0 when J is singular */
+static int velocity(const cplx *x, const cplx *p0, const cplx *dp, double tau, cplx v[6])
+{
+    cplx Fv[6], J[36];
+    int i;
+    eval_h(x, p0, dp, tau, Fv, J, v);
+    if (!csolve6(J, v))
+        return 0;
+    for (i = 0; i < 6; ++i)
+        v[i] = -v[i];
+    return 1;
+}
+
+/* Newton corrector at tau: up to 3 steps; returns 1 when it converged
+ * (first correction <= FIRST_TOL (1 + |x|), last <= 1e-11 (1 + |x|)). */
+static int correct(cplx *x, const cplx *p0, const cplx *dp, double tau)
+{
+    int it, i;
+    for (it = 0; it < 3; ++it) {
+        cplx Fv[6], J[36];
+        double nd, nx;
+        eval_h(x, p0, dp, tau, Fv, J, NULL);
+        if (!csolve6(J, Fv))
+            return 0;
+        for (i = 0; i < 6; ++i)
+            x[i] -= Fv[i];
+        nd = cnorm6(Fv);
+        nx = 1.0 + cnorm6(x);
+        if (!(nd <= FIRST_TOL * nx) && it == 0)
+            return 0;
+        if (nd <= 1e-11 * nx)
+            return 1;
+    }
+    return 0;
+}
+
+/* Track one path from x (a solution at tau = 0) to tau = 1; 1 on success */
+static int track(cplx x[6], const cplx *p0, const cplx *dp)
+{
+    double tau = 0.0, h = 0.05;
+    int steps, i, streak = 0;
+    for (steps = 0; steps < MAX_STEPS && tau < 1.0; ++steps) {
+        cplx k1[6], k2[6], k3[6], k4[6], y[6];
+        double hh = fmin(h, 1.0 - tau);
+        int ok = velocity(x, p0, dp, tau, k1);
+        if (ok) {
+            for (i = 0; i < 6; ++i)
+                y[i] = x[i] + 0.5 * hh * k1[i];
+            ok = velocity(y, p0, dp, tau + 0.5 * hh, k2);
+        }
+        if (ok) {
+            for (i = 0; i < 6; ++i)
+                y[i] = x[i] + 0.5 * hh * k2[i];
+            ok = velocity(y, p0, dp, tau + 0.5 * hh, k3);
+        }
+        if (ok) {
+            for (i = 0; i < 6; ++i)
+                y[i] = x[i] + hh * k3[i];
+            ok = velocity(y, p0, dp, tau + hh, k4);
+        }
+        if (ok) {
+            for (i = 0; i < 6; ++i)
+                y[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            ok = correct(y, p0, dp, tau + hh);
+        }
+        if (ok) {
+            memcpy(x, y, sizeof y);
+            tau = (1.0 - tau <= hh) ? 1.0 : tau + hh;
+            if (++streak >= GROW_AFTER) {
+                h = fmin(2.0 * h, H_MAX);
+                streak = 0;
+            }
+            if (cnorm6(x) > X_MAX)
+                return 0;
+        } else {
+            h *= 0.5;
+            streak = 0;
+            if (h < H_MIN)
+                return 0;
+        }
+    }
+    return tau >= 1.0;
+}
+
+/* Real Newton polish of x at the target (tau = 1); returns 0 when J is
+ * singular (relative pivot below 1e-14) or the steps do not settle. */
+static int polish_real(double x[6], const cplx *p1)
+{
+    static const cplx zero[72]; /* dp = 0: the problem is p1 itself */
+    int it, i;
+    for (it = 0; it < 6; ++it) {
+        cplx xc[6], Fv[6], J[36];
+        double nd = 0.0, nx = 0.0;
+        for (i = 0; i < 6; ++i)
+            xc[i] = x[i];
+        eval_h(xc, p1, zero, 0.0, Fv, J, NULL);
+        if (!csolve6(J, Fv))
+            return 0;
+        for (i = 0; i < 6; ++i) {
+            x[i] -= creal(Fv[i]);
+            nd += creal(Fv[i]) * creal(Fv[i]);
+            nx += x[i] * x[i];
+        }
+        if (nd <= 1e-30 * (1.0 + nx))
+            return 1;
+    }
+    return 1; /* the residual test decides */
+}
+
+/* R = Rt(s) / (1 + s.s) (real) */
+static void rot_from_cayley(const double s[3], double R[9])
+{
+    double ss = dot3(s, s), k = 1.0 / (1.0 + ss);
+    int a, b;
+    for (a = 0; a < 3; ++a)
+        for (b = 0; b < 3; ++b)
+            R[3 * a + b] = k * ((a == b ? 1.0 - ss : 0.0) + 2.0 * s[a] * s[b]);
+    R[1] -= k * 2.0 * s[2];
+    R[2] += k * 2.0 * s[1];
+    R[5] -= k * 2.0 * s[0];
+    R[3] += k * 2.0 * s[2];
+    R[6] -= k * 2.0 * s[1];
+    R[7] += k * 2.0 * s[0];
+}
+
+/* The largest normalised GEC residual of (R, t) on the normalised data p
+ * (72 real: o1, d1, o2, d2 per correspondence, unit directions) */
+static double gec_max(const double R[9], const double t[3], const double *p)
+{
+    double worst = 0.0;
+    int i;
+    for (i = 0; i < 6; ++i) {
+        const double *o1 = p + 12 * i, *d1 = o1 + 3, *o2 = o1 + 6, *d2 = o1 + 9;
+        double m1[3], m2[3], Rd1[3], Rm1[3], c[3], e;
+        cross3(o1, d1, m1);
+        cross3(o2, d2, m2);
+        mat_vec(R, d1, Rd1);
+        mat_vec(R, m1, Rm1);
+        cross3(t, Rd1, c);
+        e = dot3(d2, c) + dot3(d2, Rm1) + dot3(m2, Rd1);
+        worst = fmax(worst, fabs(e));
+    }
+    return worst;
+}
+
+int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], const double d2[18],
+              double R[576], double t[192], int *n_solutions)
+{
+    double c[3], sc, p1r[72];
+    cplx p0[72], p1[72], dp[72];
+    double sols[MCG_SIXPT_MAX_SOLUTIONS][6];
+    int ns = 0, k, i, j;
+
+    if (!o1 || !d1 || !o2 || !d2 || !R || !t || !n_solutions)
+        return MCG_EINVAL;
+    *n_solutions = 0;
+    if (!all_finite(o1, 18) || !all_finite(d1, 18) || !all_finite(o2, 18) ||
+        !all_finite(d2, 18))
+        return MCG_EINVAL;
+    /* normalised problem: unit directions, origins centred on their mean and
+     * scaled by their RMS spread (both times, one transform) */
+    sc = origin_spread(6, o1, o2, c);
+    if (!isfinite(sc))
+        return MCG_EINVAL;
+    for (k = 0; k < 6; ++k) {
+        double a = dot3(d1 + 3 * k, d1 + 3 * k), b = dot3(d2 + 3 * k, d2 + 3 * k);
+        if (!(a >= DIR2_MIN && b >= DIR2_MIN && isfinite(a) && isfinite(b)))
+            return MCG_EINVAL;
+        for (i = 0; i < 3; ++i) {
+            double s = sc > 0.0 ? sc : 1.0;
+            p1r[12 * k + i] = (o1[3 * k + i] - c[i]) / s;
+            p1r[12 * k + 3 + i] = d1[3 * k + i] / sqrt(a);
+            p1r[12 * k + 6 + i] = (o2[3 * k + i] - c[i]) / s;
+            p1r[12 * k + 9 + i] = d2[3 * k + i] / sqrt(b);
+        }
+    }
+    if (!(sc > 0.0))
+        return MCG_OK; /* one centre: a central camera, no metric scale */
+    for (i = 0; i < 72; ++i) {
+        p0[i] = sixpt_p0_re[i] + I * sixpt_p0_im[i];
+        p1[i] = p1r[i];
+        dp[i] = p1[i] - p0[i];
+    }
+    for (j = 0; j < SIXPT_N_START; ++j) {
+        cplx x[6];
+        double xr[6], Rn[9], nx = 0.0, ni = 0.0;
+        int dup = 0;
+        for (i = 0; i < 6; ++i)
+            x[i] = sixpt_x0_re[6 * j + i] + I * sixpt_x0_im[6 * j + i];
+        if (!track(x, p0, dp))
+            continue;
+        for (i = 0; i < 6; ++i) {
+            nx += creal(x[i]) * creal(x[i]) + cimag(x[i]) * cimag(x[i]);
+            ni += cimag(x[i]) * cimag(x[i]);
+        }
+        if (!(sqrt(ni) <= 1e-6 * (1.0 + sqrt(nx))))
+            continue; /* a complex solution */
+        for (i = 0; i < 6; ++i)
+            xr[i] = creal(x[i]);
+        if (!polish_real(xr, p1))
+            continue;
+        rot_from_cayley(xr, Rn);
+        if (!(gec_max(Rn, xr + 3, p1r) <= 1e-10 * (1.0 + sqrt(dot3(xr + 3, xr + 3)))))
+            continue;
+        for (k = 0; k < ns && !dup; ++k) {
+            double dd = 0.0, nn = 0.0;
+            for (i = 0; i < 6; ++i) {
+                dd += (sols[k][i] - xr[i]) * (sols[k][i] - xr[i]);
+                nn += xr[i] * xr[i];
+            }
+            dup = dd <= 1e-16 * (1.0 + nn);
+        }
+        if (dup || ns >= MCG_SIXPT_MAX_SOLUTIONS)
+            continue;
+        memcpy(sols[ns], xr, sizeof xr);
+        /* back to the rig frames: t = sc t_u + c - R c */
+        {
+            double *Ro = R + 9 * ns, *to = t + 3 * ns, Rc[3];
+            memcpy(Ro, Rn, sizeof Rn);
+            mat_vec(Rn, c, Rc);
+            for (i = 0; i < 3; ++i)
+                to[i] = sc * xr[3 + i] + c[i] - Rc[i];
+        }
+        ++ns;
+    }
+    *n_solutions = ns;
+    return MCG_OK;
+}
