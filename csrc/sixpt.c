@@ -80,7 +80,7 @@
 #define FIRST_TOL 1e-3   /* largest first corrector step, relative to |x| */
 #endif
 #define H_MIN 1e-9       /* smallest step in tau before a path is given up */
-#define MAX_STEPS 3000   /* steps (accepted or not) per path */
+#define MAX_STEPS 600    /* steps (accepted or not) per path: bounds the time */
 
 typedef double complex cplx;
 
