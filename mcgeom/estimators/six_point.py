@@ -91,27 +91,30 @@ def _cauchy_cost(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
 def _six_point(rays: RayPairs, max_scale_rel_std: float) -> RigMotion:
     cands: list = []
     used = 0
+    found = False
     for idx in _samples(rays):
         used += 1
         cands += minimal_solutions(rays.take(idx))
         # a sample can miss the motion (a degenerate or ill-conditioned sample,
         # or a homotopy path lost: csrc/sixpt.c): the next one is tried unless
         # some candidate already explains half of the correspondences
-        if any(_explained(rays, R, t) >= 0.5 for R, t in cands):
+        found = any(_explained(rays, R, t) >= 0.5 for R, t in cands)
+        if found:
             break
     source = "six_point"
-    if not cands and len(rays) >= 17:
-        # No sample has an isolated real solution: the data are degenerate for
-        # the minimal problem (critical motion, ch. 7.3.2: no rotation with
-        # intra-camera rays leaves |t| free; one centre). linear17's estimate
-        # (which handles those kinds) is refined instead; the verdict then
+    if not found and len(rays) >= 17:
+        # No sample's solution explains the data: they are degenerate for the
+        # minimal problem, whose true solution is then not isolated (critical
+        # motion, ch. 7.3.2: no rotation with intra-camera rays leaves |t|
+        # free; one centre) and only spurious ones remain. linear17's estimate
+        # (which handles those kinds) joins the candidates; the verdict then
         # says whether the scale is observable.
         try:
             m = linear17(rays, refine=False)
         except DegenerateError:
             m = None
         if m is not None:
-            cands, source = [(m.R, m.t)], "linear17 (no 6-point solution)"
+            cands, source = cands + [(m.R, m.t)], "six_point + linear17 (no sample explains half)"
     if not cands:
         raise DegenerateError(f"six_point: no motion explains the 6-samples ({used} tried): "
                               "degenerate data (e.g. every ray from one centre, or no rotation "
@@ -148,9 +151,10 @@ def six_point(rays: RayPairs, *, max_scale_rel_std: float = 0.1) -> RigMotion:
     the two best are refined jointly on all (Sampson angular error) and the
     lower final cost wins. The scale verdict rests on the covariance and
     profile of that cost; a static rig gets ``t = 0`` and "no translation
-    detected". Where no sample has a solution (degenerate data) and there are
-    >= 17 correspondences, linear17's estimate is refined instead
-    (``info["start"]`` says which). ``info``: ``candidates``,
+    detected". Where no sample's solution explains half of the
+    correspondences (degenerate data, e.g. the critical motion of ch. 7.3.2)
+    and there are >= 17 of them, linear17's estimate joins the candidates
+    (``info["start"]`` says so). ``info``: ``candidates``,
     ``samples_tried``, ``start``, ``t_metric``. Raises ValueError for bad
     input, DegenerateError when no motion is found.
     """
