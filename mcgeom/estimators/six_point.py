@@ -28,6 +28,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
+from ..geometry import count_in_front
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._finish import refine_and_report
@@ -39,9 +40,13 @@ __all__ = ["six_point", "minimal_solutions"]
 #: scale (radians) of the Cauchy cost that ranks the candidates: a few pixels
 #: at typical focal lengths, so that outliers do not decide the ranking
 _RANK_SCALE = 2e-3
-#: 6-samples tried, in turn, until a candidate explains half of the correspondences
-#: within _RANK_SCALE
+#: 6-samples tried, in turn, until a candidate explains _ENOUGH of the
+#: correspondences within _RANK_SCALE
 _SAMPLES = 4
+#: fraction of the correspondences a candidate must explain to end the sampling
+#: (a spurious solution can explain half: e.g. one turned by ~180 degrees fits
+#: the rays of some cameras of a stereo head, seen in the property suite)
+_ENOUGH = 0.8
 
 
 def minimal_solutions(sample: RayPairs) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -79,8 +84,13 @@ def _samples(rays: RayPairs):
 
 
 def _explained(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
+    """Fraction of the correspondences within _RANK_SCALE of (R, t) whose rays
+    meet in front of both cameras: cheirality rejects the spurious solutions
+    that fit the constraints, e.g. the twisted pair (R turned by 180 degrees
+    about t) with a huge t, which fits every camera's rays like a central
+    camera's essential matrix."""
     r = _core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t)
-    return float(np.mean(np.abs(r) <= _RANK_SCALE))
+    return count_in_front(rays, R, t, np.abs(r) <= _RANK_SCALE) / len(rays)
 
 
 def _cauchy_cost(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
@@ -97,8 +107,8 @@ def _six_point(rays: RayPairs, max_scale_rel_std: float) -> RigMotion:
         cands += minimal_solutions(rays.take(idx))
         # a sample can miss the motion (a degenerate or ill-conditioned sample,
         # or a homotopy path lost: csrc/sixpt.c): the next one is tried unless
-        # some candidate already explains half of the correspondences
-        found = any(_explained(rays, R, t) >= 0.5 for R, t in cands)
+        # some candidate already explains most of the correspondences
+        found = any(_explained(rays, R, t) >= _ENOUGH for R, t in cands)
         if found:
             break
     source = "six_point"
@@ -106,7 +116,9 @@ def _six_point(rays: RayPairs, max_scale_rel_std: float) -> RigMotion:
         # No sample's solution explains the data: they are degenerate for the
         # minimal problem, whose true solution is then not isolated (critical
         # motion, ch. 7.3.2: no rotation with intra-camera rays leaves |t|
-        # free; one centre) and only spurious ones remain. linear17's estimate
+        # free; one centre) and only spurious ones remain; or ill-conditioned
+        # (a stereo head's intra-camera rays: 3e-4 rad of noise moves the
+        # minimal solutions by 0.1 rad). linear17's estimate
         # (which handles those kinds) joins the candidates; the verdict then
         # says whether the scale is observable.
         try:
@@ -114,13 +126,14 @@ def _six_point(rays: RayPairs, max_scale_rel_std: float) -> RigMotion:
         except DegenerateError:
             m = None
         if m is not None:
-            cands, source = cands + [(m.R, m.t)], "six_point + linear17 (no sample explains half)"
+            cands, source = cands + [(m.R, m.t)], "six_point + linear17 (no sample explains 80 %)"
     if not cands:
         raise DegenerateError(f"six_point: no motion explains the 6-samples ({used} tried): "
                               "degenerate data (e.g. every ray from one centre, or no rotation "
                               "with intra-camera rays only)")
-    cost = [_cauchy_cost(rays, R, t) for R, t in cands]
-    starts = [cands[k] for k in np.argsort(cost, kind="stable")[:2]]
+    # most correspondences explained in front first, then the Cauchy cost
+    key = [(-_explained(rays, R, t), _cauchy_cost(rays, R, t)) for R, t in cands]
+    starts = [cands[k] for k in sorted(range(len(cands)), key=lambda k: key[k])[:2]]
     info: dict = {"candidates": len(cands), "samples_tried": used, "start": source}
     return refine_and_report(rays, starts, "six_point", max_scale_rel_std, info)
 
@@ -145,14 +158,16 @@ def six_point(rays: RayPairs, *, max_scale_rel_std: float = 0.1) -> RigMotion:
     ``rays`` in the rig frame (origins at the camera centres, metres), any mix
     of intra- and cross-camera correspondences. The real solutions of the
     minimal 6-point problem on 6-samples spread over the correspondences (the
-    next of up to four samples until a solution explains half of them within
-    2e-3 rad) are ranked by a Cauchy
-    cost (scale 2e-3 rad) of the Sampson angular residuals on all of them;
+    next of up to four samples until a solution explains 80 % of them within
+    2e-3 rad and in front of both
+    cameras) are ranked by that fraction, then by a Cauchy cost (scale
+    2e-3 rad) of the Sampson angular residuals on all of them;
     the two best are refined jointly on all (Sampson angular error) and the
     lower final cost wins. The scale verdict rests on the covariance and
     profile of that cost; a static rig gets ``t = 0`` and "no translation
-    detected". Where no sample's solution explains half of the
-    correspondences (degenerate data, e.g. the critical motion of ch. 7.3.2)
+    detected". Where no sample's solution explains 80 % of the
+    correspondences (degenerate or ill-conditioned data, e.g. the critical
+    motion of ch. 7.3.2)
     and there are >= 17 of them, linear17's estimate joins the candidates
     (``info["start"]`` says so). ``info``: ``candidates``,
     ``samples_tried``, ``start``, ``t_metric``. Raises ValueError for bad
