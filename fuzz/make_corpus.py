@@ -122,6 +122,17 @@ def _u16_in(x: float, lo: float, hi: float) -> bytes:
     return struct.pack("<H", max(0, min(65535, round((x - lo) / (hi - lo) * 65535))))
 
 
+def _rodrigues(w: list) -> list:
+    """The rotation (3 x 3 nested lists) of the angle-axis vector w."""
+    th = math.sqrt(sum(v * v for v in w)) or 1e-300
+    k = [v / th for v in w]
+    c, s_, v_ = math.cos(th), math.sin(th), 1.0 - math.cos(th)
+    R = [[k[i] * k[j] * v_ + (c if i == j else 0.0) for j in range(3)] for i in range(3)]
+    R[0][1] -= k[2] * s_; R[0][2] += k[1] * s_; R[1][0] += k[2] * s_
+    R[1][2] -= k[0] * s_; R[2][0] -= k[1] * s_; R[2][1] += k[0] * s_
+    return R
+
+
 def essential5_seeds(rng: random.Random) -> list[bytes]:
     """fuzz_essential5: well-posed 5-point problems as the harness decodes them
     (mode 0: rotation angles, translation, five points, no replaced entry;
@@ -139,12 +150,7 @@ def essential5_seeds(rng: random.Random) -> list[bytes]:
         out.append(bytes([0]) + body + bytes([1]))
         out += [bytes([2, kind]) + body for kind in range(5)]
         # the same problem's bearings (rotation by Rodrigues' formula)
-        th = math.sqrt(sum(v * v for v in w)) or 1e-300
-        k = [v / th for v in w]
-        c, s_, v_ = math.cos(th), math.sin(th), 1.0 - math.cos(th)
-        R = [[k[i] * k[j] * v_ + (c if i == j else 0.0) for j in range(3)] for i in range(3)]
-        R[0][1] -= k[2] * s_; R[0][2] += k[1] * s_; R[1][0] += k[2] * s_
-        R[1][2] -= k[0] * s_; R[2][0] -= k[1] * s_; R[2][1] += k[0] * s_
+        R = _rodrigues(w)
         d1, d2 = [], []
         for X in pts:
             X2 = [sum(R[i][j] * X[j] for j in range(3)) + t[i] for i in range(3)]
@@ -164,12 +170,7 @@ def sixpt_seeds(rng: random.Random) -> list[bytes]:
     for _ in range(6):
         w = [rng.uniform(-0.3, 0.3) for _ in range(3)]
         t = [rng.uniform(-2.0, 2.0) for _ in range(3)]
-        th = math.sqrt(sum(v * v for v in w)) or 1e-300
-        k = [v / th for v in w]
-        c, s_, v_ = math.cos(th), math.sin(th), 1.0 - math.cos(th)
-        R = [[k[i] * k[j] * v_ + (c if i == j else 0.0) for j in range(3)] for i in range(3)]
-        R[0][1] -= k[2] * s_; R[0][2] += k[1] * s_; R[1][0] += k[2] * s_
-        R[1][2] -= k[0] * s_; R[2][0] -= k[1] * s_; R[2][1] += k[0] * s_
+        R = _rodrigues(w)
         cams = [[rng.uniform(-1, 1) for _ in range(3)] for _ in range(6)]
         o1, d1, o2, d2 = [], [], [], []
         for i in range(6):

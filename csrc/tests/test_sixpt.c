@@ -26,15 +26,27 @@
 #include <stdio.h>
 #include <string.h>
 
+/* A rotation by an angle uniform in (-max_angle, max_angle) about a random
+ * axis, from its unit quaternion (w, x, y, z) */
 static void random_rotation(double R[9], double max_angle)
 {
-    double w[3], n;
-    int i;
-    randn(w, 3);
-    n = sqrt(dot3(w, w));
-    for (i = 0; i < 3; i++)
-        w[i] *= max_angle * (2.0 * urand() - 1.0) / n;
-    mcg_rot_from_angle_axis(w, R);
+    double q[4], half = 0.5 * max_angle * (2.0 * urand() - 1.0), n;
+    randn(q + 1, 3);
+    n = sqrt(dot3(q + 1, q + 1));
+    q[0] = cos(half);
+    q[1] *= sin(half) / n;
+    q[2] *= sin(half) / n;
+    q[3] *= sin(half) / n;
+    mcg_rot_from_quat(q, R);
+}
+
+/* v scaled to length len */
+static void normalize_scale(double v[3], double len)
+{
+    double n = sqrt(dot3(v, v));
+    v[0] *= len / n;
+    v[1] *= len / n;
+    v[2] *= len / n;
 }
 
 /* A noise-free problem: 6 correspondences of a rig with 6 cameras (centres
@@ -44,32 +56,34 @@ static void random_rotation(double R[9], double max_angle)
 static void make_problem(int kind, int cross, const double R[9], const double t[3],
                          double o1[18], double d1[18], double o2[18], double d2[18])
 {
-    double cen[6][3];
+    double cen[6][3] = {{0.0}};
     int k, i;
-    for (k = 0; k < 6; k++)
-        for (i = 0; i < 3; i++)
-            cen[k][i] = kind == 2 ? 0.0
-                        : kind == 1 ? (i == 0 ? (k & 1 ? 0.15 : -0.15) : 0.0)
-                                    : 0.5 * nrand();
+    for (k = 0; k < 6 && kind != 2; k++) {
+        if (kind == 1) /* a head: two centres 0.3 m apart on the x axis */
+            cen[k][0] = (k & 1) ? 0.15 : -0.15;
+        else
+            randn(cen[k], 3), cen[k][0] *= 0.5, cen[k][1] *= 0.5, cen[k][2] *= 0.5;
+    }
     for (k = 0; k < 6; k++) {
         int c1 = k, c2 = (cross && (k & 1)) ? (k + 1) % 6 : k;
-        double X[3], X2[3], dir[3], n;
+        double depth = 2.0 + 8.0 * urand(), X2[3];
         if (kind == 1) {
             c1 = k & 1;
             c2 = (cross && (k & 2)) ? 1 - c1 : c1;
         }
-        randn(dir, 3);
-        n = sqrt(dot3(dir, dir));
-        for (i = 0; i < 3; i++)
-            X[i] = cen[c1][i] + (2.0 + 8.0 * urand()) * dir[i] / n;
-        mat_vec(R, X, X2);
-        for (i = 0; i < 3; i++) {
-            X2[i] += t[i];
-            o1[3 * k + i] = cen[c1][i];
-            d1[3 * k + i] = X[i] - cen[c1][i];
-            o2[3 * k + i] = cen[c2][i];
-            d2[3 * k + i] = X2[i] - cen[c2][i];
+        /* the time-1 ray: a random unit direction; the point at depth on it */
+        randn(d1 + 3 * k, 3);
+        normalize_scale(d1 + 3 * k, depth);
+        memcpy(o1 + 3 * k, cen[c1], sizeof cen[c1]);
+        memcpy(o2 + 3 * k, cen[c2], sizeof cen[c2]);
+        /* the time-2 ray: from camera c2 to R X + t, X = o1 + d1 */
+        {
+            double X[3] = {o1[3 * k] + d1[3 * k], o1[3 * k + 1] + d1[3 * k + 1],
+                           o1[3 * k + 2] + d1[3 * k + 2]};
+            mat_vec(R, X, X2);
         }
+        for (i = 0; i < 3; i++)
+            d2[3 * k + i] = X2[i] + t[i] - o2[3 * k + i];
     }
 }
 
@@ -93,20 +107,16 @@ static double triple_residual(const double *o1, const double *d1, const double *
     return worst;
 }
 
+/* max |R R^T - I| and |det R - 1| */
 static double rot_error(const double R[9])
 {
-    double RRt[9], e = 0.0;
-    int i, j, k;
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++) {
-            double s = 0.0;
-            for (k = 0; k < 3; k++)
-                s += R[3 * i + k] * R[3 * j + k];
-            RRt[3 * i + j] = s;
-            e = fmax(e, fabs(s - (i == j)));
-        }
-    e = fmax(e, fabs(det33(R) - 1.0));
-    (void)RRt;
+    double Rt[9], P[9], e = fabs(det33(R) - 1.0);
+    int i;
+    for (i = 0; i < 9; i++)
+        Rt[i] = R[3 * (i % 3) + i / 3];
+    mul33(R, Rt, P);
+    for (i = 0; i < 9; i++)
+        e = fmax(e, fabs(P[i] - (i % 4 == 0 ? 1.0 : 0.0)));
     return e;
 }
 
