@@ -33,6 +33,7 @@ from ..registry import register
 from ..types import RayPairs, RigMotion
 from ._finish import refine_and_report
 from ._static import check_static
+from .five_plus_one import five_plus_one
 from .linear17 import linear17
 
 __all__ = ["six_point", "minimal_solutions"]
@@ -112,25 +113,32 @@ def _six_point(rays: RayPairs, max_scale_rel_std: float) -> RigMotion:
         if found:
             break
     source = "six_point"
-    if not found and len(rays) >= 17:
+    if not found:
         # No sample's solution explains the data: they are degenerate for the
         # minimal problem, whose true solution is then not isolated (critical
         # motion, ch. 7.3.2: no rotation with intra-camera rays leaves |t|
-        # free; one centre) and only spurious ones remain; or ill-conditioned
-        # (a stereo head's intra-camera rays: 3e-4 rad of noise moves the
-        # minimal solutions by 0.1 rad). linear17's estimate
-        # (which handles those kinds) joins the candidates; the verdict then
-        # says whether the scale is observable.
-        try:
-            m = linear17(rays, refine=False)
-        except DegenerateError:
-            m = None
-        if m is not None:
-            cands, source = cands + [(m.R, m.t)], "six_point + linear17 (no sample explains 80 %)"
+        # free; one centre, a central camera) and only spurious ones remain;
+        # or ill-conditioned (a stereo head's intra-camera rays: 3e-4 rad of
+        # noise moves the minimal solutions by 0.1 rad). The estimates of
+        # linear17 (>= 17 correspondences) and 5+1 (a camera with 5), which
+        # handle those kinds, join the candidates; the verdict then says
+        # whether the scale is observable.
+        for name, fn, need in (("linear17", lambda: linear17(rays, refine=False), 17),
+                               ("five_plus_one", lambda: five_plus_one(rays), 6)):
+            if len(rays) < need:
+                continue
+            try:
+                m = fn()
+            except (DegenerateError, ValueError):
+                continue
+            cands.append((m.R, m.t))
+            source = f"six_point + {name} (no sample explains 80 %)"
+            break
     if not cands:
-        raise DegenerateError(f"six_point: no motion explains the 6-samples ({used} tried): "
-                              "degenerate data (e.g. every ray from one centre, or no rotation "
-                              "with intra-camera rays only)")
+        raise DegenerateError(f"six_point: the motion is not determined by the data: no "
+                              f"6-sample ({used} tried) has an isolated real solution "
+                              "(degenerate data, e.g. every ray from one centre, or no "
+                              "rotation with intra-camera rays only)")
     # most correspondences explained in front first, then the Cauchy cost
     key = [(-_explained(rays, R, t), _cauchy_cost(rays, R, t)) for R, t in cands]
     starts = [cands[k] for k in sorted(range(len(cands)), key=lambda k: key[k])[:2]]
@@ -168,8 +176,8 @@ def six_point(rays: RayPairs, *, max_scale_rel_std: float = 0.1) -> RigMotion:
     detected". Where no sample's solution explains 80 % of the
     correspondences (degenerate or ill-conditioned data, e.g. the critical
     motion of ch. 7.3.2)
-    and there are >= 17 of them, linear17's estimate joins the candidates
-    (``info["start"]`` says so). ``info``: ``candidates``,
+    linear17's estimate (>= 17 correspondences), else five_plus_one's, joins
+    the candidates (``info["start"]`` says so). ``info``: ``candidates``,
     ``samples_tried``, ``start``, ``t_metric``. Raises ValueError for bad
     input, DegenerateError when no motion is found.
     """
