@@ -175,7 +175,7 @@ def six_point(rays: RayPairs, *, max_scale_rel_std: float = 0.1) -> RigMotion:
     profile of that cost; a static rig gets ``t = 0`` and "no translation
     detected". Where no sample's solution explains 80 % of the
     correspondences (degenerate or ill-conditioned data, e.g. the critical
-    motion of ch. 7.3.2)
+    motion of ch. 7.3.2),
     linear17's estimate (>= 17 correspondences), else five_plus_one's, joins
     the candidates (``info["start"]`` says so). ``info``: ``candidates``,
     ``samples_tried``, ``start``, ``t_metric``. Raises ValueError for bad
