@@ -35,7 +35,8 @@
  *    tracked by a fourth-order Runge-Kutta predictor on dx/dtau = -J^-1
  *    dH/dtau and Newton corrector steps, with step-size control: a step is
  *    accepted when the corrector converges (first correction below 1e-3 of
- *    |x|, last below 1e-11) -- the usual guard against jumping between paths.
+ *    |x|, last below 1e-8; a stricter last test stalls paths that pass near
+ *    infinity, |x| ~ 1e3) -- the usual guard against jumping between paths.
  *    Paths whose |x| exceeds 1e7 go to infinity (e.g. a rotation of 180
  *    degrees, or a degenerate problem) and are dropped.
  *
@@ -49,7 +50,7 @@
  * 5. Back to the rig frames: with o = sc u + c, t = sc t_u + c - R c.
  *
  * Cost: 64 paths of about 100 steps (a third rejected), each four to seven
- * evaluations and complex 6 x 6 solves: some 70 ms per call on a 2-core
+ * evaluations and complex 6 x 6 solves: some 60 ms per call on a 2-core
  * machine, far slower than an elimination template;
  * no allocation (all work is on the stack). Every solution returned is
  * checked (step 4); a miss (a path that failed or jumped) is possible in
@@ -72,11 +73,14 @@
 #ifndef GROW_AFTER
 #define GROW_AFTER 2     /* accepted steps in a row before the step doubles */
 #endif
+#ifndef LAST_TOL
+#define LAST_TOL 1e-8    /* corrector step that ends the corrector, relative to |x| */
+#endif
 #ifndef FIRST_TOL
 #define FIRST_TOL 1e-3   /* largest first corrector step, relative to |x| */
 #endif
 #define H_MIN 1e-9       /* smallest step in tau before a path is given up */
-#define MAX_STEPS 3000   /* steps (accepted or not) per path */
+#define MAX_STEPS 600    /* steps (accepted or not) per path: bounds the time */
 
 typedef double complex cplx;
 
@@ -288,7 +292,7 @@ static int velocity(const cplx *x, const cplx *p0, const cplx *dp, double tau, c
 }
 
 /* Newton corrector at tau: up to 3 steps; returns 1 when it converged
- * (first correction <= FIRST_TOL (1 + |x|), last <= 1e-11 (1 + |x|)). */
+ * (first correction <= FIRST_TOL (1 + |x|), last <= LAST_TOL (1 + |x|)). */
 static int correct(cplx *x, const cplx *p0, const cplx *dp, double tau)
 {
     int it, i;
@@ -304,7 +308,7 @@ static int correct(cplx *x, const cplx *p0, const cplx *dp, double tau)
         nx = 1.0 + cnorm6(x);
         if (!(nd <= FIRST_TOL * nx) && it == 0)
             return 0;
-        if (nd <= 1e-11 * nx)
+        if (nd <= LAST_TOL * nx)
             return 1;
     }
     return 0;

@@ -122,6 +122,17 @@ def _u16_in(x: float, lo: float, hi: float) -> bytes:
     return struct.pack("<H", max(0, min(65535, round((x - lo) / (hi - lo) * 65535))))
 
 
+def _rodrigues(w: list) -> list:
+    """The rotation (3 x 3 nested lists) of the angle-axis vector w."""
+    th = math.sqrt(sum(v * v for v in w)) or 1e-300
+    k = [v / th for v in w]
+    c, s_, v_ = math.cos(th), math.sin(th), 1.0 - math.cos(th)
+    R = [[k[i] * k[j] * v_ + (c if i == j else 0.0) for j in range(3)] for i in range(3)]
+    R[0][1] -= k[2] * s_; R[0][2] += k[1] * s_; R[1][0] += k[2] * s_
+    R[1][2] -= k[0] * s_; R[2][0] -= k[1] * s_; R[2][1] += k[0] * s_
+    return R
+
+
 def essential5_seeds(rng: random.Random) -> list[bytes]:
     """fuzz_essential5: well-posed 5-point problems as the harness decodes them
     (mode 0: rotation angles, translation, five points, no replaced entry;
@@ -139,12 +150,7 @@ def essential5_seeds(rng: random.Random) -> list[bytes]:
         out.append(bytes([0]) + body + bytes([1]))
         out += [bytes([2, kind]) + body for kind in range(5)]
         # the same problem's bearings (rotation by Rodrigues' formula)
-        th = math.sqrt(sum(v * v for v in w)) or 1e-300
-        k = [v / th for v in w]
-        c, s_, v_ = math.cos(th), math.sin(th), 1.0 - math.cos(th)
-        R = [[k[i] * k[j] * v_ + (c if i == j else 0.0) for j in range(3)] for i in range(3)]
-        R[0][1] -= k[2] * s_; R[0][2] += k[1] * s_; R[1][0] += k[2] * s_
-        R[1][2] -= k[0] * s_; R[2][0] -= k[1] * s_; R[2][1] += k[0] * s_
+        R = _rodrigues(w)
         d1, d2 = [], []
         for X in pts:
             X2 = [sum(R[i][j] * X[j] for j in range(3)) + t[i] for i in range(3)]
@@ -155,10 +161,38 @@ def essential5_seeds(rng: random.Random) -> list[bytes]:
     return out
 
 
+def sixpt_seeds(rng: random.Random) -> list[bytes]:
+    """fuzz_sixpt mode 1: the rays of well-posed 6-point problems (6 cameras
+    within 1 m, every other pair cross-camera, points 2..8 m away, rotations
+    up to ~30 degrees) as nice doubles, i.e. rounded to 1/4096 like a noisy
+    sample; each of the four arrays with fz_matrix layout 0 (as decoded)."""
+    out = []
+    for _ in range(6):
+        w = [rng.uniform(-0.3, 0.3) for _ in range(3)]
+        t = [rng.uniform(-2.0, 2.0) for _ in range(3)]
+        R = _rodrigues(w)
+        cams = [[rng.uniform(-1, 1) for _ in range(3)] for _ in range(6)]
+        o1, d1, o2, d2 = [], [], [], []
+        for i in range(6):
+            c1, c2 = cams[i], cams[(i + (i & 1)) % 6]
+            X = [c1[j] + rng.uniform(2.0, 8.0) * rng.choice((-1, 1)) * (j == i % 3)
+                 + rng.uniform(-1, 1) for j in range(3)]
+            X2 = [sum(R[a][b] * X[b] for b in range(3)) + t[a] for a in range(3)]
+            o1 += c1
+            d1 += [X[j] - c1[j] for j in range(3)]
+            o2 += c2
+            d2 += [X2[j] - c2[j] for j in range(3)]
+        out.append(bytes([1]) + b"".join(bytes([0]) + b"".join(nice(v) for v in a)
+                                         for a in (o1, d1, o2, d2)))
+    return out
+
+
 def seeds_for(name: str) -> list[bytes]:
     rng = random.Random(f"mcgeom-{name}")
     if name == "fuzz_essential5":
         return c_seeds(name, rng) + essential5_seeds(rng)
+    if name == "fuzz_sixpt":
+        return c_seeds(name, rng) + sixpt_seeds(rng)
     if name in MODES:
         return c_seeds(name, rng)
     if name == "fuzz_calibration":
