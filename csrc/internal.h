@@ -113,7 +113,7 @@ int mcg_linf_local(int n, const double *u1, const double *a1, const double *u2,
 /* The k-th smallest of x[0..m) (x is reordered; Hoare's selection), and the
  * median as numpy.median (the mean of the two middle values for even m,
  * m >= 1; x is reordered). For the robust statistics of the kernels
- * (static_test.c). */
+ * (static_test.c, robust.c). */
 static inline double select_kth_inplace(double *x, int m, int k)
 {
     int lo = 0, hi = m - 1;

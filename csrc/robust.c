@@ -1208,50 +1208,12 @@ static void mark_usable(ctx *c)
                        plane_rms(c, g, 0) > c->loss_scale && plane_rms(c, g, 1) > c->loss_scale;
 }
 
-/* k-th smallest of x[0..n) (Hoare's selection; x is reordered) */
-static double select_kth(double *x, int n, int k)
-{
-    int lo = 0, hi = n - 1;
-    while (lo < hi) {
-        double p = x[lo + (hi - lo) / 2];
-        int i = lo, j = hi;
-        while (i <= j) {
-            while (x[i] < p)
-                i++;
-            while (x[j] > p)
-                j--;
-            if (i <= j) {
-                double tmp = x[i];
-                x[i] = x[j];
-                x[j] = tmp;
-                i++;
-                j--;
-            }
-        }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            return x[k];
-    }
-    return x[k];
-}
-
 /* median of x[0..n) as numpy's (mean of the two middle values for even n),
- * computed on the scratch copy y */
+ * computed on the scratch copy y (internal.h's median_inplace) */
 static double median(const double *x, double *y, int n)
 {
-    double hi, lo;
-    int k;
     memcpy(y, x, (size_t)n * sizeof *y);
-    hi = select_kth(y, n, n / 2);
-    if (n % 2)
-        return hi;
-    lo = y[0];
-    for (k = 1; k < n / 2; k++) /* the largest of the lower half */
-        lo = y[k] > lo ? y[k] : lo;
-    return 0.5 * (lo + hi);
+    return median_inplace(y, n);
 }
 
 /* Pixel scaling of the final refinement at (R, t): with the camera table,
