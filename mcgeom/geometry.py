@@ -14,12 +14,14 @@ metres, unit directions), a motion ``(R, t)`` is rig2_from_rig1, ``X2 = R X1
 
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 from . import _core
 from .types import RayPairs
 
-__all__ = ["rcross", "unit_rows", "displacements", "same_camera", "count_in_front",
+__all__ = ["find_essential_mat", "rcross", "unit_rows", "displacements", "same_camera", "count_in_front",
            "counts_in_front", "rotation_only_fit", "rotation_fit", "rotation_only_residuals",
            "refine_centred"]
 
@@ -151,3 +153,24 @@ def refine_centred(rays: RayPairs, R: np.ndarray, t: np.ndarray, **options) -> d
                               np.asarray(t, dtype=np.float64) + R @ c - c, **options)
     out["t"] = out["t"] - out["R"] @ c + c
     return out
+
+
+def find_essential_mat(x1: np.ndarray, x2: np.ndarray, *args, **kwargs
+                       ) -> tuple[Optional[np.ndarray], Optional[np.ndarray]]:
+    """``cv2.findEssentialMat(x1, x2, *args, **kwargs)``, with degenerate data
+    answered the same way by every OpenCV version: ``(None, None)``.
+
+    ``x1``, ``x2``: N x 2 normalised image points (or pixels with the camera
+    matrix in ``args``), as OpenCV takes them. OpenCV 5.1 raises ``cv2.error``
+    (an assertion in ``solvePoly``: the 5-point polynomial's leading
+    coefficient vanishes) on point sets that earlier versions answered with no
+    model, e.g. the identical points of a static rig; both mean "no essential
+    matrix", which the callers already handle (the static-rig test then
+    decides).
+    """
+    import cv2
+    try:
+        return cv2.findEssentialMat(x1, x2, *args, **kwargs)
+    except cv2.error:
+        return None, None
+

@@ -26,7 +26,7 @@ import cv2
 import numpy as np
 
 from ..errors import DegenerateError
-from ..geometry import rcross
+from ..geometry import find_essential_mat, rcross
 from ..types import RayPairs
 
 __all__ = ["LEAST_SQUARES", "USAC_EXPLICIT", "essential_motions", "bearings_planar"]
@@ -158,7 +158,7 @@ def _least_squares_essential(x1: np.ndarray, x2: np.ndarray,
     import cv2
     m = len(x1)
     if m == 5:
-        E, _ = cv2.findEssentialMat(x1, x2, np.eye(3), method=cv2.RANSAC, threshold=1e-3)
+        E, _ = find_essential_mat(x1, x2, np.eye(3), method=cv2.RANSAC, threshold=1e-3)
         return [] if E is None else list(E.reshape(-1, 3, 3))
     # an order invariant to the rig frame (the local image plane's in-plane
     # rotation depends on it): by distance from the image centre
@@ -169,7 +169,7 @@ def _least_squares_essential(x1: np.ndarray, x2: np.ndarray,
         s = order[(j + step * np.arange(5)) % m]
         if len(np.unique(s)) < 5:
             continue
-        E, _ = cv2.findEssentialMat(x1[s], x2[s], np.eye(3), method=cv2.RANSAC,
+        E, _ = find_essential_mat(x1[s], x2[s], np.eye(3), method=cv2.RANSAC,
                                     threshold=1e-3)
         if E is None or E.shape[0] % 3:
             continue
@@ -248,10 +248,10 @@ def essential_motions(rays: RayPairs, index: np.ndarray, centre: np.ndarray,
         Es = _least_squares_essential(x1, x2)
     else:
         if method == USAC_EXPLICIT:
-            E, mask = cv2.findEssentialMat(x1, x2, _I3, _I3, _NO_DISTORTION, _NO_DISTORTION,
+            E, mask = find_essential_mat(x1, x2, _I3, _I3, _NO_DISTORTION, _NO_DISTORTION,
                                            _usac_params(threshold, prob, max_iters))
         else:
-            E, mask = cv2.findEssentialMat(x1, x2, _I3, method=method, prob=prob,
+            E, mask = find_essential_mat(x1, x2, _I3, method=method, prob=prob,
                                            threshold=threshold, maxIters=max_iters)
         if E is None or E.shape[0] % 3 or not np.all(np.isfinite(E)):
             return []

@@ -33,6 +33,7 @@ from typing import Any, Callable, Iterable, Optional, Sequence
 
 import numpy as np
 
+from mcgeom.geometry import find_essential_mat
 from mcgeom.io.images import ImageSequence, read_image
 from mcgeom.rig import Rig
 from mcgeom.sequence.features import FeatureDetector, Keypoints, match_descriptors
@@ -135,7 +136,7 @@ def essential_inliers(rig: Rig, camera: int, pixels1: np.ndarray, pixels2: np.nd
         return out
     x1 = np.ascontiguousarray(b1[ok, :2] / b1[ok, 2:])
     x2 = np.ascontiguousarray(b2[ok, :2] / b2[ok, 2:])
-    E, mask = cv2.findEssentialMat(x1, x2, np.eye(3), method=cv2.RANSAC, prob=prob,
+    E, mask = find_essential_mat(x1, x2, np.eye(3), method=cv2.RANSAC, prob=prob,
                                    threshold=threshold_px / _focal(cam))
     if E is None or mask is None:
         # RANSAC found no model (degenerate configuration): keep them all, the

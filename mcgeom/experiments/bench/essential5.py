@@ -23,6 +23,7 @@ import cv2
 import numpy as np
 
 from ... import _core
+from ...geometry import find_essential_mat
 from ..common import MissingPeerError, Progress, import_peer, no_progress
 from .timing import best_of
 
@@ -69,7 +70,7 @@ def random_problems(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.n
 def _opencv(a: np.ndarray, b: np.ndarray) -> list:
     p1 = a[:, :2] / a[:, 2:]
     p2 = b[:, :2] / b[:, 2:]
-    E, _ = cv2.findEssentialMat(p1, p2, np.eye(3), method=cv2.RANSAC, prob=0.999,
+    E, _ = find_essential_mat(p1, p2, np.eye(3), method=cv2.RANSAC, prob=0.999,
                                 threshold=1e-3)
     return [] if E is None else list(E.reshape(-1, 3, 3))
 
