@@ -33,9 +33,12 @@ def _given(name, R, g1=G1):
     """Options of an estimator that needs the rotation: the true one, expressed
     as the test's transformed data require (conjugated, inverted); of one that
     takes the vertical (``gravity1``/``gravity2``, e.g. an IMU's): ``g1`` in rig
-    frame 1 (re-expressed likewise) and ``R g1`` in rig frame 2."""
+    frame 1 (re-expressed likewise) and ``R g1`` in rig frame 2. The rotation
+    is exact, and said so where the estimator takes its error (``rotation_std``)."""
     info = registry.get(name)
     out = {"rotation": R} if info.needs_rotation else {}
+    if "rotation_std" in info.options:
+        out["rotation_std"] = 0.0
     if "gravity1" in info.options:
         out.update(gravity1=g1, gravity2=R @ g1)
     return out
