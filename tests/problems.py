@@ -61,3 +61,15 @@ def rigid(rng: np.random.Generator):
 
 
 rot_err = metrics.rotation_error  # angle (rad) between two rotations, accurate near zero
+
+
+def turning_motion(rng: np.random.Generator, max_angle: float = 0.3,
+                   min_angle: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
+    """A motion that is far from the critical one: a random rotation of at
+    least ``min_angle`` radians (drawn up to ``max_angle``) and a unit t."""
+    R = synth.random_rotation(rng, max_angle)
+    while metrics.rotation_error(R, np.eye(3)) < min_angle:
+        R = synth.random_rotation(rng, max_angle)
+    t = rng.normal(size=3)
+    return R, t / np.linalg.norm(t)
+

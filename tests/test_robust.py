@@ -6,19 +6,15 @@ import numpy as np
 import pytest
 
 import mcgeom
-from mcgeom import metrics, robust, synth
+from mcgeom import robust, synth
 from mcgeom.cv import estimate as cv_estimate
-from problems import rot_err
+from problems import rot_err, turning_motion
 
 
 def _ladybug_problem(seed, n=300, outliers=0.3, noise=0.5):
     rng = np.random.default_rng(seed)
     rig = synth.ladybug2()
-    R = synth.random_rotation(rng, 0.3)
-    while metrics.rotation_error(R, np.eye(3)) < 0.1:
-        R = synth.random_rotation(rng, 0.3)
-    t = rng.normal(size=3)
-    t *= 1.0 / np.linalg.norm(t)
+    R, t = turning_motion(rng)
     return synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outliers)
 
 

@@ -6,20 +6,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mcgeom import _core, metrics, robust, synth
+from mcgeom import _core, robust, synth
 from mcgeom.observability import scale_profile
 from mcgeom.pixel_noise import camera_table, pixels_per_radian
-from problems import rot_err
+from problems import rot_err, turning_motion
 
 
 def _problem(seed, n=300, outliers=0.3, cross=0.2):
     rng = np.random.default_rng(seed)
     rig = synth.ladybug2()
-    R = synth.random_rotation(rng, 0.3)
-    while metrics.rotation_error(R, np.eye(3)) < 0.1:
-        R = synth.random_rotation(rng, 0.3)
-    t = rng.normal(size=3)
-    t /= np.linalg.norm(t)
+    R, t = turning_motion(rng)
     p = synth.make_problem(rig, R, t, n, rng, pixel_noise=0.5, outlier_fraction=outliers,
                            cross_fraction=cross)
     return rig, p, R, t
