@@ -301,6 +301,24 @@ static void polish(const double *d1, const double *m1, const double *d2, const d
     }
 }
 
+/* One ray in the upright frame Q (vertical along z): its unit direction
+ * e = Q d inv_norm and the moment n = (Q (o - c) / s) x e of the line through
+ * the normalised origin (Pluecker coordinates, thesis ch. 2.3). */
+static void upright_line(const double Q[9], const double d[3], double inv_norm,
+                         const double o[3], const double c[3], double s, double e[3],
+                         double n[3])
+{
+    double a[3], b[3], u[3];
+    int i;
+    for (i = 0; i < 3; ++i) {
+        a[i] = d[i] * inv_norm;
+        b[i] = (o[i] - c[i]) / s;
+    }
+    mat_vec(Q, a, e);
+    mat_vec(Q, b, u);
+    cross3(u, e, n);
+}
+
 int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
                  const double d2[12], const double g1[3], const double g2[3], double R[72],
                  double t[24], int *n_solutions)
@@ -340,27 +358,11 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
     if (!(s > 0.0))
         s = 1.0; /* one centre: central rays, no metric scale (handled below) */
     for (k = 0; k < 4; ++k) {
-        double a[3], b[3], x, y;
-        x = dot3(d1 + 3 * k, d1 + 3 * k);
-        y = dot3(d2 + 3 * k, d2 + 3 * k);
+        double x = dot3(d1 + 3 * k, d1 + 3 * k), y = dot3(d2 + 3 * k, d2 + 3 * k);
         if (!(x >= DIR2_MIN && y >= DIR2_MIN && isfinite(x) && isfinite(y)))
             return MCG_EINVAL;
-        x = 1.0 / sqrt(x);
-        y = 1.0 / sqrt(y);
-        for (i = 0; i < 3; ++i) {
-            a[i] = d1[3 * k + i] * x;
-            b[i] = (o1[3 * k + i] - c[i]) / s;
-        }
-        mat_vec(Q1, a, e1 + 3 * k);
-        mat_vec(Q1, b, u1);
-        cross3(u1, e1 + 3 * k, n1 + 3 * k);
-        for (i = 0; i < 3; ++i) {
-            a[i] = d2[3 * k + i] * y;
-            b[i] = (o2[3 * k + i] - c[i]) / s;
-        }
-        mat_vec(Q2, a, e2 + 3 * k);
-        mat_vec(Q2, b, u2);
-        cross3(u2, e2 + 3 * k, n2 + 3 * k);
+        upright_line(Q1, d1 + 3 * k, 1.0 / sqrt(x), o1 + 3 * k, c, s, e1 + 3 * k, n1 + 3 * k);
+        upright_line(Q2, d2 + 3 * k, 1.0 / sqrt(y), o2 + 3 * k, c, s, e2 + 3 * k, n2 + 3 * k);
     }
     /* (U2): the coefficient matrices of q^0, q^1, q^2 */
     memset(P, 0, sizeof P);
