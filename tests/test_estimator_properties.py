@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, example, given, settings, strategies as st
 
 import mcgeom
 from mcgeom import registry
@@ -167,6 +167,9 @@ SCALE_CASES = [(e.name, kind) for e in registry.list_estimators()
 @pytest.mark.parametrize("name,kind", SCALE_CASES)
 @SETTINGS
 @given(seed=seeds)
+# six_point, 2-camera head: a spurious minimal solution with a tiny t explained
+# every ray and the refinement stalled there (CI, 2026-12-02)
+@example(seed=233693993)
 def test_critical_motion_reported(name, kind, seed):
     """No rotation and only intra-camera rays: |t| is not observable (ch. 7.3.2);
     the rotation and the direction of t must still be right."""
