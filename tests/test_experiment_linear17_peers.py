@@ -80,3 +80,11 @@ def test_run_and_table_without_opengv(capsys):
     assert exp.run_cli(args) == 0
     out = capsys.readouterr().out
     assert "OpenGV not available" in out and "noise-free" in out and "mcgeom" in out
+
+
+def test_agreement_and_paired_with_another_reference():
+    e = np.array([[0.01, 0.02, 1e-4, 1.0], [0.03, 0.01, 1e-4, 0.0]])
+    res = {CASE: {"mcgeom": e, "opengv": e + [0.01, 0.0, 0, 0], "numpy:opengv": e + [0.01, 0, 0, 0]}}
+    assert "rotation 0.0e+00 deg  scale 0.0e+00" in exp.agreement(res)
+    text = exp.linear17_accuracy.paired(res, "mcgeom", ref="opengv")
+    assert text.startswith("opengv vs mcgeom") and "1.00" in text     # mcgeom better in both trials
