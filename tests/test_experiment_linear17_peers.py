@@ -43,7 +43,12 @@ def test_noise_free_mcgeom_is_exact_and_missing_opengv_is_reported():
         assert "OpenGV not available" in note and "--opengv" in note
 
 
-def test_opengv_option_errors(tmp_path):
+def test_opengv_option_errors(tmp_path, capsys):
+    ap = argparse.ArgumentParser()
+    exp.add_arguments(ap)
+    with pytest.raises(SystemExit) as stop:          # a usage error, not a traceback
+        ap.parse_args(["--opengv", str(tmp_path / "nowhere")])
+    assert stop.value.code == 2 and "--opengv" in capsys.readouterr().err
     with pytest.raises(ValueError, match="--opengv"):
         exp.load_opengv(str(tmp_path / "nowhere"))
     mod, note = exp.load_opengv(str(tmp_path))          # a folder without the module

@@ -118,6 +118,15 @@ def load_opengv(path: Optional[str] = None) -> tuple[Optional[ModuleType], str]:
     return mod, f"OpenGV: {file}"
 
 
+def _opengv_path(text: str) -> str:
+    """argparse type of ``--opengv``: an existing file or folder (a usage
+    error, exit code 2, otherwise)."""
+    if not os.path.exists(text):
+        raise argparse.ArgumentTypeError(f"{text!r} does not exist (give the {OPENGV_MODULE} "
+                                         "extension module or the folder that holds it)")
+    return text
+
+
 def _unit(d: np.ndarray) -> np.ndarray:
     return d / np.linalg.norm(d, axis=1, keepdims=True)
 
@@ -261,7 +270,7 @@ def agreement(res: dict, a: str = "opengv", b: str = "numpy:opengv") -> str:
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment linear17_peers``."""
     add_count_and_seed(ap, "--trials", 100, "problems per case")
-    ap.add_argument("--opengv", default=None, metavar="PATH",
+    ap.add_argument("--opengv", default=None, metavar="PATH", type=_opengv_path,
                     help=f"the {OPENGV_MODULE} extension module built against OpenGV, or its "
                          "folder (default: import it from sys.path; absent: mcgeom alone)")
     ap.add_argument("--variants", nargs="*", default=[], metavar="NAME",
