@@ -30,6 +30,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
     "linear17_accuracy": ("linear17_accuracy", "issue 22: the steps of linear17 varied one "
                                                "at a time against OpenGV's reported approach "
                                                "and the previous version, paired"),
+    "linear17_peers": ("linear17_peers", "issue 22: linear17 next to OpenGV's seventeenpt on "
+                                         "identical rays of the issue's five cases (needs a "
+                                         "user-built OpenGV module, else mcgeom alone)"),
     "minimal_5p1": ("minimal_5p1", "noise-free minimal 5+1 samples: how often the true "
                                    "motion is among the solutions"),
     "calibration_coverage": ("calibration_coverage", "synthetic rigs with perturbed "

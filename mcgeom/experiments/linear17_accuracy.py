@@ -293,18 +293,19 @@ def table(res: dict) -> str:
                                for v, e in variants.items()])
 
 
-def paired(res: dict, against: str, boot: int = 2000, seed: int = 1) -> str:
-    """The kernel against variant ``against`` on the same trials: the fraction
-    of trials where ``against`` is more accurate and the median per-trial
-    difference (kernel - against) with a bootstrap 95 % interval, for the
-    rotation and the scale error."""
+def paired(res: dict, against: str, boot: int = 2000, seed: int = 1,
+           ref: str = "kernel") -> str:
+    """Variant ``ref`` (default the kernel) against variant ``against`` on the
+    same trials: the fraction of trials where ``against`` is more accurate and
+    the median per-trial difference (ref - against) with a bootstrap 95 %
+    interval, for the rotation and the scale error."""
     rng = np.random.default_rng(seed)
-    lines = [f"kernel vs {against}: fraction of trials where {against} is more accurate; "
-             "median per-trial difference (kernel - other) [95% CI]",
+    lines = [f"{ref} vs {against}: fraction of trials where {against} is more accurate; "
+             f"median per-trial difference ({ref} - other) [95% CI]",
              f"{'case':<27} {'rot: other better':>17} {'rot diff deg':>32} "
              f"{'scale: other better':>19} {'scale diff':>32}"]
     for case, variants in res.items():
-        a, b = variants["kernel"], variants[against]
+        a, b = variants[ref], variants[against]
         cells = []
         for col in (0, 1):
             d = a[:, col] - b[:, col]
