@@ -100,6 +100,11 @@
  * (issue 19: 1e6 pairs in under 2 s; the full refinement took 10 steps of
  * all pairs, twice, and the profile two more such fits). */
 #define FINAL_SUB 4096
+/* mcgeom.observability's ZERO_FACTOR (|t| shrunk to 1 %: a static rig?) and
+ * UNDETERMINED_REL_STD (above it the data define no metric scale at all);
+ * tests/test_robust_c.py checks that the two copies agree */
+#define ZERO_FACTOR 0.01
+#define UNDETERMINED_REL_STD 1.0
 #define FINAL_POLISH 3
 /* Steps of the local optimisation's refinement: LO only has to improve the
  * inlier set (the final stage converges on all of them); the LM runs of LO
@@ -1339,9 +1344,8 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
  * matters only near the 9 of the verdict, where the scale of m > 4096 pairs
  * is seldom). Keeps the profile's cost independent of N (issue 19). */
 static double scale_profile(ctx *c, const mcg_robust_result *res, const unsigned char *mask,
-                            const double *weights)
+                            const double *weights, const double *f, int nf)
 {
-    const double k = 1.0 + 3.0 * c->opt.max_scale_rel_std, f[2] = {1.0 / k, k};
     double cen[3], worst = INFINITY, rc[3], shift[3], base, gain = 1.0;
     int j, i, m;
     const mcg_refine_result *fr = &res->refinement;
@@ -1369,7 +1373,7 @@ static double scale_profile(ctx *c, const mcg_robust_result *res, const unsigned
     mat_vec(res->R, cen, rc);
     for (i = 0; i < 3; i++)
         shift[i] = rc[i] - cen[i];
-    for (j = 0; j < 2; j++) {
+    for (j = 0; j < nf; j++) {
         double R[9], t[3];
         mcg_refine_result rr;
         memcpy(R, res->R, sizeof R);
@@ -1513,16 +1517,36 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         finish(&c, res, mask, weights);
     memcpy(res->R, c.R, sizeof c.R);
     memcpy(res->t, c.t, sizeof c.t);
-    if (res->refined && c.opt.max_scale_rel_std > 0.0 &&
-        res->refinement.scale_rel_std <= c.opt.max_scale_rel_std)
-        res->scale_profile = scale_profile(
-            &c, res, mask,
-            weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL));
+    res->zero_profile = NAN;
+    if (res->refined && c.opt.max_scale_rel_std > 0.0) {
+        const double *wp =
+            weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL);
+        const double srs = res->refinement.scale_rel_std,
+                     k1 = 1.0 + 3.0 * c.opt.max_scale_rel_std;
+        const double f[2] = {1.0 / k1, k1}, f0[1] = {ZERO_FACTOR};
+        if (srs <= c.opt.max_scale_rel_std)
+            res->scale_profile = scale_profile(&c, res, mask, wp, f, 2);
+        /* "could the cameras not have moved at all?" where the verdict will
+         * not call the scale observable but it may still be determined
+         * (mcgeom.observability.scale_determined: the profile at
+         * ZERO_FACTOR decides; Python computed it in numpy before) */
+        if (srs <= UNDETERMINED_REL_STD &&
+            (srs > c.opt.max_scale_rel_std || !(res->scale_profile >= 9.0)))
+            res->zero_profile = scale_profile(&c, res, mask, wp, f0, 1);
+    }
     res->n_inliers = 0;
-    for (k = 0; k < n; k++) {
-        int in = c.rbest[k] < c.opt.threshold;
-        mask[k] = (unsigned char)((mask[k] & 2) | in);
-        res->n_inliers += in;
+    res->inlier_rms = NAN;
+    {
+        double ss = 0.0;
+        for (k = 0; k < n; k++) {
+            int in = c.rbest[k] < c.opt.threshold;
+            mask[k] = (unsigned char)((mask[k] & 2) | in);
+            res->n_inliers += in;
+            if (in)
+                ss += c.rbest[k] * c.rbest[k];
+        }
+        if (res->n_inliers > 0)
+            res->inlier_rms = sqrt(ss / res->n_inliers);
     }
     res->seconds = now_seconds() - t_start;
     return MCG_OK;
