@@ -32,6 +32,8 @@
 #include <stddef.h>
 
 #define MAX_VERDICT_CAMERAS 4096
+/* origins, R and t beyond this overflow the products of the mid-point test */
+#define MAX_MAGNITUDE 1e150
 
 size_t mcg_verdict_stats_work_size(int n_cameras)
 {
@@ -43,15 +45,20 @@ size_t mcg_verdict_stats_work_size(int n_cameras)
            3 * (size_t)n_cameras + 1;
 }
 
-/* Unit copy of a 3-vector; 0 when its length is not positive and finite. */
+/* Unit copy of a 3-vector; 0 when its length is not positive and finite
+ * (scaled by its largest entry first: no underflow of tiny vectors). */
 static int unit(const double *v, double u[3])
 {
-    double s = sqrt(dot3(v, v));
-    if (!(s > 0.0 && isfinite(s)))
+    double m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2]))), s;
+    if (!(m > 0.0 && isfinite(m)))
         return 0;
-    u[0] = v[0] / s;
-    u[1] = v[1] / s;
-    u[2] = v[2] / s;
+    u[0] = v[0] / m;
+    u[1] = v[1] / m;
+    u[2] = v[2] / m;
+    s = sqrt(dot3(u, u));
+    u[0] /= s;
+    u[1] /= s;
+    u[2] /= s;
     return 1;
 }
 
@@ -127,6 +134,12 @@ static int check_args(int n, const double *o1, const double *d1, const double *o
     if (!all_finite(o1, 3 * (size_t)n) || !all_finite(d1, 3 * (size_t)n) ||
         !all_finite(o2, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
         return 0;
+    for (k = 0; k < 9; ++k)
+        if (fabs(R[k]) > MAX_MAGNITUDE || (k < 3 && fabs(t[k]) > MAX_MAGNITUDE))
+            return 0;
+    for (k = 0; k < 3 * n; ++k)
+        if (fabs(o1[k]) > MAX_MAGNITUDE || fabs(o2[k]) > MAX_MAGNITUDE)
+            return 0;
     for (k = 0; k < n; ++k) {
         double u[3];
         if (cam1[k] < 0 || cam1[k] >= n_cameras || cam2[k] < 0 || cam2[k] >= n_cameras)

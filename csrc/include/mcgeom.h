@@ -1116,7 +1116,8 @@ size_t mcg_verdict_stats_work_size(int n_cameras);
  * over the pairs for the counts and the fit, one for the angles, three for
  * cheirality (cost O(n + n_cameras^2)). MCG_EINVAL: NULL pointers, n
  * outside [0, 2^20], n_cameras, ids out of range, NaN/inf, a zero
- * direction, still_angle; MCG_ENOMEM: lwork below
+ * direction, origins, R or t
+ * entries above 1e150 in magnitude, still_angle; MCG_ENOMEM: lwork below
  * mcg_verdict_stats_work_size. */
 int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o2,
                       const double *d2, const int *cam1, const int *cam2, int n_cameras,
