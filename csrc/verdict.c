@@ -46,10 +46,19 @@ size_t mcg_verdict_stats_work_size(int n_cameras)
 }
 
 /* Unit copy of a 3-vector; 0 when its length is not positive and finite
- * (scaled by its largest entry first: no underflow of tiny vectors). */
+ * (outside the safe range of the squared length, scaled by its largest
+ * entry first: no underflow of tiny vectors, no overflow of huge ones). */
 static int unit(const double *v, double u[3])
 {
-    double m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2]))), s;
+    double m, s = dot3(v, v);
+    if (s > 1e-280 && s < 1e280) {
+        s = 1.0 / sqrt(s);
+        u[0] = v[0] * s;
+        u[1] = v[1] * s;
+        u[2] = v[2] * s;
+        return 1;
+    }
+    m = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
     if (!(m > 0.0 && isfinite(m)))
         return 0;
     u[0] = v[0] / m;
@@ -62,38 +71,39 @@ static int unit(const double *v, double u[3])
     return 1;
 }
 
-/* Mid-point depths of the rays p + s1 a and q + s2 b: 1 when both are
- * positive and the rays are not parallel (den > 1e-14 |a|^2 |b|^2, the test
- * of mcgeom.geometry.counts_in_front), w = q - p. */
-static int front(const double a[3], const double b[3], const double w[3])
+/* Inliers in front at each of the nt translations T (nt x 3), in one pass
+ * (R d1 and d2 as they are): the translation enters the mid-point depths
+ * only through a.w and b.w, w = o2 - R o1 - T, affine in T. */
+static void count_front(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const unsigned char *inlier, const double R[9],
+                        const double *T, int nt, int *count)
 {
-    const double aa = dot3(a, a), bb = dot3(b, b), ab = dot3(a, b);
-    const double aw = dot3(a, w), bw = dot3(b, w), den = aa * bb - ab * ab;
-    double s1, s2;
-    if (!(den > 1e-14 * aa * bb))
-        return 0;
-    s1 = (aw * bb - bw * ab) / den;
-    s2 = (aw * ab - bw * aa) / den;
-    return s1 > 0.0 && s2 > 0.0;
-}
-
-/* Inliers in front at the translation t0 + v (R d1 and d2 as they are). */
-static int count_front(int n, const double *o1, const double *d1, const double *o2,
-                       const double *d2, const unsigned char *inlier, const double R[9],
-                       const double t0[3], const double v[3])
-{
-    int k, i, count = 0;
+    int k, i, j;
+    for (j = 0; j < nt; ++j)
+        count[j] = 0;
     for (k = 0; k < n; ++k) {
-        double a[3], p[3], w[3];
+        double a[3], p[3], w[3], aa, bb, ab, aw0, bw0, den;
+        const double *b = d2 + 3 * k;
         if (!(inlier[k] & 1))
             continue;
         mat_vec(R, d1 + 3 * k, a);
         mat_vec(R, o1 + 3 * k, p);
         for (i = 0; i < 3; ++i)
-            w[i] = o2[3 * k + i] - (p[i] + t0[i] + v[i]);
-        count += front(a, d2 + 3 * k, w);
+            w[i] = o2[3 * k + i] - p[i];
+        aa = dot3(a, a);
+        bb = dot3(b, b);
+        ab = dot3(a, b);
+        den = aa * bb - ab * ab;
+        if (!(den > 1e-14 * aa * bb))
+            continue; /* parallel rays: no depth (mcgeom.geometry.counts_in_front) */
+        aw0 = dot3(a, w);
+        bw0 = dot3(b, w);
+        for (j = 0; j < nt; ++j) {
+            const double aw = aw0 - dot3(a, T + 3 * j), bw = bw0 - dot3(b, T + 3 * j);
+            const double s1 = (aw * bb - bw * ab) / den, s2 = (aw * ab - bw * aa) / den;
+            count[j] += s1 > 0.0 && s2 > 0.0;
+        }
     }
-    return count;
 }
 
 /* The largest folded angle between the displacement lines of the centres
@@ -141,10 +151,11 @@ static int check_args(int n, const double *o1, const double *d1, const double *o
         if (fabs(o1[k]) > MAX_MAGNITUDE || fabs(o2[k]) > MAX_MAGNITUDE)
             return 0;
     for (k = 0; k < n; ++k) {
-        double u[3];
+        const double *a = d1 + 3 * k, *b = d2 + 3 * k;
         if (cam1[k] < 0 || cam1[k] >= n_cameras || cam2[k] < 0 || cam2[k] >= n_cameras)
             return 0;
-        if (!unit(d1 + 3 * k, u) || !unit(d2 + 3 * k, u))
+        if ((a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0) ||
+            (b[0] == 0.0 && b[1] == 0.0 && b[2] == 0.0))
             return 0;
     }
     return 1;
@@ -233,13 +244,9 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
     }
     out->critical_angle = out->n_cameras_intra >= 2 ? largest_angle(disp, n_c) : 0.0;
 
-    /* cheirality at (R, t) */
-    {
-        const double zero[3] = {0.0, 0.0, 0.0};
-        out->n_in_front = count_front(n, o1, d1, o2, d2, inlier, R, t, zero);
-    }
-
-    /* the direction of travel (travel_direction) */
+    /* the direction of travel (travel_direction): the centroid's motion,
+     * its sign by cheirality at a length L where the rotation-induced part
+     * is negligible; cheirality at (R, t) in the same pass */
     if (out->n_inliers > 0)
         for (i = 0; i < 3; ++i)
             c[i] /= out->n_inliers;
@@ -251,9 +258,12 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
     for (i = 0; i < 3; ++i)
         tau[i] = nt >= 20.0 * ns ? t[i] : t[i] + shift[i];
     if (!unit(tau, out->t_direction)) {
+        int count;
         const double m = nt > 1e-300 ? nt : 1e-300;
         for (i = 0; i < 3; ++i)
             out->t_direction[i] = t[i] / m;
+        count_front(n, o1, d1, o2, d2, inlier, R, t, 1, &count);
+        out->n_in_front = count;
         return MCG_OK;
     }
     for (k = 0; k < n; ++k)
@@ -265,19 +275,16 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
         }
     spread = out->n_inliers > 0 ? sqrt(spread / out->n_inliers) : 1.0;
     {
-        double L = 1.0, v[3], mshift[3];
-        int plus, minus;
-        L = fmax(L, 100.0 * spread);
-        L = fmax(L, 100.0 * ns);
+        double L = fmax(1.0, fmax(100.0 * spread, 100.0 * ns)), T[9];
+        int count[3];
         for (i = 0; i < 3; ++i) {
-            v[i] = L * out->t_direction[i];
-            mshift[i] = -shift[i];
+            T[i] = t[i];
+            T[3 + i] = -shift[i] + L * out->t_direction[i];
+            T[6 + i] = -shift[i] - L * out->t_direction[i];
         }
-        plus = count_front(n, o1, d1, o2, d2, inlier, R, mshift, v);
-        for (i = 0; i < 3; ++i)
-            v[i] = -v[i];
-        minus = count_front(n, o1, d1, o2, d2, inlier, R, mshift, v);
-        if (plus < minus)
+        count_front(n, o1, d1, o2, d2, inlier, R, T, 3, count);
+        out->n_in_front = count[0];
+        if (count[1] < count[2])
             for (i = 0; i < 3; ++i)
                 out->t_direction[i] = -out->t_direction[i];
     }

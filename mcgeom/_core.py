@@ -1319,9 +1319,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     if st == lib.MCG_EDEGENERATE:
         return None
     if st != lib.MCG_OK:
-        if st == lib.MCG_EINVAL and f is not None and not (np.isfinite(f).all() and
-                                                            (f > 0).all()):
-            raise ValueError("focal must be finite and > 0 (pixels per radian)")
+        if st == lib.MCG_EINVAL:
+            _camera_id_error(ids, int(n_cameras))
+            if f is not None and not (np.isfinite(f).all() and (f > 0).all()):
+                raise ValueError("focal must be finite and > 0 (pixels per radian)")
         _ray_error(st, "robust_rig_motion", rays)
     R = np.frombuffer(ffi.buffer(res.R), dtype=np.float64).reshape(3, 3).copy()
     t = np.frombuffer(ffi.buffer(res.t), dtype=np.float64).copy()
@@ -1341,8 +1342,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
 
 def _camera_id_arrays(cam1: Any, cam2: Any, n: int, n_cameras: Any
                       ) -> tuple[np.ndarray, np.ndarray]:
-    """``cam1``, ``cam2`` as int32 C arrays of ``n`` ids in ``[0, n_cameras)``
-    (ValueError naming the argument otherwise)."""
+    """``cam1``, ``cam2`` as int32 C arrays of ``n`` integer ids (shape and dtype
+    checked; the range ``[0, n_cameras)`` is the kernel's to check, and
+    :func:`_camera_id_error` names the argument on its MCG_EINVAL)."""
     if isinstance(n_cameras, bool) or not isinstance(n_cameras, (int, np.integer)) \
             or not 1 <= int(n_cameras) <= 4096:
         raise ValueError(f"n_cameras must be an integer in 1..4096, got {n_cameras!r}")
@@ -1352,10 +1354,18 @@ def _camera_id_arrays(cam1: Any, cam2: Any, n: int, n_cameras: Any
         if a.shape != (n,) or (n and a.dtype.kind not in "iu"):
             raise ValueError(f"{name} must be {n} integer camera ids, got shape {a.shape} "
                              f"and dtype {a.dtype}")
-        if a.size and (a.min() < 0 or a.max() >= n_cameras):
+        if a.dtype != np.int32 and a.size and (a.min() < 0 or a.max() >= n_cameras):
+            # (int64 ids beyond int32 would wrap in the conversion)
             raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
         ids.append(np.ascontiguousarray(a, dtype=np.int32))
     return ids[0], ids[1]
+
+
+def _camera_id_error(ids: tuple, n_cameras: int) -> None:
+    """After a kernel's MCG_EINVAL: ValueError naming an id array out of range."""
+    for name, a in zip(("cam1", "cam2"), ids):
+        if a.size and (a.min() < 0 or a.max() >= n_cameras):
+            raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
 
 
 # ------------------------------------------------------------- verdict.c
@@ -1396,13 +1406,16 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
                                ffi.from_buffer("unsigned char[]", m), _p(Rm), _p(tv),
                                float(still_angle), out, _p(work), work.size)
     if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL:
+            _camera_id_error((c1, c2), int(n_cameras))
         _ray_error(st, "verdict_stats", rays)
     return {
         "n_inliers": out.n_inliers, "n_intra": out.n_intra, "n_cross": out.n_cross,
         "n_cameras_intra": out.n_cameras_intra, "fit_ok": bool(out.fit_ok),
-        "R_fit": np.array(list(out.R_fit)).reshape(3, 3), "n_still": out.n_still,
-        "critical_angle": out.critical_angle, "n_in_front": out.n_in_front,
-        "t_direction": np.array(list(out.t_direction)),
+        "R_fit": np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy(),
+        "n_still": out.n_still, "critical_angle": out.critical_angle,
+        "n_in_front": out.n_in_front,
+        "t_direction": np.frombuffer(ffi.buffer(out.t_direction), dtype=np.float64).copy(),
     }
 # ------------------------------------------------------------- upright4.c
 

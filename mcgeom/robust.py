@@ -338,7 +338,10 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     n = len(rays)
     if n < need:
         raise ValueError(f"too few correspondences: {method} needs at least {need}, got {n}")
-    rays.check_finite()
+    if not in_c or (method == "five_plus_one" and n == 6):
+        # (the C entry point checks finiteness and zero directions in its own
+        # pass and names the array: no extra numpy passes on its path)
+        rays.check_finite()
     registry.check_distinct(rays, need, method)
     f = _focal_array(focal, n)
     if motion_focal is not None and f is None:
@@ -807,6 +810,10 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             raise ValueError(f"pixel_cameras describes {len(cam_focal)} cameras, the rays "
                              f"use camera ids up to {n_cameras - 1}")
         n_cameras = len(cam_focal)
+    if n_cameras <= _MAX_CAMERAS:
+        # int32 once for both C calls (the search and the verdict's evidence);
+        # ids are >= 0 and below n_cameras here, so nothing wraps
+        cam1, cam2 = cam1.astype(np.int32), cam2.astype(np.int32)
     intra = cam1 == cam2
     if method == "five_plus_one" and not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
         raise ValueError(f"too few correspondences: {method} needs 5 intra-camera "
