@@ -199,6 +199,22 @@ static int check_options(const mcg_robust_options *o)
 /* doubles for n ints (rounded up) */
 static size_t ints_as_doubles(size_t n) { return (n * sizeof(int) + sizeof(double) - 1) / sizeof(double); }
 
+/* Below PREEMPT_MIN pairs the scale search's workspace lies over the
+ * gathered subset (sub, wsub: 13 n doubles), which is dead while
+ * mcg_scale_ransac runs (LO and the final stage gather it afresh; the
+ * preemptive subset that lives in its tail exists only from PREEMPT_MIN):
+ * only what exceeds 13 n is its own (issue 19: the peak memory of a call
+ * on 1e3 pairs was 3.1x its input, mostly this fixed-size workspace). */
+static int scale_work_aliased(int n) { return n < PREEMPT_MIN; }
+
+static size_t scale_work_own(int n)
+{
+    const size_t m = min_sz((size_t)n, SCALE_PAIRS), w = mcg_scale_ransac_work_size((int)m);
+    if (!scale_work_aliased(n))
+        return w;
+    return w > 13 * (size_t)n ? w - 13 * (size_t)n : 0;
+}
+
 size_t mcg_robust_work_size(int n, int n_cameras)
 {
     int ok = 1;
@@ -213,7 +229,7 @@ size_t mcg_robust_work_size(int n, int n_cameras)
     s = add_sz(s, ints_as_doubles(2 * (size_t)n_cameras + 2), &ok);
     /* the scale search: its pairs (12 m), its workspace and order, m <= SCALE_PAIRS */
     nn = min_sz(nn, SCALE_PAIRS);
-    s = add_sz(s, 12 * nn + mcg_scale_ransac_work_size((int)nn) + ints_as_doubles(nn), &ok);
+    s = add_sz(s, 12 * nn + scale_work_own(n) + ints_as_doubles(nn), &ok);
     /* the solutions of one minimal sample (the 6-point solver's are the most) */
     s = add_sz(s, MINIMAL_SOLUTIONS_SIZE, &ok);
     return ok ? s : 0;
@@ -1144,16 +1160,25 @@ static void carve(ctx *c, double *work)
     c->fsc = work + 2 * n;
     c->sub = work + 3 * n;
     c->wsub = work + 15 * n;
-    c->perm = (int *)(work + 16 * n);
-    c->off = (int *)(work + 16 * n + ints_as_doubles(n));
-    c->usable = c->off + c->ncam + 2;
     {
-        size_t m = min_sz(n, SCALE_PAIRS);
-        c->xs = work + 16 * n + ints_as_doubles(n) + ints_as_doubles(2 * (size_t)c->ncam + 2);
-        c->xwork = c->xs + 12 * m;
+        /* (the scale search's own workspace beyond the 13 n of sub and wsub
+         * follows wsub when it lies over them: scale_work_own) */
+        const size_t m = min_sz(n, SCALE_PAIRS), own = scale_work_own(c->n);
+        double *after = work + 16 * n + (scale_work_aliased(c->n) ? own : 0);
+        c->perm = (int *)after;
+        c->off = (int *)(after + ints_as_doubles(n));
+        c->usable = c->off + c->ncam + 2;
+        c->xs = after + ints_as_doubles(n) + ints_as_doubles(2 * (size_t)c->ncam + 2);
         c->lxwork = mcg_scale_ransac_work_size((int)m);
-        c->xorder = (int *)(c->xwork + c->lxwork);
-        c->msol = c->xwork + c->lxwork + ints_as_doubles(m);
+        if (scale_work_aliased(c->n)) {
+            c->xwork = c->sub;
+            c->xorder = (int *)(c->xs + 12 * m);
+            c->msol = c->xs + 12 * m + ints_as_doubles(m);
+        } else {
+            c->xwork = c->xs + 12 * m;
+            c->xorder = (int *)(c->xwork + c->lxwork);
+            c->msol = c->xwork + c->lxwork + ints_as_doubles(m);
+        }
     }
 }
 

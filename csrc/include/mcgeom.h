@@ -1017,8 +1017,9 @@ typedef struct {
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_robust_default_options(mcg_robust_options *opt);
 
-/* Doubles of workspace for mcg_robust_rig_motion: about 16.5 n + 800 (0
- * for n outside [6, 2^26] or n_cameras outside [1, 4096]). */
+/* Doubles of workspace for mcg_robust_rig_motion: about 30 n + 800 up to
+ * 4096 pairs, 17.5 n + 43000 up to 16383, 16.5 n + 106000 beyond (0 for n
+ * outside [6, 2^26] or n_cameras outside [1, 4096]). */
 size_t mcg_robust_work_size(int n, int n_cameras);
 
 /* Robust rig motion rig2_from_rig1 from n ray correspondences with
