@@ -28,22 +28,14 @@ static int c1[N], c2[N];
 static unsigned char inl[N];
 static double work[64];
 
+/* R = exp([th axis/|axis|]x) (the library's Rodrigues, tested in test_linalg.c) */
 static void rot_about(const double axis[3], double th, double r[9])
 {
-    double k[3], n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    double c = cos(th), s = sin(th), v = 1.0 - c;
-    int i, j;
+    double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]), w[3];
+    int i;
     for (i = 0; i < 3; ++i)
-        k[i] = axis[i] / n;
-    for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j)
-            r[3 * i + j] = k[i] * k[j] * v + ((i == j) ? c : 0.0);
-    r[1] -= k[2] * s;
-    r[2] += k[1] * s;
-    r[3] += k[2] * s;
-    r[5] -= k[0] * s;
-    r[6] -= k[1] * s;
-    r[7] += k[0] * s;
+        w[i] = th * axis[i] / n;
+    mcg_rot_from_angle_axis(w, r);
 }
 
 /* A rig of NC cameras on a ring (radius 0.5 m), points 2..20 m out, moving by
