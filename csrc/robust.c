@@ -100,6 +100,11 @@
  * (issue 19: 1e6 pairs in under 2 s; the full refinement took 10 steps of
  * all pairs, twice, and the profile two more such fits). */
 #define FINAL_SUB 4096
+/* mcgeom.observability's ZERO_FACTOR (|t| shrunk to 1 %: a static rig?) and
+ * UNDETERMINED_REL_STD (above it the data define no metric scale at all);
+ * tests/test_robust_c.py checks that the two copies agree */
+#define ZERO_FACTOR 0.01
+#define UNDETERMINED_REL_STD 1.0
 #define FINAL_POLISH 3
 /* Steps of the local optimisation's refinement: LO only has to improve the
  * inlier set (the final stage converges on all of them); the LM runs of LO
@@ -194,6 +199,22 @@ static int check_options(const mcg_robust_options *o)
 /* doubles for n ints (rounded up) */
 static size_t ints_as_doubles(size_t n) { return (n * sizeof(int) + sizeof(double) - 1) / sizeof(double); }
 
+/* Below PREEMPT_MIN pairs the scale search's workspace lies over the
+ * gathered subset (sub, wsub: 13 n doubles), which is dead while
+ * mcg_scale_ransac runs (LO and the final stage gather it afresh; the
+ * preemptive subset that lives in its tail exists only from PREEMPT_MIN):
+ * only what exceeds 13 n is its own (issue 19: the peak memory of a call
+ * on 1e3 pairs was 3.1x its input, mostly this fixed-size workspace). */
+static int scale_work_aliased(int n) { return n < PREEMPT_MIN; }
+
+static size_t scale_work_own(int n)
+{
+    const size_t m = min_sz((size_t)n, SCALE_PAIRS), w = mcg_scale_ransac_work_size((int)m);
+    if (!scale_work_aliased(n))
+        return w;
+    return w > 13 * (size_t)n ? w - 13 * (size_t)n : 0;
+}
+
 size_t mcg_robust_work_size(int n, int n_cameras)
 {
     int ok = 1;
@@ -208,7 +229,7 @@ size_t mcg_robust_work_size(int n, int n_cameras)
     s = add_sz(s, ints_as_doubles(2 * (size_t)n_cameras + 2), &ok);
     /* the scale search: its pairs (12 m), its workspace and order, m <= SCALE_PAIRS */
     nn = min_sz(nn, SCALE_PAIRS);
-    s = add_sz(s, 12 * nn + mcg_scale_ransac_work_size((int)nn) + ints_as_doubles(nn), &ok);
+    s = add_sz(s, 12 * nn + scale_work_own(n) + ints_as_doubles(nn), &ok);
     /* the solutions of one minimal sample (the 6-point solver's are the most) */
     s = add_sz(s, MINIMAL_SOLUTIONS_SIZE, &ok);
     return ok ? s : 0;
@@ -1139,16 +1160,25 @@ static void carve(ctx *c, double *work)
     c->fsc = work + 2 * n;
     c->sub = work + 3 * n;
     c->wsub = work + 15 * n;
-    c->perm = (int *)(work + 16 * n);
-    c->off = (int *)(work + 16 * n + ints_as_doubles(n));
-    c->usable = c->off + c->ncam + 2;
     {
-        size_t m = min_sz(n, SCALE_PAIRS);
-        c->xs = work + 16 * n + ints_as_doubles(n) + ints_as_doubles(2 * (size_t)c->ncam + 2);
-        c->xwork = c->xs + 12 * m;
+        /* (the scale search's own workspace beyond the 13 n of sub and wsub
+         * follows wsub when it lies over them: scale_work_own) */
+        const size_t m = min_sz(n, SCALE_PAIRS), own = scale_work_own(c->n);
+        double *after = work + 16 * n + (scale_work_aliased(c->n) ? own : 0);
+        c->perm = (int *)after;
+        c->off = (int *)(after + ints_as_doubles(n));
+        c->usable = c->off + c->ncam + 2;
+        c->xs = after + ints_as_doubles(n) + ints_as_doubles(2 * (size_t)c->ncam + 2);
         c->lxwork = mcg_scale_ransac_work_size((int)m);
-        c->xorder = (int *)(c->xwork + c->lxwork);
-        c->msol = c->xwork + c->lxwork + ints_as_doubles(m);
+        if (scale_work_aliased(c->n)) {
+            c->xwork = c->sub;
+            c->xorder = (int *)(c->xs + 12 * m);
+            c->msol = c->xs + 12 * m + ints_as_doubles(m);
+        } else {
+            c->xwork = c->xs + 12 * m;
+            c->xorder = (int *)(c->xwork + c->lxwork);
+            c->msol = c->xwork + c->lxwork + ints_as_doubles(m);
+        }
     }
 }
 
@@ -1339,9 +1369,8 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
  * matters only near the 9 of the verdict, where the scale of m > 4096 pairs
  * is seldom). Keeps the profile's cost independent of N (issue 19). */
 static double scale_profile(ctx *c, const mcg_robust_result *res, const unsigned char *mask,
-                            const double *weights)
+                            const double *weights, const double *f, int nf)
 {
-    const double k = 1.0 + 3.0 * c->opt.max_scale_rel_std, f[2] = {1.0 / k, k};
     double cen[3], worst = INFINITY, rc[3], shift[3], base, gain = 1.0;
     int j, i, m;
     const mcg_refine_result *fr = &res->refinement;
@@ -1369,7 +1398,7 @@ static double scale_profile(ctx *c, const mcg_robust_result *res, const unsigned
     mat_vec(res->R, cen, rc);
     for (i = 0; i < 3; i++)
         shift[i] = rc[i] - cen[i];
-    for (j = 0; j < 2; j++) {
+    for (j = 0; j < nf; j++) {
         double R[9], t[3];
         mcg_refine_result rr;
         memcpy(R, res->R, sizeof R);
@@ -1513,16 +1542,36 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         finish(&c, res, mask, weights);
     memcpy(res->R, c.R, sizeof c.R);
     memcpy(res->t, c.t, sizeof c.t);
-    if (res->refined && c.opt.max_scale_rel_std > 0.0 &&
-        res->refinement.scale_rel_std <= c.opt.max_scale_rel_std)
-        res->scale_profile = scale_profile(
-            &c, res, mask,
-            weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL));
+    res->zero_profile = NAN;
+    if (res->refined && c.opt.max_scale_rel_std > 0.0) {
+        const double *wp =
+            weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL);
+        const double srs = res->refinement.scale_rel_std,
+                     k1 = 1.0 + 3.0 * c.opt.max_scale_rel_std;
+        const double f[2] = {1.0 / k1, k1}, f0[1] = {ZERO_FACTOR};
+        if (srs <= c.opt.max_scale_rel_std)
+            res->scale_profile = scale_profile(&c, res, mask, wp, f, 2);
+        /* "could the cameras not have moved at all?" where the verdict will
+         * not call the scale observable but it may still be determined
+         * (mcgeom.observability.scale_determined: the profile at
+         * ZERO_FACTOR decides; Python computed it in numpy before) */
+        if (srs <= UNDETERMINED_REL_STD &&
+            (srs > c.opt.max_scale_rel_std || !(res->scale_profile >= 9.0)))
+            res->zero_profile = scale_profile(&c, res, mask, wp, f0, 1);
+    }
     res->n_inliers = 0;
-    for (k = 0; k < n; k++) {
-        int in = c.rbest[k] < c.opt.threshold;
-        mask[k] = (unsigned char)((mask[k] & 2) | in);
-        res->n_inliers += in;
+    res->inlier_rms = NAN;
+    {
+        double ss = 0.0;
+        for (k = 0; k < n; k++) {
+            int in = c.rbest[k] < c.opt.threshold;
+            mask[k] = (unsigned char)((mask[k] & 2) | in);
+            res->n_inliers += in;
+            if (in)
+                ss += c.rbest[k] * c.rbest[k];
+        }
+        if (res->n_inliers > 0)
+            res->inlier_rms = sqrt(ss / res->n_inliers);
     }
     res->seconds = now_seconds() - t_start;
     return MCG_OK;

@@ -1233,29 +1233,21 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     ``iterations``, ``hypotheses``, ``local_optimizations``, ``stop`` (a name
     of ``ROBUST_STOP_NAMES``), ``seconds`` and ``refinement`` (the dict of
     :func:`refine_motion` of the final refinement, or None if it did not run),
-    ``scale_profile`` (NaN if not computed).
+    ``scale_profile`` (NaN if not computed), ``zero_profile`` (the same at the
+    factor 0.01, NaN if not computed), ``inlier_rms`` (RMS residual of the
+    inliers, pixels with ``focal``, else radians), ``mask`` (N,) uint8 (bit 0
+    inlier, bit 1 used).
     Raises ValueError naming the bad argument.
     """
     rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
     n = rays[0].shape[0]
-    ids = []
-    for name, c in (("cam1", cam1), ("cam2", cam2)):
-        a = np.asarray(c)
-        if a.shape != (n,) or (n and a.dtype.kind not in "iu"):
-            raise ValueError(f"{name} must be {n} integer camera ids, got shape {a.shape} "
-                             f"and dtype {a.dtype}")
-        ids.append(np.ascontiguousarray(a, dtype=np.int32))
-    if isinstance(n_cameras, bool) or not isinstance(n_cameras, (int, np.integer)) \
-            or not 1 <= int(n_cameras) <= 4096:
-        raise ValueError(f"n_cameras must be an integer in 1..4096, got {n_cameras!r}")
-    for name, a in (("cam1", ids[0]), ("cam2", ids[1])):
-        if a.size and (a.min() < 0 or a.max() >= n_cameras):
-            raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
+    ids = _camera_id_arrays(cam1, cam2, n, n_cameras)
     f_ptr = ax_ptr = cf_ptr = ffi.NULL
+    f = None
     if focal is not None:
-        f = _arr("focal", focal, (n,))
-        if not (f > 0).all():
-            raise ValueError("focal must be > 0 (pixels per radian)")
+        # finiteness and sign are checked by the kernel (no extra passes
+        # here); the error path below names the argument
+        f = _arr("focal", focal, (n,), check_finite=False)
         f_ptr = _p(f)
     if (cam_axes is None) != (cam_focal is None):
         raise ValueError("cam_axes and cam_focal go together (both or neither)")
@@ -1327,19 +1319,103 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     if st == lib.MCG_EDEGENERATE:
         return None
     if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL:
+            _camera_id_error(ids, int(n_cameras))
+            if f is not None and not (np.isfinite(f).all() and (f > 0).all()):
+                raise ValueError("focal must be finite and > 0 (pixels per radian)")
         _ray_error(st, "robust_rig_motion", rays)
     R = np.frombuffer(ffi.buffer(res.R), dtype=np.float64).reshape(3, 3).copy()
     t = np.frombuffer(ffi.buffer(res.t), dtype=np.float64).copy()
     return {
         "R": R, "t": t,
         "t_hypothesis": np.frombuffer(ffi.buffer(res.t_hypothesis), dtype=np.float64).copy(),
-        "inliers": (mask & 1).view(bool), "used": (mask >> 1).view(bool),
+        "inliers": (mask & 1).view(bool), "used": (mask >> 1).view(bool), "mask": mask,
         "weights": weights, "loss_scale": res.loss_scale, "score": res.score,
         "n_inliers": res.n_inliers, "iterations": res.iterations,
         "hypotheses": res.hypotheses, "local_optimizations": res.local_optimizations,
         "stop": ROBUST_STOP_NAMES.get(res.stop, "unknown"), "seconds": res.seconds,
-        "scale_profile": res.scale_profile,
+        "scale_profile": res.scale_profile, "zero_profile": res.zero_profile,
+        "inlier_rms": res.inlier_rms,
         "refinement": _refine_dict(res.refinement, R, t) if res.refined else None,
+    }
+
+
+def _camera_id_arrays(cam1: Any, cam2: Any, n: int, n_cameras: Any
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """``cam1``, ``cam2`` as int32 C arrays of ``n`` integer ids (shape and dtype
+    checked; the range ``[0, n_cameras)`` is the kernel's to check, and
+    :func:`_camera_id_error` names the argument on its MCG_EINVAL)."""
+    if isinstance(n_cameras, bool) or not isinstance(n_cameras, (int, np.integer)) \
+            or not 1 <= int(n_cameras) <= 4096:
+        raise ValueError(f"n_cameras must be an integer in 1..4096, got {n_cameras!r}")
+    ids = []
+    for name, c in (("cam1", cam1), ("cam2", cam2)):
+        a = np.asarray(c)
+        if a.shape != (n,) or (n and a.dtype.kind not in "iu"):
+            raise ValueError(f"{name} must be {n} integer camera ids, got shape {a.shape} "
+                             f"and dtype {a.dtype}")
+        if a.dtype != np.int32 and a.size and (a.min() < 0 or a.max() >= n_cameras):
+            # (int64 ids beyond int32 would wrap in the conversion)
+            raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
+        ids.append(np.ascontiguousarray(a, dtype=np.int32))
+    return ids[0], ids[1]
+
+
+def _camera_id_error(ids: tuple, n_cameras: int) -> None:
+    """After a kernel's MCG_EINVAL: ValueError naming an id array out of range."""
+    for name, a in zip(("cam1", "cam2"), ids):
+        if a.size and (a.min() < 0 or a.max() >= n_cameras):
+            raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
+
+
+# ------------------------------------------------------------- verdict.c
+
+def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: Any, cam2: Any,
+                  n_cameras: int, inliers: Any, R: Any, t: Any, still_angle: float) -> dict:
+    """The O(N) evidence of the scale verdict in one C call (``mcg_verdict_stats``).
+
+    Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins
+    the camera centres in metres), ``cam1``/``cam2`` (N,) camera ids in
+    ``[0, n_cameras)``, ``inliers`` (N,) bool or uint8 (bit 0: inlier), the
+    motion ``(R, t)`` rig2_from_rig1 (metres), ``still_angle`` (radians) the
+    no-parallax threshold of the rotation-only angles. Returns a dict:
+    ``n_inliers``, ``n_intra``, ``n_cross``, ``n_cameras_intra`` (cameras
+    with an intra-camera inlier), ``fit_ok`` and ``R_fit`` (the best pure
+    rotation of the intra-camera inliers' unit bearings; identity when
+    not defined), ``n_still`` (their angles between d2 and R_fit d1 below
+    ``still_angle``), ``critical_angle`` (radians), ``n_in_front``
+    (cheirality at (R, t)) and ``t_direction`` (unit direction of travel as
+    :func:`mcgeom.estimators._common.travel_direction`). Raises ValueError
+    naming the bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    n = rays[0].shape[0]
+    c1, c2 = _camera_id_arrays(cam1, cam2, n, n_cameras)
+    m = np.asarray(inliers)
+    if m.shape != (n,) or m.dtype.kind not in "bu":
+        raise ValueError(f"inliers must be {n} booleans (or uint8 with bit 0 the inlier), "
+                         f"got shape {m.shape} and dtype {m.dtype}")
+    m = np.ascontiguousarray(m.view(np.uint8) if m.dtype == bool else m, dtype=np.uint8)
+    Rm, tv = _arr("R", R, (3, 3)), _arr("t", t, (3,))
+    if not (isinstance(still_angle, (int, float, np.floating)) and 0.0 <= still_angle < 4.0):
+        raise ValueError(f"still_angle must be a number in [0, 4) radians, got {still_angle!r}")
+    out = ffi.new("mcg_verdict_stats_result *")
+    work = _work(lib.mcg_verdict_stats_work_size(int(n_cameras)))
+    st = lib.mcg_verdict_stats(n, *map(_p, rays), ffi.from_buffer("int[]", c1),
+                               ffi.from_buffer("int[]", c2), int(n_cameras),
+                               ffi.from_buffer("unsigned char[]", m), _p(Rm), _p(tv),
+                               float(still_angle), out, _p(work), work.size)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL:
+            _camera_id_error((c1, c2), int(n_cameras))
+        _ray_error(st, "verdict_stats", rays)
+    return {
+        "n_inliers": out.n_inliers, "n_intra": out.n_intra, "n_cross": out.n_cross,
+        "n_cameras_intra": out.n_cameras_intra, "fit_ok": bool(out.fit_ok),
+        "R_fit": np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy(),
+        "n_still": out.n_still, "critical_angle": out.critical_angle,
+        "n_in_front": out.n_in_front,
+        "t_direction": np.frombuffer(ffi.buffer(out.t_direction), dtype=np.float64).copy(),
     }
 # ------------------------------------------------------------- upright4.c
 

@@ -34,7 +34,8 @@ from .types import RayPairs, ScaleVerdict
 
 __all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
            "scale_determined", "UNDETERMINED_REL_STD", "ZERO_FACTOR", "calibration_scale_std",
-           "combine_rel_std", "total_scale_std", "no_parallax", "with_calibration"]
+           "combine_rel_std", "total_scale_std", "no_parallax", "with_calibration",
+           "scale_verdict_stats"]
 
 #: relative std of ``|t|`` above which the data define no metric scale at all:
 #: a one-sigma interval that reaches zero bounds neither the length nor (with
@@ -206,15 +207,76 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     if np.isfinite(noise_level):
         _, ang = rotation_fit(rays, inliers & same)
         if no_parallax(ang, noise_level):
-            return ScaleVerdict(False, "no translation detected: a pure rotation explains the "
-                                       f"correspondences (median residual "
-                                       f"{np.degrees(np.median(ang)) * 3600:.3g} arcsec); static "
-                                       "rig, pure rotation or scene at infinity: neither the "
-                                       "direction nor the scale of t is determined",
-                                0.0, float("inf"), 0.0)
+            return _static_verdict(ang)
     centres, n_cross = _centres_with_intra(rays, inliers, same)
     crit = rig_critical_angle(R, t, centres) if len(centres) >= 2 else 0.0
     n_in = int(np.count_nonzero(inliers))
+    return _verdict(n_in, n_cross, len(centres), crit, rel_std, max_rel_std, direction_only,
+                    profile, lambda: count_in_front(rays, R, t, inliers))
+
+
+def _static_verdict(ang: np.ndarray) -> ScaleVerdict:
+    """The verdict when a pure rotation explains the intra-camera inliers
+    (``ang``: their rotation-only angles, radians)."""
+    return ScaleVerdict(False, "no translation detected: a pure rotation explains the "
+                               f"correspondences (median residual "
+                               f"{np.degrees(np.median(ang)) * 3600:.3g} arcsec); static "
+                               "rig, pure rotation or scene at infinity: neither the "
+                               "direction nor the scale of t is determined",
+                        0.0, float("inf"), 0.0)
+
+
+def scale_verdict_stats(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int,
+                        inliers: np.ndarray, R: np.ndarray, t: np.ndarray, rel_std: float,
+                        max_rel_std: float = 0.1, noise_level: float = float("nan"),
+                        profile: float = float("nan")) -> tuple[ScaleVerdict, np.ndarray]:
+    """:func:`scale_verdict` with its O(N) evidence from one C call
+    (``_core.verdict_stats``, csrc/verdict.c: the rotation-only fit and its
+    angles, the cameras with intra-camera inliers, the critical angle, the
+    cross-camera count, cheirality), and the direction of travel that
+    :func:`mcgeom.estimators._common.travel_direction` gives for the same
+    inliers and motion (from the same call).
+
+    ``cam1``, ``cam2`` are the rays' camera ids (int, ``[0, n_cameras)``;
+    origins the camera centres, metres), ``inliers`` (N,) bool or uint8
+    (bit 0: inlier), (R, t) rig2_from_rig1 (metres); the other arguments as
+    for :func:`scale_verdict`. The same verdict as :func:`scale_verdict` on
+    these rays (all inliers: no subsample), without a Python pass over them
+    (issue 19). Returns ``(verdict, t_direction)``.
+    """
+    still = NO_PARALLAX_FACTOR * noise_level if np.isfinite(noise_level) else 0.0
+    if not 0.0 <= still < 4.0:
+        # beyond any angle between two bearings: every angle is explained
+        still = 3.5 if still >= 4.0 else 0.0
+    s = _core.verdict_stats(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2,
+                            n_cameras, inliers, R, t, still)
+    n_intra = s["n_intra"]
+    if np.isfinite(noise_level) and noise_level > 0 and n_intra >= NO_PARALLAX_MIN:
+        if not s["fit_ok"]:
+            # the bearings span rank < 2 (one direction repeated): the numpy
+            # fit decides as before
+            mask = np.asarray(inliers).astype(bool) & same_camera(rays)
+            _, ang = rotation_fit(rays, mask)
+            if no_parallax(ang, noise_level):
+                return _static_verdict(ang), s["t_direction"]
+        elif s["n_still"] / n_intra >= NO_PARALLAX_FRACTION:
+            # the rare static answer: its message quotes the median angle
+            mask = np.asarray(inliers).astype(bool) & same_camera(rays)
+            return _static_verdict(rotation_fit(rays, mask)[1]), s["t_direction"]
+    n_in = s["n_inliers"]
+    verdict = _verdict(n_in, s["n_cross"], s["n_cameras_intra"], s["critical_angle"], rel_std,
+                       max_rel_std, False, profile, lambda: s["n_in_front"])
+    return verdict, s["t_direction"]
+
+
+def _verdict(n_in: int, n_cross: int, n_centres: int, crit: float, rel_std: float,
+             max_rel_std: float, direction_only: bool, profile: float,
+             in_front) -> ScaleVerdict:
+    """The verdict from its evidence (see :func:`scale_verdict`): ``n_in``
+    inliers of which ``n_cross`` cross-camera, ``n_centres`` cameras with
+    intra-camera inliers and their critical angle ``crit`` (radians);
+    ``in_front()`` the number of inliers in front of the cameras (asked
+    only when the scale would otherwise be called observable)."""
     if n_in <= _MOTION_DOF:
         # no redundancy: the motion fits its 6 correspondences exactly whatever
         # the noise (a zero residual says nothing about |t|), and a minimal
@@ -227,12 +289,12 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
                                    "solutions may exist and no uncertainty can be estimated",
                             float("nan"), float("inf"), crit)
     evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {np.degrees(crit):.3g} deg "
-                f"over {len(centres)} cameras, {n_cross} cross-camera inliers")
+                f"over {n_centres} cameras, {n_cross} cross-camera inliers")
     if np.isfinite(profile):
         evidence += f", |t| x/ {1 + 3 * max_rel_std:.2g} excluded at {np.sqrt(profile):.2g} sigma"
     if (direction_only or not np.isfinite(rel_std) or rel_std > max_rel_std
             or (np.isfinite(profile) and profile < 9.0)):
-        if n_cross == 0 and len(centres) < 2:
+        if n_cross == 0 and n_centres < 2:
             why = "one camera only and no cross-camera correspondence"
         elif n_cross == 0 and crit < np.radians(0.05):
             why = ("critical motion: camera displacements parallel (no rotation, thesis "
@@ -243,7 +305,7 @@ def scale_verdict(rays: RayPairs, inliers: np.ndarray, R: np.ndarray, t: np.ndar
     # last guard against a confident wrong answer: a metric motion must put
     # its inliers in front of the cameras (a flipped or twisted solution that
     # survived the search puts most of them behind)
-    front = count_in_front(rays, R, t, inliers) / n_in if n_in else 0.0
+    front = in_front() / n_in if n_in else 0.0
     if front < 0.5:
         return ScaleVerdict(False, f"cheirality fails: only {100 * front:.0f} % of the inliers "
                                    f"triangulate in front of the cameras (a wrong solution?); "

@@ -41,7 +41,7 @@ from .estimators.five_plus_one import minimal_answer
 from .estimators.upright_four_point import check_gravity
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
 from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
-                            total_scale_std)
+                            scale_verdict_stats, total_scale_std)
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 from .validation import check_seed
 
@@ -338,7 +338,10 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     n = len(rays)
     if n < need:
         raise ValueError(f"too few correspondences: {method} needs at least {need}, got {n}")
-    rays.check_finite()
+    if not in_c or (method == "five_plus_one" and n == 6):
+        # (the C entry point checks finiteness and zero directions in its own
+        # pass and names the array: no extra numpy passes on its path)
+        rays.check_finite()
     registry.check_distinct(rays, need, method)
     f = _focal_array(focal, n)
     if motion_focal is not None and f is None:
@@ -585,7 +588,8 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
               inl: np.ndarray, fit: Optional[tuple], loss_scale: float, n0: float,
               options: RansacOptions, method: str, info: dict, t_start: float,
               profile: Optional[float] = None, calibration_std: Any = None,
-              rms: Optional[float] = None) -> RigMotion:
+              rms: Optional[float] = None, c_ids: Optional[tuple] = None,
+              zero_profile: float = float("nan")) -> RigMotion:
     """Scale verdict and the returned ``RigMotion`` of a robust estimate.
 
     ``r`` are the residuals at the final (R, t) (pixels when thresholds are),
@@ -596,7 +600,11 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
     statistic of :func:`scale_profile`, when already computed (by C);
     ``calibration_std`` as in :func:`ransac` (its effect enters ``rel_std``);
     ``rms`` the RMS residual of the inliers when the caller has it (``r`` may
-    then be None).
+    then be None). ``c_ids = (cam1, cam2, n_cameras, mask)`` (the C search's
+    camera ids and its inlier mask, bit 0) switches the verdict's evidence
+    and the travel direction to one C pass over all the rays
+    (:func:`scale_verdict_stats`); ``zero_profile`` the statistic of
+    :func:`scale_profile` at ``ZERO_FACTOR`` when already computed (by C).
     """
     rel_std = float("inf")
     given, profile = profile, float("nan")
@@ -618,9 +626,16 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
                                     (1.0 / k, k), options.loss, scale_used, w_used)
         info["scale_profile"] = profile
     noise_level = fit[2] if fit is not None else loss_scale
-    v_rays, v_inl = _verdict_sample(rays, inl, options.seed)
-    verdict = scale_verdict(v_rays, v_inl, R, t, rel_std, options.max_scale_rel_std,
-                            noise_level=noise_level, profile=profile)
+    direction = None
+    if c_ids is not None:
+        cam1, cam2, n_cameras, mask = c_ids
+        verdict, direction = scale_verdict_stats(rays, cam1, cam2, n_cameras, mask, R, t,
+                                                 rel_std, options.max_scale_rel_std,
+                                                 noise_level=noise_level, profile=profile)
+    else:
+        v_rays, v_inl = _verdict_sample(rays, inl, options.seed)
+        verdict = scale_verdict(v_rays, v_inl, R, t, rel_std, options.max_scale_rel_std,
+                                noise_level=noise_level, profile=profile)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
     # the metric estimate whatever the verdict (when the scale is unobservable
     # the refinement may have slid |t| far along its flat valley: a guess)
@@ -643,12 +658,15 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         slid = not nt <= 10.0 * n0
         if slid:
             nt = n0
-        direction = travel_direction(rays, inl, R, t)
+        if direction is None:
+            direction = travel_direction(rays, inl, R, t)
         info["t_direction"] = direction
         zero = float("nan")
         if fit is not None and not slid and scale_determined(rel_std):
-            zero = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
-                                 (ZERO_FACTOR,), options.loss, scale_used, w_used)
+            zero = zero_profile
+            if not np.isfinite(zero):
+                zero = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
+                                     (ZERO_FACTOR,), options.loss, scale_used, w_used)
         if slid or not scale_determined(rel_std, zero_profile=zero):
             # the data define no scale: a unit direction (issue 18: never a
             # silent unit vector where a metric estimate exists, and never a
@@ -708,19 +726,19 @@ def _camera_count(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, int]:
     :func:`camera_ids` that every camera id has one origin at both times (the
     C search takes a camera's centre from any of its rays).
 
-    With camera ids the check compares every origin with its camera's first
-    one (a gather and a maximum: at 1e6 rays a fifth of the time of
-    :func:`camera_ids`, which scatters every origin into its table first).
+    With camera ids the check compares every origin with one origin of its
+    camera (a scatter, a gather and a maximum, no loop over the cameras).
     """
     if rays.cam1 is None or rays.cam2 is None:
         cam1, cam2, centres = camera_ids(rays)
         return cam1, cam2, len(centres)
     cam1, cam2 = rays.cam1, rays.cam2
     m = int(max(cam1.max(initial=-1), cam2.max(initial=-1))) + 1
-    table = np.full((m, 3), np.nan)
-    for cam, o in ((cam2, rays.origins2), (cam1, rays.origins1)):   # time 1 wins
-        for k in np.flatnonzero(np.bincount(cam, minlength=m)):
-            table[k] = o[int(np.argmax(cam == k))]
+    table = np.empty((m, 3))
+    # any one origin of each camera (numpy keeps one of the repeated
+    # writes): if they differ, some origin differs from the one kept
+    table[cam2] = rays.origins2
+    table[cam1] = rays.origins1
     for cam, o in ((cam1, rays.origins1), (cam2, rays.origins2)):
         if np.abs(table[cam] - o).max(initial=0.0) > 1e-9 * (1.0 + np.abs(o).max(initial=0.0)):
             raise ValueError("rays: one camera id has several different origins; origins must "
@@ -792,6 +810,10 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             raise ValueError(f"pixel_cameras describes {len(cam_focal)} cameras, the rays "
                              f"use camera ids up to {n_cameras - 1}")
         n_cameras = len(cam_focal)
+    if n_cameras <= _MAX_CAMERAS:
+        # int32 once for both C calls (the search and the verdict's evidence);
+        # ids are >= 0 and below n_cameras here, so nothing wraps
+        cam1, cam2 = cam1.astype(np.int32), cam2.astype(np.int32)
     intra = cam1 == cam2
     if method == "five_plus_one" and not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
         raise ValueError(f"too few correspondences: {method} needs 5 intra-camera "
@@ -831,10 +853,6 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             scorer.n_hyp = int(probe["hypotheses"])
         return _nothing_found(rays, scorer, options, method, t_start, 6, "")
     R, t, inl = out["R"], out["t"], out["inliers"]
-    # the RMS residual of the inliers: one C pass over the rays in place (a
-    # copy of the inliers' rays costs more than the residuals of all, and
-    # ~0.8x the input in memory)
-    r = _residuals(rays, R, t, focal)[inl]
     info = {k: out[k] for k in ("iterations", "hypotheses", "local_optimizations", "score",
                                 "stop")}
     info["c_seconds"] = out["seconds"]
@@ -845,7 +863,10 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
         w = out["weights"][used]
         fit = (out["refinement"], used, out["loss_scale"],
                None if focal is None or np.ptp(w) == 0 else w)
+    # the RMS residual of the inliers and the verdict's evidence come from C
+    # (no Python pass over the rays: issue 19)
     return _conclude(rays, R, t, None, inl, fit, out["loss_scale"],
                      float(np.linalg.norm(out["t_hypothesis"])), options, method, info, t_start,
-                     out["scale_profile"], calibration_std,
-                     rms=float(np.sqrt(np.dot(r, r) / r.size)) if r.size else float("nan"))
+                     out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
+                     c_ids=(cam1, cam2, n_cameras, out["mask"]),
+                     zero_profile=float(out["zero_profile"]))

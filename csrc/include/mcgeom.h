@@ -1004,13 +1004,22 @@ typedef struct {
                                not computed, 0 if a refit failed) */
     mcg_refine_result refinement; /* of the last final refinement, in the
                                frame centred on its pairs' origins */
+    double zero_profile;    /* the same statistic for the single factor 0.01
+                               (could the cameras not have moved at all?),
+                               computed when the refinement's scale_rel_std
+                               is at most 1 but above max_scale_rel_std or
+                               scale_profile < 9; NaN otherwise */
+    double inlier_rms;      /* RMS of the inliers' residuals at (R, t)
+                               (pixels with focal, else radians; NaN when
+                               there is no inlier) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_robust_default_options(mcg_robust_options *opt);
 
-/* Doubles of workspace for mcg_robust_rig_motion: about 16.5 n + 800 (0
- * for n outside [6, 2^26] or n_cameras outside [1, 4096]). */
+/* Doubles of workspace for mcg_robust_rig_motion: about 30 n + 800 up to
+ * 4096 pairs, 17.5 n + 43000 up to 16383, 16.5 n + 106000 beyond (0 for n
+ * outside [6, 2^26] or n_cameras outside [1, 4096]). */
 size_t mcg_robust_work_size(int n, int n_cameras);
 
 /* Robust rig motion rig2_from_rig1 from n ray correspondences with
@@ -1067,6 +1076,55 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                           const double *cam_focal, const mcg_robust_options *opt,
                           mcg_robust_result *res, unsigned char *mask, double *weights,
                           double *work, size_t lwork);
+/* ------------------------------------------------------------- verdict.c */
+
+/* Result of mcg_verdict_stats: the O(n) evidence of the scale verdict
+ * (mcgeom.observability.scale_verdict, thesis ch. 7.3.2) of an estimate. */
+typedef struct {
+    int n_inliers;          /* pairs with inlier bit 0 set */
+    int n_intra;            /* of which intra-camera (cam1 == cam2) */
+    int n_cross;            /* of which cross-camera */
+    int n_cameras_intra;    /* cameras with an intra-camera inlier */
+    int fit_ok;             /* 1: R_fit is the Wahba rotation (>= 2 intra
+                               inliers whose bearings span rank >= 2) */
+    double R_fit[9];        /* best pure rotation of the unit intra-camera
+                               inlier bearings (nearest to sum d2 d1^T);
+                               identity when fit_ok = 0 */
+    int n_still;            /* intra inliers whose angle between d2 and
+                               R_fit d1 is below still_angle (0 if !fit_ok) */
+    double critical_angle;  /* radians in [0, pi/2]: the largest angle between
+                               the displacement lines R^T (c - t) - c of the
+                               cameras with intra inliers (c: the time-1
+                               origin of each one's first intra inlier);
+                               0 for fewer than two */
+    int n_in_front;         /* inliers whose rays (the time-1 one moved by
+                               (R, t)) meet in front of both origins */
+    double t_direction[3];  /* unit direction of travel when |t| is not
+                               observable (travel_direction of
+                               mcgeom/estimators/_common.py) */
+} mcg_verdict_stats_result;
+
+/* Doubles of workspace of mcg_verdict_stats (0 for n_cameras outside
+ * [1, 4096]): about 3.5 n_cameras. */
+size_t mcg_verdict_stats_work_size(int n_cameras);
+
+/* The evidence of the scale verdict of the motion (R, t) (rig2_from_rig1,
+ * metres) over the pairs k with (inlier[k] & 1): pairs (o1, d1) <-> (o2,
+ * d2) as for mcg_gec_residuals (n x 3 each, rig frames at times 1 and 2,
+ * origins the camera centres in metres, directions of any non-zero length),
+ * cameras cam1[k], cam2[k] in [0, n_cameras). still_angle (radians, in
+ * [0, 4)): the no-parallax threshold of the rotation-only angles. One pass
+ * over the pairs for the counts and the fit, one for the angles, three for
+ * cheirality (cost O(n + n_cameras^2)). MCG_EINVAL: NULL pointers, n
+ * outside [0, 2^20], n_cameras, ids out of range, NaN/inf, a zero
+ * direction, origins, R or t
+ * entries above 1e150 in magnitude, still_angle; MCG_ENOMEM: lwork below
+ * mcg_verdict_stats_work_size. */
+int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o2,
+                      const double *d2, const int *cam1, const int *cam2, int n_cameras,
+                      const unsigned char *inlier, const double R[9], const double t[3],
+                      double still_angle, mcg_verdict_stats_result *out, double *work,
+                      size_t lwork);
 /* ------------------------------------------------------------- upright4.c */
 
 /* Upper bound on the solutions of mcg_upright4 (the degree of its polynomial). */

@@ -1,0 +1,243 @@
+/*
+ * test_verdict.c -- plain-C checks of csrc/verdict.c (mcg_verdict_stats)
+ * against independent references: the counts recounted here; a pure
+ * rotation of the bearings recovered (R_fit = the true rotation, every angle
+ * "still") and, after a translation, no longer still; the critical angle of
+ * a rig driving straight (no rotation: parallel displacements, 0) and of a
+ * turning rig against the angle computed by acos here over every pair of
+ * centres; cheirality by explicit least-squares triangulation here; the
+ * travel direction of a straight drive (the true direction, also with the
+ * bearings swapped end for end: the sign); the status codes of invalid
+ * arguments. Exit status 0 iff every check passes.
+ */
+#include "mcgeom.h"
+
+#define TEST_SEED 0x7e7d1c75ULL
+#include "testutil.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define NC 4
+#define PER 30
+#define N (NC * PER)
+
+static double o1[3 * N], d1[3 * N], o2[3 * N], d2[3 * N], cen[3 * NC];
+static int c1[N], c2[N];
+static unsigned char inl[N];
+static double work[64];
+
+/* R = exp([th axis/|axis|]x) (the library's Rodrigues, tested in test_linalg.c) */
+static void rot_about(const double axis[3], double th, double r[9])
+{
+    double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]), w[3];
+    int i;
+    for (i = 0; i < 3; ++i)
+        w[i] = th * axis[i] / n;
+    mcg_rot_from_angle_axis(w, r);
+}
+
+/* A rig of NC cameras on a ring (radius 0.5 m), points 2..20 m out, moving by
+ * (R, t); every fifth pair cross-camera when cross != 0. */
+static void scene(const double R[9], const double t[3], int cross)
+{
+    int i, k, g, h;
+    for (g = 0; g < NC; ++g) {
+        cen[3 * g] = 0.5 * cos(2.0 * 3.141592653589793 * g / NC);
+        cen[3 * g + 1] = 0.5 * sin(2.0 * 3.141592653589793 * g / NC);
+        cen[3 * g + 2] = 0.1 * g;
+    }
+    for (i = 0; i < N; ++i) {
+        double X[3], X2[3], depth = 2.0 + 18.0 * urand();
+        g = i % NC;
+        h = (cross && i % 5 == 4) ? (g + 1) % NC : g;
+        for (k = 0; k < 3; ++k)
+            X[k] = cen[3 * g + k] * (1.0 + depth) + (urand() - 0.5) * depth;
+        for (k = 0; k < 3; ++k)
+            X2[k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + t[k];
+        for (k = 0; k < 3; ++k) {
+            o1[3 * i + k] = cen[3 * g + k];
+            d1[3 * i + k] = (X[k] - cen[3 * g + k]) * (1.0 + urand()); /* any length */
+            o2[3 * i + k] = cen[3 * h + k];
+            d2[3 * i + k] = X2[k] - cen[3 * h + k];
+        }
+        c1[i] = g;
+        c2[i] = h;
+        inl[i] = (unsigned char)(urand() < 0.8 ? 1 : 0) | (urand() < 0.5 ? 2 : 0);
+    }
+}
+
+/* Depths along the two rays of the least-squares closest points (normal
+ * equations solved by Cramer's rule): the reference for cheirality. */
+static int front_ref(const double R[9], const double t[3], int k)
+{
+    double a[3], p[3], b[3], w[3], A11 = 0, A12 = 0, A22 = 0, r1 = 0, r2 = 0, det, s1, s2;
+    int i, j;
+    for (i = 0; i < 3; ++i) {
+        a[i] = p[i] = 0.0;
+        for (j = 0; j < 3; ++j) {
+            a[i] += R[3 * i + j] * d1[3 * k + j];
+            p[i] += R[3 * i + j] * o1[3 * k + j];
+        }
+        p[i] += t[i];
+        b[i] = d2[3 * k + i];
+        w[i] = o2[3 * k + i] - p[i];
+    }
+    /* p + s1 a = o2 + s2 b in least squares: [a -b] [s1 s2]^T = w */
+    for (i = 0; i < 3; ++i) {
+        A11 += a[i] * a[i];
+        A12 -= a[i] * b[i];
+        A22 += b[i] * b[i];
+        r1 += a[i] * w[i];
+        r2 -= b[i] * w[i];
+    }
+    det = A11 * A22 - A12 * A12;
+    s1 = (r1 * A22 - A12 * r2) / det;
+    s2 = (A11 * r2 - A12 * r1) / det;
+    return s1 > 0.0 && s2 > 0.0;
+}
+
+static double crit_ref(const double R[9], const double t[3])
+{
+    double u[3 * NC], best = 0.0;
+    int g, i, j, m = 0;
+    for (g = 0; g < NC; ++g) {
+        double d[3], n;
+        for (i = 0; i < 3; ++i) {
+            d[i] = -cen[3 * g + i];
+            for (j = 0; j < 3; ++j)
+                d[i] += R[3 * j + i] * (cen[3 * g + j] - t[j]);
+        }
+        n = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (n > 0) {
+            for (i = 0; i < 3; ++i)
+                u[3 * m + i] = d[i] / n;
+            m++;
+        }
+    }
+    for (i = 0; i < m; ++i)
+        for (j = i + 1; j < m; ++j) {
+            double c = fabs(u[3 * i] * u[3 * j] + u[3 * i + 1] * u[3 * j + 1] +
+                            u[3 * i + 2] * u[3 * j + 2]);
+            double a = acos(c > 1.0 ? 1.0 : c);
+            best = a > best ? a : best;
+        }
+    return best;
+}
+
+static void test_counts_crit_front(void)
+{
+    double R[9], t[3] = {0.3, -0.2, 0.9}, axis[3] = {0.2, 1.0, 0.1};
+    mcg_verdict_stats_result s;
+    int k, n_in = 0, n_intra = 0, n_front = 0, st;
+    rot_about(axis, 0.2, R);
+    scene(R, t, 1);
+    for (k = 0; k < N; ++k)
+        if (inl[k] & 1) {
+            n_in++;
+            n_intra += c1[k] == c2[k];
+        }
+    /* a wrong translation so that some pairs are behind */
+    t[2] = -0.9;
+    for (k = 0; k < N; ++k)
+        if (inl[k] & 1)
+            n_front += front_ref(R, t, k);
+    st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work, 64);
+    check_status(st, MCG_OK, "verdict_stats on a turning ring");
+    check(s.n_inliers == n_in && s.n_intra == n_intra && s.n_cross == n_in - n_intra,
+          "inlier / intra / cross counts", (double)s.n_inliers, 0);
+    check(s.n_cameras_intra == NC, "every camera has intra inliers", s.n_cameras_intra, 0);
+    check(fabs(s.critical_angle - crit_ref(R, t)) < 1e-9, "critical angle vs acos reference",
+          fabs(s.critical_angle - crit_ref(R, t)), 1e-9);
+    check(s.n_in_front == n_front && n_front > 0 && n_front < n_in,
+          "cheirality vs least-squares triangulation", (double)(s.n_in_front - n_front), 0);
+    check(s.fit_ok && s.n_still < s.n_intra / 2, "a translating rig is not still",
+          (double)s.n_still, 0);
+}
+
+static void test_pure_rotation(void)
+{
+    double R[9], t[3] = {0, 0, 0}, axis[3] = {1.0, -0.3, 0.5}, err = 0.0;
+    mcg_verdict_stats_result s;
+    int k, st;
+    rot_about(axis, 0.4, R);
+    scene(R, t, 0);
+    for (k = 0; k < N; ++k) { /* d2 = R d1: a pure rotation, no parallax */
+        int i, j;
+        for (i = 0; i < 3; ++i) {
+            d2[3 * k + i] = 0.0;
+            for (j = 0; j < 3; ++j)
+                d2[3 * k + i] += R[3 * i + j] * d1[3 * k + j];
+        }
+    }
+    st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-9, &s, work, 64);
+    check_status(st, MCG_OK, "verdict_stats of a pure rotation");
+    for (k = 0; k < 9; ++k)
+        err = fmax(err, fabs(s.R_fit[k] - R[k]));
+    check(s.fit_ok && err < 1e-12, "R_fit is the rotation", err, 1e-12);
+    check(s.n_still == s.n_intra && s.n_intra > 0, "every angle still", (double)s.n_still, 0);
+}
+
+static void test_straight_drive(void)
+{
+    double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {-1.5, 0.0, 0.0}, e;
+    mcg_verdict_stats_result s;
+    int st, k;
+    scene(R, t, 0);
+    st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work, 64);
+    check_status(st, MCG_OK, "verdict_stats of a straight drive");
+    check(s.critical_angle < 1e-12, "no rotation: critical angle 0", s.critical_angle, 1e-12);
+    e = fabs(s.t_direction[0] + 1.0) + fabs(s.t_direction[1]) + fabs(s.t_direction[2]);
+    check(e < 1e-12, "travel direction of the straight drive", e, 1e-12);
+    /* the direction given with the wrong sign: cheirality turns it round */
+    t[0] = 1e-3; /* tiny: tau = t is taken, and its sign decided by the rays */
+    st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work, 64);
+    e = fabs(s.t_direction[0] + 1.0);
+    check(st == MCG_OK && e < 1e-12, "travel direction's sign by cheirality", e, 1e-12);
+    for (k = 0; k < N; ++k)
+        inl[k] = 2; /* used, no inlier */
+    st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work, 64);
+    check(st == MCG_OK && s.n_inliers == 0 && !s.fit_ok && s.critical_angle == 0.0,
+          "no inlier: nothing counted", (double)s.n_inliers, 0);
+}
+
+static void test_invalid(void)
+{
+    double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {0, 0, 1}, keep;
+    mcg_verdict_stats_result s;
+    scene(R, t, 1);
+    check(mcg_verdict_stats_work_size(0) == 0 && mcg_verdict_stats_work_size(4097) == 0 &&
+              mcg_verdict_stats_work_size(NC) > 0,
+          "work size of bad camera counts is 0", 0, 0);
+    check_status(mcg_verdict_stats(N, NULL, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_EINVAL, "NULL origins");
+    check_status(mcg_verdict_stats(-1, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_EINVAL, "negative n");
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC - 1, inl, R, t, 1e-3, &s,
+                                   work, 64), MCG_EINVAL, "camera id out of range");
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, -1.0, &s, work,
+                                   64), MCG_EINVAL, "negative still_angle");
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   1), MCG_ENOMEM, "workspace too small");
+    keep = d2[7];
+    d2[7] = NAN;
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_EINVAL, "NaN direction");
+    d2[7] = keep;
+    memset(d1, 0, 3 * sizeof(double));
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_EINVAL, "zero direction");
+    check_status(mcg_verdict_stats(0, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_OK, "no pairs at all");
+}
+
+int main(void)
+{
+    test_counts_crit_front();
+    test_pure_rotation();
+    test_straight_drive();
+    test_invalid();
+    printf("%d checks, %d failed\n", n_checks, n_failed);
+    return n_failed ? 1 : 0;
+}
