@@ -1467,7 +1467,7 @@ def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
     ``decided_at`` (0 the pure rotation, 1 the estimate's), ``R`` (that
     rotation), ``R_fit`` (the best pure rotation), ``noise_level`` (radians),
     ``noise_from_default``, ``explained``, ``n_intra``, ``median_angle``
-    (radians). Raises ValueError naming the bad argument.
+    (radians; nan unless static). Raises ValueError naming the bad argument.
     """
     rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
     n = rays[0].shape[0]
