@@ -87,6 +87,30 @@ def test_static_noise_matches_the_numpy_reference(seed, outliers):
     assert med == pytest.approx(float(np.median(ref[ref >= 0])), rel=1e-6)
 
 
+@pytest.mark.parametrize("n", [301, 700])
+def test_static_noise_large_cameras_match_the_reference(n):
+    """Cameras of hundreds of pairs (odd and even counts): the counting pass
+    that rejects a least-median candidate in blocks of 64 rows (issue 22)
+    picks the directions of the plain median rule."""
+    rng = np.random.default_rng(n)
+    p = synth.make_problem(synth.generic_rig(2, rng), synth.random_rotation(rng, 0.3),
+                           0.3 * rng.normal(size=3), n, rng, angular_noise=3e-4,
+                           outlier_fraction=0.25, require_visible=False)
+    rays = p.rays
+    group = np.where(rays.cam1 == rays.cam2, rays.cam1, -1)
+    assert np.bincount(group[group >= 0]).max() > 128
+    R = synth.random_rotation(np.random.default_rng(n), 0.01) @ p.R
+    res, med, used = _core.static_noise(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                        group, R, 12, 32)
+    ref = _reference(rays, group, R, 12, 32)
+    np.testing.assert_allclose(res, ref, rtol=1e-6, atol=1e-12)
+    # camera ids far above n take the merge sort instead of the counting sort
+    big = np.where(group >= 0, 10 ** 6 - group, -1)
+    res2, med2, _ = _core.static_noise(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                       big, R, 12, 32)
+    assert np.array_equal(res, res2) and med == med2
+
+
 def test_static_noise_exact_data_and_a_planted_outlier():
     """Noise-free moving rig at the true rotation: every camera's direction is
     exact, the residuals vanish; an outlier leaves the others at zero."""
