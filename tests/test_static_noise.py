@@ -205,7 +205,7 @@ def test_check_static_in_c_decides_as_the_python_rule(case):
     rays, R_est, rotation = _cases()[case]
     ref = _reference_decision(rays, R_est, rotation)
     got = _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
-                             _static._intra_groups(rays), R_est, rotation, 0.0,
+                             _static.intra_groups(rays), R_est, rotation, 0.0,
                              **_static._C_OPTIONS)
     assert got["static"] == ref.static
     assert got["n_intra"] == ref.n_intra
@@ -232,14 +232,14 @@ def test_check_static_cases_cover_both_answers():
 def test_check_static_given_noise_level_and_repeats():
     p = make("locally-central", 2, n=40, angular_noise=3e-4, t_norm=0.0)
     rays = p.rays
-    g = _static._intra_groups(rays)
+    g = _static.intra_groups(rays)
     big = _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, g,
                              noise_level=1.0, **_static._C_OPTIONS)
     assert big["static"] and big["noise_level"] == 1.0
     # one correspondence repeated explains any rotation: not static
     one = rays.take(np.zeros(40, dtype=int))
     rep = _core.static_check(one.origins1, one.dirs1, one.origins2, one.dirs2,
-                             _static._intra_groups(one), noise_level=1.0, **_static._C_OPTIONS)
+                             _static.intra_groups(one), noise_level=1.0, **_static._C_OPTIONS)
     assert not rep["static"]
     with pytest.raises(ValueError, match="noise_level"):
         _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, g,

@@ -55,7 +55,7 @@ from ._common import camera_ids
 
 __all__ = ["StaticTest", "NOISE_FACTOR", "DEFAULT_NOISE_LEVEL", "camera_residuals",
            "noise_level_of", "with_static_check",
-           "static_test", "static_motion", "check_static"]
+           "static_test", "static_motion", "check_static", "intra_groups", "KERNEL_OPTIONS"]
 
 #: noise level = this many robust standard deviations of the per-camera
 #: Sampson residuals (what an inlier threshold is to the noise: see above)
@@ -245,11 +245,13 @@ _C_OPTIONS = dict(noise_factor=NOISE_FACTOR, noise_floor=_FLOOR,
                   default_level=DEFAULT_NOISE_LEVEL, parallax_factor=NO_PARALLAX_FACTOR,
                   fraction=NO_PARALLAX_FRACTION, min_pairs=NO_PARALLAX_MIN,
                   min_distinct=_MIN_DISTINCT, min_rows=_MIN_PER_CAMERA, samples=_LMEDS_SAMPLES)
-#: the same as the C struct, made once (check_static runs on every estimator call)
-_C_STRUCT = _core.static_options(**_C_OPTIONS)
+#: the constants above as the ``mcg_static_options *`` of the kernel, made once
+#: (check_static runs on every estimator call; ``mcgeom bench linear17`` times
+#: the bare kernel with it)
+KERNEL_OPTIONS = _core.static_options(**_C_OPTIONS)
 
 
-def _intra_groups(rays: RayPairs) -> np.ndarray:
+def intra_groups(rays: RayPairs) -> np.ndarray:
     """(N,) int32: the camera of each intra-camera correspondence, -1 for
     cross-camera ones (RayPairs bounds the ids by MAX_CAMERA_ID < 2^31)."""
     if rays.cam1 is not None and rays.cam2 is not None:
@@ -308,9 +310,9 @@ def check_static(rays: RayPairs, method: str, full: Optional[RigMotion] = None, 
     if noise_level is not None and not (np.isfinite(noise_level) and noise_level > 0):
         raise ValueError(f"noise_level must be a positive number of radians, got {noise_level}")
     r = _core.static_check_rays(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
-                                _intra_groups(rays), None if full is None else full.R,
+                                intra_groups(rays), None if full is None else full.R,
                                 rotation, 0.0 if noise_level is None else float(noise_level),
-                                _C_STRUCT)
+                                KERNEL_OPTIONS)
     if r is None:  # the rig moved: keep the full estimate
         return None
     source = "given" if noise_level is not None else \

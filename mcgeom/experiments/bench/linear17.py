@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mcgeom import _core, estimate, synth
-from mcgeom.estimators import _static
+from mcgeom.estimators._static import KERNEL_OPTIONS, intra_groups
 from mcgeom.estimators.linear17 import linear17_no_static_check
 from ..common import Progress, no_progress
 from .linear17_numpy import linear17_numpy
@@ -93,12 +93,12 @@ def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float 
         res = _core.ffi.new("mcg_linear17_result *")
         kernel = _core.lib.mcg_linear17
         # the static test's kernel as check_static calls it on this estimate
-        group = _static._intra_groups(rays)
+        group = intra_groups(rays)
         R_est = np.ascontiguousarray(linear17_no_static_check(rays).R)
         work = np.empty(_core.lib.mcg_static_check_work_size(n))
         s_args = (n, *ptrs, _core.ffi.from_buffer("int[]", group),
                   _core.ffi.from_buffer("double[]", R_est), _core.ffi.NULL, 0.0,
-                  _static._C_STRUCT, _core.ffi.new("mcg_static_result *"),
+                  KERNEL_OPTIONS, _core.ffi.new("mcg_static_result *"),
                   _core.ffi.from_buffer("double[]", work), work.size)
         static_kernel = _core.lib.mcg_static_check
         public_t = _timed(lambda: estimate(rays, "linear17"), budget_s)
