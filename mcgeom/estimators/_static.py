@@ -124,7 +124,7 @@ def camera_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:
     otherwise swing the plain least-squares null vector, inflate the noise
     level and make a moving rig pass for a static one. Its 32 samples come
     from a fixed stream, so the result is a function of the data. One C call
-    for all cameras (``mcg_static_noise``, O(N log N), no Python loop).
+    for all cameras (``mcg_static_noise``, O(N) with camera ids below N, no Python loop).
     Cameras with fewer than :data:`_MIN_PER_CAMERA` intra-camera
     correspondences are left out: with a handful of rays the fitted direction
     (2 dof) absorbs the noise and its residuals understate it. Returned in
