@@ -32,7 +32,7 @@ __all__ = [
     "skyline_eig",
     "essential5", "essential_decompose",
     "upright4", "eigensolver",
-    "static_noise", "static_check",
+    "static_noise", "static_check", "static_options", "static_check_rays",
     "sixpt",
 ]
 
@@ -1528,6 +1528,48 @@ def static_noise(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
     return res, float(med[0]), int(used[0])
 
 
+def static_options(*, noise_factor: float, noise_floor: float, default_level: float,
+                   parallax_factor: float, fraction: float, min_pairs: int, min_distinct: int,
+                   min_rows: int, samples: int) -> Any:
+    """The ``mcg_static_options *`` of :func:`static_check` (made once and
+    reused by the lean :func:`static_check_rays`; see ``mcg_static_options``
+    in mcgeom.h for the meaning and units)."""
+    opt = ffi.new("mcg_static_options *")
+    for name, v in (("noise_factor", noise_factor), ("noise_floor", noise_floor),
+                    ("default_level", default_level), ("parallax_factor", parallax_factor),
+                    ("fraction", fraction), ("min_pairs", min_pairs),
+                    ("min_distinct", min_distinct), ("min_rows", min_rows),
+                    ("samples", samples)):
+        setattr(opt, name, v)
+    return opt
+
+
+def _static_check_call(rays: tuple, g: np.ndarray, R_est: Optional[np.ndarray],
+                       R_given: Optional[np.ndarray], noise_level: float, opt: Any
+                       ) -> tuple[int, Any]:
+    """``mcg_static_check`` on prepared arguments: (status, result struct)."""
+    n = rays[0].shape[0]
+    out = ffi.new("mcg_static_result *")
+    work = _work(lib.mcg_static_check_work_size(n))
+    st = lib.mcg_static_check(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
+                              ffi.from_buffer("int[]", g),
+                              ffi.NULL if R_est is None else _p(R_est),
+                              ffi.NULL if R_given is None else _p(R_given),
+                              float(noise_level), opt, out, _p(work), work.size)
+    return st, out
+
+
+def _static_result(out: Any) -> dict:
+    """The dict of :func:`static_check` from the result struct."""
+    return {"static": bool(out.is_static), "decided_at": int(out.decided_at),
+            "R": np.frombuffer(ffi.buffer(out.R), dtype=np.float64).reshape(3, 3).copy(),
+            "R_fit": np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy(),
+            "noise_level": float(out.noise_level),
+            "noise_from_default": bool(out.noise_from_default),
+            "explained": float(out.explained), "n_intra": int(out.n_intra),
+            "median_angle": float(out.median_angle)}
+
+
 def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: Any,
                  R_est: Any = None, R_given: Any = None, noise_level: float = 0.0, *,
                  noise_factor: float, noise_floor: float, default_level: float,
@@ -1543,7 +1585,7 @@ def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
     ``decided_at`` (0 the pure rotation, 1 the estimate's), ``R`` (that
     rotation), ``R_fit`` (the best pure rotation), ``noise_level`` (radians),
     ``noise_from_default``, ``explained``, ``n_intra``, ``median_angle``
-    (radians). Raises ValueError naming the bad argument.
+    (radians; nan unless static). Raises ValueError naming the bad argument.
     """
     rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
     n = rays[0].shape[0]
@@ -1554,20 +1596,11 @@ def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
             for name, M in (("R_est", R_est), ("R_given", R_given))]
     if not (np.isfinite(noise_level) and noise_level >= 0):
         raise ValueError(f"noise_level must be >= 0 radians (0: estimate it), got {noise_level}")
-    opt = ffi.new("mcg_static_options *")
-    for name, v in (("noise_factor", noise_factor), ("noise_floor", noise_floor),
-                    ("default_level", default_level), ("parallax_factor", parallax_factor),
-                    ("fraction", fraction), ("min_pairs", min_pairs),
-                    ("min_distinct", min_distinct), ("min_rows", min_rows),
-                    ("samples", samples)):
-        setattr(opt, name, v)
-    out = ffi.new("mcg_static_result *")
-    work = _work(lib.mcg_static_check_work_size(n))
-    st = lib.mcg_static_check(n, _p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
-                              ffi.from_buffer("int[]", g),
-                              ffi.NULL if mats[0] is None else _p(mats[0]),
-                              ffi.NULL if mats[1] is None else _p(mats[1]),
-                              float(noise_level), opt, out, _p(work), work.size)
+    opt = static_options(noise_factor=noise_factor, noise_floor=noise_floor,
+                         default_level=default_level, parallax_factor=parallax_factor,
+                         fraction=fraction, min_pairs=min_pairs, min_distinct=min_distinct,
+                         min_rows=min_rows, samples=samples)
+    st, out = _static_check_call(rays, g, mats[0], mats[1], noise_level, opt)
     if st != lib.MCG_OK:
         if st == lib.MCG_EINVAL and not (1 <= min_rows and 0 <= samples <= 65536
                                          and 0 <= min_distinct <= 64):
@@ -1575,13 +1608,34 @@ def static_check(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, group: An
         _ray_error(st, "static_check", rays, tuple((k, M) for k, M in
                                                    (("R_est", mats[0]), ("R_given", mats[1]))
                                                    if M is not None))
-    return {"static": bool(out.is_static), "decided_at": int(out.decided_at),
-            "R": np.frombuffer(ffi.buffer(out.R), dtype=np.float64).reshape(3, 3).copy(),
-            "R_fit": np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy(),
-            "noise_level": float(out.noise_level),
-            "noise_from_default": bool(out.noise_from_default),
-            "explained": float(out.explained), "n_intra": int(out.n_intra),
-            "median_angle": float(out.median_angle)}
+    return _static_result(out)
+
+
+def static_check_rays(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
+                      dirs2: np.ndarray, group: np.ndarray, R_est: Optional[np.ndarray],
+                      R_given: Optional[np.ndarray], noise_level: float, options: Any
+                      ) -> Optional[dict]:
+    """The lean :func:`static_check` of the estimators' hot path (issue 22:
+    the test runs on every estimator call): the rays of a validated
+    :class:`~mcgeom.types.RayPairs` (float64 C-contiguous (N, 3), rig
+    frames, metres, N <= 2^20), ``group`` int32 (N,) (camera id of an
+    intra-camera pair, -1 otherwise), ``options`` from :func:`static_options`.
+    Returns None when the rig moved (no dict is built), else the dict of
+    :func:`static_check`. Any kernel failure is re-run through
+    :func:`static_check`, which raises the ValueError naming the bad argument.
+    """
+    mats = [None if M is None else _f64(name, M, (3, 3))
+            for name, M in (("R_est", R_est), ("R_given", R_given))]
+    st, out = _static_check_call((origins1, dirs1, origins2, dirs2), group, mats[0], mats[1],
+                                 noise_level, options)
+    if st != lib.MCG_OK:
+        kw = {name: getattr(options, name) for name in
+              ("noise_factor", "noise_floor", "default_level", "parallax_factor", "fraction",
+               "min_pairs", "min_distinct", "min_rows", "samples")}
+        static_check(origins1, dirs1, origins2, dirs2, group, R_est, R_given, noise_level,
+                     **kw)
+        raise_for(st, "static_check")
+    return _static_result(out) if out.is_static else None
 # --------------------------------------------------------------- sixpt.c
 
 def sixpt(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any) -> tuple[np.ndarray, np.ndarray]:

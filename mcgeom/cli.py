@@ -267,14 +267,15 @@ def _bench_linear17(args: argparse.Namespace) -> int:
 
     rows = bench_linear17(_sizes(args), budget_s=args.budget, progress=progress_bar)
     print("linear17: the public call mcgeom.estimate (RayPairs in, RigMotion with its verdict "
-          "out), the plugin without the shared static-rig test (static = public - plugin), the "
-          "cffi wrapper, the bare C kernel, and a numpy implementation of the same algorithm; "
-          "python = public - C")
-    print(f"{'N':>7} {'public[us]':>10} {'static[us]':>10} {'plugin[us]':>10} "
+          "out), the plugin without the shared static-rig test (static = public - plugin; "
+          "staticC: its bare kernel mcg_static_check), the cffi wrapper, the bare C kernel, and "
+          "a numpy implementation of the same algorithm; python = public - C")
+    print(f"{'N':>7} {'public[us]':>10} {'static[us]':>10} {'staticC[us]':>11} {'plugin[us]':>10} "
           f"{'wrapper[us]':>11} {'C[us]':>8} {'python[us]':>10} "
           f"{'C share':>7} {'numpy[us]':>10} {'ratio':>6} {'us/ray':>7} {'iters':>5}")
     for r in rows:
-        print(f"{r.n:7d} {r.public_us:10.1f} {r.static_us:10.1f} {r.plugin_us:10.1f} "
+        print(f"{r.n:7d} {r.public_us:10.1f} {r.static_us:10.1f} {r.static_c_us:11.1f} "
+              f"{r.plugin_us:10.1f} "
               f"{r.wrapper_us:11.1f} {r.c_us:8.1f} "
               f"{r.python_us:10.1f} {r.c_us / r.public_us:7.0%} {r.numpy_us:10.1f} "
               f"{r.ratio:6.1f} {r.public_us / r.n:7.3f} {r.iterations:5d}")

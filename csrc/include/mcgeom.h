@@ -1233,7 +1233,8 @@ typedef struct {
     int noise_from_default; /* 1: no camera had min_rows pairs */
     double explained;       /* fraction of intra-camera pairs explained at R */
     int n_intra;            /* intra-camera pairs (group >= 0) */
-    double median_angle;    /* their median rotation-only angle at R, radians */
+    double median_angle;    /* their median rotation-only angle at R, radians
+                               (computed for a static answer only, else nan) */
 } mcg_static_result;
 
 /* Fill *opt with the defaults (no-op for NULL). */

@@ -265,9 +265,64 @@ static void test_check(void)
     free(work);
 }
 
+/* issue 22's faster paths against plain references: camera ids >= n (the
+ * merge sort instead of the counting sort, ids in decreasing order) give
+ * the same residuals bit for bit; the explained fraction of a given level
+ * is the count of atan2 angles below parallax_factor x level, for levels
+ * at several quantiles of the angles (the tan prefilter near its bound) */
+static void test_fast_paths(void)
+{
+    mcg_static_options opt;
+    mcg_static_result res;
+    double r1[N], r2[N], m1, m2, ang[N], *work;
+    size_t lw = mcg_static_check_work_size(N);
+    int big[N], u1, u2, j, q, same = 1, st;
+    work = malloc(sizeof(double) * lw);
+    scene(1e-3);
+    for (j = 0; j < N; j++)
+        big[j] = 100000 - 7 * grp[j];
+    st = mcg_static_noise(N, o1, d1, o2, d2, grp, R, 12, 32, r1, &m1, &u1, work, lw);
+    st |= mcg_static_noise(N, o1, d1, o2, d2, big, R, 12, 32, r2, &m2, &u2, work, lw);
+    for (j = 0; j < N; j++)
+        same &= r1[j] == r2[j];
+    check(st == MCG_OK && same && m1 == m2 && u1 == u2,
+          "ids >= n: the same residuals as compact ids", m1 - m2, 0.0);
+    for (j = 0; j < N; j++) {
+        double a[3], b[3], x[3], na = 0.0, nb = 0.0;
+        int c;
+        for (c = 0; c < 3; c++) {
+            na += d1[3 * j + c] * d1[3 * j + c];
+            nb += d2[3 * j + c] * d2[3 * j + c];
+        }
+        for (c = 0; c < 3; c++) {
+            a[c] = (R[3 * c] * d1[3 * j] + R[3 * c + 1] * d1[3 * j + 1] +
+                    R[3 * c + 2] * d1[3 * j + 2]) / sqrt(na);
+            b[c] = d2[3 * j + c] / sqrt(nb);
+        }
+        x[0] = a[1] * b[2] - a[2] * b[1];
+        x[1] = a[2] * b[0] - a[0] * b[2];
+        x[2] = a[0] * b[1] - a[1] * b[0];
+        ang[j] = atan2(sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]),
+                       a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+    }
+    mcg_static_default_options(&opt);
+    for (q = 1; q < 10; q++) {
+        double lim = sorted_median(ang, N) * 0.25 * q, level = lim / opt.parallax_factor;
+        int inside = 0;
+        for (j = 0; j < N; j++)
+            inside += ang[j] < lim;
+        st = mcg_static_check(N, o1, d1, o2, d2, grp, NULL, R, level, &opt, &res, work, lw);
+        check(st == MCG_OK && fabs(res.explained - (double)inside / N) < 1e-12,
+              "explained = atan2 count below the bound", res.explained - (double)inside / N,
+              1e-12);
+    }
+    free(work);
+}
+
 int main(void)
 {
     test_check();
+    test_fast_paths();
     test_exact_and_outliers();
     test_noisy_median();
     test_selection();

@@ -28,7 +28,7 @@ static int check_whole_test(fz_in *in, int n, const int *group, const double R[9
                             const double *o1, const double *d1, const double *o2,
                             const double *d2, double *work, size_t lw_noise)
 {
-    static double w2[10 * MAXN + 16];
+    static double w2[32 * MAXN + 16]; /* 29 n + 1 since issue 22 */
     mcg_static_options opt;
     mcg_static_result out;
     double level = (fz_u8(in) & 1) ? fz_range(in, 0.0, 0.01) : 0.0, r_fit_err;
@@ -72,7 +72,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int mode = fz_u8(&in) % FUZZ_MODES, valid, st, i, k, used, count, min_rows, samples;
     int n = fz_size(&in, 0, MAXN, &valid);
     static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], res[MAXN];
-    static double work[8 * MAXN + 8];
+    static double work[24 * MAXN + 8]; /* 21 n + 1 since issue 22 */
     static int group[MAXN], size_of[16];
     double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {0, 0, 0}, med, lo = HUGE_VAL, hi = 0.0;
     size_t lw;

@@ -55,7 +55,7 @@ from ._common import camera_ids
 
 __all__ = ["StaticTest", "NOISE_FACTOR", "DEFAULT_NOISE_LEVEL", "camera_residuals",
            "noise_level_of", "with_static_check",
-           "static_test", "static_motion", "check_static"]
+           "static_test", "static_motion", "check_static", "intra_groups", "KERNEL_OPTIONS"]
 
 #: noise level = this many robust standard deviations of the per-camera
 #: Sampson residuals (what an inlier threshold is to the noise: see above)
@@ -124,7 +124,7 @@ def camera_residuals(rays: RayPairs, R: np.ndarray) -> np.ndarray:
     otherwise swing the plain least-squares null vector, inflate the noise
     level and make a moving rig pass for a static one. Its 32 samples come
     from a fixed stream, so the result is a function of the data. One C call
-    for all cameras (``mcg_static_noise``, O(N log N), no Python loop).
+    for all cameras (``mcg_static_noise``, O(N) with camera ids below N, no Python loop).
     Cameras with fewer than :data:`_MIN_PER_CAMERA` intra-camera
     correspondences are left out: with a handful of rays the fitted direction
     (2 dof) absorbs the noise and its residuals understate it. Returned in
@@ -245,15 +245,20 @@ _C_OPTIONS = dict(noise_factor=NOISE_FACTOR, noise_floor=_FLOOR,
                   default_level=DEFAULT_NOISE_LEVEL, parallax_factor=NO_PARALLAX_FACTOR,
                   fraction=NO_PARALLAX_FRACTION, min_pairs=NO_PARALLAX_MIN,
                   min_distinct=_MIN_DISTINCT, min_rows=_MIN_PER_CAMERA, samples=_LMEDS_SAMPLES)
+#: the constants above as the ``mcg_static_options *`` of the kernel, made once
+#: (check_static runs on every estimator call; ``mcgeom bench linear17`` times
+#: the bare kernel with it)
+KERNEL_OPTIONS = _core.static_options(**_C_OPTIONS)
 
 
-def _intra_groups(rays: RayPairs) -> np.ndarray:
-    """(N,) the camera of each intra-camera correspondence, -1 for cross-camera ones."""
+def intra_groups(rays: RayPairs) -> np.ndarray:
+    """(N,) int32: the camera of each intra-camera correspondence, -1 for
+    cross-camera ones (RayPairs bounds the ids by MAX_CAMERA_ID < 2^31)."""
     if rays.cam1 is not None and rays.cam2 is not None:
         cam1, cam2 = rays.cam1, rays.cam2
     else:
         cam1, cam2, _ = camera_ids(rays)
-    return np.where(cam1 == cam2, cam1, -1)
+    return np.where(cam1 == cam2, cam1, -1).astype(np.int32)
 
 
 def _cross_median(rays: RayPairs, R: np.ndarray) -> float:
@@ -304,10 +309,11 @@ def check_static(rays: RayPairs, method: str, full: Optional[RigMotion] = None, 
     # static_test, noise_level_of and observability.no_parallax above
     if noise_level is not None and not (np.isfinite(noise_level) and noise_level > 0):
         raise ValueError(f"noise_level must be a positive number of radians, got {noise_level}")
-    r = _core.static_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
-                           _intra_groups(rays), None if full is None else full.R, rotation,
-                           0.0 if noise_level is None else float(noise_level), **_C_OPTIONS)
-    if not r["static"]:
+    r = _core.static_check_rays(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                intra_groups(rays), None if full is None else full.R,
+                                rotation, 0.0 if noise_level is None else float(noise_level),
+                                KERNEL_OPTIONS)
+    if r is None:  # the rig moved: keep the full estimate
         return None
     source = "given" if noise_level is not None else \
         "default" if r["noise_from_default"] else "per-camera fit"

@@ -11,6 +11,9 @@ intra-camera correspondences, 0.05 deg angular noise), the best mean time of:
   info dict and the verdict); ``static`` = public - plugin is what the test
   of :mod:`mcgeom.estimators._static` costs (issue 18's, shared by every
   estimator);
+- ``static C``: that test's kernel ``mcg_static_check`` alone through cffi
+  (its pointers, workspace and options made beforehand, the plugin's
+  rotation as the estimate's): ``static - static C`` is its Python;
 - ``wrapper``: ``mcgeom._core.linear17`` (the cffi wrapper: buffers in, the
   result struct as a dict of numpy views out);
 - ``C``: the kernel ``mcg_linear17`` alone through cffi, its pointers made
@@ -27,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mcgeom import _core, estimate, synth
+from mcgeom.estimators._static import KERNEL_OPTIONS, intra_groups
 from mcgeom.estimators.linear17 import linear17_no_static_check
 from ..common import Progress, no_progress
 from .linear17_numpy import linear17_numpy
@@ -44,6 +48,7 @@ class Linear17Timing:
     plugin_us: float
     wrapper_us: float
     c_us: float
+    static_c_us: float
     numpy_us: float
     iterations: int
 
@@ -72,7 +77,7 @@ def _timed(fn, budget_s: float) -> float:
 def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float = 0.5,
                    progress: Progress = no_progress) -> list[Linear17Timing]:
     """Time linear17 through the public call, the plugin, the wrapper and the bare kernel,
-    and the numpy reference, for each N (microseconds per call, best of
+    the static test's bare kernel, and the numpy reference, for each N (microseconds per call, best of
     batches; ``budget_s`` seconds per timing)."""
     rng = np.random.default_rng(seed)
     rig = synth.generic_rig(4, rng)
@@ -87,11 +92,21 @@ def bench_linear17(sizes=(17, 100, 1000, 10000), seed: int = 0, budget_s: float 
         ptrs = [_core.ffi.from_buffer("double[]", a) for a in args]
         res = _core.ffi.new("mcg_linear17_result *")
         kernel = _core.lib.mcg_linear17
+        # the static test's kernel as check_static calls it on this estimate
+        group = intra_groups(rays)
+        R_est = np.ascontiguousarray(linear17_no_static_check(rays).R)
+        work = np.empty(_core.lib.mcg_static_check_work_size(n))
+        s_args = (n, *ptrs, _core.ffi.from_buffer("int[]", group),
+                  _core.ffi.from_buffer("double[]", R_est), _core.ffi.NULL, 0.0,
+                  KERNEL_OPTIONS, _core.ffi.new("mcg_static_result *"),
+                  _core.ffi.from_buffer("double[]", work), work.size)
+        static_kernel = _core.lib.mcg_static_check
         public_t = _timed(lambda: estimate(rays, "linear17"), budget_s)
         plugin_t = _timed(lambda: linear17_no_static_check(rays), budget_s)
         wrapper_t = _timed(lambda: _core.linear17(*args), budget_s)
         c_t = _timed(lambda: kernel(n, *ptrs, _core.ffi.NULL, res), budget_s)
+        static_c_t = _timed(lambda: static_kernel(*s_args), budget_s)
         np_t = _timed(lambda: linear17_numpy(*args), budget_s)
-        out.append(Linear17Timing(n, public_t * 1e6, plugin_t * 1e6, wrapper_t * 1e6, c_t * 1e6, np_t * 1e6,
-                                  m.info["iterations"]))
+        out.append(Linear17Timing(n, public_t * 1e6, plugin_t * 1e6, wrapper_t * 1e6, c_t * 1e6,
+                                  static_c_t * 1e6, np_t * 1e6, m.info["iterations"]))
     return out
