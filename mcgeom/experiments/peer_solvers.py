@@ -46,13 +46,18 @@ only where the façade chose it: ``mcg_sixpt`` (a homotopy continuation of 64
 paths) takes about 0.1 s per sample on this machine, a minute per RANSAC
 problem, which on the cases with a 5-point camera would only measure that.
 
-``mcgeom experiment peer_solvers [--part minimal|ransac|all] [--configs 10000]
-[--configs6 N] [--problems 50] [--seed 0] [--cases CASE ...]`` (needs poselib)
+``mcgeom experiment peer_solvers [--part minimal|minimal4|minimal6|ransac|all]
+[--configs 10000] [--configs6 N] [--chunk6 500] [--problems 50] [--seed 0]
+[--cases CASE ...]`` (needs poselib). The 6-point table runs the families in
+rounds of ``--chunk6`` configurations each and prints the table so far to
+stderr after every round (10,000 configurations of mcgeom's homotopy take
+hours on a shared 2-core machine).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from typing import Callable, Optional
 
@@ -207,33 +212,50 @@ def _sixpt_list(o1, d1, o2, d2) -> list:
 
 
 def run_minimal6(configs: int = 10000, seed: int = 0, families=SIX_FAMILIES,
-                 progress: Progress = no_progress) -> dict:
+                 progress: Progress = no_progress, chunk: Optional[int] = None,
+                 on_chunk: Optional[Callable[[int, dict], None]] = None) -> dict:
     """The 6-point solvers: {family: {solver: (success fraction, mean real
     solutions, seconds per call)}}: mcgeom's ``_core.sixpt`` (csrc/sixpt.c)
-    and ``poselib.gen_relpose_6pt`` on the same noise-free configurations."""
+    and ``poselib.gen_relpose_6pt`` on the same noise-free configurations.
+
+    The families are run in turn, ``chunk`` configurations of each at a time
+    (default: all at once), and ``on_chunk(done, table)`` receives the table of
+    the first ``done`` configurations per family after each round: mcgeom's
+    homotopy takes ~50 ms a call, so 10,000 configurations of 7 families run
+    for hours on a shared machine, and a run stopped early still has figures
+    for every family. Each family draws from its own generator seeded with
+    ``seed``, so the configurations do not depend on ``chunk``."""
     poselib = import_peer("poselib", "peer_solvers")
-    out = {}
-    for fam in progress(families, total=len(families), desc="6-point families"):
-        rng = np.random.default_rng(seed)
-        args, theirs, truth = [], [], []
-        for _ in range(configs):
-            (o1, d1, o2, d2), R, t = _config6(fam, rng)
-            args.append((o1, d1, o2, d2))
-            theirs.append((o1, _unit(d1), o2, _unit(d2)))
-            truth.append((R, t))
-        res = {}
-        for name, fn, a_list in (("mcgeom sixpt", _safe(_sixpt_list), args),
-                                 ("poselib gen_relpose_6pt", _safe(poselib.gen_relpose_6pt),
-                                  theirs)):
-            hits, counts, t0 = 0, 0, time.perf_counter()
-            for a, (R, t) in zip(a_list, truth):
-                sols = [(np.asarray(p.R), np.asarray(p.t)) if hasattr(p, "R") else p
-                        for p in fn(*a)]
-                hits += _hit(sols, R, t)
-                counts += len(sols)
-            # one pass: the solver is timed on the same calls that are scored
-            res[name] = (hits / configs, counts / configs, (time.perf_counter() - t0) / configs)
-        out[fam] = res
+    solvers = (("mcgeom sixpt", _safe(_sixpt_list), False),
+               ("poselib gen_relpose_6pt", _safe(poselib.gen_relpose_6pt), True))
+    rngs = {fam: np.random.default_rng(seed) for fam in families}
+    acc = {fam: {name: [0, 0, 0.0] for name, _, _ in solvers} for fam in families}
+    chunk = configs if chunk is None else max(1, min(chunk, configs))
+    out: dict = {}
+    done = 0
+    for start in progress(range(0, configs, chunk), total=-(-configs // chunk),
+                          desc="6-point rounds"):
+        m = min(chunk, configs - start)
+        for fam in families:
+            cfgs = [_config6(fam, rngs[fam]) for _ in range(m)]
+            for name, fn, unit in solvers:
+                a = acc[fam][name]
+                # PoseLib takes unit directions: made outside the timing
+                calls = [((o1, _unit(d1), o2, _unit(d2)) if unit else (o1, d1, o2, d2), R, t)
+                         for (o1, d1, o2, d2), R, t in cfgs]
+                t0 = time.perf_counter()
+                for args, R, t in calls:
+                    sols = [(np.asarray(p.R), np.asarray(p.t)) if hasattr(p, "R") else p
+                            for p in fn(*args)]
+                    a[0] += _hit(sols, R, t)
+                    a[1] += len(sols)
+                # one pass: the solver is timed on the same calls that are scored
+                a[2] += time.perf_counter() - t0
+        done += m
+        out = {fam: {name: (h / done, c / done, secs / done)
+                     for name, (h, c, secs) in res.items()} for fam, res in acc.items()}
+        if on_chunk is not None:
+            on_chunk(done, out)
     return out
 
 
@@ -419,14 +441,19 @@ def ransac_table(res: dict) -> str:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment peer_solvers``."""
-    ap.add_argument("--part", choices=("minimal", "ransac", "all"), default="all",
-                    help="minimal solvers on noise-free configurations, RANSAC from "
+    ap.add_argument("--part", choices=("minimal", "minimal4", "minimal6", "ransac", "all"),
+                    default="all",
+                    help="minimal solvers on noise-free configurations (minimal4: the "
+                         "upright 4-point only, minimal6: the 6-point only), RANSAC from "
                          "pixels, or both")
     ap.add_argument("--configs", type=positive_int, default=10000,
                     help="noise-free configurations per family (minimal part)")
     ap.add_argument("--configs6", type=positive_int, default=None,
                     help="configurations per family of the 6-point comparison (minimal "
                          "part; default --configs; mcgeom's homotopy takes ~60 ms a call)")
+    ap.add_argument("--chunk6", type=positive_int, default=500,
+                    help="6-point configurations per family and round; the table so far "
+                         "goes to stderr after each round")
     add_count_and_seed(ap, "--problems", 50, "problems per case (RANSAC part)")
     ap.add_argument("--cases", nargs="*", default=None, choices=list(RANSAC_CASES),
                     metavar="CASE", help="cases of the RANSAC part (default: all), of: "
@@ -436,11 +463,18 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     """Print the tables of the requested parts."""
     import_peer("poselib", "peer_solvers")
-    if args.part in ("minimal", "all"):
+    def partial(done: int, table: dict) -> None:
+        # a long run stopped early keeps the figures of the rounds done
+        print(f"[6-point: {done} configurations per family so far]\n{minimal_table(table)}",
+              file=sys.stderr, flush=True)
+
+    if args.part in ("minimal", "minimal4", "all"):
         print(minimal_table(run_minimal(args.configs, args.seed, progress=progress)))
-        print()
+        print(flush=True)
+    if args.part in ("minimal", "minimal6", "all"):
         print(minimal_table(run_minimal6(args.configs6 or args.configs, args.seed,
-                                         progress=progress)))
+                                         progress=progress, chunk=args.chunk6,
+                                         on_chunk=partial)))
     if args.part in ("ransac", "all"):
         if args.part == "all":
             print()
