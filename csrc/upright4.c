@@ -196,11 +196,12 @@ static double bracket_root(const double *a, const double *da, int n, double lo, 
  * returns their number. A multiple root is returned once. Roots beyond
  * |x| = ROOT_MAX (a yaw within 2e-12 rad of pi) are not searched. */
 #define ROOT_MAX 1e12
+#define STURM_EVALS 512
 static int real_roots(const double *a, int n, double *r)
 {
     sturm_chain sc;
     double da[8], lo[72], hi[72], bound = 4.0;
-    int vlo[72], vhi[72], top = 0, nr = 0, i, vm_inf, vp_inf, v_lo, v_hi;
+    int vlo[72], vhi[72], top = 0, nr = 0, i, vm_inf, vp_inf, v_lo, v_hi, evals = 0;
     if (n == 1) {
         r[0] = -a[0] / a[1];
         return 1;
@@ -225,7 +226,10 @@ static int real_roots(const double *a, int n, double *r)
     vlo[0] = v_lo;
     vhi[0] = v_hi;
     top = 1;
-    while (top > 0) {
+    /* at most STURM_EVALS bisections: with rounding, V need not be monotone
+     * along the line and the splits of a counted interval could otherwise
+     * multiply (generic configurations take ~12 per call) */
+    while (top > 0 && evals < STURM_EVALS) {
         double l, h, m;
         int cl, ch, cm;
         --top;
@@ -256,6 +260,7 @@ static int real_roots(const double *a, int n, double *r)
             continue;
         }
         cm = sturm_changes(&sc, m);
+        ++evals;
         /* the upper half first onto the stack: the lower is taken next */
         lo[top] = m;
         hi[top] = h;
