@@ -239,6 +239,40 @@ static void test_status(void)
     check_status(st, MCG_EDEGENERATE, "central rays (one centre)");
 }
 
+/* A yaw within 1e-4 rad of pi: the tangent half-angle q ~ 2e4 is a root far
+ * out on the line, which the root search must still bracket (its interval
+ * grows until the Sturm counts at its ends are those of the infinities). */
+static void test_near_pi(int trials)
+{
+    int trial, found = 0;
+    for (trial = 0; trial < trials; trial++) {
+        double g1[3], w[3], R[9], t[3], g2[3], o1[12], d1[12], o2[12], d2[12], Rs[72], ts[24];
+        double n, th = 3.14159265358979323846 - 1e-4 * (trial & 1 ? 1.0 : -1.0);
+        int ns = 0, s, i, hit = 0;
+        randn(g1, 3);
+        n = sqrt(dot3(g1, g1));
+        for (i = 0; i < 3; i++)
+            w[i] = th * g1[i] / n;
+        mcg_rot_from_angle_axis(w, R);
+        randn(t, 3);
+        mat_vec(R, g1, g2);
+        make_problem(0, 1, R, t, o1, d1, o2, d2);
+        if (mcg_upright4(o1, d1, o2, d2, g1, g2, Rs, ts, &ns) != MCG_OK)
+            continue;
+        for (s = 0; s < ns; s++) {
+            double e = 0.0;
+            for (i = 0; i < 9; i++)
+                e = fmax(e, fabs(Rs[9 * s + i] - R[i]));
+            for (i = 0; i < 3; i++)
+                e = fmax(e, fabs(ts[3 * s + i] - t[i]) / sqrt(dot3(t, t)));
+            hit |= e < 1e-8;
+        }
+        found += hit;
+    }
+    check(found >= 0.995 * trials, "yaw pi -+ 1e-4: true motion among the solutions (fraction)",
+          (double)found / trials, 0.995);
+}
+
 /* Time per call on generic 4-camera problems with cross-camera rays
  * (printed, not asserted: the machine may be shared; issue 21 targets
  * <= 3 us, PoseLib's gen_relpose_upright_4pt 1.2 us). CPU time of the whole
@@ -273,6 +307,7 @@ int main(void)
     test_random(0, 0, scaled(3000), "generic 4-camera rig, intra-camera");
     test_random(1, 0, scaled(3000), "2-camera head, intra-camera");
     test_random(1, 1, scaled(3000), "2-camera head, cross-camera");
+    test_near_pi(scaled(2000));
     test_status();
     timing();
     printf("%d checks, %d failed\n", n_checks, n_failed);
