@@ -325,13 +325,14 @@ def _errors(R, t, Rt, tt) -> tuple[float, float]:
 
 
 def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: float) -> dict:
-    """{row: call returning (R, t, sampler, seconds in C)} of one problem."""
+    """{row: call returning (R, t, sampler, seconds in C, samples drawn)} of one problem."""
     def facade(**kw):
         m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
-        return m.R, m.info["t_metric"], m.info.get("sampler", ""), m.info.get("c_seconds", np.nan)
+        return (m.R, m.info["t_metric"], m.info.get("sampler", ""),
+                m.info.get("c_seconds", np.nan), m.info.get("iterations", np.nan))
 
     def peer(opt):
-        return lambda: poselib_estimate(setup, p, opt) + ("5+1", np.nan)
+        return lambda: poselib_estimate(setup, p, opt) + ("5+1", np.nan, np.nan)
 
     runs = {"mcgeom façade (auto)": facade,
             "mcgeom 5+1": lambda: facade(method="ransac:five_plus_one"),
@@ -345,11 +346,12 @@ def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: flo
 def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                gravity_error_deg: float = 0.2, progress: Progress = no_progress) -> dict:
     """{case: {method: (errors problems x 2, seconds per problem, samplers, seconds
-    in C)}}: the rotation (deg) and scale errors, NaN where the method cannot
-    sample the data (a ValueError, e.g. 5+1 without a 5-point camera) or finds
-    no motion; the samplers the façade chose; the time of mcgeom's C search
-    (``info["c_seconds"]``: sampling, scoring, LO, final refinement; NaN for
-    the Python drivers and PoseLib). Each gravity vector is turned by
+    in C, samples drawn)}}: the rotation (deg) and scale errors, NaN where the
+    method cannot sample the data (a ValueError, e.g. 5+1 without a 5-point
+    camera) or finds no motion; the samplers the façade chose; the time of
+    mcgeom's C search (``info["c_seconds"]``: sampling, scoring, LO, final
+    refinement; NaN for the Python drivers and PoseLib) and its samples
+    (``info["iterations"]``: the adaptive stop's count, NaN for PoseLib). Each gravity vector is turned by
     ``gravity_error_deg`` about a random axis (the IMU's error)."""
     out = {}
     for name, (make_rig, n, outl, noise, cross, motion) in (cases or RANSAC_CASES).items():
@@ -377,27 +379,28 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                 forced = _FORCED.get(meth)
                 if forced is not None and forced == chosen:
                     # the façade ran this very search (same C call, same seed)
-                    e, s, used, cs = res["mcgeom façade (auto)"]
-                    err, secs, sampler, c_secs = e[-1], s[-1], used[-1], cs[-1]
+                    e, s, used, cs, its = res["mcgeom façade (auto)"]
+                    err, secs, sampler, c_secs, iters = e[-1], s[-1], used[-1], cs[-1], its[-1]
                 elif meth == "mcgeom 6-pt":
                     continue    # only where the façade chose it (see the module)
                 else:
                     t0 = time.perf_counter()
                     try:
-                        Re, te, sampler, c_secs = fn()
+                        Re, te, sampler, c_secs, iters = fn()
                         err = _errors(Re, te, R, t)
                     except (ValueError, ArithmeticError):   # cannot sample / nothing found
-                        err, sampler, c_secs = (np.nan, np.nan), "-", np.nan
+                        err, sampler, c_secs, iters = (np.nan, np.nan), "-", np.nan, np.nan
                     secs = time.perf_counter() - t0
                 if meth == "mcgeom façade (auto)":
                     chosen = sampler
-                e, s, used, cs = res.setdefault(meth, ([], [], [], []))
+                e, s, used, cs, its = res.setdefault(meth, ([], [], [], [], []))
                 e.append(err)
                 s.append(secs)
                 used.append(sampler)
                 cs.append(c_secs)
-        out[name] = {k: (np.array(e), np.array(s), u, np.array(cs))
-                     for k, (e, s, u, cs) in res.items()}
+                its.append(iters)
+        out[name] = {k: (np.array(e), np.array(s), u, np.array(cs), np.array(its, dtype=float))
+                     for k, (e, s, u, cs, its) in res.items()}
     return out
 
 
@@ -411,17 +414,19 @@ def ransac_table(res: dict) -> str:
     fraction it failed, the median time, the speed-up over 5+1 and 17-point
     RANSAC (their median time / this one's), and the median time of the C
     search with its speed-up over 5+1's (the search alone, without the
-    façade's Python conversions and verdict)."""
+    façade's Python conversions and verdict), and the mean number of samples
+    the C search drew (its adaptive stop: w^4 for the upright sampler, w^6
+    for 5+1 and the 6-point)."""
     lines = [f"{'case':<30} {'method':<23} {'sampler':<18} {'rot med deg':>11} "
              f"{'scale med':>9} {'failed':>6} {'ms med':>8} {'vs 5+1':>7} {'vs 17-pt':>8} "
-             f"{'C ms med':>8} {'C vs 5+1':>8}"]
+             f"{'C ms med':>8} {'C vs 5+1':>8} {'samples':>7}"]
     for case, methods in res.items():
         ok5 = np.isfinite(methods["mcgeom 5+1"][0][:, 0])   # (rows not run are absent)
         base5 = np.median(methods["mcgeom 5+1"][1]) if ok5.any() else np.nan
         base17 = np.median(methods["mcgeom 17-pt"][1])
         c5 = methods["mcgeom 5+1"][3]
         c5 = np.median(c5[np.isfinite(c5)]) if np.isfinite(c5).any() else np.nan
-        for meth, (e, secs, used, c_secs) in methods.items():
+        for meth, (e, secs, used, c_secs, iters) in methods.items():
             ok = np.isfinite(e[:, 0])
             med = np.median(e[ok], axis=0) if ok.any() else (np.nan, np.nan)
             names, counts = np.unique(used, return_counts=True)
@@ -430,10 +435,11 @@ def ransac_table(res: dict) -> str:
             ms = np.median(secs)
             cms = np.median(c_secs[np.isfinite(c_secs)]) if np.isfinite(c_secs).any() \
                 else np.nan
+            its = np.mean(iters[np.isfinite(iters)]) if np.isfinite(iters).any() else np.nan
             lines.append(f"{case:<30} {meth:<23} {sampler[:18]:<18} {med[0]:11.4f} "
                          f"{med[1]:9.4f} {np.mean(~ok):6.2f} {1e3 * ms:8.2f} "
                          f"{base5 / ms:6.2f}x {base17 / ms:7.2f}x {1e3 * cms:8.2f} "
-                         f"{c5 / cms:7.2f}x")
+                         f"{c5 / cms:7.2f}x {its:7.1f}")
     return "\n".join(lines)
 
 
