@@ -159,8 +159,9 @@ static int sturm_changes_inf(const sturm_chain *sc, int dir)
     return v;
 }
 
-/* The root of a (degree n, derivative da) in (lo, hi), where a(lo) = flo
- * and a(hi) differ in sign: Newton steps inside the shrinking bracket,
+/* The root of a (degree n, derivative da) in (lo, hi), where a(hi) = fhi
+ * and flo (a(lo), or when lo is itself a root a value of the sign of a just
+ * right of lo) differ in sign: Newton steps inside the shrinking bracket,
  * bisection when a step leaves it; to a few ulps. */
 static double bracket_root(const double *a, const double *da, int n, double lo, double hi,
                            double flo, double fhi)
@@ -241,6 +242,11 @@ static int real_roots(const double *a, int n, double *r)
             continue;
         if (cl - ch == 1) {
             double fl = poly_eval(a, n, l), fh = poly_eval(a, n, h);
+            /* l itself may be a root, counted in the interval to its left
+             * (e.g. q = 0 exactly, where the first split falls): just
+             * right of a simple root a has the sign of a'(l) */
+            if (fl == 0.0)
+                fl = poly_eval(da, n - 1, l);
             if (fh == 0.0)
                 r[nr++] = h;
             else if (fl != 0.0 && (fl < 0.0) != (fh < 0.0))
