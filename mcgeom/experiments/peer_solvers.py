@@ -27,8 +27,9 @@ ch. 7.3.2), the same columns (the time: one pass over the scored calls).
 
 Part ``ransac``: the robust estimate from pixels with 1 px threshold, median
 rotation error (deg), scale error ``| |t| / |t_true| - 1 |`` (the metric
-estimate ``info["t_metric"]``, whatever the verdict) and time per problem
-(ms) of: mcgeom's façade as it chooses its sampler (upright with a vertical
+estimate ``info["t_metric"]``, whatever the verdict), time per problem
+(ms) and, for mcgeom's C search, its time and the mean number of samples its
+adaptive stop drew (w^4 for the upright sampler, w^6 for 5+1 and 6-point) of: mcgeom's façade as it chooses its sampler (upright with a vertical
 prior, else 5+1 when a camera has 5 intra-camera correspondences, else
 6-point; the sampler column counts its choices), the C search forced to 5+1,
 to the generic 6-point, and to the upright 4-point with the vertical known
@@ -46,13 +47,18 @@ only where the façade chose it: ``mcg_sixpt`` (a homotopy continuation of 64
 paths) takes about 0.1 s per sample on this machine, a minute per RANSAC
 problem, which on the cases with a 5-point camera would only measure that.
 
-``mcgeom experiment peer_solvers [--part minimal|ransac|all] [--configs 10000]
-[--configs6 N] [--problems 50] [--seed 0] [--cases CASE ...]`` (needs poselib)
+``mcgeom experiment peer_solvers [--part minimal|minimal4|minimal6|ransac|all]
+[--configs 10000] [--configs6 N] [--chunk6 500] [--problems 50] [--seed 0]
+[--cases CASE ...]`` (needs poselib). The 6-point table runs the families in
+rounds of ``--chunk6`` configurations each and prints the table so far to
+stderr after every round (10,000 configurations of mcgeom's homotopy take
+hours on a shared 2-core machine).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from typing import Callable, Optional
 
@@ -207,33 +213,50 @@ def _sixpt_list(o1, d1, o2, d2) -> list:
 
 
 def run_minimal6(configs: int = 10000, seed: int = 0, families=SIX_FAMILIES,
-                 progress: Progress = no_progress) -> dict:
+                 progress: Progress = no_progress, chunk: Optional[int] = None,
+                 on_chunk: Optional[Callable[[int, dict], None]] = None) -> dict:
     """The 6-point solvers: {family: {solver: (success fraction, mean real
     solutions, seconds per call)}}: mcgeom's ``_core.sixpt`` (csrc/sixpt.c)
-    and ``poselib.gen_relpose_6pt`` on the same noise-free configurations."""
+    and ``poselib.gen_relpose_6pt`` on the same noise-free configurations.
+
+    The families are run in turn, ``chunk`` configurations of each at a time
+    (default: all at once), and ``on_chunk(done, table)`` receives the table of
+    the first ``done`` configurations per family after each round: mcgeom's
+    homotopy takes ~50 ms a call, so 10,000 configurations of 7 families run
+    for hours on a shared machine, and a run stopped early still has figures
+    for every family. Each family draws from its own generator seeded with
+    ``seed``, so the configurations do not depend on ``chunk``."""
     poselib = import_peer("poselib", "peer_solvers")
-    out = {}
-    for fam in progress(families, total=len(families), desc="6-point families"):
-        rng = np.random.default_rng(seed)
-        args, theirs, truth = [], [], []
-        for _ in range(configs):
-            (o1, d1, o2, d2), R, t = _config6(fam, rng)
-            args.append((o1, d1, o2, d2))
-            theirs.append((o1, _unit(d1), o2, _unit(d2)))
-            truth.append((R, t))
-        res = {}
-        for name, fn, a_list in (("mcgeom sixpt", _safe(_sixpt_list), args),
-                                 ("poselib gen_relpose_6pt", _safe(poselib.gen_relpose_6pt),
-                                  theirs)):
-            hits, counts, t0 = 0, 0, time.perf_counter()
-            for a, (R, t) in zip(a_list, truth):
-                sols = [(np.asarray(p.R), np.asarray(p.t)) if hasattr(p, "R") else p
-                        for p in fn(*a)]
-                hits += _hit(sols, R, t)
-                counts += len(sols)
-            # one pass: the solver is timed on the same calls that are scored
-            res[name] = (hits / configs, counts / configs, (time.perf_counter() - t0) / configs)
-        out[fam] = res
+    solvers = (("mcgeom sixpt", _safe(_sixpt_list), False),
+               ("poselib gen_relpose_6pt", _safe(poselib.gen_relpose_6pt), True))
+    rngs = {fam: np.random.default_rng(seed) for fam in families}
+    acc = {fam: {name: [0, 0, 0.0] for name, _, _ in solvers} for fam in families}
+    chunk = configs if chunk is None else max(1, min(chunk, configs))
+    out: dict = {}
+    done = 0
+    for start in progress(range(0, configs, chunk), total=-(-configs // chunk),
+                          desc="6-point rounds"):
+        m = min(chunk, configs - start)
+        for fam in families:
+            cfgs = [_config6(fam, rngs[fam]) for _ in range(m)]
+            for name, fn, unit in solvers:
+                a = acc[fam][name]
+                # PoseLib takes unit directions: made outside the timing
+                calls = [((o1, _unit(d1), o2, _unit(d2)) if unit else (o1, d1, o2, d2), R, t)
+                         for (o1, d1, o2, d2), R, t in cfgs]
+                t0 = time.perf_counter()
+                for args, R, t in calls:
+                    sols = [(np.asarray(p.R), np.asarray(p.t)) if hasattr(p, "R") else p
+                            for p in fn(*args)]
+                    a[0] += _hit(sols, R, t)
+                    a[1] += len(sols)
+                # one pass: the solver is timed on the same calls that are scored
+                a[2] += time.perf_counter() - t0
+        done += m
+        out = {fam: {name: (h / done, c / done, secs / done)
+                     for name, (h, c, secs) in res.items()} for fam, res in acc.items()}
+        if on_chunk is not None:
+            on_chunk(done, out)
     return out
 
 
@@ -303,13 +326,14 @@ def _errors(R, t, Rt, tt) -> tuple[float, float]:
 
 
 def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: float) -> dict:
-    """{row: call returning (R, t, sampler, seconds in C)} of one problem."""
+    """{row: call returning (R, t, sampler, seconds in C, samples drawn)} of one problem."""
     def facade(**kw):
         m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
-        return m.R, m.info["t_metric"], m.info.get("sampler", ""), m.info.get("c_seconds", np.nan)
+        return (m.R, m.info["t_metric"], m.info.get("sampler", ""),
+                m.info.get("c_seconds", np.nan), m.info.get("iterations", np.nan))
 
     def peer(opt):
-        return lambda: poselib_estimate(setup, p, opt) + ("5+1", np.nan)
+        return lambda: poselib_estimate(setup, p, opt) + ("5+1", np.nan, np.nan)
 
     runs = {"mcgeom façade (auto)": facade,
             "mcgeom 5+1": lambda: facade(method="ransac:five_plus_one"),
@@ -323,11 +347,12 @@ def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: flo
 def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                gravity_error_deg: float = 0.2, progress: Progress = no_progress) -> dict:
     """{case: {method: (errors problems x 2, seconds per problem, samplers, seconds
-    in C)}}: the rotation (deg) and scale errors, NaN where the method cannot
-    sample the data (a ValueError, e.g. 5+1 without a 5-point camera) or finds
-    no motion; the samplers the façade chose; the time of mcgeom's C search
-    (``info["c_seconds"]``: sampling, scoring, LO, final refinement; NaN for
-    the Python drivers and PoseLib). Each gravity vector is turned by
+    in C, samples drawn)}}: the rotation (deg) and scale errors, NaN where the
+    method cannot sample the data (a ValueError, e.g. 5+1 without a 5-point
+    camera) or finds no motion; the samplers the façade chose; the time of
+    mcgeom's C search (``info["c_seconds"]``: sampling, scoring, LO, final
+    refinement; NaN for the Python drivers and PoseLib) and its samples
+    (``info["iterations"]``: the adaptive stop's count, NaN for PoseLib). Each gravity vector is turned by
     ``gravity_error_deg`` about a random axis (the IMU's error)."""
     out = {}
     for name, (make_rig, n, outl, noise, cross, motion) in (cases or RANSAC_CASES).items():
@@ -355,27 +380,28 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                 forced = _FORCED.get(meth)
                 if forced is not None and forced == chosen:
                     # the façade ran this very search (same C call, same seed)
-                    e, s, used, cs = res["mcgeom façade (auto)"]
-                    err, secs, sampler, c_secs = e[-1], s[-1], used[-1], cs[-1]
+                    e, s, used, cs, its = res["mcgeom façade (auto)"]
+                    err, secs, sampler, c_secs, iters = e[-1], s[-1], used[-1], cs[-1], its[-1]
                 elif meth == "mcgeom 6-pt":
                     continue    # only where the façade chose it (see the module)
                 else:
                     t0 = time.perf_counter()
                     try:
-                        Re, te, sampler, c_secs = fn()
+                        Re, te, sampler, c_secs, iters = fn()
                         err = _errors(Re, te, R, t)
                     except (ValueError, ArithmeticError):   # cannot sample / nothing found
-                        err, sampler, c_secs = (np.nan, np.nan), "-", np.nan
+                        err, sampler, c_secs, iters = (np.nan, np.nan), "-", np.nan, np.nan
                     secs = time.perf_counter() - t0
                 if meth == "mcgeom façade (auto)":
                     chosen = sampler
-                e, s, used, cs = res.setdefault(meth, ([], [], [], []))
+                e, s, used, cs, its = res.setdefault(meth, ([], [], [], [], []))
                 e.append(err)
                 s.append(secs)
                 used.append(sampler)
                 cs.append(c_secs)
-        out[name] = {k: (np.array(e), np.array(s), u, np.array(cs))
-                     for k, (e, s, u, cs) in res.items()}
+                its.append(iters)
+        out[name] = {k: (np.array(e), np.array(s), u, np.array(cs), np.array(its, dtype=float))
+                     for k, (e, s, u, cs, its) in res.items()}
     return out
 
 
@@ -389,17 +415,19 @@ def ransac_table(res: dict) -> str:
     fraction it failed, the median time, the speed-up over 5+1 and 17-point
     RANSAC (their median time / this one's), and the median time of the C
     search with its speed-up over 5+1's (the search alone, without the
-    façade's Python conversions and verdict)."""
+    façade's Python conversions and verdict), and the mean number of samples
+    the C search drew (its adaptive stop: w^4 for the upright sampler, w^6
+    for 5+1 and the 6-point)."""
     lines = [f"{'case':<30} {'method':<23} {'sampler':<18} {'rot med deg':>11} "
              f"{'scale med':>9} {'failed':>6} {'ms med':>8} {'vs 5+1':>7} {'vs 17-pt':>8} "
-             f"{'C ms med':>8} {'C vs 5+1':>8}"]
+             f"{'C ms med':>8} {'C vs 5+1':>8} {'samples':>7}"]
     for case, methods in res.items():
         ok5 = np.isfinite(methods["mcgeom 5+1"][0][:, 0])   # (rows not run are absent)
         base5 = np.median(methods["mcgeom 5+1"][1]) if ok5.any() else np.nan
         base17 = np.median(methods["mcgeom 17-pt"][1])
         c5 = methods["mcgeom 5+1"][3]
         c5 = np.median(c5[np.isfinite(c5)]) if np.isfinite(c5).any() else np.nan
-        for meth, (e, secs, used, c_secs) in methods.items():
+        for meth, (e, secs, used, c_secs, iters) in methods.items():
             ok = np.isfinite(e[:, 0])
             med = np.median(e[ok], axis=0) if ok.any() else (np.nan, np.nan)
             names, counts = np.unique(used, return_counts=True)
@@ -408,10 +436,11 @@ def ransac_table(res: dict) -> str:
             ms = np.median(secs)
             cms = np.median(c_secs[np.isfinite(c_secs)]) if np.isfinite(c_secs).any() \
                 else np.nan
+            its = np.mean(iters[np.isfinite(iters)]) if np.isfinite(iters).any() else np.nan
             lines.append(f"{case:<30} {meth:<23} {sampler[:18]:<18} {med[0]:11.4f} "
                          f"{med[1]:9.4f} {np.mean(~ok):6.2f} {1e3 * ms:8.2f} "
                          f"{base5 / ms:6.2f}x {base17 / ms:7.2f}x {1e3 * cms:8.2f} "
-                         f"{c5 / cms:7.2f}x")
+                         f"{c5 / cms:7.2f}x {its:7.1f}")
     return "\n".join(lines)
 
 
@@ -419,14 +448,19 @@ def ransac_table(res: dict) -> str:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment peer_solvers``."""
-    ap.add_argument("--part", choices=("minimal", "ransac", "all"), default="all",
-                    help="minimal solvers on noise-free configurations, RANSAC from "
+    ap.add_argument("--part", choices=("minimal", "minimal4", "minimal6", "ransac", "all"),
+                    default="all",
+                    help="minimal solvers on noise-free configurations (minimal4: the "
+                         "upright 4-point only, minimal6: the 6-point only), RANSAC from "
                          "pixels, or both")
     ap.add_argument("--configs", type=positive_int, default=10000,
                     help="noise-free configurations per family (minimal part)")
     ap.add_argument("--configs6", type=positive_int, default=None,
                     help="configurations per family of the 6-point comparison (minimal "
                          "part; default --configs; mcgeom's homotopy takes ~60 ms a call)")
+    ap.add_argument("--chunk6", type=positive_int, default=500,
+                    help="6-point configurations per family and round; the table so far "
+                         "goes to stderr after each round")
     add_count_and_seed(ap, "--problems", 50, "problems per case (RANSAC part)")
     ap.add_argument("--cases", nargs="*", default=None, choices=list(RANSAC_CASES),
                     metavar="CASE", help="cases of the RANSAC part (default: all), of: "
@@ -436,11 +470,18 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     """Print the tables of the requested parts."""
     import_peer("poselib", "peer_solvers")
-    if args.part in ("minimal", "all"):
+    def partial(done: int, table: dict) -> None:
+        # a long run stopped early keeps the figures of the rounds done
+        print(f"[6-point: {done} configurations per family so far]\n{minimal_table(table)}",
+              file=sys.stderr, flush=True)
+
+    if args.part in ("minimal", "minimal4", "all"):
         print(minimal_table(run_minimal(args.configs, args.seed, progress=progress)))
-        print()
+        print(flush=True)
+    if args.part in ("minimal", "minimal6", "all"):
         print(minimal_table(run_minimal6(args.configs6 or args.configs, args.seed,
-                                         progress=progress)))
+                                         progress=progress, chunk=args.chunk6,
+                                         on_chunk=partial)))
     if args.part in ("ransac", "all"):
         if args.part == "all":
             print()
