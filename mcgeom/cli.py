@@ -368,8 +368,15 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     from .experiments import load
 
     module = load(args.name)
-    eargs = _experiment_parser(args.name, module).parse_args(args.options)
-    return module.run_cli(eargs, progress=progress_bar)
+    ep = _experiment_parser(args.name, module)
+    eargs = ep.parse_args(args.options)
+    try:
+        return module.run_cli(eargs, progress=progress_bar)
+    except ValueError as exc:
+        # mcgeom's ValueErrors name the argument or option at fault: a usage
+        # message (exit 2), not a traceback, for options whose bad values an
+        # experiment only finds while running (e.g. a case name, a data set)
+        ep.error(str(exc))
 
 
 def _name_list(title: str, items: dict) -> str:

@@ -64,6 +64,22 @@ def test_unknown_experiment_is_an_argparse_error(capsys):
     assert "invalid choice: 'no_such_experiment'" in err
 
 
+def test_a_value_error_while_an_experiment_runs_is_a_usage_error(monkeypatch, capsys):
+    # a bad value an experiment only finds while running (named by mcgeom's
+    # ValueError) is reported like an argparse error: usage, message, exit 2
+    mod = load("ch8")
+
+    def run_cli(args, progress):
+        raise ValueError("threshold: must be positive, got -1")
+
+    monkeypatch.setattr(mod, "run_cli", run_cli)
+    assert _exit_code(["experiment", "ch8"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("usage: mcgeom experiment ch8")
+    assert "mcgeom experiment ch8: error: threshold: must be positive, got -1" in err
+    assert "Traceback" not in err
+
+
 @pytest.mark.parametrize("argv, message", [
     (["demo", "--frames", "1"], "argument --frames: expected at least 2 frames"),
     (["demo", "--frames", "-4"], "argument --frames: expected a positive integer"),

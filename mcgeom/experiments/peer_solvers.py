@@ -29,7 +29,8 @@ Part ``ransac``: the robust estimate from pixels with 1 px threshold, median
 rotation error (deg), scale error ``| |t| / |t_true| - 1 |`` (the metric
 estimate ``info["t_metric"]``, whatever the verdict), time per problem
 (ms) and, for mcgeom's C search, its time and the mean number of samples its
-adaptive stop drew (w^4 for the upright sampler, w^6 for 5+1 and 6-point) of: mcgeom's façade as it chooses its sampler (upright with a vertical
+adaptive stop drew (w^4 for the upright sampler, w^6 for 5+1 and 6-point)
+of: mcgeom's façade as it chooses its sampler (upright with a vertical
 prior, else 5+1 when a camera has 5 intra-camera correspondences, else
 6-point; the sampler column counts its choices), the C search forced to 5+1,
 to the generic 6-point, and to the upright 4-point with the vertical known
