@@ -252,17 +252,13 @@ def scale_verdict_stats(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_ca
                             n_cameras, inliers, R, t, still)
     n_intra = s["n_intra"]
     if np.isfinite(noise_level) and noise_level > 0 and n_intra >= NO_PARALLAX_MIN:
-        if not s["fit_ok"]:
-            # the bearings span rank < 2 (one direction repeated): the numpy
-            # fit decides as before
-            mask = np.asarray(inliers).astype(bool) & same_camera(rays)
-            _, ang = rotation_fit(rays, mask)
-            if no_parallax(ang, noise_level):
+        # the numpy fit decides where C's fit failed (the bearings span rank
+        # < 2: one direction repeated), and gives the angles that the rare
+        # static answer's message quotes
+        if not s["fit_ok"] or s["n_still"] / n_intra >= NO_PARALLAX_FRACTION:
+            _, ang = rotation_fit(rays, np.asarray(inliers).astype(bool) & same_camera(rays))
+            if s["fit_ok"] or no_parallax(ang, noise_level):
                 return _static_verdict(ang), s["t_direction"]
-        elif s["n_still"] / n_intra >= NO_PARALLAX_FRACTION:
-            # the rare static answer: its message quotes the median angle
-            mask = np.asarray(inliers).astype(bool) & same_camera(rays)
-            return _static_verdict(rotation_fit(rays, mask)[1]), s["t_direction"]
     n_in = s["n_inliers"]
     verdict = _verdict(n_in, s["n_cross"], s["n_cameras_intra"], s["critical_angle"], rel_std,
                        max_rel_std, False, profile, lambda: s["n_in_front"])
