@@ -132,10 +132,11 @@ class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter,
                     argparse.RawDescriptionHelpFormatter):
     """Descriptions as written (paragraphs and lists kept), every option's
     default appended to its help, except where the help states it itself
-    (default None: it depends on other options)."""
+    (default None: it depends on other options; or the help already says
+    "default", which argparse would repeat as a Python repr)."""
 
     def _get_help_string(self, action: argparse.Action) -> str:
-        if action.default is None:
+        if action.default is None or "default" in (action.help or ""):
             return action.help or ""
         return super()._get_help_string(action)
 
