@@ -511,11 +511,14 @@ def with_calibration(motion, rays: RayPairs, calibration_std,
     total = combine_rel_std(float(motion.scale.rel_std), cal)
     v = motion.scale
     observable = bool(v.observable and total <= max_scale_rel_std)
-    reason = v.reason
     if v.observable and not observable:
         reason = (f"scale too uncertain with the rig's calibration error: relative std of "
                   f"|t| {total:.3g} (noise {v.rel_std:.3g}, calibration {cal:.3g}) above "
                   f"{max_scale_rel_std:g}; {v.reason}")
+    else:
+        # the estimator's reason quotes its noise-only std: say what rel_std now is
+        reason = (f"{v.reason}; with the rig's calibration error the relative std of |t| "
+                  f"is {total:.3g} (noise {v.rel_std:.3g}, calibration {cal:.3g})")
     verdict = ScaleVerdict(observable, reason, v.conditioning, total, v.critical_angle)
     new_info = {**info, "scale_rel_std_noise": float(v.rel_std),
                 "scale_rel_std_calibration": float(cal)}

@@ -104,3 +104,21 @@ def test_facade_override_enters_rel_std_and_the_verdict():
     assert loose.info["covariance"].shape == (6, 6)
     with pytest.raises(ValueError, match="calibration_std"):
         cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, calibration_std=(1.0, 2.0, 3.0))
+
+
+def test_with_calibration_reason_quotes_the_total_rel_std():
+    # the verdict's reason must quote the rel_std the user reads in scale.rel_std,
+    # not the estimator's noise-only figure
+    from mcgeom import estimate
+    from mcgeom.observability import with_calibration
+    rng = np.random.default_rng(5)
+    rig = synth.vehicle8()
+    Rw = synth.rotation_about([0, 0, 1], np.radians(10))
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    p = synth.make_problem(rig, R, t, 400, rng, pixel_noise=0.5, cross_fraction=0.1)
+    m = estimate(p.rays, "linear17")
+    assert m.scale.observable and "scale_rel_std_calibration" not in m.info
+    c = with_calibration(m, p.rays, (2e-3, np.radians(0.1)))
+    assert c.scale.observable and c.scale.rel_std > m.scale.rel_std
+    assert f"{c.scale.rel_std:.3g}" in c.scale.reason
+    assert f"{m.scale.rel_std:.3g}" in c.scale.reason   # the noise part is still named
