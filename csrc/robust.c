@@ -202,17 +202,25 @@ static size_t ints_as_doubles(size_t n) { return (n * sizeof(int) + sizeof(doubl
 /* Below PREEMPT_MIN pairs the scale search's workspace lies over the
  * gathered subset (sub, wsub: 13 n doubles), which is dead while
  * mcg_scale_ransac runs (LO and the final stage gather it afresh; the
- * preemptive subset that lives in its tail exists only from PREEMPT_MIN):
- * only what exceeds 13 n is its own (issue 19: the peak memory of a call
- * on 1e3 pairs was 3.1x its input, mostly this fixed-size workspace). */
+ * preemptive subset that lives in its tail exists only from PREEMPT_MIN),
+ * and the search takes at most 13 n / 14 pairs so that its 14 doubles per
+ * pair fit there; its pairs are indices into the input, not a copy
+ * (issue 19: the peak memory of a call on 1e3 pairs was 3.1x, then 2.26x
+ * its input, mostly these buffers). */
 static int scale_work_aliased(int n) { return n < PREEMPT_MIN; }
+
+/* pairs of the scale search at most */
+static int scale_cap(int n)
+{
+    int cap = n < SCALE_PAIRS ? n : SCALE_PAIRS;
+    if (scale_work_aliased(n) && cap > 13 * n / 14)
+        cap = 13 * n / 14;
+    return cap;
+}
 
 static size_t scale_work_own(int n)
 {
-    const size_t m = min_sz((size_t)n, SCALE_PAIRS), w = mcg_scale_ransac_work_size((int)m);
-    if (!scale_work_aliased(n))
-        return w;
-    return w > 13 * (size_t)n ? w - 13 * (size_t)n : 0;
+    return scale_work_aliased(n) ? 0 : mcg_scale_ransac_work_size(scale_cap(n));
 }
 
 size_t mcg_robust_work_size(int n, int n_cameras)
@@ -227,9 +235,9 @@ size_t mcg_robust_work_size(int n, int n_cameras)
     s = mul_sz(nn, 16, &ok);
     s = add_sz(s, ints_as_doubles(nn), &ok);
     s = add_sz(s, ints_as_doubles(2 * (size_t)n_cameras + 2), &ok);
-    /* the scale search: its pairs (12 m), its workspace and order, m <= SCALE_PAIRS */
-    nn = min_sz(nn, SCALE_PAIRS);
-    s = add_sz(s, 12 * nn + scale_work_own(n) + ints_as_doubles(nn), &ok);
+    /* the scale search: its pairs' indices and order, its workspace */
+    nn = (size_t)scale_cap(n);
+    s = add_sz(s, 2 * ints_as_doubles(nn) + scale_work_own(n), &ok);
     /* the solutions of one minimal sample (the 6-point solver's are the most) */
     s = add_sz(s, MINIMAL_SOLUTIONS_SIZE, &ok);
     return ok ? s : 0;
@@ -247,14 +255,13 @@ typedef struct {
     double *rbest, *rcur, *fsc, *sub, *wsub;
     int *perm, *off; /* indices grouped: intra of camera 0, 1, ..., cross */
     int *usable;     /* per camera: 1 if it can be the 5-point camera */
-    double *xs;      /* the scale search's cross-camera pairs: o1 d1 o2 d2 */
+    int *xidx;       /* the scale search's pairs (indices of the input) */
     double *xwork;   /* its mcg_scale_ransac workspace */
     int *xorder;     /* its proposal order */
     double *msol;    /* the solutions of an upright / 6-point sample */
     int sample_size; /* pairs per sample (adaptive stop) */
     int nx;          /* its pairs (0: no scale search) */
     int nx_others;   /* 1: they are another camera's (gather_others) */
-    size_t lxwork;
     /* derived */
     double thr2, med_focal, loss_scale;
     double size;     /* RMS spread of the origins + |their centroid| (metres) */
@@ -593,10 +600,9 @@ static int offer(ctx *c, const double R[9], const double t0[3], const double u[3
             c->xorder[j] = c->xorder[r];
             c->xorder[r] = tmp;
         }
-        if (mcg_scale_ransac(c->nx, c->xs, c->xs + 3 * (size_t)c->nx, c->xs + 6 * (size_t)c->nx,
-                             c->xs + 9 * (size_t)c->nx, R, t0, u, c->nx, c->xorder,
-                             SCALE_PROPOSALS, c->loss_scale, c->opt.prob, &lam2, &sc2, NULL,
-                             c->xwork, c->lxwork) == MCG_OK &&
+        if (mcg_scale_ransac_indexed(c->nx, c->xidx, c->o1, c->d1, c->o2, c->d2, R, t0, u,
+                                     c->nx, c->xorder, SCALE_PROPOSALS, c->loss_scale,
+                                     c->opt.prob, &lam2, &sc2, NULL, c->xwork) == MCG_OK &&
             lam2 != lam &&
             /* not the trivial root lam = 0 of pairs whose cameras sit at
              * camera a's centre (a central rig: every F vanishes there, a
@@ -617,13 +623,13 @@ static int offer(ctx *c, const double R[9], const double t0[3], const double u[3
     return 1;
 }
 
-/* The pairs of the scale search: up to SCALE_PAIRS cross-camera pairs
+/* The pairs of the scale search: up to scale_cap cross-camera pairs
  * (a random subset when there are more: the scale is one number), when
  * there are at least MIN_CROSS of them. */
 static void gather_cross(ctx *c)
 {
-    int g0 = c->off[c->ncam], m = c->off[c->ncam + 1] - g0, k, i, j;
-    int take = m < SCALE_PAIRS ? m : SCALE_PAIRS;
+    int g0 = c->off[c->ncam], m = c->off[c->ncam + 1] - g0, j, cap = scale_cap(c->n);
+    int take = m < cap ? m : cap;
     c->nx = 0;
     if (m < MIN_CROSS)
         return;
@@ -631,55 +637,34 @@ static void gather_cross(ctx *c)
         int r = j + rng_below(&c->rng, m - j), tmp = c->perm[g0 + j];
         c->perm[g0 + j] = c->perm[g0 + r];
         c->perm[g0 + r] = tmp;
-        k = c->perm[g0 + j];
-        for (i = 0; i < 3; i++) {
-            c->xs[3 * j + i] = c->o1[3 * (size_t)k + i];
-            c->xs[3 * (size_t)take + 3 * j + i] = c->d1[3 * (size_t)k + i];
-            c->xs[6 * (size_t)take + 3 * j + i] = c->o2[3 * (size_t)k + i];
-            c->xs[9 * (size_t)take + 3 * j + i] = c->d2[3 * (size_t)k + i];
-        }
+        c->xidx[j] = c->perm[g0 + j];
         c->xorder[j] = j;
     }
     c->nx = take;
 }
 
 /* The pairs of the scale search when there are few cross-camera pairs: up
- * to SCALE_PAIRS of those not of camera a (each kept with probability
- * SCALE_PAIRS / their count), gathered for one search. */
+ * to scale_cap of those not of camera a (each kept with probability
+ * cap / their count), gathered for one search. */
 static int gather_others(ctx *c, int a)
 {
-    int start = c->off[a], cnt = c->off[a + 1] - start, nother = c->n - cnt, j, i, m = 0;
-    int cap = c->n < SCALE_PAIRS ? c->n : SCALE_PAIRS;
+    int start = c->off[a], cnt = c->off[a + 1] - start, nother = c->n - cnt, j, m = 0;
+    int cap = scale_cap(c->n);
     uint64_t cut = nother > cap ? (uint64_t)((double)cap / nother * 18446744073709551615.0)
                                 : UINT64_MAX;
-    double *xo1 = c->xs, *xd1 = c->xs + 3 * (size_t)cap, *xo2 = c->xs + 6 * (size_t)cap,
-           *xd2 = c->xs + 9 * (size_t)cap;
     if (nother < 1)
         return 0;
     for (j = 0; j < c->n && m < cap; j++) {
-        int k;
         if (j >= start && j < start + cnt)
             continue;
         if (cut != UINT64_MAX && rng_next(&c->rng) > cut)
             continue;
-        k = c->perm[j];
-        for (i = 0; i < 3; i++) {
-            xo1[3 * m + i] = c->o1[3 * (size_t)k + i];
-            xd1[3 * m + i] = c->d1[3 * (size_t)k + i];
-            xo2[3 * m + i] = c->o2[3 * (size_t)k + i];
-            xd2[3 * m + i] = c->d2[3 * (size_t)k + i];
-        }
+        c->xidx[m] = c->perm[j];
         c->xorder[m] = m;
         m++;
     }
     if (m == 0)
         return 0;
-    /* the four arrays contiguous for mcg_scale_ransac (m <= cap) */
-    if (m < cap) {
-        memmove(c->xs + 3 * (size_t)m, xd1, 3 * (size_t)m * sizeof *xd1);
-        memmove(c->xs + 6 * (size_t)m, xo2, 3 * (size_t)m * sizeof *xo2);
-        memmove(c->xs + 9 * (size_t)m, xd2, 3 * (size_t)m * sizeof *xd2);
-    }
     c->nx = m;
     c->nx_others = 1;
     return m;
@@ -1161,24 +1146,19 @@ static void carve(ctx *c, double *work)
     c->sub = work + 3 * n;
     c->wsub = work + 15 * n;
     {
-        /* (the scale search's own workspace beyond the 13 n of sub and wsub
-         * follows wsub when it lies over them: scale_work_own) */
-        const size_t m = min_sz(n, SCALE_PAIRS), own = scale_work_own(c->n);
-        double *after = work + 16 * n + (scale_work_aliased(c->n) ? own : 0);
+        /* (below PREEMPT_MIN the scale search's workspace lies over sub and
+         * wsub: scale_work_own) */
+        const size_t m = (size_t)scale_cap(c->n);
+        double *after = work + 16 * n, *x;
         c->perm = (int *)after;
         c->off = (int *)(after + ints_as_doubles(n));
         c->usable = c->off + c->ncam + 2;
-        c->xs = after + ints_as_doubles(n) + ints_as_doubles(2 * (size_t)c->ncam + 2);
-        c->lxwork = mcg_scale_ransac_work_size((int)m);
-        if (scale_work_aliased(c->n)) {
-            c->xwork = c->sub;
-            c->xorder = (int *)(c->xs + 12 * m);
-            c->msol = c->xs + 12 * m + ints_as_doubles(m);
-        } else {
-            c->xwork = c->xs + 12 * m;
-            c->xorder = (int *)(c->xwork + c->lxwork);
-            c->msol = c->xwork + c->lxwork + ints_as_doubles(m);
-        }
+        x = after + ints_as_doubles(n) + ints_as_doubles(2 * (size_t)c->ncam + 2);
+        c->xidx = (int *)x;
+        c->xorder = (int *)(x + ints_as_doubles(m));
+        x += 2 * ints_as_doubles(m);
+        c->xwork = scale_work_aliased(c->n) ? c->sub : x;
+        c->msol = x + scale_work_own(c->n);
     }
 }
 

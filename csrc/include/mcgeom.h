@@ -1017,8 +1017,8 @@ typedef struct {
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_robust_default_options(mcg_robust_options *opt);
 
-/* Doubles of workspace for mcg_robust_rig_motion: about 30 n + 800 up to
- * 4096 pairs, 17.5 n + 43000 up to 16383, 16.5 n + 106000 beyond (0 for n
+/* Doubles of workspace for mcg_robust_rig_motion: about 17.5 n + 300 up to
+ * 4096 pairs, 16.5 n + 4400 up to 16383, 16.5 n + 62000 beyond (0 for n
  * outside [6, 2^26] or n_cameras outside [1, 4096]). */
 size_t mcg_robust_work_size(int n, int n_cameras);
 
