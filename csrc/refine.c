@@ -287,21 +287,25 @@ static void loss_eval(const lossfn *l, double z, double *rho, double *drho)
  * refinement; rho(z) = s^2 log(1 + z / s^2)), the sums of the accumulator,
  * and the block's cost sum w s^2 log1p(u). The cost is computed without a
  * log1p per pair (issue 19: log1p was 1/5 of the refinements' time at 1e3
- * pairs, and its call kept the loop from vectorising): with unit weights,
+ * pairs, and its call kept the loop from vectorising):
  * sum log1p(u) = log(prod (1 + u)) over the terms with u >= CAUCHY_SERIES
  * (one log per block; the relative rounding of each factor, 1e-16 / u
  * <= 2.2e-13 of its term, is far below the cost differences LM decides
  * on), plus the series u - u^2/2 + u^3/3 - u^4/4 of the smaller ones
- * (where 1 + u would lose u's digits). A product that overflows (huge u),
- * non-unit weights or a NaN take log1p per pair. */
+ * (where 1 + u would lose u's digits); a block of equal weights (all 1
+ * when none are given, the common case) is that times its weight. A
+ * product that overflows (huge u), unequal weights or a NaN take log1p
+ * per pair. */
 static double cauchy_block(int nb, const double *rb, const double *wts, const double *okb,
                            const lossfn *l, double *ob, double *sw, double *swr2,
                            double *som, double *somr2, int *used_n)
 {
     double prod = 1.0, series = 0.0, a = 0.0, b = 0.0, c = 0.0, d = 0.0;
-    int k, used = 0;
+    const double w0 = wts ? wts[0] : 1.0;
+    int k, used = 0, same = 1;
     for (k = 0; k < nb; k++) {
         double w = wts ? wts[k] : 1.0, z = rb[k] * rb[k], u = z * l->inv_s2;
+        same &= w == w0;
         double om = w / (1.0 + u), small = u < CAUCHY_SERIES ? 1.0 : 0.0;
         ob[k] = om;
         a += w;
@@ -317,8 +321,8 @@ static double cauchy_block(int nb, const double *rb, const double *wts, const do
     *som += c;
     *somr2 += d;
     *used_n += used;
-    if (!wts && prod < DBL_MAX && series == series) /* (prod >= 1 or NaN) */
-        return l->s2 * (series + log(prod));
+    if (same && prod < DBL_MAX && series == series) /* (prod >= 1 or NaN) */
+        return w0 * l->s2 * (series + log(prod));
     series = 0.0;
     for (k = 0; k < nb; k++)
         series += (wts ? wts[k] : 1.0) * log1p(rb[k] * rb[k] * l->inv_s2);

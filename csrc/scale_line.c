@@ -85,6 +85,28 @@ static double msac(const double *t, size_t n, double lam, double thr2, int *inli
     return s;
 }
 
+/* msac without the count, abandoned (HUGE_VAL) once the partial sum reaches
+ * `bound`: the terms are >= 0, so such a proposal cannot score below the
+ * bound (the bail-out of Chum & Matas' randomised RANSAC, here with an
+ * exact bound: the decisions are those of the full score). Blocks of
+ * MSAC_BLOCK pairs between two tests keep the inner loop vectorisable. */
+#define MSAC_BLOCK 64
+static double msac_bounded(const double *t, size_t n, double lam, double thr2, double bound)
+{
+    double s = 0.0;
+    size_t k0, k;
+    for (k0 = 0; k0 < n; k0 += MSAC_BLOCK) {
+        size_t k1 = n - k0 < MSAC_BLOCK ? n : k0 + MSAC_BLOCK;
+        for (k = k0; k < k1; k++) {
+            double r2 = r2_at(t, n, k, lam);
+            s += r2 < thr2 ? r2 : thr2;
+        }
+        if (s >= bound)
+            return HUGE_VAL;
+    }
+    return s;
+}
+
 /* the terms a, b, A, B, C of every pair (see the file comment); 0 on a NaN,
  * inf, zero direction or overflow */
 static int terms(size_t n, const int *idx, const double *o1, const double *d1,
@@ -214,7 +236,9 @@ int mcg_scale_ransac_indexed(int n, const int *idx, const double *o1, const doub
              * MCG_OK (found by fuzz_scale_line in its 10-minute run) */
             if (!(lj > 0.0))
                 continue;
-            sj = msac(work, nn, lj, thr2, NULL);
+            /* (a score >= the batch's best or the overall best changes
+             * nothing below: neither is replaced) */
+            sj = msac_bounded(work, nn, lj, thr2, bs < best ? bs : best);
             if (!isfinite(sj))
                 continue;
             if (sj < bs) { /* the first of equal scores */
