@@ -121,6 +121,14 @@ int mcg_scale_ransac_indexed(int n, const int *idx, const double *o1, const doub
                              double prob, double *lam, double *score, int *n_inliers,
                              double *work);
 
+/* mcg_refine_motion (refine.c) that also stops, converged with reason
+ * MCG_REFINE_STOP_COST, once its cost is at most cost_target (-HUGE_VAL:
+ * never; mcg_refine_motion itself). */
+int mcg_refine_motion_until(int n, const double *o1, const double *d1, const double *o2,
+                            const double *d2, const double *weights,
+                            const mcg_refine_options *opt, double cost_target, double R[9],
+                            double t[3], mcg_refine_result *res);
+
 /* The k-th smallest of x[0..m) (x is reordered; Hoare's selection), and the
  * median as numpy.median (the mean of the two middle values for even m,
  * m >= 1; x is reordered). For the robust statistics of the kernels

@@ -817,6 +817,17 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
                       const mcg_refine_options *opt, double R[9], double t[3],
                       mcg_refine_result *res)
 {
+    return mcg_refine_motion_until(n, o1, d1, o2, d2, weights, opt, -HUGE_VAL, R, t, res);
+}
+
+/* mcg_refine_motion that also stops (converged, MCG_REFINE_STOP_COST) as
+ * soon as the cost is at most cost_target (internal.h): for a statistic
+ * that is only compared with a bound, robust.c's zero profile. */
+int mcg_refine_motion_until(int n, const double *o1, const double *d1, const double *o2,
+                            const double *d2, const double *weights,
+                            const mcg_refine_options *opt, double cost_target, double R[9],
+                            double t[3], mcg_refine_result *res)
+{
     mcg_refine_options o;
     lossfn lf;
     accum cur;
@@ -871,9 +882,15 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
     lm.reason = MCG_REFINE_STOP_MAX_ITERATIONS;
     lm.converged = 0;
     lm.trials = 0;
-    for (it = 0; it < o.max_iterations; it++)
+    for (it = 0; it < o.max_iterations; it++) {
+        if (cur.cost <= cost_target) {
+            lm.converged = 1;
+            lm.reason = MCG_REFINE_STOP_COST;
+            break;
+        }
         if (lm_iteration(n, o1, d1, o2, d2, weights, &lf, &o, ell, rho0, r, tv, &cur, &lm))
             break;
+    }
     res->iterations = lm.trials;
 
     st = final_statistics(&cur, tv, pdim, &lm, res);

@@ -1008,7 +1008,9 @@ typedef struct {
                                (could the cameras not have moved at all?),
                                computed when the refinement's scale_rel_std
                                is at most 1 but above max_scale_rel_std or
-                               scale_profile < 9; NaN otherwise */
+                               scale_profile < 9; NaN otherwise. Only its
+                               side of 9 is exact: below 9 it is an upper
+                               bound (the fit stops there) */
     double inlier_rms;      /* RMS of the inliers' residuals at (R, t)
                                (pixels with focal, else radians; NaN when
                                there is no inlier) */
