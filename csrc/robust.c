@@ -129,10 +129,11 @@
  * the verdict compares with 9 sigma^2, within ~1e-3 sigma^2. The default
  * relative 1e-10 of mcg_refine_motion took 9-16 steps per fit where 4-8
  * reach this (issue 19: refinements were ~2/3 of the C time at 1e3 pairs).
- * Not the final refinement: where |t| is unobservable its cost is flat along
- * |t| and where it stops decides how far it slides, which the verdict in
- * Python judges (an exactly critical motion converged at another |t| than
- * 50 steps of the tight tolerance reached); it keeps the default. */
+ * Not the final refinement's first fit: where |t| is unobservable its cost
+ * is flat along |t| and where it stops decides how far it slides, which the
+ * verdict in Python judges (an exactly critical motion converged at
+ * another |t| than 50 steps of the tight tolerance reached); it keeps the
+ * default, and so does its refit unless the first fit found |t| determined. */
 #define REFINE_TOL 1e-3
 /* Preemptive scoring (issue 19; cf. the preemptive and randomised RANSAC of
  * Nister 2003 and Chum & Matas 2002): with at least PREEMPT_MIN pairs, a
@@ -1328,6 +1329,10 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
         m = gather(c, c->rcur, 0.5, w, cen, 1.0);
         if (m < MIN_REFIT)
             break;
+        /* the refit of a moved set from the first fit's optimum with
+         * REFINE_TOL where that fit found |t| determined (no flat valley to
+         * slide along: the argument of REFINE_TOL holds) */
+        c->final_stage = !(round > 0 && res->refinement.scale_rel_std <= UNDETERMINED_REL_STD);
         if (refine_capped(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr) != MCG_OK)
             break;
         res->refined = 1;
