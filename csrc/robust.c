@@ -1370,6 +1370,90 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
         mask[k] &= 2;
 }
 
+/* The start of a profile fit: the free optimum (R, t) (rig frame; the
+ * centroid's translation tc = t + shift, shift = R cen - cen) with tc
+ * scaled to f |tc|, and the other five parameters (rotation, direction of
+ * tc) moved to their conditional optimum under the quadratic model of the
+ * cost at the optimum, information h (6 x 6 in [dw, dt], the centred
+ * frame): for the step s u along u = tc / |tc|, s = (f - 1) |tc|, the rest
+ * y (dw and tc's two tangent directions b1, b2) solves
+ * (P^T h P) y = -P^T h u s (the Schur complement step of a profile
+ * likelihood). The fit then starts near its optimum instead of at R
+ * (measured: the profile's pair evaluations at 1e3 pairs -17 %, ring4
+ * -15 %; none gained for the zero profile, whose 1 % of |tc| lies far
+ * beyond the quadratic model: not used there). On a
+ * singular block or a step of more than MAX_START_TURN the plain start is
+ * kept. R, t: in, the plain start (R the optimum's); out, the start. */
+#define MAX_START_TURN 0.1
+static void profile_start(const double h[36], const double t_opt[3], const double shift[3],
+                          double f, const double cen[3], double R[9], double t[3])
+{
+    double tc[3], u[3], b1[3], b2[3], p[6][5], hp[6][5], a[25], rhs[5], y[5], hu[6];
+    double ntc, sstep, dw[3], dr[9], rn[9], tn[3], rc[3];
+    int i, j, k;
+    for (i = 0; i < 3; i++)
+        tc[i] = t_opt[i] + shift[i];
+    ntc = sqrt(dot3(tc, tc));
+    if (!(ntc > 0.0) || !all_finite(h, 36))
+        return;
+    for (i = 0; i < 3; i++)
+        u[i] = tc[i] / ntc;
+    /* b1, b2: an orthonormal basis of u's normal plane */
+    k = fabs(u[0]) <= fabs(u[1]) && fabs(u[0]) <= fabs(u[2]) ? 0 : fabs(u[1]) <= fabs(u[2]) ? 1 : 2;
+    {
+        double ax[3] = {0.0, 0.0, 0.0};
+        ax[k] = 1.0;
+        cross3(u, ax, b1);
+        if (!unit3(b1, b1))
+            return;
+        cross3(u, b1, b2);
+    }
+    memset(p, 0, sizeof p);
+    for (i = 0; i < 3; i++) {
+        p[i][i] = 1.0;
+        p[3 + i][3] = b1[i];
+        p[3 + i][4] = b2[i];
+    }
+    for (i = 0; i < 6; i++) {
+        hu[i] = h[6 * i + 3] * u[0] + h[6 * i + 4] * u[1] + h[6 * i + 5] * u[2];
+        for (j = 0; j < 5; j++) {
+            hp[i][j] = 0.0;
+            for (k = 0; k < 6; k++)
+                hp[i][j] += h[6 * i + k] * p[k][j];
+        }
+    }
+    sstep = (f - 1.0) * ntc;
+    for (i = 0; i < 5; i++) {
+        rhs[i] = 0.0;
+        for (k = 0; k < 6; k++)
+            rhs[i] -= p[k][i] * hu[k] * sstep;
+        for (j = 0; j < 5; j++) {
+            a[5 * i + j] = 0.0;
+            for (k = 0; k < 6; k++)
+                a[5 * i + j] += p[k][i] * hp[k][j];
+        }
+    }
+    if (mcg_spd_solve(5, a, rhs, y) != MCG_OK || !all_finite(y, 5))
+        return;
+    for (i = 0; i < 3; i++)
+        dw[i] = y[i];
+    if (!(sqrt(dot3(dw, dw)) <= MAX_START_TURN) ||
+        mcg_rot_from_angle_axis(dw, dr) != MCG_OK)
+        return;
+    mul33(dr, R, rn);
+    if (!orthonormalise(rn))
+        return;
+    /* tc + s u + y3 b1 + y4 b2 on the sphere of radius f |tc| */
+    for (i = 0; i < 3; i++)
+        tn[i] = tc[i] + sstep * u[i] + y[3] * b1[i] + y[4] * b2[i];
+    if (!unit3(tn, tn))
+        return;
+    mat_vec(rn, cen, rc);
+    for (i = 0; i < 3; i++)
+        t[i] = f * ntc * tn[i] - rc[i] + cen[i];
+    memcpy(R, rn, sizeof rn);
+}
+
 /* The scale profile of the final refinement (the statistic of
  * mcgeom.observability.scale_profile): the motion re-optimised on the same
  * pairs with the centroid's translation held at 1/k and k times its length
@@ -1426,6 +1510,8 @@ static double scale_profile(ctx *c, const mcg_robust_result *res, const unsigned
         memcpy(R, res->R, sizeof R);
         for (i = 0; i < 3; i++)
             t[i] = (res->t[i] + shift[i]) * f[j] - shift[i];
+        if (f[j] >= 0.5 && f[j] <= 2.0) /* (the zero profile's 1 % is beyond the model) */
+            profile_start(fr->info, res->t, shift, f[j], cen, R, t);
         st = refine_subset(c, m, cen, weights != NULL, c->opt.loss, res->loss_scale, 1, R, t,
                            &rr);
         if (st != MCG_OK)
