@@ -1063,7 +1063,11 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * non-finite g1/g2 with MCG_SAMPLER_UPRIGHT4), MCG_ENOMEM (lwork below
  * mcg_robust_work_size). Budgets: opt->max_iterations samples and
  * opt->max_seconds for the search; each refinement is capped by
- * mcg_refine_motion's defaults (a local optimisation by 8 steps). Cost
+ * mcg_refine_motion's defaults (a local optimisation by 8 steps, on at
+ * most 256 of the inliers); the local optimisations, the scale profiles
+ * and the refit of a moved final set whose |t| the first fit determined
+ * stop once a step lowers the cost by less than 1e-3 of its mean per pair
+ * (~1e-3 sigma^2), the final fit at mcg_refine_motion's tolerance. Cost
  * O(n) per hypothesis scored (early exit once its score exceeds the best)
  * and per refinement iteration. Large n (issue 19): from 16384 pairs a
  * hypothesis is first scored on a fixed random subset of 2048 pairs and on
