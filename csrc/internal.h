@@ -110,6 +110,25 @@ int mcg_linf_local(int n, const double *u1, const double *a1, const double *u2,
                    double delta_min, int max_steps, double *work, double *f_out,
                    int *steps_out);
 
+/* mcg_scale_ransac (scale_line.c) on the pairs idx[0..n) of the n_all x 3
+ * arrays o1, d1, o2, d2 (idx NULL: the first n), the arguments already
+ * checked by the caller; work: mcg_scale_ransac_work_size(n) doubles. For
+ * robust.c's 1-point scale search, which then needs no copy of the pairs. */
+int mcg_scale_ransac_indexed(int n, const int *idx, const double *o1, const double *d1,
+                             const double *o2, const double *d2, const double R[9],
+                             const double t0[3], const double w[3], int n_order,
+                             const int *order, int max_proposals, double threshold,
+                             double prob, double *lam, double *score, int *n_inliers,
+                             double *work);
+
+/* mcg_refine_motion (refine.c) that also stops, converged with reason
+ * MCG_REFINE_STOP_COST, once its cost is at most cost_target (-HUGE_VAL:
+ * never; mcg_refine_motion itself). */
+int mcg_refine_motion_until(int n, const double *o1, const double *d1, const double *o2,
+                            const double *d2, const double *weights,
+                            const mcg_refine_options *opt, double cost_target, double R[9],
+                            double t[3], mcg_refine_result *res);
+
 /* The k-th smallest of x[0..m) (x is reordered; Hoare's selection), and the
  * median as numpy.median (the mean of the two middle values for even m,
  * m >= 1; x is reordered). For the robust statistics of the kernels

@@ -85,16 +85,39 @@ static double msac(const double *t, size_t n, double lam, double thr2, int *inli
     return s;
 }
 
+/* msac without the count, abandoned (HUGE_VAL) once the partial sum reaches
+ * `bound`: the terms are >= 0, so such a proposal cannot score below the
+ * bound (the bail-out of Chum & Matas' randomised RANSAC, here with an
+ * exact bound: the decisions are those of the full score). Blocks of
+ * MSAC_BLOCK pairs between two tests keep the inner loop vectorisable. */
+#define MSAC_BLOCK 64
+static double msac_bounded(const double *t, size_t n, double lam, double thr2, double bound)
+{
+    double s = 0.0;
+    size_t k0, k;
+    for (k0 = 0; k0 < n; k0 += MSAC_BLOCK) {
+        size_t k1 = n - k0 < MSAC_BLOCK ? n : k0 + MSAC_BLOCK;
+        for (k = k0; k < k1; k++) {
+            double r2 = r2_at(t, n, k, lam);
+            s += r2 < thr2 ? r2 : thr2;
+        }
+        if (s >= bound)
+            return HUGE_VAL;
+    }
+    return s;
+}
+
 /* the terms a, b, A, B, C of every pair (see the file comment); 0 on a NaN,
  * inf, zero direction or overflow */
-static int terms(size_t n, const double *o1, const double *d1, const double *o2,
-                 const double *d2, const double R[9], const double t0[3], const double w[3],
-                 double *t)
+static int terms(size_t n, const int *idx, const double *o1, const double *d1,
+                 const double *o2, const double *d2, const double R[9], const double t0[3],
+                 const double w[3], double *t)
 {
     size_t k;
     int i;
     for (k = 0; k < n; k++) {
-        const double *p1 = o1 + 3 * k, *u1 = d1 + 3 * k, *p2 = o2 + 3 * k, *u2 = d2 + 3 * k;
+        const size_t q = idx ? 3 * (size_t)idx[k] : 3 * k;
+        const double *p1 = o1 + q, *u1 = d1 + q, *p2 = o2 + q, *u2 = d2 + q;
         double n1 = dot3(u1, u1);
         double n2 = dot3(u2, u2);
         double a[3], b[3], s[3], g0[3], g1[3], k0[3], k1[3], x;
@@ -150,9 +173,7 @@ int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2
                      double threshold, double prob, double *lam, double *score,
                      int *n_inliers, double *work, size_t lwork)
 {
-    size_t nn, used = 0, pos = 0;
-    double thr2, best = HUGE_VAL, lam_best = 0.0, needed = HUGE_VAL;
-    int k, m_best = 0, round;
+    int k;
 
     if (!o1 || !d1 || !o2 || !d2 || !R || !t0 || !w || !order || !lam || !score || !work)
         return MCG_EINVAL;
@@ -169,10 +190,30 @@ int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2
     if (!all_finite(o1, 3 * (size_t)n) || !all_finite(d1, 3 * (size_t)n) ||
         !all_finite(o2, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
         return MCG_EINVAL;
-    nn = (size_t)n;
     if (lwork < mcg_scale_ransac_work_size(n))
         return MCG_ENOMEM;
-    if (!terms(nn, o1, d1, o2, d2, R, t0, w, work))
+    return mcg_scale_ransac_indexed(n, NULL, o1, d1, o2, d2, R, t0, w, n_order, order,
+                                    max_proposals, threshold, prob, lam, score, n_inliers,
+                                    work);
+}
+
+/* mcg_scale_ransac on the pairs idx[0..n) of the arrays (internal.h): the
+ * caller has checked the arguments (robust.c validates its whole input
+ * once), so only the terms' finiteness is tested here. Indices instead of
+ * a gathered copy of the pairs: robust.c's workspace then needs no 12 n
+ * doubles for them (issue 19: peak memory at 1e3 pairs). */
+int mcg_scale_ransac_indexed(int n, const int *idx, const double *o1, const double *d1,
+                             const double *o2, const double *d2, const double R[9],
+                             const double t0[3], const double w[3], int n_order,
+                             const int *order, int max_proposals, double threshold,
+                             double prob, double *lam, double *score, int *n_inliers,
+                             double *work)
+{
+    size_t nn = (size_t)n, used = 0, pos = 0;
+    double thr2, best = HUGE_VAL, lam_best = 0.0, needed = HUGE_VAL;
+    int k, m_best = 0, round;
+
+    if (!terms(nn, idx, o1, d1, o2, d2, R, t0, w, work))
         return MCG_EINVAL;
     thr2 = threshold * threshold;
 
@@ -195,7 +236,9 @@ int mcg_scale_ransac(int n, const double *o1, const double *d1, const double *o2
              * MCG_OK (found by fuzz_scale_line in its 10-minute run) */
             if (!(lj > 0.0))
                 continue;
-            sj = msac(work, nn, lj, thr2, NULL);
+            /* (a score >= the batch's best or the overall best changes
+             * nothing below: neither is replaced) */
+            sj = msac_bounded(work, nn, lj, thr2, bs < best ? bs : best);
             if (!isfinite(sj))
                 continue;
             if (sj < bs) { /* the first of equal scores */

@@ -131,8 +131,10 @@ def test_static_rig_gets_the_numpy_static_verdict():
 
 def test_robust_c_zero_profile_and_inlier_rms():
     """The C result's zero-factor profile equals observability.scale_profile at
-    ZERO_FACTOR (so the C constant is the Python one) and its RMS the inliers'
-    residuals recomputed in numpy."""
+    ZERO_FACTOR (so the C constant is the Python one) where it is at least 9,
+    and is an upper bound below 9 where that one is (the only use of it:
+    observability.scale_determined), and its RMS the inliers' residuals
+    recomputed in numpy."""
     seen = 0
     for seed in range(4):
         rig, p, R, t, rng = _problem(20 + seed, n=320, outliers=0.0, cross=0.0,
@@ -158,5 +160,10 @@ def test_robust_c_zero_profile_and_inlier_rms():
             py = scale_profile(rays.take(used), out["R"], out["t"], ref["final_cost"],
                                ref["sigma2"], (ZERO_FACTOR,), "cauchy", out["loss_scale"],
                                out["weights"][used])
-            assert out["zero_profile"] == pytest.approx(py, rel=1e-3, abs=1e-6)
+            if py >= 9.0:
+                assert out["zero_profile"] == pytest.approx(py, rel=1e-3, abs=1e-6)
+            else:
+                # below the bound of scale_determined only an upper bound (the
+                # C fit stops there): the same side of 9, never below the value
+                assert py * (1 - 1e-3) - 1e-6 <= out["zero_profile"] < 9.0
     assert seen > 0

@@ -1008,7 +1008,9 @@ typedef struct {
                                (could the cameras not have moved at all?),
                                computed when the refinement's scale_rel_std
                                is at most 1 but above max_scale_rel_std or
-                               scale_profile < 9; NaN otherwise */
+                               scale_profile < 9; NaN otherwise. Only its
+                               side of 9 is exact: below 9 it is an upper
+                               bound (the fit stops there) */
     double inlier_rms;      /* RMS of the inliers' residuals at (R, t)
                                (pixels with focal, else radians; NaN when
                                there is no inlier) */
@@ -1017,8 +1019,8 @@ typedef struct {
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_robust_default_options(mcg_robust_options *opt);
 
-/* Doubles of workspace for mcg_robust_rig_motion: about 30 n + 800 up to
- * 4096 pairs, 17.5 n + 43000 up to 16383, 16.5 n + 106000 beyond (0 for n
+/* Doubles of workspace for mcg_robust_rig_motion: about 17.5 n + 300 up to
+ * 4096 pairs, 16.5 n + 4400 up to 16383, 16.5 n + 62000 beyond (0 for n
  * outside [6, 2^26] or n_cameras outside [1, 4096]). */
 size_t mcg_robust_work_size(int n, int n_cameras);
 
@@ -1061,7 +1063,11 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * non-finite g1/g2 with MCG_SAMPLER_UPRIGHT4), MCG_ENOMEM (lwork below
  * mcg_robust_work_size). Budgets: opt->max_iterations samples and
  * opt->max_seconds for the search; each refinement is capped by
- * mcg_refine_motion's defaults (a local optimisation by 8 steps). Cost
+ * mcg_refine_motion's defaults (a local optimisation by 8 steps, on at
+ * most 256 of the inliers); the local optimisations, the scale profiles
+ * and the refit of a moved final set whose |t| the first fit determined
+ * stop once a step lowers the cost by less than 1e-3 of its mean per pair
+ * (~1e-3 sigma^2), the final fit at mcg_refine_motion's tolerance. Cost
  * O(n) per hypothesis scored (early exit once its score exceeds the best)
  * and per refinement iteration. Large n (issue 19): from 16384 pairs a
  * hypothesis is first scored on a fixed random subset of 2048 pairs and on
