@@ -263,24 +263,31 @@ typedef struct {
 static int solve_t(const double *m, const double r[9], int unit_mode,
                    const double tprev[3], int want_eig, tsolve *out)
 {
-    double b[3][9], mb[3][9], mee[81], mer[81], mervr[9], h[9], g[3];
+    double b[3][9], mb[3][9], mervr[9], h[9], g[3];
     double c0 = 0.0, hmax;
-    int k, l, i;
-    block(m, 0, 0, mee);
-    block(m, 0, 9, mer);
+    int k, l, i, j;
     for (k = 0; k < 3; k++) {
         double e[3] = {0.0, 0.0, 0.0};
         e[k] = 1.0;
         skew_times(e, r, b[k]);
-        matvec(9, mee, b[k], mb[k]);
     }
-    matvec(9, mer, r, mervr);
-    {
-        double mrr[81], tmp[9];
-        block(m, 9, 9, mrr);
-        matvec(9, mrr, r, tmp);
-        for (i = 0; i < 9; i++)
-            c0 += r[i] * tmp[i];
+    /* the blocks of M read in place (M_EE b_k, M_ER r, r^T M_RR r), in the
+     * summation order of matvec on copied blocks */
+    for (i = 0; i < 9; i++) {
+        const double *mi = m + i * NX, *ri = m + (9 + i) * NX + 9;
+        double a0 = 0.0, a1 = 0.0, a2 = 0.0, ar = 0.0, rr = 0.0;
+        for (j = 0; j < 9; j++) {
+            a0 += mi[j] * b[0][j];
+            a1 += mi[j] * b[1][j];
+            a2 += mi[j] * b[2][j];
+            ar += mi[9 + j] * r[j];
+            rr += ri[j] * r[j];
+        }
+        mb[0][i] = a0;
+        mb[1][i] = a1;
+        mb[2][i] = a2;
+        mervr[i] = ar;
+        c0 += r[i] * rr;
     }
     for (k = 0; k < 3; k++) {
         g[k] = 0.0;
