@@ -110,6 +110,24 @@ static int make_row(const double *o1, const double *d1, const double *o2,
     return 1;
 }
 
+/* 1 if none of the 12 n inputs is NaN or +-inf: 0 x is NaN exactly for
+ * those and a sum of signed zeros is zero. Four partial sums so that the
+ * loop vectorises, and no branch per value (issue 22: the per-value test
+ * and branch of all_finite cost about 5 instructions per input here, more
+ * than the rest of the check on the whole input). */
+static int finite_rays(int n, const double *o1, const double *d1, const double *o2,
+                       const double *d2)
+{
+    double acc[4] = {0.0, 0.0, 0.0, 0.0};
+    size_t i, m = 3 * (size_t)n, l;
+    for (i = 0; i + 4 <= m; i += 4)
+        for (l = 0; l < 4; l++)
+            acc[l] += 0.0 * o1[i + l] + 0.0 * d1[i + l] + 0.0 * o2[i + l] + 0.0 * d2[i + l];
+    for (; i < m; i++)
+        acc[0] += 0.0 * o1[i] + 0.0 * d1[i] + 0.0 * o2[i] + 0.0 * d2[i];
+    return acc[0] + acc[1] + acc[2] + acc[3] == 0.0;
+}
+
 /* One pass over the rays: validate, normalise (Algorithm 2 step 1) and add
  * each generalized epipolar row (eq. 8.16) to the Gram matrix. */
 static int accumulate(int n, const double *o1, const double *d1,
@@ -119,8 +137,7 @@ static int accumulate(int n, const double *o1, const double *d1,
     double o[3], ss, s;
     int k, i, j;
 
-    if (!all_finite(o1, 3 * (size_t)n) || !all_finite(o2, 3 * (size_t)n) ||
-        !all_finite(d1, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
+    if (!finite_rays(n, o1, d1, o2, d2))
         return MCG_EINVAL;
     ss = origin_spread(n, o1, o2, o);
     /* A central camera (all origins equal) has nothing to scale. */
@@ -246,24 +263,31 @@ typedef struct {
 static int solve_t(const double *m, const double r[9], int unit_mode,
                    const double tprev[3], int want_eig, tsolve *out)
 {
-    double b[3][9], mb[3][9], mee[81], mer[81], mervr[9], h[9], g[3];
+    double b[3][9], mb[3][9], mervr[9], h[9], g[3];
     double c0 = 0.0, hmax;
-    int k, l, i;
-    block(m, 0, 0, mee);
-    block(m, 0, 9, mer);
+    int k, l, i, j;
     for (k = 0; k < 3; k++) {
         double e[3] = {0.0, 0.0, 0.0};
         e[k] = 1.0;
         skew_times(e, r, b[k]);
-        matvec(9, mee, b[k], mb[k]);
     }
-    matvec(9, mer, r, mervr);
-    {
-        double mrr[81], tmp[9];
-        block(m, 9, 9, mrr);
-        matvec(9, mrr, r, tmp);
-        for (i = 0; i < 9; i++)
-            c0 += r[i] * tmp[i];
+    /* the blocks of M read in place (M_EE b_k, M_ER r, r^T M_RR r), in the
+     * summation order of matvec on copied blocks */
+    for (i = 0; i < 9; i++) {
+        const double *mi = m + i * NX, *ri = m + (9 + i) * NX + 9;
+        double a0 = 0.0, a1 = 0.0, a2 = 0.0, ar = 0.0, rr = 0.0;
+        for (j = 0; j < 9; j++) {
+            a0 += mi[j] * b[0][j];
+            a1 += mi[j] * b[1][j];
+            a2 += mi[j] * b[2][j];
+            ar += mi[9 + j] * r[j];
+            rr += ri[j] * r[j];
+        }
+        mb[0][i] = a0;
+        mb[1][i] = a1;
+        mb[2][i] = a2;
+        mervr[i] = ar;
+        c0 += r[i] * rr;
     }
     for (k = 0; k < 3; k++) {
         g[k] = 0.0;
@@ -413,83 +437,194 @@ typedef struct {
  * and g non-NULL the Gauss-Newton normal equations J^T J (6 x 6, upper
  * triangle, order [dw, dt] of R <- exp([dw]x) R, t <- t + dt) and J^T r.
  * r is homogeneous of degree 0 in the directions, so they are used as given
- * (no square root to normalise them): with a = R d1, b = d2, cA = c x a,
- * bc = b x c,
- *   e = b.cA,  D = |b|^2 |cA|^2 + |a|^2 |bc|^2 - 2 e^2,  r = e / sqrt(D),
- *   de/dw = (R o1) x (a x b) + a x bc,  de/dt = a x b,
- *   dD = 2 |b|^2 (dc.(a x cA) + dw.(a x (cA x c))) + 2 |a|^2 dc.(bc x b)
- *        - 4 e de,
- *   dc = dw x (R o1) + dt, so dc.v = dw.((R o1) x v) + dt.v;
- *   dr = de / sqrt(D) - e dD / (2 D^(3/2)).
+ * (no square root to normalise them). With a = R d1, b = d2, p = R o1'
+ * (o1' the normalised origin) and the dot products aa = |a|^2, bb = |b|^2,
+ * cc = |c|^2, ac = a.c, bc = b.c, ab = a.b, n = a x b:
+ *   e = b.(c x a) = c.n,
+ *   D = bb |c x a|^2 + aa |b x c|^2 - 2 e^2
+ *     = c.s - 2 e^2,  s = 2 aa bb c - bb ac a - aa bc b,
+ *   r = e / sqrt(D),
+ *   de/dw = p x n + a x (b x c) = p x n + ac b - ab c,   de/dt = n,
+ *   dD/dt = 2 s - 4 e n,
+ *   dD/dw = 2 (p x s + bb ac (c x a)) - 4 e de/dw
+ * (the identities a x (c x a) = aa c - ac a, (b x c) x b = bb c - bc b and
+ * a x ((c x a) x c) = ac (c x a) turn the cross products of the direct
+ * derivation into dot products), dr = de / sqrt(D) - e dD / (2 D^(3/2)).
  * Where D vanishes the residual is capped at +-pi/2 (as in refine.c) and
- * contributes no Jacobian row. */
+ * contributes no Jacobian row.
+ * Why blocks of SAMPSON_LANES rays, one array element per ray: every
+ * quantity above is computed for the whole block by loops of fixed length
+ * that the compiler turns into SIMD instructions (issue 22: this pass is
+ * most of the kernel's cost per ray); a ray that fails the test above is
+ * masked out of the sums instead of branched around. The sums are kept per
+ * lane and added at the end. */
+#define SAMPSON_LANES 4
 static double sampson_pass(const raydata *rd, const double r[9], const double t[3],
                            double h[36], double g[6])
 {
-    double cost = 0.0;
-    int k, i, j;
-    if (h) {
-        memset(h, 0, 36 * sizeof(double));
-        memset(g, 0, 6 * sizeof(double));
-    }
-    for (k = 0; k < rd->n; k++) {
-        const double *pd1 = rd->d1 + 3 * k, *pd2 = rd->d2 + 3 * k;
-        double p[3], q[3], a[3], rp[3], c[3], ca[3], bc[3];
-        double na2 = dot3(pd1, pd1), nb2 = dot3(pd2, pd2), e, dd, dm, res;
-        const double *b = pd2;
-        for (i = 0; i < 3; i++) {
-            p[i] = rd->scale * (rd->o1[3 * k + i] - rd->origin[i]);
-            q[i] = rd->scale * (rd->o2[3 * k + i] - rd->origin[i]);
+    double hl[21][SAMPSON_LANES], gl[6][SAMPSON_LANES], cl[SAMPSON_LANES];
+    double ro[3], sr[9];
+    int k0, i, j, l, q;
+    /* p = R o1' = s R o1 - s R o: s R and s R o once per pass */
+    for (i = 0; i < 9; i++)
+        sr[i] = rd->scale * r[i];
+    mat_vec(sr, rd->origin, ro);
+    memset(hl, 0, sizeof hl);
+    memset(gl, 0, sizeof gl);
+    memset(cl, 0, sizeof cl);
+    for (k0 = 0; k0 < rd->n; k0 += SAMPSON_LANES) {
+        double a[3][SAMPSON_LANES], b[3][SAMPSON_LANES], p[3][SAMPSON_LANES];
+        double c[3][SAMPSON_LANES], nn[3][SAMPSON_LANES];
+        double aa[SAMPSON_LANES], bb[SAMPSON_LANES], e[SAMPSON_LANES];
+        double dd[SAMPSON_LANES], res[SAMPSON_LANES], isd[SAMPSON_LANES];
+        double ok[SAMPSON_LANES], cap[SAMPSON_LANES];
+        double o1[3][SAMPSON_LANES], d1[3][SAMPSON_LANES], q2[3][SAMPSON_LANES];
+        int nb = rd->n - k0 < SAMPSON_LANES ? rd->n - k0 : SAMPSON_LANES;
+        /* the block by coordinate; lanes past the end get zero directions
+         * (e = 0: they add nothing) */
+        for (l = 0; l < SAMPSON_LANES; l++) {
+            int kk = k0 + (l < nb ? l : 0);
+            double z = l < nb ? 1.0 : 0.0;
+            for (i = 0; i < 3; i++) {
+                o1[i][l] = rd->o1[3 * kk + i];
+                d1[i][l] = z * rd->d1[3 * kk + i];
+                b[i][l] = z * rd->d2[3 * kk + i];
+                q2[i][l] = rd->scale * (rd->o2[3 * kk + i] - rd->origin[i]);
+            }
         }
-        mat_vec(r, pd1, a);
-        mat_vec(r, p, rp);
         for (i = 0; i < 3; i++)
-            c[i] = t[i] + rp[i] - q[i];
-        cross3(c, a, ca);
-        cross3(b, c, bc);
-        e = dot3(b, ca);
-        dd = nb2 * dot3(ca, ca) + na2 * dot3(bc, bc) - 2.0 * e * e;
-        dm = INV_HALF_PI2 * e * e;
-        if (dd > dm && dd > DBL_MIN) {
-            double isd = 1.0 / sqrt(dd), ab[3], v1[3], v2[3], jr[6], tmp[3], tmp2[3];
-            double dew[3], ddw[3], ddt[3], fe, fd;
-            res = e * isd;
-            cost += res * res;
-            if (!h)
-                continue;
-            cross3(a, b, ab);
-            cross3(rp, ab, dew);
-            cross3(a, bc, tmp);
-            for (i = 0; i < 3; i++)
-                dew[i] += tmp[i];
-            cross3(a, ca, v1);              /* d|cA|^2 / dc = 2 v1 */
-            cross3(bc, b, v2);              /* d|bc|^2 / dc = 2 v2 */
-            for (i = 0; i < 3; i++) {
-                tmp[i] = nb2 * v1[i] + na2 * v2[i];
-                ddt[i] = 2.0 * tmp[i] - 4.0 * e * ab[i];
+            for (l = 0; l < SAMPSON_LANES; l++) {
+                a[i][l] = r[3 * i] * d1[0][l] + r[3 * i + 1] * d1[1][l] + r[3 * i + 2] * d1[2][l];
+                p[i][l] = sr[3 * i] * o1[0][l] + sr[3 * i + 1] * o1[1][l] +
+                          sr[3 * i + 2] * o1[2][l] - ro[i];
+                c[i][l] = t[i] + p[i][l] - q2[i][l];
             }
-            cross3(rp, tmp, tmp2);
-            cross3(ca, c, tmp);
-            cross3(a, tmp, ddw);
-            for (i = 0; i < 3; i++)
-                ddw[i] = 2.0 * (tmp2[i] + nb2 * ddw[i]) - 4.0 * e * dew[i];
-            fe = isd;
-            fd = -0.5 * res * isd * isd;
-            for (i = 0; i < 3; i++) {
-                jr[i] = fe * dew[i] + fd * ddw[i];
-                jr[3 + i] = fe * ab[i] + fd * ddt[i];
+        for (l = 0; l < SAMPSON_LANES; l++) {
+            nn[0][l] = a[1][l] * b[2][l] - a[2][l] * b[1][l];
+            nn[1][l] = a[2][l] * b[0][l] - a[0][l] * b[2][l];
+            nn[2][l] = a[0][l] * b[1][l] - a[1][l] * b[0][l];
+            aa[l] = a[0][l] * a[0][l] + a[1][l] * a[1][l] + a[2][l] * a[2][l];
+            bb[l] = b[0][l] * b[0][l] + b[1][l] * b[1][l] + b[2][l] * b[2][l];
+            e[l] = c[0][l] * nn[0][l] + c[1][l] * nn[1][l] + c[2][l] * nn[2][l];
+        }
+        {
+            double s[3][SAMPSON_LANES], ac[SAMPSON_LANES], bc[SAMPSON_LANES];
+            double ab[SAMPSON_LANES], ee[SAMPSON_LANES], ca[3][SAMPSON_LANES];
+            /* (no inner loops and no && in the lane loops: either keeps
+             * the compiler from vectorising them) */
+            for (l = 0; l < SAMPSON_LANES; l++) {
+                double f2 = 2.0 * aa[l] * bb[l], c0, c1, c2, x0, x1, x2;
+                double y0, y1, y2;
+                c0 = c[0][l];
+                c1 = c[1][l];
+                c2 = c[2][l];
+                ac[l] = a[0][l] * c0 + a[1][l] * c1 + a[2][l] * c2;
+                bc[l] = b[0][l] * c0 + b[1][l] * c1 + b[2][l] * c2;
+                ab[l] = a[0][l] * b[0][l] + a[1][l] * b[1][l] + a[2][l] * b[2][l];
+                s[0][l] = f2 * c0 - bb[l] * ac[l] * a[0][l] - aa[l] * bc[l] * b[0][l];
+                s[1][l] = f2 * c1 - bb[l] * ac[l] * a[1][l] - aa[l] * bc[l] * b[1][l];
+                s[2][l] = f2 * c2 - bb[l] * ac[l] * a[2][l] - aa[l] * bc[l] * b[2][l];
+                /* D from the cross products themselves, not as c.s - 2 e^2:
+                 * near the epipole (forward motion) |c x a|^2 is small and
+                 * cc aa - ac^2 would lose it to cancellation */
+                x0 = c1 * a[2][l] - c2 * a[1][l];
+                x1 = c2 * a[0][l] - c0 * a[2][l];
+                x2 = c0 * a[1][l] - c1 * a[0][l];
+                ca[0][l] = x0;
+                ca[1][l] = x1;
+                ca[2][l] = x2;
+                y0 = b[1][l] * c2 - b[2][l] * c1;
+                y1 = b[2][l] * c0 - b[0][l] * c2;
+                y2 = b[0][l] * c1 - b[1][l] * c0;
+                ee[l] = e[l] * e[l];
+                dd[l] = bb[l] * (x0 * x0 + x1 * x1 + x2 * x2) +
+                        aa[l] * (y0 * y0 + y1 * y1 + y2 * y2) - 2.0 * ee[l];
             }
-            for (i = 0; i < 6; i++) {
-                double ji = jr[i];
-                g[i] += ji * res;
-                for (j = i; j < 6; j++)
-                    h[6 * i + j] += ji * jr[j];
+            /* which rays have a first-order error (D > (2/pi)^2 e^2 and
+             * D > DBL_MIN): a loop of its own, since a comparison whose
+             * result enters the arithmetic keeps the compiler from
+             * vectorising the loop around it */
+            for (l = 0; l < SAMPSON_LANES; l++) {
+                double dm = INV_HALF_PI2 * ee[l];
+                ok[l] = dd[l] > dm && dd[l] > DBL_MIN ? 1.0 : 0.0;
+                cap[l] = ok[l] == 0.0 && e[l] != 0.0 ? HALF_PI * HALF_PI : 0.0;
             }
-        } else if (e != 0.0) {
-            cost += HALF_PI * HALF_PI; /* no first-order error exists */
+            for (l = 0; l < SAMPSON_LANES; l++) {
+                isd[l] = ok[l] / sqrt(ok[l] * dd[l] + (1.0 - ok[l]));
+                res[l] = e[l] * isd[l];
+                cl[l] += res[l] * res[l] + cap[l];
+            }
+            if (h) {
+                double jr[6][SAMPSON_LANES];
+                for (l = 0; l < SAMPSON_LANES; l++) {
+                    double p0 = p[0][l], p1 = p[1][l], p2 = p[2][l], fd, dw0, dw1, dw2;
+                    double s0 = s[0][l], s1 = s[1][l], s2 = s[2][l];
+                    double n0 = nn[0][l], n1 = nn[1][l], n2 = nn[2][l];
+                    double k1 = bb[l] * ac[l], k2 = 4.0 * e[l];
+                    fd = -0.5 * res[l] * isd[l] * isd[l];
+                    dw0 = p1 * n2 - p2 * n1 + ac[l] * b[0][l] - ab[l] * c[0][l];
+                    dw1 = p2 * n0 - p0 * n2 + ac[l] * b[1][l] - ab[l] * c[1][l];
+                    dw2 = p0 * n1 - p1 * n0 + ac[l] * b[2][l] - ab[l] * c[2][l];
+                    jr[0][l] = isd[l] * dw0 +
+                               fd * (2.0 * (p1 * s2 - p2 * s1 + k1 * ca[0][l]) - k2 * dw0);
+                    jr[1][l] = isd[l] * dw1 +
+                               fd * (2.0 * (p2 * s0 - p0 * s2 + k1 * ca[1][l]) - k2 * dw1);
+                    jr[2][l] = isd[l] * dw2 +
+                               fd * (2.0 * (p0 * s1 - p1 * s0 + k1 * ca[2][l]) - k2 * dw2);
+                    jr[3][l] = isd[l] * n0 + fd * (2.0 * s0 - k2 * n0);
+                    jr[4][l] = isd[l] * n1 + fd * (2.0 * s1 - k2 * n1);
+                    jr[5][l] = isd[l] * n2 + fd * (2.0 * s2 - k2 * n2);
+                }
+                for (i = 0; i < 6; i++)
+                    for (l = 0; l < SAMPSON_LANES; l++)
+                        gl[i][l] += jr[i][l] * res[l];
+                for (l = 0; l < SAMPSON_LANES; l++) {
+                    /* the upper triangle of J^T J, row by row */
+                    hl[0][l] += jr[0][l] * jr[0][l];
+                    hl[1][l] += jr[0][l] * jr[1][l];
+                    hl[2][l] += jr[0][l] * jr[2][l];
+                    hl[3][l] += jr[0][l] * jr[3][l];
+                    hl[4][l] += jr[0][l] * jr[4][l];
+                    hl[5][l] += jr[0][l] * jr[5][l];
+                    hl[6][l] += jr[1][l] * jr[1][l];
+                    hl[7][l] += jr[1][l] * jr[2][l];
+                    hl[8][l] += jr[1][l] * jr[3][l];
+                    hl[9][l] += jr[1][l] * jr[4][l];
+                    hl[10][l] += jr[1][l] * jr[5][l];
+                    hl[11][l] += jr[2][l] * jr[2][l];
+                    hl[12][l] += jr[2][l] * jr[3][l];
+                    hl[13][l] += jr[2][l] * jr[4][l];
+                    hl[14][l] += jr[2][l] * jr[5][l];
+                    hl[15][l] += jr[3][l] * jr[3][l];
+                    hl[16][l] += jr[3][l] * jr[4][l];
+                    hl[17][l] += jr[3][l] * jr[5][l];
+                    hl[18][l] += jr[4][l] * jr[4][l];
+                    hl[19][l] += jr[4][l] * jr[5][l];
+                    hl[20][l] += jr[5][l] * jr[5][l];
+                }
+            }
         }
     }
-    return cost;
+    if (h) {
+        for (i = 0, q = 0; i < 6; i++) {
+            g[i] = 0.0;
+            for (l = 0; l < SAMPSON_LANES; l++)
+                g[i] += gl[i][l];
+            for (j = 0; j < i; j++)
+                h[6 * i + j] = 0.0;
+            for (j = i; j < 6; j++, q++) {
+                h[6 * i + j] = 0.0;
+                for (l = 0; l < SAMPSON_LANES; l++)
+                    h[6 * i + j] += hl[q][l];
+            }
+        }
+    }
+    {
+        double cost = 0.0;
+        for (l = 0; l < SAMPSON_LANES; l++)
+            cost += cl[l];
+        return cost;
+    }
 }
 
 /* Levenberg-Marquardt on the Sampson angular error from the linear estimate

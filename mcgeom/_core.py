@@ -25,7 +25,8 @@ __all__ = [
     "rot_from_angle_axis", "angle_axis_from_rot", "rot_from_quat", "quat_from_rot",
     "project_so3", "plucker_from_points", "gec_rows",
     "cls_general", "cls_partial", "cls_range",
-    "Linear17Options", "linear17", "linear17_raw", "linear17_dict", "L17_OFFSETS",
+    "Linear17Options", "linear17", "linear17_raw", "linear17_static_raw", "linear17_dict",
+    "L17_OFFSETS",
     "GC_CASE_NAMES",
     "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
@@ -361,6 +362,41 @@ def linear17_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
                           ffi.from_buffer("double[]", origins2),
                           ffi.from_buffer("double[]", dirs2), opt, res)
     return st, f64, res
+
+
+def linear17_static_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
+                        dirs2: np.ndarray, group: np.ndarray,
+                        options: Optional[Linear17Options], static_options: Any
+                        ) -> tuple[int, np.ndarray, Any, int, Any]:
+    """``mcg_linear17`` and then, on its success, the static-rig test
+    ``mcg_static_check`` of its estimate, the two calls sharing the pointers
+    to the rays (issue 22: the public linear17 call marshalled the rays
+    twice). Arrays as in :func:`linear17_raw` (float64 C-contiguous (N, 3),
+    rig frame, N <= 2^20), ``group`` int32 (N,) as in
+    :func:`static_check_rays`, ``static_options`` from
+    :func:`static_options`; the test gets the estimate's rotation (``R_est``,
+    no given rotation, its noise level estimated). Returns ``(status,
+    buffer, result, static_status, static_result)`` without raising:
+    status, buffer and result as :func:`linear17_raw`; ``static_status``
+    None when the test did not run (linear17 failed), else its status and
+    ``static_result`` the ``mcg_static_result *``.
+    """
+    f64 = np.empty(_L17_NDOUBLES, dtype=np.float64)
+    fp = ffi.cast("double *", ffi.from_buffer(f64))
+    res = ffi.cast("mcg_linear17_result *", fp)
+    opt = (options or _DEFAULT_L17)._c
+    n = origins1.shape[0]
+    rays = (ffi.from_buffer("double[]", origins1), ffi.from_buffer("double[]", dirs1),
+            ffi.from_buffer("double[]", origins2), ffi.from_buffer("double[]", dirs2))
+    st = lib.mcg_linear17(n, *rays, opt, res)
+    if st != lib.MCG_OK:
+        return st, f64, res, None, None
+    out = ffi.new("mcg_static_result *")
+    work = np.empty(max(lib.mcg_static_check_work_size(n), 1), dtype=np.float64)
+    sst = lib.mcg_static_check(n, *rays, ffi.from_buffer("int[]", group),
+                               fp + _L17_DOUBLES["R"], ffi.NULL, 0.0, static_options, out,
+                               ffi.from_buffer("double[]", work), work.size)
+    return st, f64, res, sst, out
 
 
 def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,

@@ -92,6 +92,27 @@ def test_zero_motion_is_reported_static():
     assert rot_err(m.R, np.eye(3)) < 1e-12
 
 
+@pytest.mark.parametrize("kind,R,t,noise", [
+    ("locally-central", None, None, 1e-3),   # a moving rig: the one-marshalling path
+    ("most-general", None, None, 1e-3),
+    ("locally-central", np.eye(3), np.zeros(3), 1e-3),   # static: the shared path
+])
+def test_public_path_answers_as_the_shared_static_check(kind, R, t, noise):
+    """linear17's estimate and static-rig test in one marshalling of the rays
+    (_core.linear17_static_raw, issue 22) answer exactly as the shared
+    with_static_check around linear17_no_static_check."""
+    from mcgeom.estimators._static import with_static_check
+    from mcgeom.estimators.linear17 import linear17_no_static_check
+    kw = {} if R is None else {"R": R, "t": t}
+    rays = make(kind, 3, n=80, angular_noise=noise, **kw).rays
+    got = mcgeom.estimate(rays, "linear17")
+    ref = with_static_check(rays, "linear17", lambda: linear17_no_static_check(rays))
+    assert np.array_equal(got.R, ref.R) and np.array_equal(got.t, ref.t)
+    assert got.scale == ref.scale and got.residual_rms == ref.residual_rms
+    assert sorted(got.info) == sorted(ref.info)
+    assert got.scale.reason.startswith("no translation detected") == (R is not None)
+
+
 def _rays(n=40):
     return make("locally-central", 0, n=n).rays
 

@@ -26,7 +26,7 @@ from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
-from ._static import with_static_check
+from ._static import KERNEL_OPTIONS, intra_groups, with_static_check
 
 __all__ = ["linear17", "linear17_no_static_check"]
 
@@ -96,19 +96,25 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     """
     # E = 0 has no null space of the right dimension: a static rig raises
     # DegenerateError in the kernel (thesis ch. 8.3's kinds all assume t != 0)
+    options = _options(rays, refine, max_iterations, tolerance, max_scale_rel_std, options)
+    # the estimate and the shared static-rig test of it in one marshalling of
+    # the rays (_core.linear17_static_raw; issue 22). Everything but a moving
+    # rig's answer (a kernel failure, a static rig) goes the shared way, whose
+    # results and errors these are: with_static_check re-runs it
+    st, f, r, sst, sres = _core.linear17_static_raw(
+        rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, intra_groups(rays), options,
+        KERNEL_OPTIONS)
+    if st == _core.STATUS_OK and sst == _core.STATUS_OK and not sres.is_static:
+        return _motion(f, r)
     return with_static_check(rays, "linear17", lambda: linear17_no_static_check(
-        rays, refine=refine, max_iterations=max_iterations, tolerance=tolerance,
-        max_scale_rel_std=max_scale_rel_std, options=options))
+        rays, options=options))
 
 
-def linear17_no_static_check(rays: RayPairs, *, refine: bool = True,
-                             max_iterations: Optional[int] = None,
-                             tolerance: Optional[float] = None,
-                             max_scale_rel_std: Optional[float] = None,
-                             options: Optional[_core.Linear17Options] = None) -> RigMotion:
-    """:func:`linear17` without the shared static-rig test (RANSAC's minimal
-    solver, and ``mcgeom bench linear17``'s plugin timing): same frames, units,
-    options and errors; a static rig raises DegenerateError here."""
+def _options(rays: RayPairs, refine: bool, max_iterations: Optional[int],
+             tolerance: Optional[float], max_scale_rel_std: Optional[float],
+             options: Optional[_core.Linear17Options]) -> Optional[_core.Linear17Options]:
+    """The kernel's options from the keyword options (None: the defaults),
+    after the checks of the arguments that precede the kernel's own."""
     if not isinstance(rays, RayPairs):
         raise TypeError(f"rays must be a RayPairs, got {type(rays).__name__}")
     n = len(rays)
@@ -119,15 +125,32 @@ def linear17_no_static_check(rays: RayPairs, *, refine: bool = True,
                             or max_scale_rel_std is not None):
         options = _core.Linear17Options(refine=refine, max_iterations=max_iterations,
                                         tolerance=tolerance, max_scale_rel_std=max_scale_rel_std)
+    return options
+
+
+def linear17_no_static_check(rays: RayPairs, *, refine: bool = True,
+                             max_iterations: Optional[int] = None,
+                             tolerance: Optional[float] = None,
+                             max_scale_rel_std: Optional[float] = None,
+                             options: Optional[_core.Linear17Options] = None) -> RigMotion:
+    """:func:`linear17` without the shared static-rig test (RANSAC's minimal
+    solver, and ``mcgeom bench linear17``'s plugin timing): same frames, units,
+    options and errors; a static rig raises DegenerateError here."""
+    options = _options(rays, refine, max_iterations, tolerance, max_scale_rel_std, options)
     # NaN/inf and zero-length directions (|d| < 1e-50, the one rule of every
     # estimator: mcgeom.validation.check_directions) are rejected by the
     # kernel in its one pass over the rays; _raise then names the array
     st, f, r = _core.linear17_raw(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, options)
     if st != _core.STATUS_OK:
-        _raise(st, _core.linear17_dict(f, r), rays, n)
+        _raise(st, _core.linear17_dict(f, r), rays, len(rays))
+    return _motion(f, r)
+
+
+def _motion(f: np.ndarray, r) -> RigMotion:
+    """The RigMotion of a successful kernel call (``f``, ``r``: the buffer
+    and result of :func:`mcgeom._core.linear17_raw`)."""
     d = _core.L17_OFFSETS
     gc_case = _core.GC_CASE_NAMES.get(r.gc_case, "degenerate")
-    t_metric = f[d["t_metric"]:d["t_metric"] + 3]
     info = {
         "camera_kind": gc_case,
         "rank_A_R": r.rank_ar,
@@ -135,7 +158,7 @@ def linear17_no_static_check(rays: RayPairs, *, refine: bool = True,
         "iterations": r.iterations,
         "converged": bool(r.converged),
         "cost_linear": r.cost_linear,
-        "t_metric": t_metric,
+        "t_metric": f[d["t_metric"]:d["t_metric"] + 3],
         "candidate_cost": f[d["candidate_cost"]:d["candidate_cost"] + r.n_candidates],
         "n_in_front": r.n_in_front,
         "E_normalised": f[d["E"]:d["E"] + 9].reshape(3, 3),

@@ -5,7 +5,8 @@ intra-camera correspondences, 0.05 deg angular noise), the best mean time of:
 
 - ``public``: ``mcgeom.estimate(rays, "linear17")``, what a user calls
   (RayPairs in, RigMotion with its scale verdict out: the registry, the
-  plugin, the cffi wrapper and the kernel);
+  plugin, the cffi wrapper and the kernel; the estimate and its static-rig
+  test share one marshalling of the rays, ``_core.linear17_static_raw``);
 - ``plugin``: the estimator without the shared static-rig test
   (``mcgeom.estimators.linear17.linear17_no_static_check``: input checks, the kernel, the
   info dict and the verdict); ``static`` = public - plugin is what the test
