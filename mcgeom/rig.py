@@ -528,12 +528,20 @@ class Rig:
         ids = self._check_ids("cam_ids", cam_ids, px.shape[0])
         return self._rays_checked(ids, px)
 
-    def _rays_checked(self, ids: np.ndarray, px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _rays_checked(self, ids: np.ndarray, px: np.ndarray, tables: dict | None = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`rays` for ids and pixels already checked (``ray_pairs`` checks them
-        once: the checks cost more than the arithmetic at a few hundred pixels)."""
-        origins = self.centres[ids]   # (fancy indexing: a new C-contiguous array)
+        once: the checks cost more than the arithmetic at a few hundred pixels).
+        ``tables``: a dict that keeps the per-camera rows gathered by ``ids``
+        for a second call with the same ids (the other time of a pair)."""
+        tables = {} if tables is None else tables
+        if "origins" not in tables:
+            tables["origins"] = self.centres[ids]   # (fancy indexing: a new array)
+            origins = tables["origins"]
+        else:
+            origins = tables["origins"].copy()
         if self._all_plain:  # type: ignore[attr-defined]
-            dirs, norms = self._pinhole_rays(ids, px)
+            dirs, norms = self._pinhole_rays(ids, px, tables)
             # a pinhole bearing is v / |v| with v = (x, y, 1): unit unless |v|
             # overflowed (inf) or is NaN -- the same rows as the test below
             bad = np.flatnonzero(~(norms < np.inf))
@@ -558,21 +566,27 @@ class Rig:
                              f"far outside any image)")
         return origins, dirs
 
-    def _pinhole_rays(self, ids: np.ndarray, px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _pinhole_rays(self, ids: np.ndarray, px: np.ndarray, tables: dict | None = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
         """Bearings of undistorted pinhole pixels, all cameras at once:
         ``R_i^T normalize(K_i^-1 [u, v, 1])`` row by row (the same arithmetic as
         :meth:`Camera.pixels_to_bearings`, without a call per camera), and the
-        (N,) lengths ``|K_i^-1 [u, v, 1]|`` they were divided by."""
-        fx, fy, cx, cy, skew = self._pinhole  # type: ignore[attr-defined]
-        y = (px[:, 1] - cy[ids]) / fy[ids]
-        x = (px[:, 0] - cx[ids] - skew[ids] * y) / fx[ids]
+        (N,) lengths ``|K_i^-1 [u, v, 1]|`` they were divided by. ``tables``
+        as for :meth:`_rays_checked`."""
+        tables = {} if tables is None else tables
+        if "K" not in tables:
+            tables["K"] = self._pinhole[:, ids]  # type: ignore[attr-defined]
+            tables["R"] = self._Rs[ids]  # type: ignore[attr-defined]
+        fx, fy, cx, cy, skew = tables["K"]
+        y = (px[:, 1] - cy) / fy
+        x = (px[:, 0] - cx - skew * y) / fx
         d = np.empty((px.shape[0], 3))
         d[:, 0] = x
         d[:, 1] = y
         d[:, 2] = 1.0
         norms = np.linalg.norm(d, axis=1)
         d /= norms[:, None]
-        return np.einsum("nji,nj->ni", self._Rs[ids], d), norms  # type: ignore[attr-defined]
+        return np.einsum("nji,nj->ni", tables["R"], d), norms
 
     def ray_pairs(self, pixels1: Any, pixels2: Any, cam1: Any, cam2: Any = None) -> RayPairs:
         """Ray correspondences from pixel correspondences.
@@ -606,8 +620,10 @@ class Rig:
         bearings (measured: 69 of 190 us at 300 Ladybug correspondences,
         2.3 % of an ``estimateRigMotion``).
         """
-        o1, d1 = self._rays_checked(ids1, px1)
-        o2, d2 = self._rays_checked(ids2, px2)
+        tables: dict = {}
+        o1, d1 = self._rays_checked(ids1, px1, tables)
+        # the same cameras at both times (cameraIds2 None): their rows once
+        o2, d2 = self._rays_checked(ids2, px2, tables if ids2 is ids1 else None)
         # made here from checked ids: float64 C-contiguous (N, 3), no second check
         return RayPairs.prechecked(o1, d1, o2, d2, ids1, ids2.copy())
 
