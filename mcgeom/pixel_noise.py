@@ -38,8 +38,8 @@ def camera_table(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
     :func:`sampson_pixel_scale` evaluates; :func:`mcgeom.robust.ransac` passes
     it to the C search as ``pixel_cameras``).
     """
-    Ks = rig.intrinsics
-    return 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1]), rig.rotations[:, 2, :]
+    # (made once by the rig, read-only: this is asked once per estimate)
+    return rig.focal_axes
 
 
 def pixels_per_radian(rig: Rig, rays: RayPairs) -> np.ndarray:

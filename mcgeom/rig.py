@@ -428,6 +428,11 @@ class Rig:
         Ks = self._Ks  # type: ignore[attr-defined]
         object.__setattr__(self, "_pinhole", _frozen(np.stack(
             [Ks[:, 0, 0], Ks[:, 1, 1], Ks[:, 0, 2], Ks[:, 1, 2], Ks[:, 0, 1]])))
+        # the pixel-noise table of mcgeom.pixel_noise.camera_table: mean focal
+        # length (pixels) and optical axis (rig frame, row 2 of cam_from_rig)
+        object.__setattr__(self, "_noise_table", (
+            _frozen(0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])),
+            _frozen(np.ascontiguousarray(self._Rs[:, 2, :]))))  # type: ignore[attr-defined]
         object.__setattr__(self, "_extrinsic_std", _frozen(
             np.tile(DEFAULT_EXTRINSIC_STD, (len(cams), 1)) if self.calibration_std is None
             else np.array(self.calibration_std, dtype=np.float64)))
@@ -470,6 +475,13 @@ class Rig:
         axis), rotation (radians, per axis); :data:`DEFAULT_EXTRINSIC_STD` for
         every camera when ``calibration_std`` is None."""
         return self._extrinsic_std.copy()  # type: ignore[attr-defined]
+
+    @property
+    def focal_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(M,) mean focal lengths ``(fx + fy) / 2`` (pixels) and (M, 3) optical
+        axes (rig frame: row 2 of each ``rotations[i]``) of the cameras,
+        read-only, C-contiguous, made once (the rig is immutable)."""
+        return self._noise_table  # type: ignore[attr-defined]
 
     @property
     def extrinsic_std_readonly(self) -> np.ndarray:
