@@ -1432,7 +1432,8 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
         raise ValueError(f"inliers must be {n} booleans (or uint8 with bit 0 the inlier), "
                          f"got shape {m.shape} and dtype {m.dtype}")
     m = np.ascontiguousarray(m.view(np.uint8) if m.dtype == bool else m, dtype=np.uint8)
-    Rm, tv = _arr("R", R, (3, 3)), _arr("t", t, (3,))
+    # (finiteness of R and t: the kernel checks it, the error path names them)
+    Rm, tv = _f64("R", R, (3, 3)), _f64("t", t, (3,))
     if not (isinstance(still_angle, (int, float, np.floating)) and 0.0 <= still_angle < 4.0):
         raise ValueError(f"still_angle must be a number in [0, 4) radians, got {still_angle!r}")
     out = ffi.new("mcg_verdict_stats_result *")
@@ -1444,6 +1445,9 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
     if st != lib.MCG_OK:
         if st == lib.MCG_EINVAL:
             _camera_id_error((c1, c2), int(n_cameras))
+            for name, a in (("R", Rm), ("t", tv)):
+                if not np.isfinite(a).all():
+                    raise ValueError(f"{name} contains NaN or inf")
         _ray_error(st, "verdict_stats", rays)
     return {
         "n_inliers": out.n_inliers, "n_intra": out.n_intra, "n_cross": out.n_cross,

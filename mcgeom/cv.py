@@ -222,7 +222,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     name, run_robust = _resolve(method, robust)
     if not run_robust:
         _no_ransac_options(name, prob=prob, threshold=threshold, maxIters=maxIters, seed=seed)
-    cal = rig.extrinsic_std if calibration_std is None else \
+    cal = rig.extrinsic_std_readonly if calibration_std is None else \
         Rig(rig.cameras, calibration_std).extrinsic_std   # (checked: names the option)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
@@ -231,16 +231,21 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     keep = None if use.all() else np.flatnonzero(use)
     rays = rays_all if keep is None else rays_all.take(keep)
     if run_robust and method == RIG_5P1_RANSAC:
-        name = choose_sampler(ids1[use], ids2[use])
+        name = choose_sampler(rays.cam1, rays.cam2)   # (the used correspondences')
     if run_robust:
         # thresholds in pixels: the pixel-noise model of the rig converts them
         # the vertical prior is for the minimal solver (the final refinement is free)
         prior = {k: options.pop(k) for k in ("gravity1", "gravity2") if k in options}
-        m = _robust.ransac(rays, name, threshold=threshold, prob=prob, max_iters=maxIters,
-                           seed=seed, focal=pixels_per_radian(rig, rays),
-                           motion_focal=sampson_pixel_scale(rig), calibration_std=cal,
-                           pixel_cameras=camera_table(rig), solver_options=prior or None,
-                           **options)
+        # (as robust.ransac: an ``options=`` RansacOptions replaces the
+        # others; threshold None is 1 px)
+        opts = options.pop("options", None) or _robust.RansacOptions(
+            threshold=1.0 if threshold is None else threshold, prob=prob, max_iters=maxIters,
+            seed=seed, **options)
+        # the rays, pixel-noise tables and calibration come from the rig and
+        # the checks above: the search need not check them again (issue 19)
+        m = _robust.ransac_prechecked(rays, name, opts, pixels_per_radian(rig, rays),
+                                      sampson_pixel_scale(rig), cal, camera_table(rig),
+                                      prior or None)
         m.info.setdefault("sampler", name)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()

@@ -321,6 +321,14 @@ def _rotvec(w: np.ndarray) -> np.ndarray:
     return np.eye(3) + np.sin(th) * Kx + (1.0 - np.cos(th)) * (Kx @ Kx)
 
 
+#: angular step (radians) of the central differences of :func:`calibration_scale_std`
+_H_ANG = 1e-6
+#: the +-step perturbations of one axis after another (6, 3): +x, -x, +y, ...
+_STEPS = np.repeat(np.eye(3), 2, axis=0) * np.tile([1.0, -1.0], 3)[:, None]
+#: their rotations by _H_ANG (6, 3, 3), made once
+_TURNS = np.stack([_rotvec(_H_ANG * v) for v in _STEPS])
+
+
 def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
                           extrinsic_std, weights: np.ndarray | None = None,
                           loss: str = "none", loss_scale: float = 1e-3
@@ -376,8 +384,16 @@ def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
     tau = t + R @ c - c
 
-    def res(o1_, d1_, o2_, d2_, w=np.zeros(3), dtau=np.zeros(3)) -> np.ndarray:
-        return _core.gec_residuals(o1_, d1_, o2_, d2_, _rotvec(w) @ R, tau + dtau)
+    # the rotations of the differences, made once (were one Rodrigues per
+    # residual call, issue 19): R unturned (as I @ R), then +-h_ang about
+    # each axis, as _rotvec(+-h_ang e_k) @ R
+    R_at = {None: np.eye(3) @ R}
+    for k in range(3):
+        for sgn in (1, -1):
+            R_at[k, sgn] = _TURNS[2 * k + (sgn < 0)] @ R
+
+    def res(o1_, d1_, o2_, d2_, w=None, dtau=np.zeros(3)) -> np.ndarray:
+        return _core.gec_residuals(o1_, d1_, o2_, d2_, R_at[w], tau + dtau)
 
     r0 = res(o1, d1, o2, d2)
     w = np.ones(len(rays)) if weights is None else np.asarray(weights, dtype=np.float64)
@@ -387,11 +403,11 @@ def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
         w = w * np.minimum(1.0, loss_scale / np.maximum(np.abs(r0), 1e-300))
     elif loss == "soft_l1":
         w = w / np.sqrt(1.0 + (r0 / loss_scale) ** 2)
-    h_ang, scale = 1e-6, max(float(np.linalg.norm(tau)), 1e-9)
+    h_ang, scale = _H_ANG, max(float(np.linalg.norm(tau)), 1e-9)
     e = np.eye(3)
     J = np.empty((len(rays), 6))
     for k in range(3):
-        J[:, k] = (res(o1, d1, o2, d2, w=h_ang * e[k]) - res(o1, d1, o2, d2, w=-h_ang * e[k])) \
+        J[:, k] = (res(o1, d1, o2, d2, w=(k, 1)) - res(o1, d1, o2, d2, w=(k, -1))) \
             / (2 * h_ang)
         h = 1e-6 * scale
         J[:, 3 + k] = (res(o1, d1, o2, d2, dtau=h * e[k]) - res(o1, d1, o2, d2, dtau=-h * e[k])) \
@@ -407,8 +423,8 @@ def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     h_pos = 1e-6 * max(1.0, float(np.abs(o1).max(initial=0.0)))
     # the +-step perturbations of one extrinsic axis after another: position
     # (metres, rig frame) and orientation (rotation about the camera's centre)
-    steps = np.repeat(e, 2, axis=0) * np.tile([1.0, -1.0], 3)[:, None]   # (6, 3)
-    turns = np.stack([_rotvec(h_ang * v) for v in steps])                # (6, 3, 3)
+    steps = _STEPS
+    turns = _TURNS
     for cam in range(m):
         # only the rays of this camera (at either time) move with its
         # extrinsics: the other residuals do not change (dr = 0), so the

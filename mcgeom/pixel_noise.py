@@ -38,8 +38,8 @@ def camera_table(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
     :func:`sampson_pixel_scale` evaluates; :func:`mcgeom.robust.ransac` passes
     it to the C search as ``pixel_cameras``).
     """
-    Ks = rig.intrinsics
-    return 0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1]), rig.rotations[:, 2, :]
+    # (made once by the rig, read-only: this is asked once per estimate)
+    return rig.focal_axes
 
 
 def pixels_per_radian(rig: Rig, rays: RayPairs) -> np.ndarray:
@@ -54,11 +54,17 @@ def pixels_per_radian(rig: Rig, rays: RayPairs) -> np.ndarray:
     or behind the image plane keeps a finite value.)
     """
     focal, axes = camera_table(rig)
-    var = np.zeros(len(rays))
+    var = None
     for ids, d in ((rays.cam1, rays.dirs1), (rays.cam2, rays.dirs2)):
-        cz = np.clip(np.einsum("ij,ij->i", axes[ids], d), 1e-3, 1.0)
-        var += 0.5 * (cz ** 4 + cz ** 2) / focal[ids] ** 2
-    return 1.0 / np.sqrt(0.5 * var)
+        # (in place, without np.clip's Python layers: this runs once per
+        # estimate of the façade, issue 19; the same values)
+        cz = np.einsum("ij,ij->i", axes[ids], d)
+        np.maximum(cz, 1e-3, out=cz)
+        np.minimum(cz, 1.0, out=cz)
+        term = 0.5 * (cz ** 4 + cz ** 2) / focal[ids] ** 2
+        var = term if var is None else np.add(var, term, out=var)   # (0 + x = x exactly)
+    var *= 0.5
+    return 1.0 / np.sqrt(var, out=var)
 
 
 def sampson_pixel_scale(rig: Rig) -> MotionFocal:

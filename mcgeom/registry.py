@@ -194,6 +194,20 @@ class EstimatorInfo:
         return self.func(rays, **options)
 
 
+def _first_rows_distinct(rays: RayPairs, need: int) -> bool:
+    """Are the first ``need`` correspondences pairwise different (some entry
+    of the six arrays differs, as ``!=`` compares: what
+    :meth:`RayPairs.n_distinct` counts)? Then there are at least ``need``
+    distinct ones: the common case answered by one (need, need) comparison
+    instead of a sort (issue 19: the robust façade asks this of every
+    problem)."""
+    cols = [a[:need] for a in (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)]
+    cols += [ids[:need, None] for ids in (rays.cam1, rays.cam2) if ids is not None]
+    r = np.concatenate(cols, axis=1, dtype=np.float64)
+    differ = (r[:, None, :] != r[None, :, :]).any(axis=2)
+    return int(np.count_nonzero(differ)) == need * (need - 1)
+
+
 def check_distinct(rays: RayPairs, need: int, name: str) -> None:
     """DegenerateError when repeated correspondences leave fewer distinct ones
     than ``need`` (the minimal sample): copies of one correspondence constrain
@@ -202,6 +216,8 @@ def check_distinct(rays: RayPairs, need: int, name: str) -> None:
     from .errors import DegenerateError
     if not isinstance(rays, RayPairs) or len(rays) < need:
         return  # the estimator's own checks name the problem
+    if _first_rows_distinct(rays, need):
+        return
     k = rays.n_distinct(at_least=need)
     if k < need:
         raise DegenerateError(f"{name}: only {k} distinct correspondence(s) among {len(rays)} "

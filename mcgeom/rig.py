@@ -421,6 +421,21 @@ class Rig:
         object.__setattr__(self, "_Rs", _frozen(np.stack([c.R for c in cams])))
         object.__setattr__(self, "_plain", np.array(
             [c.model == "pinhole" and not np.any(c.dist) for c in cams]))
+        object.__setattr__(self, "_all_plain", bool(self._plain.all()))  # type: ignore[attr-defined]
+        # the entries of K that :meth:`_pinhole_rays` uses, one contiguous
+        # (M,) row each (fx, fy, cx, cy, skew): five 1-D gathers per call
+        # instead of one of N 3x3 matrices (the same numbers, the same bearings)
+        Ks = self._Ks  # type: ignore[attr-defined]
+        object.__setattr__(self, "_pinhole", _frozen(np.stack(
+            [Ks[:, 0, 0], Ks[:, 1, 1], Ks[:, 0, 2], Ks[:, 1, 2], Ks[:, 0, 1]])))
+        # the pixel-noise table of mcgeom.pixel_noise.camera_table: mean focal
+        # length (pixels) and optical axis (rig frame, row 2 of cam_from_rig)
+        object.__setattr__(self, "_noise_table", (
+            _frozen(0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])),
+            _frozen(np.ascontiguousarray(self._Rs[:, 2, :]))))  # type: ignore[attr-defined]
+        object.__setattr__(self, "_extrinsic_std", _frozen(
+            np.tile(DEFAULT_EXTRINSIC_STD, (len(cams), 1)) if self.calibration_std is None
+            else np.array(self.calibration_std, dtype=np.float64)))
 
     def __len__(self) -> int:
         return len(self.cameras)
@@ -459,9 +474,20 @@ class Rig:
         """(M, 2) 1-sigma extrinsic error of each camera: position (metres, per
         axis), rotation (radians, per axis); :data:`DEFAULT_EXTRINSIC_STD` for
         every camera when ``calibration_std`` is None."""
-        if self.calibration_std is None:
-            return np.tile(DEFAULT_EXTRINSIC_STD, (len(self.cameras), 1))
-        return np.array(self.calibration_std, dtype=np.float64)
+        return self._extrinsic_std.copy()  # type: ignore[attr-defined]
+
+    @property
+    def focal_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(M,) mean focal lengths ``(fx + fy) / 2`` (pixels) and (M, 3) optical
+        axes (rig frame: row 2 of each ``rotations[i]``) of the cameras,
+        read-only, C-contiguous, made once (the rig is immutable)."""
+        return self._noise_table  # type: ignore[attr-defined]
+
+    @property
+    def extrinsic_std_readonly(self) -> np.ndarray:
+        """:attr:`extrinsic_std` without the copy (read-only; made once: the
+        rig is immutable), for the per-estimate hot path of :mod:`mcgeom.cv`."""
+        return self._extrinsic_std  # type: ignore[attr-defined]
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -514,22 +540,37 @@ class Rig:
         ids = self._check_ids("cam_ids", cam_ids, px.shape[0])
         return self._rays_checked(ids, px)
 
-    def _rays_checked(self, ids: np.ndarray, px: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _rays_checked(self, ids: np.ndarray, px: np.ndarray, tables: dict | None = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`rays` for ids and pixels already checked (``ray_pairs`` checks them
-        once: the checks cost more than the arithmetic at a few hundred pixels)."""
-        used = np.flatnonzero(np.bincount(ids, minlength=len(self.cameras)))
-        origins = np.ascontiguousarray(self.centres[ids])
-        if self._plain[used].all():  # type: ignore[attr-defined]
-            dirs = self._pinhole_rays(ids, px)
+        once: the checks cost more than the arithmetic at a few hundred pixels).
+        ``tables``: a dict that keeps the per-camera rows gathered by ``ids``
+        for a second call with the same ids (the other time of a pair)."""
+        tables = {} if tables is None else tables
+        if "origins" not in tables:
+            tables["origins"] = self.centres[ids]   # (fancy indexing: a new array)
+            origins = tables["origins"]
         else:
-            dirs = np.empty((px.shape[0], 3))
-            for i in used:  # one OpenCV call per camera
-                sel = ids == i
-                dirs[sel] = self.cameras[i].pixels_to_bearings(px[sel])
+            origins = tables["origins"].copy()
+        if self._all_plain:  # type: ignore[attr-defined]
+            dirs, norms = self._pinhole_rays(ids, px, tables)
+            # a pinhole bearing is v / |v| with v = (x, y, 1): unit unless |v|
+            # overflowed (inf) or is NaN -- the same rows as the test below
+            bad = np.flatnonzero(~(norms < np.inf))
+        else:
+            used = np.flatnonzero(np.bincount(ids, minlength=len(self.cameras)))
+            if self._plain[used].all():  # type: ignore[attr-defined]
+                dirs = self._pinhole_rays(ids, px)[0]
+            else:
+                dirs = np.empty((px.shape[0], 3))
+                for i in used:  # one OpenCV call per camera
+                    sel = ids == i
+                    dirs[sel] = self.cameras[i].pixels_to_bearings(px[sel])
+            # unit bearings have squared length 1
+            bad = np.flatnonzero(~(np.einsum("ij,ij->i", dirs, dirs) > 0.5))
         # finite pixels far enough out (1e300) overflow |K^-1 [u, v, 1]| and come
         # out as zero or NaN bearings: name them here rather than let them fail
-        # deep in an estimator (unit bearings have squared length 1)
-        bad = np.flatnonzero(~(np.einsum("ij,ij->i", dirs, dirs) > 0.5))
+        # deep in an estimator
         if bad.size:
             k = int(bad[0])
             raise ValueError(f"camera {self.cameras[ids[k]].name!r}: pixel ({px[k, 0]:.6g}, "
@@ -537,16 +578,27 @@ class Rig:
                              f"far outside any image)")
         return origins, dirs
 
-    def _pinhole_rays(self, ids: np.ndarray, px: np.ndarray) -> np.ndarray:
+    def _pinhole_rays(self, ids: np.ndarray, px: np.ndarray, tables: dict | None = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
         """Bearings of undistorted pinhole pixels, all cameras at once:
         ``R_i^T normalize(K_i^-1 [u, v, 1])`` row by row (the same arithmetic as
-        :meth:`Camera.pixels_to_bearings`, without a call per camera)."""
-        K = self._Ks[ids]  # type: ignore[attr-defined]
-        y = (px[:, 1] - K[:, 1, 2]) / K[:, 1, 1]
-        x = (px[:, 0] - K[:, 0, 2] - K[:, 0, 1] * y) / K[:, 0, 0]
-        d = np.column_stack([x, y, np.ones(len(x))])
-        d /= np.linalg.norm(d, axis=1, keepdims=True)
-        return np.ascontiguousarray(np.einsum("nji,nj->ni", self._Rs[ids], d))  # type: ignore[attr-defined]
+        :meth:`Camera.pixels_to_bearings`, without a call per camera), and the
+        (N,) lengths ``|K_i^-1 [u, v, 1]|`` they were divided by. ``tables``
+        as for :meth:`_rays_checked`."""
+        tables = {} if tables is None else tables
+        if "K" not in tables:
+            tables["K"] = self._pinhole[:, ids]  # type: ignore[attr-defined]
+            tables["R"] = self._Rs[ids]  # type: ignore[attr-defined]
+        fx, fy, cx, cy, skew = tables["K"]
+        y = (px[:, 1] - cy) / fy
+        x = (px[:, 0] - cx - skew * y) / fx
+        d = np.empty((px.shape[0], 3))
+        d[:, 0] = x
+        d[:, 1] = y
+        d[:, 2] = 1.0
+        norms = np.linalg.norm(d, axis=1)
+        d /= norms[:, None]
+        return np.einsum("nji,nj->ni", tables["R"], d), norms
 
     def ray_pairs(self, pixels1: Any, pixels2: Any, cam1: Any, cam2: Any = None) -> RayPairs:
         """Ray correspondences from pixel correspondences.
@@ -580,9 +632,12 @@ class Rig:
         bearings (measured: 69 of 190 us at 300 Ladybug correspondences,
         2.3 % of an ``estimateRigMotion``).
         """
-        o1, d1 = self._rays_checked(ids1, px1)
-        o2, d2 = self._rays_checked(ids2, px2)
-        return RayPairs(o1, d1, o2, d2, ids1, ids2.copy())
+        tables: dict = {}
+        o1, d1 = self._rays_checked(ids1, px1, tables)
+        # the same cameras at both times (cameraIds2 None): their rows once
+        o2, d2 = self._rays_checked(ids2, px2, tables if ids2 is ids1 else None)
+        # made here from checked ids: float64 C-contiguous (N, 3), no second check
+        return RayPairs.prechecked(o1, d1, o2, d2, ids1, ids2.copy())
 
     def project(self, cam_id: int, points_rig: Any) -> tuple[np.ndarray, np.ndarray]:
         """Project rig-frame points into camera ``cam_id``; see :meth:`Camera.project`."""

@@ -24,6 +24,7 @@ the epipolar constraint's gradient; the final refinement uses it.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Any, Optional, Union
@@ -84,23 +85,33 @@ class RansacOptions:
                         ("maxIters", self.max_iters)):
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
                 raise ValueError(f"{name} must be a number, got {v!r}")
-        if not (np.isfinite(self.threshold) and self.threshold > 0):
+        # (math on Python scalars: numpy's scalar ufuncs cost ~1 us each, and
+        # these checks run once per estimate)
+        if not (_finite(self.threshold) and self.threshold > 0):
             raise ValueError(f"threshold must be a positive number, got {self.threshold}")
         if not (0.0 < self.prob < 1.0):
             raise ValueError(f"prob must be in (0, 1), got {self.prob}")
-        if not (np.isfinite(self.max_iters) and self.max_iters == int(self.max_iters)):
+        if not (_finite(self.max_iters) and self.max_iters == int(self.max_iters)):
             raise ValueError(f"maxIters must be an integer, got {self.max_iters}")
         if int(self.max_iters) < 1:
             raise ValueError(f"maxIters must be >= 1, got {self.max_iters}")
         object.__setattr__(self, "seed", check_seed(self.seed))
         if isinstance(self.max_seconds, (bool, np.bool_)) or \
                 not isinstance(self.max_seconds, (int, float, np.number)) or \
-                not (np.isfinite(self.max_seconds) and 0 <= self.max_seconds <= 1e9):
+                not (_finite(self.max_seconds) and 0 <= self.max_seconds <= 1e9):
             raise ValueError(f"max_seconds must be a number in [0, 1e9] (0: no limit), got "
                              f"{self.max_seconds!r}")
         if self.strategy not in ("auto", "proposer", "minimal"):
             raise ValueError(f"strategy must be 'auto', 'proposer' or 'minimal', got "
                              f"{self.strategy!r}")
+
+
+def _finite(v: Any) -> bool:
+    """Is the real number ``v`` finite (an int too large for a float is not)?"""
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False
 
 
 def _focal_array(focal: Union[None, float, np.ndarray], n: int) -> Optional[np.ndarray]:
@@ -109,7 +120,8 @@ def _focal_array(focal: Union[None, float, np.ndarray], n: int) -> Optional[np.n
     f = np.asarray(focal, dtype=np.float64)
     if f.ndim == 0:
         f = np.full(n, float(f))
-    if f.shape != (n,) or not np.all(np.isfinite(f)) or np.any(f <= 0):
+    # min > 0 and max < inf: NaN fails both (two reductions, no temporaries)
+    if f.shape != (n,) or (n and not (f.min() > 0 and f.max() < np.inf)):
         raise ValueError(f"focal must be a positive number or {n} positive numbers")
     return f
 
@@ -330,6 +342,43 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     if options is None:
         thr = threshold if threshold is not None else (1.0 if focal is not None else 1e-3)
         options = RansacOptions(threshold=thr, prob=prob, max_iters=max_iters, seed=seed, **kw)
+    return _ransac(rays, method, options, focal, motion_focal, calibration_std, pixel_cameras,
+                   solver_options, t_start, False)
+
+
+def ransac_prechecked(rays: RayPairs, method: str, options: RansacOptions, focal: np.ndarray,
+                      motion_focal: MotionFocal, calibration_std: np.ndarray,
+                      pixel_cameras: tuple[np.ndarray, np.ndarray],
+                      solver_options: Optional[dict] = None) -> RigMotion:
+    """:func:`ransac` in pixels, for a caller that made its arguments from a
+    :class:`mcgeom.rig.Rig` and checked them (:func:`mcgeom.cv.estimate`);
+    the same result, without the checks that cannot fail on such input
+    (issue 19: each is an O(N) numpy pass).
+
+    Preconditions (the caller's to guarantee; nothing of this is checked):
+    ``rays`` from :meth:`mcgeom.rig.Rig.ray_pairs_prechecked` (or a subset:
+    origins are the camera centres, ``cam1``/``cam2`` int64 ids of the rig),
+    ``focal`` (N,) finite float64 > 0 (pixels per radian,
+    :func:`mcgeom.pixel_noise.pixels_per_radian`), ``pixel_cameras`` the
+    rig's :func:`mcgeom.pixel_noise.camera_table` and ``motion_focal`` its
+    :func:`mcgeom.pixel_noise.sampson_pixel_scale`, ``calibration_std`` an
+    (M, 2) array (:attr:`mcgeom.rig.Rig.extrinsic_std`), ``options`` a
+    :class:`RansacOptions` (validated when made). What the data may still
+    get wrong (too few or repeated correspondences, no camera with 5
+    intra-camera ones for 5+1, a threshold above 1 rad) is checked as by
+    :func:`ransac`, with the same messages.
+    """
+    return _ransac(rays, method, options, focal, motion_focal, calibration_std, pixel_cameras,
+                   solver_options, time.perf_counter(), True)
+
+
+def _ransac(rays: RayPairs, method: str, options: RansacOptions, focal: Any,
+            motion_focal: Optional[MotionFocal], calibration_std: Any,
+            pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
+            solver_options: Optional[dict], t_start: float, from_rig: bool) -> RigMotion:
+    """:func:`ransac` with ``options`` made; ``from_rig``: the preconditions
+    of :func:`ransac_prechecked` hold (``focal`` a checked array, camera ids
+    of the rig of ``pixel_cameras``, origins at their centres)."""
     in_c = method in C_SAMPLERS and options.strategy == "auto" and \
         (motion_focal is None or pixel_cameras is not None)
     # (the C search needs no plugin: its samplers are the C solvers)
@@ -343,7 +392,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
         # pass and names the array: no extra numpy passes on its path)
         rays.check_finite()
     registry.check_distinct(rays, need, method)
-    f = _focal_array(focal, n)
+    f = focal if from_rig else _focal_array(focal, n)
     if motion_focal is not None and f is None:
         raise ValueError("motion_focal needs focal (thresholds in pixels)")
     if method == "five_plus_one" and n == 6:
@@ -355,7 +404,7 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
             return m
     if in_c:
         return _ransac_c(rays, f, options, pixel_cameras, t_start, calibration_std, method,
-                         solver_options or {})
+                         solver_options or {}, from_rig and pixel_cameras is not None)
     rng = np.random.default_rng(options.seed)
     scorer = _Scorer(rays, options.threshold, f, options, motion_focal)
     _check_threshold_angle(options.threshold, scorer.loss_scale, f)
@@ -740,7 +789,11 @@ def _camera_count(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, int]:
     table[cam2] = rays.origins2
     table[cam1] = rays.origins1
     for cam, o in ((cam1, rays.origins1), (cam2, rays.origins2)):
-        if np.abs(table[cam] - o).max(initial=0.0) > 1e-9 * (1.0 + np.abs(o).max(initial=0.0)):
+        kept = table[cam]
+        # exactly equal (origins copied from a table of centres): one
+        # comparison; otherwise within the tolerance
+        if not (kept == o).all() and \
+                np.abs(kept - o).max(initial=0.0) > 1e-9 * (1.0 + np.abs(o).max(initial=0.0)):
             raise ValueError("rays: one camera id has several different origins; origins must "
                              "be the camera centres (rig frame) for five_plus_one")
     return cam1, cam2, m
@@ -793,11 +846,15 @@ def _solver_gravity(method: str, solver_options: dict) -> dict:
 def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions,
               pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
               t_start: float, calibration_std: Any = None, method: str = "five_plus_one",
-              solver_options: Optional[dict] = None) -> RigMotion:
+              solver_options: Optional[dict] = None, from_rig: bool = False) -> RigMotion:
     """The methods of :data:`C_SAMPLERS`: the search and the final refinement
-    in one C call (``_core.robust_rig_motion``, csrc/robust.c), the verdict here."""
+    in one C call (``_core.robust_rig_motion``, csrc/robust.c), the verdict here.
+    ``from_rig``: the rays' ids are those of the rig of ``pixel_cameras`` and
+    their origins its centres (:func:`ransac_prechecked`): not checked again."""
     gravity = _solver_gravity(method, solver_options or {})
-    if method == "five_plus_one":
+    if from_rig:
+        cam1, cam2, n_cameras = rays.cam1, rays.cam2, 0
+    elif method == "five_plus_one":
         cam1, cam2, n_cameras = _camera_count(rays)
     else:
         cam1, cam2, n_cameras = _sampler_ids(rays, method, pixel_cameras is not None)
@@ -818,11 +875,15 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     if method == "five_plus_one" and not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
         raise ValueError(f"too few correspondences: {method} needs 5 intra-camera "
                          f"correspondences in one camera ({_per_camera(rays)})")
-    # the loss scale (radians) as _Scorer computes it; the scorer itself (its
-    # weights: an O(N) pass) only where nothing was found
-    loss_scale = options.threshold if focal is None else \
-        options.threshold / float(np.median(focal))
-    _check_threshold_angle(options.threshold, loss_scale, focal)
+    # the threshold as an angle (radians), as _Scorer's loss scale: threshold /
+    # median(focal) can exceed the limit only if threshold > min(focal) (the
+    # median is >= the minimum; the rounded quotient is monotone), so the
+    # median (a partition of all N) is taken only then
+    if focal is None:
+        _check_threshold_angle(options.threshold, options.threshold, focal)
+    elif options.threshold > MAX_THRESHOLD_RAD * float(focal.min()):
+        _check_threshold_angle(options.threshold, options.threshold / float(np.median(focal)),
+                               focal)
     seed = options.seed if options.seed is not None else \
         int(np.random.SeedSequence().entropy % (1 << 63))
 

@@ -46,6 +46,23 @@ class RayPairs:
         object.__setattr__(self, "cam1", as_camera_ids("cam1", self.cam1, n))
         object.__setattr__(self, "cam2", as_camera_ids("cam2", self.cam2, n))
 
+    @classmethod
+    def prechecked(cls, origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
+                   dirs2: np.ndarray, cam1: Optional[np.ndarray] = None,
+                   cam2: Optional[np.ndarray] = None) -> "RayPairs":
+        """A RayPairs of arrays that already pass the checks of ``__init__``,
+        without checking them again (the caller's to guarantee): four (N, 3)
+        float64 C-contiguous arrays (metres, rig frame), ``cam1``/``cam2``
+        None or (N,) int64 ids in ``0 .. 2^20 - 1``. For producers that made
+        the arrays themselves (:meth:`mcgeom.rig.Rig.ray_pairs_prechecked`):
+        the checks of ``__init__`` cost about as much as the bearings at a
+        few hundred correspondences (issue 19)."""
+        out = object.__new__(cls)
+        for name, a in (("origins1", origins1), ("dirs1", dirs1), ("origins2", origins2),
+                        ("dirs2", dirs2), ("cam1", cam1), ("cam2", cam2)):
+            object.__setattr__(out, name, a)
+        return out
+
     def __len__(self) -> int:
         return self.origins1.shape[0]
 

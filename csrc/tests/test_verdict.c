@@ -7,8 +7,9 @@
  * turning rig against the angle computed by acos here over every pair of
  * centres; cheirality by explicit least-squares triangulation here; the
  * travel direction of a straight drive (the true direction, also with the
- * bearings swapped end for end: the sign); the status codes of invalid
- * arguments. Exit status 0 iff every check passes.
+ * bearings swapped end for end: the sign); the no-parallax count recounted
+ * with atan2 at many thresholds, also exactly at the angles; the status
+ * codes of invalid arguments. Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
@@ -179,6 +180,54 @@ static void test_pure_rotation(void)
     check(s.n_still == s.n_intra && s.n_intra > 0, "every angle still", (double)s.n_still, 0);
 }
 
+/* The no-parallax count against a recount here (atan2 of |R_fit e1 x e2|
+ * and its dot, the definition) at thresholds spread over the angles and at
+ * each of a few angles exactly (the count must then leave that pair out:
+ * "below", the kernel's shortcut must fall back at the boundary). */
+static void test_still_count(void)
+{
+    double R[9], t[3] = {0.05, -0.02, 0.01}, axis[3] = {0.2, 1.0, -0.4}, ang[N];
+    mcg_verdict_stats_result s;
+    int k, j, m = 0, st, bad = 0;
+    rot_about(axis, 0.3, R);
+    scene(R, t, 1);
+    st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work, 64);
+    check(st == MCG_OK && s.fit_ok, "verdict_stats of a small translation", (double)st, 0);
+    for (k = 0; k < N; ++k) {
+        double e1[3], e2[3], a[3], x[3], n1 = 0, n2 = 0;
+        int i;
+        if (!(inl[k] & 1) || c1[k] != c2[k])
+            continue;
+        for (i = 0; i < 3; ++i) {
+            n1 += d1[3 * k + i] * d1[3 * k + i];
+            n2 += d2[3 * k + i] * d2[3 * k + i];
+        }
+        n1 = 1.0 / sqrt(n1); /* (as the kernel scales: the same rounding) */
+        n2 = 1.0 / sqrt(n2);
+        for (i = 0; i < 3; ++i) {
+            e1[i] = d1[3 * k + i] * n1;
+            e2[i] = d2[3 * k + i] * n2;
+        }
+        for (i = 0; i < 3; ++i)
+            a[i] = s.R_fit[3 * i] * e1[0] + s.R_fit[3 * i + 1] * e1[1] + s.R_fit[3 * i + 2] * e1[2];
+        x[0] = a[1] * e2[2] - a[2] * e2[1];
+        x[1] = a[2] * e2[0] - a[0] * e2[2];
+        x[2] = a[0] * e2[1] - a[1] * e2[0];
+        ang[m++] = atan2(sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]),
+                         a[0] * e2[0] + a[1] * e2[1] + a[2] * e2[2]);
+    }
+    for (j = 0; j < 60 + m; ++j) {
+        /* 60 thresholds from 1e-6 to 3.5 rad, then each angle itself */
+        const double still = j < 60 ? 1e-6 * pow(3.5e6, j / 59.0) : ang[j - 60];
+        int ref = 0;
+        for (k = 0; k < m; ++k)
+            ref += ang[k] < still;
+        st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, still, &s, work, 64);
+        bad += st != MCG_OK || s.n_still != ref;
+    }
+    check(m > 10 && bad == 0, "no-parallax count = recount at every threshold", (double)bad, 0);
+}
+
 static void test_straight_drive(void)
 {
     double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {-1.5, 0.0, 0.0}, e;
@@ -225,6 +274,19 @@ static void test_invalid(void)
     check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
                                    64), MCG_EINVAL, "NaN direction");
     d2[7] = keep;
+    keep = o1[5];
+    o1[5] = INFINITY;
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_EINVAL, "infinite origin");
+    o1[5] = NAN;
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_EINVAL, "NaN origin");
+    o1[5] = keep;
+    keep = o2[N];
+    o2[N] = -1e200;
+    check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
+                                   64), MCG_EINVAL, "origin beyond 1e150");
+    o2[N] = keep;
     memset(d1, 0, 3 * sizeof(double));
     check_status(mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work,
                                    64), MCG_EINVAL, "zero direction");
@@ -236,6 +298,7 @@ int main(void)
 {
     test_counts_crit_front();
     test_pure_rotation();
+    test_still_count();
     test_straight_drive();
     test_invalid();
     printf("%d checks, %d failed\n", n_checks, n_failed);
