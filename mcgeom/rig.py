@@ -596,8 +596,11 @@ class Rig:
         d[:, 0] = x
         d[:, 1] = y
         d[:, 2] = 1.0
-        norms = np.linalg.norm(d, axis=1)
-        d /= norms[:, None]
+        # pixels far outside any image (1e300) overflow here: the caller names
+        # them from the non-finite lengths, so numpy's warning would only add noise
+        with np.errstate(over="ignore", invalid="ignore"):
+            norms = np.linalg.norm(d, axis=1)
+            d /= norms[:, None]
         return np.einsum("nji,nj->ni", tables["R"], d), norms
 
     def ray_pairs(self, pixels1: Any, pixels2: Any, cam1: Any, cam2: Any = None) -> RayPairs:

@@ -3,6 +3,8 @@ known failure mode (near-zero rotation) and the ch. 10.5.1 set-up."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -83,9 +85,14 @@ def test_runs_through_the_opencv_facade():
     R = synth.rotation_about([0.3, 1.0, 0.2], np.radians(15))
     t = np.array([0.5, 0.2, 0.1])
     p = synth.make_problem(rig, R, t, 200, rng, pixel_noise=0.3, outlier_fraction=0.1)
-    retval, Re, te, mask = mcgeom.estimateRigMotion(p.pixels1, p.pixels2, p.cam1, p.cam2, rig,
-                                                    method="e_socp")
-    assert rot_err(Re, R) < np.radians(0.1)
     m = mcgeom.cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, method="e_socp")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        retval, Re, te, mask = mcgeom.estimateRigMotion(p.pixels1, p.pixels2, p.cam1, p.cam2,
+                                                        rig, method="e_socp")
+    # the OpenCV-style call warns exactly when its t is no metric estimate
+    warned = [w for w in caught if issubclass(w.category, mcgeom.ScaleNotObservableWarning)]
+    assert bool(warned) == (not m.scale.observable and bool(np.any(m.t != 0)))
+    assert rot_err(Re, R) < np.radians(0.1)
     if m.scale.observable:
         assert np.linalg.norm(te.ravel() - t) < 0.1 * np.linalg.norm(t)
