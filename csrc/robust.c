@@ -1540,6 +1540,9 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         return MCG_EINVAL;
     memset(res, 0, sizeof *res);
     memset(&c, 0, sizeof c);
+    /* the clock covers the input checks too (O(N): part of the call's cost,
+     * and of the time budget) */
+    t_start = now_seconds();
     if (opt)
         c.opt = *opt;
     else
@@ -1551,7 +1554,6 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         return st;
     if (lwork < mcg_robust_work_size(n, n_cameras))
         return MCG_ENOMEM;
-    t_start = now_seconds();
     deadline = c.opt.max_seconds > 0.0 ? t_start + c.opt.max_seconds : INFINITY;
     c.n = n;
     c.ncam = n_cameras;
