@@ -705,11 +705,19 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         # huge |t|, which the refinement on all inliers brings back
         # (measured on the Ladybug head: 565 -> 1.06, 45 -> 0.97 for |t| = 1).
         slid = not nt <= 10.0 * n0
-        if slid:
-            nt = n0
         if direction is None:
             direction = travel_direction(rays, inl, R, t)
         info["t_direction"] = direction
+        # A refined t in the mirrored minimum, within ~25 deg of the opposite
+        # of the travel direction that cheirality picks, is no metric
+        # estimate either: near the critical motion the refinement can cross
+        # |t| = 0 (car rig driving forward, 20 % outliers: t = +0.06 m for a
+        # true -0.54 m). It is treated as slid: the direction, the
+        # hypothesis' length. (A t dominated by the rotation-induced shift
+        # may point elsewhere, up to ~130 deg off on KITTI, and is left alone.)
+        slid = slid or float(np.dot(direction, t)) < -0.9 * nt
+        if slid:
+            nt = n0
         zero = float("nan")
         if fit is not None and not slid and scale_determined(rel_std):
             zero = zero_profile

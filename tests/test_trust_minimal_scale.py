@@ -151,3 +151,24 @@ def test_scale_determined_rule():
     assert not scale_determined(0.05, direction_only=True)
     assert not scale_determined(float("inf")) and not scale_determined(float("nan"))
     assert not scale_determined(2 * UNDETERMINED_REL_STD)
+
+
+def test_mirrored_refinement_is_no_metric_estimate():
+    # problem 165 of `mcgeom experiment robust_vs_poselib` (car rig driving
+    # forward, <= 2 deg yaw, 20 % outliers): the refinement crossed |t| = 0
+    # into the mirrored minimum (t = +0.06 m for a true -0.54 m) and was
+    # returned as a determined metric t pointing backwards
+    from mcgeom.experiments import robust_vs_poselib as rv
+    make_rig, n, outl, noise, motion = rv.CASES["car8 fwd<=2deg 400c 20%out"]
+    rng, rig = np.random.default_rng(0), make_rig()
+    for _ in range(166):
+        R, t = motion(rng)
+        p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
+    m = cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0)
+    assert rot_err(m.R, R) < np.radians(0.1)
+    cos = float(m.t @ t) / (np.linalg.norm(m.t) * np.linalg.norm(t))
+    assert cos > 0.99, (m.t, t)                      # never the mirrored direction
+    if m.info["scale_determined"]:
+        assert abs(np.linalg.norm(m.t) / np.linalg.norm(t) - 1) < 3 * m.scale.rel_std
+    else:
+        assert not m.scale.observable and np.linalg.norm(m.t) == pytest.approx(1.0)
