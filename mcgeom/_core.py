@@ -1392,9 +1392,9 @@ def _camera_id_arrays(cam1: Any, cam2: Any, n: int, n_cameras: Any
         if a.shape != (n,) or (n and a.dtype.kind not in "iu"):
             raise ValueError(f"{name} must be {n} integer camera ids, got shape {a.shape} "
                              f"and dtype {a.dtype}")
-        if a.dtype != np.int32 and a.size and (a.min() < 0 or a.max() >= n_cameras):
+        if a.dtype != np.int32:
             # (int64 ids beyond int32 would wrap in the conversion)
-            raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
+            _id_range_error(name, a, int(n_cameras))
         ids.append(np.ascontiguousarray(a, dtype=np.int32))
     return ids[0], ids[1]
 
@@ -1402,8 +1402,13 @@ def _camera_id_arrays(cam1: Any, cam2: Any, n: int, n_cameras: Any
 def _camera_id_error(ids: tuple, n_cameras: int) -> None:
     """After a kernel's MCG_EINVAL: ValueError naming an id array out of range."""
     for name, a in zip(("cam1", "cam2"), ids):
-        if a.size and (a.min() < 0 or a.max() >= n_cameras):
-            raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
+        _id_range_error(name, a, n_cameras)
+
+
+def _id_range_error(name: str, a: np.ndarray, n_cameras: int) -> None:
+    """ValueError naming ``name`` when the ids ``a`` leave ``[0, n_cameras)``."""
+    if a.size and (a.min() < 0 or a.max() >= n_cameras):
+        raise ValueError(f"{name} holds camera ids outside [0, {n_cameras})")
 
 
 # ------------------------------------------------------------- verdict.c

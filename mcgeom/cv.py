@@ -222,7 +222,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     name, run_robust = _resolve(method, robust)
     if not run_robust:
         _no_ransac_options(name, prob=prob, threshold=threshold, maxIters=maxIters, seed=seed)
-    cal = rig.extrinsic_std_readonly if calibration_std is None else \
+    cal = rig.extrinsic_std if calibration_std is None else \
         Rig(rig.cameras, calibration_std).extrinsic_std   # (checked: names the option)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again

@@ -484,12 +484,6 @@ class Rig:
         return self._noise_table  # type: ignore[attr-defined]
 
     @property
-    def extrinsic_std_readonly(self) -> np.ndarray:
-        """:attr:`extrinsic_std` without the copy (read-only; made once: the
-        rig is immutable), for the per-estimate hot path of :mod:`mcgeom.cv`."""
-        return self._extrinsic_std  # type: ignore[attr-defined]
-
-    @property
     def names(self) -> tuple[str, ...]:
         """Camera names, in id order."""
         return tuple(c.name for c in self.cameras)
