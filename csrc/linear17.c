@@ -89,7 +89,7 @@ static void motion_vector(const double r[9], const double t[3], double x[NX])
 
 /* Generalized epipolar row (eq. 8.16, row-major vec) of one ray pair in the
  * normalised frame X' = s (X - o); 0 if a direction has zero length. */
-static int make_row(const double *o1, const double *d1, const double *o2,
+static inline int make_row(const double *o1, const double *d1, const double *o2,
                     const double *d2, const double o[3], double s, double row[NX])
 {
     double a[3], b[3], p[3], q[3], m1[3], m2[3], na, nb;
