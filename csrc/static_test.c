@@ -384,25 +384,25 @@ static int check_rays(int n, const double *o1, const double *d1, const double *o
     return bad ? MCG_EINVAL : MCG_OK;
 }
 
-/* mcg_static_noise on checked arguments */
+/* The residuals of the cameras of pairs idx[*pos..m) (sorted by group by
+ * pairs_by_group) into res, a camera at a time; stops after the camera
+ * that brings the rows done to at least stop (0: never) and leaves *pos at
+ * the next camera, so that a later call resumes there. *done counts the
+ * rows whose residual was computed. work: as static_noise's. */
 MCG_AVX2_CLONE
-static int static_noise(int n, const double *o1, const double *d1, const double *o2,
-                        const double *d2, const int *group, const double R[9], int min_rows,
-                        int samples, double *res, double *median, int *n_used, double *work)
+static int noise_cameras(const double *o1, const double *d1, const double *o2,
+                         const double *d2, const int *group, const double R[9], int min_rows,
+                         int samples, double *res, int n, double *work, int m, int *pos,
+                         int stop, int *done)
 {
-    int *idx, *tmp, i, m = 0, used = 0;
+    int *idx = (int *)work, i;
     double *ahat, *prod, *buf, *cres, *raw;
-    idx = (int *)work;
-    tmp = idx + n;
     ahat = work + 2 * ints_as_doubles((size_t)n);
     prod = ahat + 3 * (size_t)n;
     buf = prod + (size_t)n;
     cres = buf + 12 * (size_t)n;
     raw = cres + (size_t)n;
-    for (i = 0; i < n; i++)
-        res[i] = -1.0;
-    m = pairs_by_group(n, group, idx, tmp);
-    for (i = 0; i < m;) {
+    for (i = *pos; i < m;) {
         int j = i, k, c, st, mc;
         double u[3], cc[3], rc[3], t[3], *bo1, *bd1, *bo2, *bd2;
         while (j < m && group[idx[j]] == group[idx[i]])
@@ -436,12 +436,42 @@ static int static_noise(int n, const double *o1, const double *d1, const double 
                 return st;
             for (k = 0; k < mc; k++)
                 res[idx[i + k]] = fabs(cres[k]);
+            *done += mc;
         }
         i = j;
+        if (stop > 0 && *done >= stop)
+            break;
     }
+    *pos = i;
+    return MCG_OK;
+}
+
+/* the residuals res >= 0 (the cameras done; NaN and -1 left out) into out;
+ * returns their number */
+static int gather_used(int n, const double *res, double *out)
+{
+    int i, used = 0;
     for (i = 0; i < n; i++)
         if (res[i] >= 0.0)
-            prod[used++] = res[i];
+            out[used++] = res[i];
+    return used;
+}
+
+/* mcg_static_noise on checked arguments */
+static int static_noise(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const int *group, const double R[9], int min_rows,
+                        int samples, double *res, double *median, int *n_used, double *work)
+{
+    int *idx = (int *)work, i, m, used, pos = 0, done = 0, st;
+    double *prod = work + 2 * ints_as_doubles((size_t)n) + 3 * (size_t)n;
+    for (i = 0; i < n; i++)
+        res[i] = -1.0;
+    m = pairs_by_group(n, group, idx, idx + n);
+    st = noise_cameras(o1, d1, o2, d2, group, R, min_rows, samples, res, n, work, m, &pos,
+                       0, &done);
+    if (st != MCG_OK)
+        return st;
+    used = gather_used(n, res, prod);
     *n_used = used;
     *median = used ? median_inplace(prod, used) : 0.0;
     return MCG_OK;
@@ -585,6 +615,30 @@ static int distinct_at_least(int n, const double *o1, const double *d1, const do
     return found >= k;
 }
 
+/* the noise level of the median residual med: noise_factor robust stds,
+ * at least noise_floor */
+static double level_of(double med, const mcg_static_options *o)
+{
+    double level = o->noise_factor * MAD_TO_STD * med;
+    return level < o->noise_floor ? o->noise_floor : level;
+}
+
+/* the pairs of the cameras with at least min_rows of them (idx[0..m)
+ * sorted by group): the residuals the noise level can have */
+static int rows_of_fitted_cameras(const int *group, const int *idx, int m, int min_rows)
+{
+    int i = 0, rows = 0;
+    while (i < m) {
+        int j = i;
+        while (j < m && group[idx[j]] == group[idx[i]])
+            j++;
+        if (j - i >= min_rows)
+            rows += j - i;
+        i = j;
+    }
+    return rows;
+}
+
 /* the noise level at R (noise_factor robust stds of the per-camera
  * residuals, at least noise_floor), 0 when no camera has min_rows pairs */
 static int level_at(int n, const double *o1, const double *d1, const double *o2,
@@ -634,6 +688,33 @@ static void explained_anywhere(int n, const double *o1, const double *d1, const 
     /* the median angle only for the answer that reports it (a static rig) */
     out->median_angle =
         out->is_static ? median_angle_at(n, u1, u2, group, out->R, ang) : NAN;
+}
+
+/* explained_anywhere's statistic without its distinct-pairs condition and
+ * median angle (a necessary condition of a static answer, for the bound of
+ * mcg_static_check): 1 if enough angles are within the bound at R_given
+ * (else R_fit) or, without R_given, at R_est; out gets the figures of the
+ * last rotation tried, as explained_anywhere reports a moving rig */
+static int explained_somewhere(int n, const double *u1, const double *u2, const int *group,
+                               const double *R_est, const double *R_given,
+                               const mcg_static_options *o, mcg_static_result *out)
+{
+    double lim = o->parallax_factor * out->noise_level;
+    int i, r;
+    out->is_static = 0;
+    out->median_angle = NAN;
+    for (i = 0; i < 2; i++) {
+        const double *R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
+        if (i == 1 && (!R_est || R_given))
+            break;
+        rotation_statistic(n, u1, u2, group, R_test, lim, &out->n_intra, &out->explained);
+        out->decided_at = i;
+        for (r = 0; r < 9; r++)
+            out->R[r] = R_test[r];
+        if (out->n_intra >= o->min_pairs && out->n_intra > 0 && out->explained >= o->fraction)
+            return 1;
+    }
+    return 0;
 }
 
 int mcg_static_check(int n, const double *o1, const double *d1, const double *o2,
@@ -702,9 +783,43 @@ int mcg_static_check(int n, const double *o1, const double *d1, const double *o2
     if (noise_level > 0.0) {
         out->noise_level = noise_level;
     } else {
-        st = level_at(n, o1, d1, o2, d2, group, out->R_fit, &o, res, work, &levels[1]);
+        /* the level at the pure rotation, with an exact early exit for a
+         * moving rig (issue 22: the per-camera fits are most of the test).
+         * Once the cameras done hold more than half of the residuals any
+         * camera could add (U_max: the rows of the cameras with min_rows
+         * pairs), the median of all of them is at most the stop-th smallest
+         * done, stop = floor(U_max / 2) + 1: both middle values of the
+         * sorted residuals are then at most that value. The level at that
+         * bound is an upper bound of the level, and the statistic only
+         * explains fewer angles at a smaller level, so a rig that is
+         * moving at the bound (at both rotations) is moving at the level:
+         * the remaining cameras are not fitted. Otherwise they are, and the
+         * test goes on as without the bound. */
+        int *idx = (int *)work, m, pos = 0, done = 0, used, stop = 0;
+        double *prod = work + 2 * ints_as_doubles((size_t)n) + 3 * (size_t)n;
+        for (i = 0; i < n; i++)
+            res[i] = -1.0;
+        m = pairs_by_group(n, group, idx, idx + n);
+        if (R_est || R_given)
+            stop = rows_of_fitted_cameras(group, idx, m, o.min_rows) / 2 + 1;
+        st = noise_cameras(o1, d1, o2, d2, group, out->R_fit, o.min_rows, o.samples, res, n,
+                           work, m, &pos, stop, &done);
         if (st != MCG_OK)
             return st;
+        if (pos < m) {
+            used = gather_used(n, res, prod);
+            if (used >= stop) {
+                out->noise_level = level_of(select_kth_inplace(prod, used, stop - 1), &o);
+                if (!explained_somewhere(n, u1, u2, group, R_est, R_given, &o, out))
+                    return MCG_OK; /* moving at an upper bound of the level */
+            }
+            st = noise_cameras(o1, d1, o2, d2, group, out->R_fit, o.min_rows, o.samples, res,
+                               n, work, m, &pos, 0, &done);
+            if (st != MCG_OK)
+                return st;
+        }
+        used = gather_used(n, res, prod);
+        levels[1] = used ? level_of(median_inplace(prod, used), &o) : 0.0;
         if (levels[1] == 0.0) { /* no camera with min_rows pairs */
             out->noise_level = o.default_level;
             out->noise_from_default = 1;
