@@ -26,7 +26,10 @@
  * mcgeom.observability.no_parallax (a fraction of the rotation-only angles
  * within a factor of the level) at the pure rotation and, failing that, at
  * the estimate's own rotation; and at least min_distinct distinct
- * intra-camera pairs (repeats of one pair explain any rotation).
+ * intra-camera pairs (repeats of one pair explain any rotation). A moving
+ * rig is recognised at an upper bound of the level, from the cameras that
+ * hold just over half of the residuals, without fitting the others (see
+ * mcg_static_check); its reported noise_level is then that bound.
  */
 #include "mcgeom.h"
 #include "internal.h"
