@@ -30,6 +30,17 @@
 
 /* Jacobi converges quadratically: a handful of sweeps in practice. The cap
  * only turns a pathological input into MCG_ENUMERIC instead of a hang. */
+/* The Householder reduction and the QR rotations of mcg_sym_eig_tridiag
+ * (linear17's two 9 x 9 decompositions per call) are also compiled for
+ * AVX2 on x86-64 (GCC, glibc: an ifunc picks the clone at load time).
+ * Only "avx2", not "fma": every product and sum rounds as in the default
+ * clone, so the results are the same to the bit on every CPU (issue 22). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define MCG_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
+#else
+#define MCG_AVX2_CLONE
+#endif
+
 #define MAX_SWEEPS 60
 #define SPD_MAX 64
 /* Rotations of one Jacobi round whose parameters are computed together. */
@@ -889,6 +900,7 @@ int mcg_sym_eig(int n, double *a, double *w, double *v)
  * annihilates column k below the sub-diagonal and is applied to the
  * trailing block as A - v w^T - w v^T with w = p - (v^T p / v^T v) v,
  * p = 2 A v / (v^T v) (Golub & Van Loan, ch. 8.3.1). */
+MCG_AVX2_CLONE
 static void tridiagonalize(size_t n, double *a, double *d, double *e, double *q)
 {
     double v[SPD_MAX], p[SPD_MAX];
@@ -953,6 +965,7 @@ static void tridiagonalize(size_t n, double *a, double *d, double *e, double *q)
  * compiler vectorises; the products per entry are the same, so the result
  * is the same to the bit (issue 22: this loop was a third of the 9 x 9
  * decomposition). Returns 0 if the iteration budget ran out. */
+MCG_AVX2_CLONE
 static int tridiagonal_qr(size_t n, double *d, double *e, double *qt)
 {
     size_t hi = n - 1, budget = 40 * n, i;
