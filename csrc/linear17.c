@@ -931,6 +931,7 @@ static int plain_svd_refine(const double *m, double e[9], double r[9])
 }
 
 /* Linear step: the 9-vector e of E (and the R part r) minimising |A x|. */
+MCG_AVX2_CLONE
 static int linear_step(const double *m, int gc_case,
                        const double *wr, const double *vr, double pinv_rtol,
                        double rtol, double tr_m, double e[9], double r[9],
