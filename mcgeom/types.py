@@ -14,7 +14,8 @@ import numpy as np
 from .validation import (as_camera_ids, as_vectors, check_directions, check_rotation,
                          check_vector3)
 
-__all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "MotionFocal"]
+__all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "MotionFocal", "make_scale_verdict",
+           "make_rig_motion"]
 
 
 @dataclass(frozen=True)
@@ -225,6 +226,8 @@ MotionFocal = Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]
 
 
 # ------------------------------------------------- hot-path constructors
+# (public so that estimators may use them: the same objects as the
+# constructors make, for an estimator's per-call path)
 # A frozen dataclass's __init__ sets each field through object.__setattr__
 # (about 0.7 us for ScaleVerdict and RigMotion each, issue 22: a tenth of the
 # Python time of mcgeom.estimate(rays, "linear17") at 100 rays). Neither
@@ -236,16 +239,16 @@ if ([f.name for f in ScaleVerdict.__dataclass_fields__.values()] !=
         [f.name for f in RigMotion.__dataclass_fields__.values()] !=
         ["R", "t", "scale", "method", "residual_rms", "inliers", "info"] or
         hasattr(ScaleVerdict, "__post_init__") or hasattr(RigMotion, "__post_init__")):
-    raise RuntimeError("mcgeom.types: update _scale_verdict and _rig_motion to the fields "
-                       "of ScaleVerdict and RigMotion")
+    raise RuntimeError("mcgeom.types: update make_scale_verdict and make_rig_motion to "
+                       "the fields of ScaleVerdict and RigMotion")
 #: the default critical_angle object itself (nan): fields compare equal to
 #: those of ScaleVerdict(...) (tuple equality tests identity before ==)
 _NO_CRITICAL_ANGLE = ScaleVerdict.__dataclass_fields__["critical_angle"].default
 _new = object.__new__
 
 
-def _scale_verdict(observable: bool, reason: str, conditioning: float,
-                   rel_std: float) -> ScaleVerdict:
+def make_scale_verdict(observable: bool, reason: str, conditioning: float,
+                       rel_std: float) -> ScaleVerdict:
     """``ScaleVerdict(observable, reason, conditioning, rel_std)`` (no
     critical angle), without the frozen dataclass's per-field setattr."""
     v = _new(ScaleVerdict)
@@ -258,8 +261,8 @@ def _scale_verdict(observable: bool, reason: str, conditioning: float,
     return v
 
 
-def _rig_motion(R: np.ndarray, t: np.ndarray, scale: ScaleVerdict, method: str,
-                residual_rms: float, inliers: Optional[np.ndarray], info: dict) -> RigMotion:
+def make_rig_motion(R: np.ndarray, t: np.ndarray, scale: ScaleVerdict, method: str,
+                    residual_rms: float, inliers: Optional[np.ndarray], info: dict) -> RigMotion:
     """``RigMotion(R, t, scale, method, residual_rms, inliers, info)`` (R 3x3,
     t metres, rig2_from_rig1), without the frozen dataclass's per-field
     setattr."""
