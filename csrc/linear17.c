@@ -39,6 +39,7 @@
 #include <string.h>
 
 #define NX 18
+#define NXP 20 /* NX rounded up to a multiple of 4 */
 
 /* The loops over the rays (the accumulation of M, the Sampson passes) are
  * written in lanes of 4 doubles for the vectoriser; on x86-64 (GCC, glibc:
@@ -148,7 +149,7 @@ static int accumulate(int n, const double *o1, const double *d1,
                       const double *o2, const double *d2,
                       double *m, double origin[3], double *scale)
 {
-    double o[3], ss, s;
+    double o[3], ss, s, mp[NX][NXP];
     int k, i, j;
 
     if (!finite_rays(n, o1, d1, o2, d2))
@@ -160,12 +161,18 @@ static int accumulate(int n, const double *o1, const double *d1,
     *scale = s;
 
     /* rank-4 updates of the upper triangle: a quarter of the loads and
-     * stores of M per row, the products of 4 rows summed in registers */
-    memset(m, 0, NX * NX * sizeof(double));
+     * stores of M per row, the products of 4 rows summed in registers.
+     * Rows padded to NXP (zeros) and each row of M updated from the
+     * multiple of 4 at or below the diagonal: whole 4-double vectors, no
+     * loop prologue or epilogue (issue 22: the triangular loop's were half
+     * of this pass). The few entries left of the diagonal are discarded;
+     * each upper entry is the same sum of the same products as before. */
+    memset(mp, 0, sizeof mp);
     for (k = 0; k < n; k += 4) {
-        double rows[4][NX];
+        double rows[4][NXP];
         int r, nb = n - k < 4 ? n - k : 4;
         for (r = 0; r < 4; r++) {
+            rows[r][NX] = rows[r][NX + 1] = 0.0;
             if (r >= nb) {
                 memset(rows[r], 0, sizeof rows[r]);
                 continue;
@@ -176,15 +183,17 @@ static int accumulate(int n, const double *o1, const double *d1,
         }
         for (i = 0; i < NX; i++) {
             double a0 = rows[0][i], a1 = rows[1][i], a2 = rows[2][i], a3 = rows[3][i];
-            double *mi = m + i * NX;
-            for (j = i; j < NX; j++)
-                mi[j] += a0 * rows[0][j] + a1 * rows[1][j] + a2 * rows[2][j] +
-                         a3 * rows[3][j];
+            double *mi = mp[i];
+            int l;
+            for (j = i & ~3; j < NXP; j += 4)
+                for (l = 0; l < 4; l++)
+                    mi[j + l] += a0 * rows[0][j + l] + a1 * rows[1][j + l] +
+                                 a2 * rows[2][j + l] + a3 * rows[3][j + l];
         }
     }
     for (i = 0; i < NX; i++)
-        for (j = 0; j < i; j++)
-            m[i * NX + j] = m[j * NX + i];
+        for (j = i; j < NX; j++)
+            m[i * NX + j] = m[j * NX + i] = mp[i][j];
     return MCG_OK;
 }
 
