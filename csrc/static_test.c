@@ -26,7 +26,10 @@
  * mcgeom.observability.no_parallax (a fraction of the rotation-only angles
  * within a factor of the level) at the pure rotation and, failing that, at
  * the estimate's own rotation; and at least min_distinct distinct
- * intra-camera pairs (repeats of one pair explain any rotation).
+ * intra-camera pairs (repeats of one pair explain any rotation). A moving
+ * rig is recognised at an upper bound of the level, from the cameras that
+ * hold just over half of the residuals, without fitting the others (see
+ * mcg_static_check); its reported noise_level is then that bound.
  */
 #include "mcgeom.h"
 #include "internal.h"
@@ -35,6 +38,18 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+
+/* The passes over a camera's rows (the candidates' counting passes of
+ * the least median of squares) and over the bearings (the rotation-only
+ * statistic) vectorise; on x86-64 (GCC, glibc: an ifunc picks the clone at
+ * load time) they are also compiled for AVX2 (4 doubles a register).
+ * Only "avx2", not "fma": every product and sum rounds as in the default
+ * clone, so the results are the same to the bit on every CPU (issue 22). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define MCG_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
+#else
+#define MCG_AVX2_CLONE
+#endif
 
 #define MAX_SAMPLES 65536
 #define MAD_TO_STD 1.4826 /* 1 / the median of |N(0, 1)| */
@@ -202,18 +217,27 @@ static double median_abs_dot(const double *ax, const double *ay, const double *a
 }
 
 /* whether at least need of the k rows have |ahat . v| < x: counted in
- * blocks (a double count: the block loop vectorises), stopping once the
- * rows left cannot make up the count */
+ * blocks, stopping once the rows left cannot make up the count. The count
+ * is kept in 4 lanes (whole numbers in doubles: their sum is exact in any
+ * order), since one running sum is a chain the compiler may not reorder and
+ * so does not vectorise (issue 22: this pass is most of the test's time) */
 #define COUNT_BLOCK 64
+#define COUNT_LANES 4
 static int enough_below(const double *ax, const double *ay, const double *az, int k,
                         const double v[3], double x, int need)
 {
     int i0;
     double c = 0.0;
     for (i0 = 0; i0 < k; i0 += COUNT_BLOCK) {
-        int i, end = k - i0 < COUNT_BLOCK ? k : i0 + COUNT_BLOCK;
-        for (i = i0; i < end; i++)
-            c += fabs(ax[i] * v[0] + ay[i] * v[1] + az[i] * v[2]) < x ? 1.0 : 0.0;
+        int i, l, end = k - i0 < COUNT_BLOCK ? k : i0 + COUNT_BLOCK;
+        double cl[COUNT_LANES] = {0.0, 0.0, 0.0, 0.0};
+        for (i = i0; i + COUNT_LANES <= end; i += COUNT_LANES)
+            for (l = 0; l < COUNT_LANES; l++)
+                cl[l] += fabs(ax[i + l] * v[0] + ay[i + l] * v[1] + az[i + l] * v[2]) < x
+                             ? 1.0 : 0.0;
+        for (; i < end; i++)
+            cl[0] += fabs(ax[i] * v[0] + ay[i] * v[1] + az[i] * v[2]) < x ? 1.0 : 0.0;
+        c += (cl[0] + cl[1]) + (cl[2] + cl[3]);
         if (c >= need)
             return 1;
         if (c + (k - end) < need)
@@ -333,14 +357,19 @@ static int camera_direction(const double *d1, const double *d2, const double R[9
 /* 1 if none of the n values is NaN or +-inf: 0 x is NaN exactly for those,
  * and a sum of signed zeros is zero (one branch-free pass, where all_finite
  * tests and branches on every value: with the row checks below, 88
- * against 119 instructions per correspondence measured) */
+ * against 119 instructions per correspondence measured). Four partial sums
+ * (any order gives zero, or NaN), so that the loop vectorises: one running
+ * sum is a chain the compiler may not reorder (issue 22). */
 static int all_finite_fast(const double *x, size_t n)
 {
-    size_t i;
-    double acc = 0.0;
-    for (i = 0; i < n; i++)
-        acc += 0.0 * x[i];
-    return acc == 0.0;
+    size_t i, l;
+    double acc[4] = {0.0, 0.0, 0.0, 0.0};
+    for (i = 0; i + 4 <= n; i += 4)
+        for (l = 0; l < 4; l++)
+            acc[l] += 0.0 * x[i + l];
+    for (; i < n; i++)
+        acc[0] += 0.0 * x[i];
+    return (acc[0] + acc[1]) + (acc[2] + acc[3]) == 0.0;
 }
 
 /* the checks shared by both entry points (sizes and workspace aside) */
@@ -363,24 +392,25 @@ static int check_rays(int n, const double *o1, const double *d1, const double *o
     return bad ? MCG_EINVAL : MCG_OK;
 }
 
-/* mcg_static_noise on checked arguments */
-static int static_noise(int n, const double *o1, const double *d1, const double *o2,
-                        const double *d2, const int *group, const double R[9], int min_rows,
-                        int samples, double *res, double *median, int *n_used, double *work)
+/* The residuals of the cameras of pairs idx[*pos..m) (sorted by group by
+ * pairs_by_group) into res, a camera at a time; stops after the camera
+ * that brings the rows done to at least stop (0: never) and leaves *pos at
+ * the next camera, so that a later call resumes there. *done counts the
+ * rows whose residual was computed. work: as static_noise's. */
+MCG_AVX2_CLONE
+static int noise_cameras(const double *o1, const double *d1, const double *o2,
+                         const double *d2, const int *group, const double R[9], int min_rows,
+                         int samples, double *res, int n, double *work, int m, int *pos,
+                         int stop, int *done)
 {
-    int *idx, *tmp, i, m = 0, used = 0;
+    int *idx = (int *)work, i;
     double *ahat, *prod, *buf, *cres, *raw;
-    idx = (int *)work;
-    tmp = idx + n;
     ahat = work + 2 * ints_as_doubles((size_t)n);
     prod = ahat + 3 * (size_t)n;
     buf = prod + (size_t)n;
     cres = buf + 12 * (size_t)n;
     raw = cres + (size_t)n;
-    for (i = 0; i < n; i++)
-        res[i] = -1.0;
-    m = pairs_by_group(n, group, idx, tmp);
-    for (i = 0; i < m;) {
+    for (i = *pos; i < m;) {
         int j = i, k, c, st, mc;
         double u[3], cc[3], rc[3], t[3], *bo1, *bd1, *bo2, *bd2;
         while (j < m && group[idx[j]] == group[idx[i]])
@@ -414,12 +444,42 @@ static int static_noise(int n, const double *o1, const double *d1, const double 
                 return st;
             for (k = 0; k < mc; k++)
                 res[idx[i + k]] = fabs(cres[k]);
+            *done += mc;
         }
         i = j;
+        if (stop > 0 && *done >= stop)
+            break;
     }
+    *pos = i;
+    return MCG_OK;
+}
+
+/* the residuals res >= 0 (the cameras done; NaN and -1 left out) into out;
+ * returns their number */
+static int gather_used(int n, const double *res, double *out)
+{
+    int i, used = 0;
     for (i = 0; i < n; i++)
         if (res[i] >= 0.0)
-            prod[used++] = res[i];
+            out[used++] = res[i];
+    return used;
+}
+
+/* mcg_static_noise on checked arguments */
+static int static_noise(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const int *group, const double R[9], int min_rows,
+                        int samples, double *res, double *median, int *n_used, double *work)
+{
+    int *idx = (int *)work, i, m, used, pos = 0, done = 0, st;
+    double *prod = work + 2 * ints_as_doubles((size_t)n) + 3 * (size_t)n;
+    for (i = 0; i < n; i++)
+        res[i] = -1.0;
+    m = pairs_by_group(n, group, idx, idx + n);
+    st = noise_cameras(o1, d1, o2, d2, group, R, min_rows, samples, res, n, work, m, &pos,
+                       0, &done);
+    if (st != MCG_OK)
+        return st;
+    used = gather_used(n, res, prod);
     *n_used = used;
     *median = used ? median_inplace(prod, used) : 0.0;
     return MCG_OK;
@@ -474,7 +534,7 @@ size_t mcg_static_check_work_size(int n)
 }
 
 /* unit copy of v */
-static void unit3(const double *v, double u[3])
+static inline void unit3(const double *v, double u[3])
 {
     double s = 1.0 / sqrt(dot3(v, v));
     u[0] = v[0] * s;
@@ -501,6 +561,7 @@ static inline void rotation_angle_terms(const double a[3], const double b[3], co
  * (1 + 1e-9) or c <= 0 surely above (atan2 and tan are accurate to a few
  * ulps, far inside the margin), so the count is that of atan2(s, c) < lim
  * exactly, without an atan2 per pair (issue 22) */
+MCG_AVX2_CLONE
 static void rotation_statistic(int n, const double *u1, const double *u2, const int *group,
                                const double R[9], double lim, int *n_intra, double *explained)
 {
@@ -562,6 +623,30 @@ static int distinct_at_least(int n, const double *o1, const double *d1, const do
     return found >= k;
 }
 
+/* the noise level of the median residual med: noise_factor robust stds,
+ * at least noise_floor */
+static double level_of(double med, const mcg_static_options *o)
+{
+    double level = o->noise_factor * MAD_TO_STD * med;
+    return level < o->noise_floor ? o->noise_floor : level;
+}
+
+/* the pairs of the cameras with at least min_rows of them (idx[0..m)
+ * sorted by group): the residuals the noise level can have */
+static int rows_of_fitted_cameras(const int *group, const int *idx, int m, int min_rows)
+{
+    int i = 0, rows = 0;
+    while (i < m) {
+        int j = i;
+        while (j < m && group[idx[j]] == group[idx[i]])
+            j++;
+        if (j - i >= min_rows)
+            rows += j - i;
+        i = j;
+    }
+    return rows;
+}
+
 /* the noise level at R (noise_factor robust stds of the per-camera
  * residuals, at least noise_floor), 0 when no camera has min_rows pairs */
 static int level_at(int n, const double *o1, const double *d1, const double *o2,
@@ -611,6 +696,33 @@ static void explained_anywhere(int n, const double *o1, const double *d1, const 
     /* the median angle only for the answer that reports it (a static rig) */
     out->median_angle =
         out->is_static ? median_angle_at(n, u1, u2, group, out->R, ang) : NAN;
+}
+
+/* explained_anywhere's statistic without its distinct-pairs condition and
+ * median angle (a necessary condition of a static answer, for the bound of
+ * mcg_static_check): 1 if enough angles are within the bound at R_given
+ * (else R_fit) or, without R_given, at R_est; out gets the figures of the
+ * last rotation tried, as explained_anywhere reports a moving rig */
+static int explained_somewhere(int n, const double *u1, const double *u2, const int *group,
+                               const double *R_est, const double *R_given,
+                               const mcg_static_options *o, mcg_static_result *out)
+{
+    double lim = o->parallax_factor * out->noise_level;
+    int i, r;
+    out->is_static = 0;
+    out->median_angle = NAN;
+    for (i = 0; i < 2; i++) {
+        const double *R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
+        if (i == 1 && (!R_est || R_given))
+            break;
+        rotation_statistic(n, u1, u2, group, R_test, lim, &out->n_intra, &out->explained);
+        out->decided_at = i;
+        for (r = 0; r < 9; r++)
+            out->R[r] = R_test[r];
+        if (out->n_intra >= o->min_pairs && out->n_intra > 0 && out->explained >= o->fraction)
+            return 1;
+    }
+    return 0;
 }
 
 int mcg_static_check(int n, const double *o1, const double *d1, const double *o2,
@@ -679,9 +791,43 @@ int mcg_static_check(int n, const double *o1, const double *d1, const double *o2
     if (noise_level > 0.0) {
         out->noise_level = noise_level;
     } else {
-        st = level_at(n, o1, d1, o2, d2, group, out->R_fit, &o, res, work, &levels[1]);
+        /* the level at the pure rotation, with an exact early exit for a
+         * moving rig (issue 22: the per-camera fits are most of the test).
+         * Once the cameras done hold more than half of the residuals any
+         * camera could add (U_max: the rows of the cameras with min_rows
+         * pairs), the median of all of them is at most the stop-th smallest
+         * done, stop = floor(U_max / 2) + 1: both middle values of the
+         * sorted residuals are then at most that value. The level at that
+         * bound is an upper bound of the level, and the statistic only
+         * explains fewer angles at a smaller level, so a rig that is
+         * moving at the bound (at both rotations) is moving at the level:
+         * the remaining cameras are not fitted. Otherwise they are, and the
+         * test goes on as without the bound. */
+        int *idx = (int *)work, m, pos = 0, done = 0, used, stop = 0;
+        double *prod = work + 2 * ints_as_doubles((size_t)n) + 3 * (size_t)n;
+        for (i = 0; i < n; i++)
+            res[i] = -1.0;
+        m = pairs_by_group(n, group, idx, idx + n);
+        if (R_est || R_given)
+            stop = rows_of_fitted_cameras(group, idx, m, o.min_rows) / 2 + 1;
+        st = noise_cameras(o1, d1, o2, d2, group, out->R_fit, o.min_rows, o.samples, res, n,
+                           work, m, &pos, stop, &done);
         if (st != MCG_OK)
             return st;
+        if (pos < m) {
+            used = gather_used(n, res, prod);
+            if (used >= stop) {
+                out->noise_level = level_of(select_kth_inplace(prod, used, stop - 1), &o);
+                if (!explained_somewhere(n, u1, u2, group, R_est, R_given, &o, out))
+                    return MCG_OK; /* moving at an upper bound of the level */
+            }
+            st = noise_cameras(o1, d1, o2, d2, group, out->R_fit, o.min_rows, o.samples, res,
+                               n, work, m, &pos, 0, &done);
+            if (st != MCG_OK)
+                return st;
+        }
+        used = gather_used(n, res, prod);
+        levels[1] = used ? level_of(median_inplace(prod, used), &o) : 0.0;
         if (levels[1] == 0.0) { /* no camera with min_rows pairs */
             out->noise_level = o.default_level;
             out->noise_from_default = 1;

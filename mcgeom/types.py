@@ -14,7 +14,8 @@ import numpy as np
 from .validation import (as_camera_ids, as_vectors, check_directions, check_rotation,
                          check_vector3)
 
-__all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "MotionFocal"]
+__all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "MotionFocal", "make_scale_verdict",
+           "make_rig_motion"]
 
 
 @dataclass(frozen=True)
@@ -222,3 +223,56 @@ class RigMotion:
 #: pixel-noise model (:func:`mcgeom.pixel_noise.sampson_pixel_scale`), called by
 #: :func:`mcgeom.robust.ransac`: a type both layers share, so it lives here
 MotionFocal = Callable[[RayPairs, np.ndarray, np.ndarray], np.ndarray]
+
+
+# ------------------------------------------------- hot-path constructors
+# (public so that estimators may use them: the same objects as the
+# constructors make, for an estimator's per-call path)
+# A frozen dataclass's __init__ sets each field through object.__setattr__
+# (about 0.7 us for ScaleVerdict and RigMotion each, issue 22: a tenth of the
+# Python time of mcgeom.estimate(rays, "linear17") at 100 rays). Neither
+# class has __post_init__ or validation, so filling the instance's __dict__
+# makes the same object; the check below makes a later field or
+# __post_init__ fail at import instead of silently skipping it.
+if ([f.name for f in ScaleVerdict.__dataclass_fields__.values()] !=
+        ["observable", "reason", "conditioning", "rel_std", "critical_angle"] or
+        [f.name for f in RigMotion.__dataclass_fields__.values()] !=
+        ["R", "t", "scale", "method", "residual_rms", "inliers", "info"] or
+        hasattr(ScaleVerdict, "__post_init__") or hasattr(RigMotion, "__post_init__")):
+    raise RuntimeError("mcgeom.types: update make_scale_verdict and make_rig_motion to "
+                       "the fields of ScaleVerdict and RigMotion")
+#: the default critical_angle object itself (nan): fields compare equal to
+#: those of ScaleVerdict(...) (tuple equality tests identity before ==)
+_NO_CRITICAL_ANGLE = ScaleVerdict.__dataclass_fields__["critical_angle"].default
+_new = object.__new__
+
+
+def make_scale_verdict(observable: bool, reason: str, conditioning: float,
+                       rel_std: float) -> ScaleVerdict:
+    """``ScaleVerdict(observable, reason, conditioning, rel_std)`` (no
+    critical angle), without the frozen dataclass's per-field setattr."""
+    v = _new(ScaleVerdict)
+    d = v.__dict__
+    d["observable"] = observable
+    d["reason"] = reason
+    d["conditioning"] = conditioning
+    d["rel_std"] = rel_std
+    d["critical_angle"] = _NO_CRITICAL_ANGLE
+    return v
+
+
+def make_rig_motion(R: np.ndarray, t: np.ndarray, scale: ScaleVerdict, method: str,
+                    residual_rms: float, inliers: Optional[np.ndarray], info: dict) -> RigMotion:
+    """``RigMotion(R, t, scale, method, residual_rms, inliers, info)`` (R 3x3,
+    t metres, rig2_from_rig1), without the frozen dataclass's per-field
+    setattr."""
+    m = _new(RigMotion)
+    d = m.__dict__
+    d["R"] = R
+    d["t"] = t
+    d["scale"] = scale
+    d["method"] = method
+    d["residual_rms"] = residual_rms
+    d["inliers"] = inliers
+    d["info"] = info
+    return m

@@ -174,3 +174,27 @@ def test_refinement_reaches_the_geometric_optimum_and_a_better_scale():
         for m, out in ((lin, lin_err), (ref, ref_err)):
             out.append(abs(np.linalg.norm(m.info["t_metric"]) / np.linalg.norm(p.t) - 1))
     assert np.median(ref_err) < 0.75 * np.median(lin_err)
+
+
+def test_hot_path_constructors_make_the_dataclass_objects():
+    # linear17's per-call path fills RigMotion and ScaleVerdict directly
+    # (mcgeom.types.make_rig_motion / make_scale_verdict, issue 22): the
+    # objects must equal, print and hash as the constructors' and stay frozen
+    import dataclasses
+
+    from mcgeom.types import (RigMotion, ScaleVerdict, make_rig_motion,
+                              make_scale_verdict)
+    v = make_scale_verdict(False, "why", 0.25, 0.5)
+    ref = ScaleVerdict(False, "why", conditioning=0.25, rel_std=0.5)
+    assert v == ref and repr(v) == repr(ref) and hash(v) == hash(ref)
+    R, t = np.eye(3), np.array([0.1, 0.0, 0.0])
+    m = make_rig_motion(R, t, v, "linear17", 1e-3, None, {"a": 1})
+    mref = RigMotion(R, t, ref, "linear17", 1e-3, None, {"a": 1})
+    assert repr(m) == repr(mref)
+    assert dataclasses.asdict(m).keys() == dataclasses.asdict(mref).keys()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        v.observable = True
+    # and the estimator's own answer is such an object
+    got = mcgeom.estimate(make("most-general", 0, n=40).rays, "linear17")
+    assert type(got) is RigMotion and type(got.scale) is ScaleVerdict
+    assert dataclasses.replace(got.scale) == got.scale

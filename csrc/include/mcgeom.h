@@ -1234,8 +1234,10 @@ typedef struct {
     double R[9];            /* that rotation (rig2_from_rig1, row-major) */
     double R_fit[9];        /* best pure rotation of the intra-camera bearings */
     double noise_level;     /* radians; when the test stopped early (not
-                               static even at the level of the pure rotation,
-                               the upper bound) that bound */
+                               static even at an upper bound of the level:
+                               the pure rotation's, or the one of the cameras
+                               holding just over half of its residuals) that
+                               bound */
     int noise_from_default; /* 1: no camera had min_rows pairs */
     double explained;       /* fraction of intra-camera pairs explained at R */
     int n_intra;            /* intra-camera pairs (group >= 0) */
@@ -1261,7 +1263,11 @@ size_t mcg_static_check_work_size(int n);
  * distinct. The pure rotation's level is computed first: it bounds the
  * level from above, and when no rotation explains enough angles at that
  * bound the answer is "not static" without the second level (exact: a
- * smaller level explains fewer). Workspace lwork >=
+ * smaller level explains fewer). The pure rotation's level itself is
+ * bounded first, once the cameras fitted hold more than half of the
+ * residuals it can have (the median is then at most the middle one of
+ * those), and a rig moving at that bound is answered without fitting the
+ * other cameras. Workspace lwork >=
  * mcg_static_check_work_size(n). MCG_EINVAL
  * as mcg_static_noise, and for bad options, a negative or non-finite
  * noise_level, NaN/inf in R_est or R_given; MCG_ENOMEM; MCG_ENUMERIC. */

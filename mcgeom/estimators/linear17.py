@@ -25,7 +25,7 @@ import numpy as np
 from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
-from ..types import RayPairs, RigMotion, ScaleVerdict
+from ..types import RayPairs, RigMotion, ScaleVerdict, make_rig_motion, make_scale_verdict
 from ._static import KERNEL_OPTIONS, intra_groups, with_static_check
 
 __all__ = ["linear17", "linear17_no_static_check"]
@@ -53,7 +53,7 @@ def _verdict(observable: bool, gc_case: str, conditioning: float,
     else:
         reason = (f"scale too uncertain: relative std {rel_std:.3g} "
                   "(near-critical motion, too little rotation for the noise level)")
-    return ScaleVerdict(observable, reason, conditioning=conditioning, rel_std=rel_std)
+    return make_scale_verdict(observable, reason, conditioning, rel_std)
 
 
 @register(
@@ -168,8 +168,8 @@ def _motion(f: np.ndarray, r) -> RigMotion:
     }
     verdict = _verdict(bool(r.scale_observable), gc_case, r.scale_conditioning,
                        r.scale_rel_std)
-    return RigMotion(f[d["R"]:d["R"] + 9].reshape(3, 3), f[d["t"]:d["t"] + 3], verdict,
-                     "linear17", r.cost_final, None, info)
+    return make_rig_motion(f[d["R"]:d["R"] + 9].reshape(3, 3), f[d["t"]:d["t"] + 3], verdict,
+                           "linear17", r.cost_final, None, info)
 
 
 def _minimal(sample: RayPairs) -> list:
