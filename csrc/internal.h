@@ -14,6 +14,19 @@
 
 #include "so3.h" /* dot3, cross3, mat_vec, mul33, det33, skew3, is_rotation, ... */
 
+/* MCG_AVX2_CLONE before a hot loop's function: on x86-64 Linux with GCC and
+ * glibc it is also compiled for AVX2 (4 doubles a register) and an ifunc
+ * picks the clone at load time; elsewhere (clang, musl -- no ifunc --,
+ * other CPUs) the plain function alone. Only "avx2", never "fma": without
+ * fused multiply-adds every product and sum rounds as in the default clone,
+ * so the results are the same to the bit on every CPU (issue 22). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
+    defined(__linux__) && defined(__GLIBC__)
+#define MCG_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
+#else
+#define MCG_AVX2_CLONE
+#endif
+
 /* Size limits. They keep every work-size computation far from overflow and
  * reject absurd sizes (usually a mix-up of arguments) up front. */
 #define MAX_ROWS ((size_t)1 << 20)

@@ -28,19 +28,12 @@
 #include <stdint.h>
 #include <string.h>
 
+/* The Householder reduction and the QR rotations of mcg_sym_eig_tridiag
+ * (linear17's two 9 x 9 decompositions per call) carry MCG_AVX2_CLONE
+ * (internal.h: the same bits on every CPU). */
+
 /* Jacobi converges quadratically: a handful of sweeps in practice. The cap
  * only turns a pathological input into MCG_ENUMERIC instead of a hang. */
-/* The Householder reduction and the QR rotations of mcg_sym_eig_tridiag
- * (linear17's two 9 x 9 decompositions per call) are also compiled for
- * AVX2 on x86-64 (GCC, glibc: an ifunc picks the clone at load time).
- * Only "avx2", not "fma": every product and sum rounds as in the default
- * clone, so the results are the same to the bit on every CPU (issue 22). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define MCG_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
-#else
-#define MCG_AVX2_CLONE
-#endif
-
 #define MAX_SWEEPS 60
 #define SPD_MAX 64
 /* Rotations of one Jacobi round whose parameters are computed together. */

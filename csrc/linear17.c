@@ -42,17 +42,10 @@
 #define NXP 20 /* NX rounded up to a multiple of 4 */
 
 /* The loops over the rays (the accumulation of M, the Sampson passes) are
- * written in lanes of 4 doubles for the vectoriser; on x86-64 (GCC, glibc:
- * an ifunc picks the clone at load time) they are also compiled for AVX2,
- * whose 4-double registers hold a whole lane block (issue 22: 8 % of the
- * instructions of the public call at 100 rays). Only "avx2", not "fma":
- * without fused multiply-adds every product and sum rounds as in the
- * default clone, so the results are the same to the bit on every CPU. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define MCG_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
-#else
-#define MCG_AVX2_CLONE
-#endif
+ * written in lanes of 4 doubles for the vectoriser and carry MCG_AVX2_CLONE
+ * (internal.h: AVX2's 4-double registers hold a whole lane block, the same
+ * bits on every CPU; issue 22: 8 % of the instructions of the public call
+ * at 100 rays). */
 #define MAX_RAYS (1 << 26)
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction (|d| >= 1e-50) */
 

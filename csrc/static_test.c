@@ -41,15 +41,8 @@
 
 /* The passes over a camera's rows (the candidates' counting passes of
  * the least median of squares) and over the bearings (the rotation-only
- * statistic) vectorise; on x86-64 (GCC, glibc: an ifunc picks the clone at
- * load time) they are also compiled for AVX2 (4 doubles a register).
- * Only "avx2", not "fma": every product and sum rounds as in the default
- * clone, so the results are the same to the bit on every CPU (issue 22). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define MCG_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
-#else
-#define MCG_AVX2_CLONE
-#endif
+ * statistic) vectorise, and carry MCG_AVX2_CLONE (internal.h: the same
+ * bits on every CPU; issue 22). */
 
 #define MAX_SAMPLES 65536
 #define MAD_TO_STD 1.4826 /* 1 / the median of |N(0, 1)| */
