@@ -53,7 +53,9 @@ static int pinhole_ray(const double *intr, const double *rot, const double *cent
         d[i] = R[i] * b[0] + R[3 + i] * b[1] + R[6 + i] * b[2];
         o[i] = c[i];
     }
-    return 1;
+    /* a table of huge entries (not a rotation) can overflow R^T b: found
+     * by fuzz_pixel_rays */
+    return all_finite(d, 3);
 }
 
 /* half the mean pixel-noise variance (radians^2 per pixel^2) of a bearing d
@@ -109,6 +111,9 @@ int mcg_pinhole_ray_pairs(int n, int m, const double *intr, const double *rot,
                        bearing_var(d2 + 3 * k, rot + 9 * c2 + 6, focal[c2]);
             v *= 0.5;
             ppr[k] = 1.0 / sqrt(v);
+            /* focal lengths beyond ~1e+-150 px: f^2 overflowed or vanished */
+            if (!(ppr[k] > 0.0 && ppr[k] < HUGE_VAL))
+                return MCG_EINVAL;
         }
     }
     return MCG_OK;
