@@ -12,6 +12,7 @@
 #define TEST_SEED 0x5eed0f1a7e5ULL
 #include "testutil.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -200,6 +201,28 @@ static void test_status(void)
     check_status(st, MCG_EINVAL, "a pixel without a finite bearing (1e300)");
     check(bad == N + 13, "its index n + k (time 2)", (double)bad, 0.0);
     px2[2 * 13 + 1] = keep;
+    /* fuzz_pixel_rays' finding: a rotation table of huge entries overflowed
+     * R^T b to inf with MCG_OK */
+    {
+        static double saved[9 * NC];
+        int j;
+        for (j = 0; j < 9 * NC; j++) {
+            saved[j] = rot[j];
+            rot[j] = DBL_MAX; /* R^T b = DBL_MAX (b0 + b1 + b2): inf where that sum > 1 */
+        }
+        st = mcg_pinhole_ray_pairs(N, NC, intr, rot, cen, foc, ids1, ids2, px1, px2, o1, d1, o2,
+                                   d2, ppr, &bad);
+        check_status(st, MCG_EINVAL, "a rotation table whose R^T b overflows");
+        check(bad >= 0 && bad < 2 * N, "the index of a pair it overflows", (double)bad, 0.0);
+        for (j = 0; j < 9 * NC; j++)
+            rot[j] = saved[j];
+    }
+    /* focal lengths whose squares overflow: no finite pixels per radian */
+    keep = foc[(int)ids1[0]];
+    foc[(int)ids1[0]] = 1e200;
+    check_status(mcg_pinhole_ray_pairs(N, NC, intr, rot, cen, foc, ids1, ids2, px1, px2, o1, d1,
+                                       o2, d2, ppr, &bad), MCG_EINVAL, "focal 1e200 (f^2 = inf)");
+    foc[(int)ids1[0]] = keep;
     keep = intr[5 * 2];
     intr[5 * 2] = 0.0;
     check_status(mcg_pinhole_ray_pairs(N, NC, intr, rot, cen, foc, ids1, ids2, px1, px2, o1, d1,
