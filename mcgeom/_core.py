@@ -609,6 +609,41 @@ def sampson_pixel_scale(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R:
     return out
 
 
+# ------------------------------------------------------------- pixel_rays.c
+
+def pinhole_ray_pairs(intr: np.ndarray, rot: np.ndarray, centres: np.ndarray,
+                      focal: Optional[np.ndarray], ids1: np.ndarray, ids2: np.ndarray,
+                      px1: np.ndarray, px2: np.ndarray
+                      ) -> Optional[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                          Optional[np.ndarray]]]:
+    """Rays of pinhole pixel correspondences and their pixels per radian
+    (``mcg_pinhole_ray_pairs``), for a caller that made the arrays itself.
+
+    ``intr`` (M, 5) fx, fy, cx, cy, skew (pixels), ``rot`` (M, 3, 3)
+    cam_from_rig, ``centres`` (M, 3) (rig frame, metres), ``focal`` (M,) mean
+    focal lengths (pixels) or None (no pixels per radian); ``ids1``/``ids2``
+    (N,) int64 camera ids, ``px1``/``px2`` (N, 2) pixels; every array
+    float64 (ids int64) and C-contiguous (not checked: the caller's to
+    guarantee). Returns ``(origins1, dirs1, origins2, dirs2, ppr)``
+    (rig frame; ``ppr`` (N,) pixels per radian, None without ``focal``), or
+    None when the kernel refuses the input (an id out of range, a pixel
+    without a finite bearing, ...): the caller's general path then names
+    what is wrong.
+    """
+    n, m = px1.shape[0], intr.shape[0]
+    o1, d1, o2, d2 = (np.empty((n, 3)) for _ in range(4))
+    ppr = None if focal is None else np.empty(n)
+    bad = ffi.new("int *")
+    st = lib.mcg_pinhole_ray_pairs(
+        n, m, _p(intr), _p(rot), _p(centres), ffi.NULL if focal is None else _p(focal),
+        ffi.from_buffer("long long[]", ids1), ffi.from_buffer("long long[]", ids2),
+        _p(px1), _p(px2), _p(o1), _p(d1), _p(o2), _p(d2),
+        ffi.NULL if ppr is None else _p(ppr), bad)
+    if st != lib.MCG_OK:
+        return None
+    return o1, d1, o2, d2, ppr
+
+
 def _not_rotation(R: np.ndarray) -> bool:
     return bool(np.abs(R @ R.T - np.eye(3)).max() > 1e-6 or np.linalg.det(R) <= 0)
 

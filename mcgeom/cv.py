@@ -32,7 +32,7 @@ import numpy as np
 from . import registry
 from . import robust as _robust   # (the name robust is estimate()'s flag)
 from .errors import ScaleNotObservableWarning
-from .pixel_noise import camera_table, pixels_per_radian, sampson_pixel_scale
+from .pixel_noise import camera_table, ray_pairs_per_radian, sampson_pixel_scale
 from .rig import Rig
 from .types import RigMotion
 from .validation import integral_camera_ids
@@ -226,7 +226,9 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         Rig(rig.cameras, calibration_std).extrinsic_std   # (checked: names the option)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
-    rays_all = rig.ray_pairs_prechecked(p1, p2, ids1, ids2)
+    # the rays and their pixels per radian (the pixel-noise model of the
+    # rig), in one C pass for a pinhole rig (issue 19)
+    rays_all, focal_all = ray_pairs_per_radian(rig, p1, p2, ids1, ids2)
     # without a mask every correspondence is used: no copy of the rays
     keep = None if use.all() else np.flatnonzero(use)
     rays = rays_all if keep is None else rays_all.take(keep)
@@ -243,7 +245,9 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
             seed=seed, **options)
         # the rays, pixel-noise tables and calibration come from the rig and
         # the checks above: the search need not check them again (issue 19)
-        m = _robust.ransac_prechecked(rays, name, opts, pixels_per_radian(rig, rays),
+        # (pixels per radian are per pair: those of the kept pairs are theirs)
+        focal = focal_all if keep is None else focal_all[keep]
+        m = _robust.ransac_prechecked(rays, name, opts, focal,
                                       sampson_pixel_scale(rig), cal, camera_table(rig),
                                       prior or None)
         m.info.setdefault("sampler", name)

@@ -28,7 +28,7 @@ from . import _core
 from .rig import Rig
 from .types import MotionFocal, RayPairs
 
-__all__ = ["pixels_per_radian", "sampson_pixel_scale", "camera_table"]
+__all__ = ["pixels_per_radian", "sampson_pixel_scale", "camera_table", "ray_pairs_per_radian"]
 
 
 def camera_table(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
@@ -58,13 +58,49 @@ def pixels_per_radian(rig: Rig, rays: RayPairs) -> np.ndarray:
     for ids, d in ((rays.cam1, rays.dirs1), (rays.cam2, rays.dirs2)):
         # (in place, without np.clip's Python layers: this runs once per
         # estimate of the façade, issue 19; the same values)
-        cz = np.einsum("ij,ij->i", axes[ids], d)
+        # The dot product and cos^4 = (cos^2)^2 are spelled out, in the
+        # order of csrc/pixel_rays.c (the façade's fast path), so that both
+        # give the same bits on any machine: numpy's einsum sums in a
+        # SIMD-dependent order and its power may use SVML on AVX-512.
+        z = axes[ids]
+        cz = z[:, 0] * d[:, 0]
+        cz += z[:, 1] * d[:, 1]
+        cz += z[:, 2] * d[:, 2]
         np.maximum(cz, 1e-3, out=cz)
         np.minimum(cz, 1.0, out=cz)
-        term = 0.5 * (cz ** 4 + cz ** 2) / focal[ids] ** 2
+        c2 = np.multiply(cz, cz, out=cz)
+        f = focal[ids]
+        term = 0.5 * (c2 * c2 + c2) / (f * f)
         var = term if var is None else np.add(var, term, out=var)   # (0 + x = x exactly)
     var *= 0.5
     return 1.0 / np.sqrt(var, out=var)
+
+
+def ray_pairs_per_radian(rig: Rig, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
+                         ids2: np.ndarray) -> tuple[RayPairs, np.ndarray]:
+    """:meth:`mcgeom.rig.Rig.ray_pairs_prechecked` and :func:`pixels_per_radian`
+    of its rays, for the same checked input (its preconditions: finite
+    float64 C-contiguous (N, 2) pixels, (N,) int64 ids of the rig's cameras).
+
+    Returns the rays (rig frame, metres, unit bearings, camera ids) and (N,)
+    pixels per radian. When every camera of ``rig`` is an undistorted pinhole
+    both come from one C pass (``_core.pinhole_ray_pairs``,
+    csrc/pixel_rays.c: the same bits as the numpy path); otherwise, or when
+    a pixel has no finite bearing (its ValueError names it), from the rig
+    and :func:`pixels_per_radian`.
+    """
+    tables = rig.pinhole_tables
+    out = None
+    if tables is not None:
+        intr, rot, centres, focal = tables
+        out = _core.pinhole_ray_pairs(intr, rot, centres, focal, ids1, ids2, px1, px2)
+    if out is None:
+        rays = rig.ray_pairs_prechecked(px1, px2, ids1, ids2)
+        return rays, pixels_per_radian(rig, rays)
+    o1, d1, o2, d2, ppr = out
+    # made here from checked ids: float64 C-contiguous (N, 3); ids2 may be
+    # ids1 (the same cameras at both times): its own array, as the rig's
+    return RayPairs.prechecked(o1, d1, o2, d2, ids1, ids2.copy()), ppr
 
 
 def sampson_pixel_scale(rig: Rig) -> MotionFocal:

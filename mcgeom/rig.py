@@ -433,6 +433,12 @@ class Rig:
         object.__setattr__(self, "_noise_table", (
             _frozen(0.5 * (Ks[:, 0, 0] + Ks[:, 1, 1])),
             _frozen(np.ascontiguousarray(self._Rs[:, 2, :]))))  # type: ignore[attr-defined]
+        # the tables of the C input stage (csrc/pixel_rays.c, issue 19): one
+        # (M, 5) row of fx, fy, cx, cy, skew per camera, in camera order
+        object.__setattr__(self, "_pinhole_tables", (
+            _frozen(np.ascontiguousarray(self._pinhole.T)),  # type: ignore[attr-defined]
+            self._Rs, self._centres, self._noise_table[0])  # type: ignore[attr-defined]
+            if self._all_plain else None)  # type: ignore[attr-defined]
         object.__setattr__(self, "_extrinsic_std", _frozen(
             np.tile(DEFAULT_EXTRINSIC_STD, (len(cams), 1)) if self.calibration_std is None
             else np.array(self.calibration_std, dtype=np.float64)))
@@ -482,6 +488,15 @@ class Rig:
         axes (rig frame: row 2 of each ``rotations[i]``) of the cameras,
         read-only, C-contiguous, made once (the rig is immutable)."""
         return self._noise_table  # type: ignore[attr-defined]
+
+    @property
+    def pinhole_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """The per-camera tables of :func:`mcgeom._core.pinhole_ray_pairs` when
+        every camera is an undistorted pinhole, else None: (M, 5) ``fx, fy,
+        cx, cy, skew`` (pixels), (M, 3, 3) rotations cam_from_rig, (M, 3)
+        centres (rig frame, metres), (M,) mean focal lengths (pixels);
+        read-only, C-contiguous float64, made once (the rig is immutable)."""
+        return self._pinhole_tables  # type: ignore[attr-defined]
 
     @property
     def names(self) -> tuple[str, ...]:

@@ -104,3 +104,124 @@ def test_check_distinct_fast_path_agrees_with_the_count():
     z[:, 1] = [1, 1, 2, 2, 3, 3]
     with pytest.raises(DegenerateError, match="only 3 distinct"):
         registry.check_distinct(_rays(z), 6, "x")
+
+
+# ---- the C input stage of the façade (csrc/pixel_rays.c, issue 19)
+
+def _ppr_reference(rig, rays) -> np.ndarray:
+    """Pixels per radian straight from the model of mcgeom.pixel_noise (an
+    independent spelling: the angle to each camera's axis, then cos^4 + cos^2
+    per bearing, averaged over both bearings)."""
+    focal = 0.5 * (rig.intrinsics[:, 0, 0] + rig.intrinsics[:, 1, 1])
+    axes = rig.rotations[:, 2, :]
+    var = np.zeros(len(rays))
+    for ids, d in ((rays.cam1, rays.dirs1), (rays.cam2, rays.dirs2)):
+        theta = np.arccos(np.clip(np.sum(axes[ids] * d, axis=1), -1.0, 1.0))
+        c = np.clip(np.cos(theta), 1e-3, 1.0)
+        var += (c ** 4 + c ** 2) / (2.0 * focal[ids] ** 2)
+    return 1.0 / np.sqrt(var / 2.0)
+
+
+@pytest.mark.parametrize("seed,make_rig", [(0, synth.ladybug2), (1, synth.vehicle8),
+                                           (2, synth.ladybug2), (3, synth.vehicle8)])
+@pytest.mark.parametrize("same_ids", [False, True])
+def test_c_input_stage_is_the_numpy_one(seed, make_rig, same_ids):
+    """One C pass gives the rays of Rig.ray_pairs_prechecked and the pixels per
+    radian of pixel_noise.pixels_per_radian bit for bit, and the latter match
+    the model spelled independently."""
+    from mcgeom.pixel_noise import ray_pairs_per_radian
+    rig, p = _problem(seed, make_rig)
+    assert rig.pinhole_tables is not None
+    px1, px2 = (np.ascontiguousarray(a, dtype=np.float64) for a in (p.pixels1, p.pixels2))
+    ids1 = np.asarray(p.cam1, np.int64)
+    ids2 = ids1 if same_ids else np.asarray(p.cam2, np.int64)
+    if same_ids:   # pixels of the same cameras at both times (cross pairs re-labelled)
+        px2 = px2.copy()
+    rays, f = ray_pairs_per_radian(rig, px1, px2, ids1, ids2)
+    ref = rig.ray_pairs_prechecked(px1, px2, ids1, ids2)
+    for name in ("origins1", "dirs1", "origins2", "dirs2", "cam1", "cam2"):
+        a, b = getattr(rays, name), getattr(ref, name)
+        assert a.dtype == b.dtype and a.flags.c_contiguous and np.array_equal(a, b), name
+    assert rays.cam2 is not rays.cam1
+    assert np.array_equal(f, pixels_per_radian(rig, ref))
+    np.testing.assert_allclose(f, _ppr_reference(rig, ref), rtol=1e-12)
+
+
+def _distorted(rig):
+    """The rig with a small radial distortion on camera 1 (the general path)."""
+    from dataclasses import replace
+    from mcgeom.rig import Rig
+    cams = list(rig.cameras)
+    cams[1] = replace(cams[1], dist=np.array([0.01, 0.0, 0.0, 0.0]))
+    return Rig(tuple(cams), rig.calibration_std)
+
+
+def test_distorted_rig_takes_the_general_input_path():
+    from mcgeom.pixel_noise import ray_pairs_per_radian
+    rig, p = _problem(4)
+    drig = _distorted(rig)
+    assert drig.pinhole_tables is None
+    px1, px2 = (np.ascontiguousarray(a, dtype=np.float64) for a in (p.pixels1, p.pixels2))
+    ids1, ids2 = np.asarray(p.cam1, np.int64), np.asarray(p.cam2, np.int64)
+    rays, f = ray_pairs_per_radian(drig, px1, px2, ids1, ids2)
+    ref = drig.ray_pairs_prechecked(px1, px2, ids1, ids2)
+    assert np.array_equal(rays.dirs1, ref.dirs1) and np.array_equal(rays.dirs2, ref.dirs2)
+    assert np.array_equal(f, pixels_per_radian(drig, ref))
+    # camera 1's bearings are not the pinhole ones: the distortion was applied
+    sel = p.cam1 == 1
+    assert sel.any() and not np.allclose(rays.dirs1[sel], rig.ray_pairs(
+        p.pixels1, p.pixels2, p.cam1, p.cam2).dirs1[sel], atol=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, drig, threshold=2.0, seed=0)
+    assert m.inliers.sum() > 100
+
+
+def test_c_input_stage_refuses_what_the_numpy_path_names():
+    """Input the C pass refuses (an id outside the rig, a pixel without a
+    finite bearing) returns None from _core: the rig's path names it."""
+    from mcgeom import _core
+    from mcgeom.pixel_noise import ray_pairs_per_radian
+    rig, p = _problem(5)
+    intr, rot, centres, focal = rig.pinhole_tables
+    px1, px2 = (np.ascontiguousarray(a, dtype=np.float64) for a in (p.pixels1, p.pixels2))
+    ids = np.asarray(p.cam1, np.int64)
+    assert _core.pinhole_ray_pairs(intr, rot, centres, focal, ids, ids, px1, px2) is not None
+    bad_ids = ids.copy()
+    bad_ids[7] = len(rig)
+    assert _core.pinhole_ray_pairs(intr, rot, centres, focal, bad_ids, ids, px1, px2) is None
+    huge = px2.copy()
+    huge[3] = 1e300
+    assert _core.pinhole_ray_pairs(intr, rot, centres, focal, ids, ids, px1, huge) is None
+    with pytest.raises(ValueError, match="no finite bearing"):
+        ray_pairs_per_radian(rig, px1, huge, ids, ids)
+    # without focal: the rays only, the same ones
+    o1, d1, o2, d2, none = _core.pinhole_ray_pairs(intr, rot, centres, None, ids, ids, px1, px2)
+    assert none is None
+    ref = rig.ray_pairs_prechecked(px1, px2, ids, ids)
+    assert np.array_equal(d1, ref.dirs1) and np.array_equal(d2, ref.dirs2)
+    assert np.array_equal(o1, ref.origins1) and np.array_equal(o2, ref.origins2)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_facade_with_mask_and_calibration_is_the_general_path(seed):
+    """cv.estimate (C input stage, masked pairs' pixels per radian taken from
+    all of them) equals robust.ransac on the rig's rays of the kept pairs."""
+    rig, p = _problem(10 + seed)
+    mask = np.random.default_rng(seed).random(len(p.cam1)) > 0.25
+    cal = (0.002, 0.001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        c = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, seed=seed,
+                        mask=mask, calibration_std=cal)
+    rays = rig.ray_pairs(p.pixels1, p.pixels2, p.cam1, p.cam2).take(np.flatnonzero(mask))
+    from mcgeom.rig import Rig
+    a = robust.ransac(rays, "five_plus_one", threshold=1.0, seed=seed,
+                      focal=pixels_per_radian(rig, rays), motion_focal=sampson_pixel_scale(rig),
+                      calibration_std=Rig(rig.cameras, cal).extrinsic_std,
+                      pixel_cameras=camera_table(rig))
+    assert np.array_equal(c.inliers[mask], a.inliers) and not c.inliers[~mask].any()
+    assert np.array_equal(a.R, c.R) and np.array_equal(a.t, c.t)
+    assert a.scale.observable == c.scale.observable and a.scale.reason == c.scale.reason
+    for key in ("t_metric", "scale_rel_std_noise", "scale_rel_std_calibration", "covariance"):
+        assert np.array_equal(a.info[key], c.info[key], equal_nan=True), key

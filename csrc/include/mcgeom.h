@@ -904,6 +904,34 @@ int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const dou
                             const double *axis1, const double *axis2, const double *f1,
                             const double *f2, double min_var_ratio, double *scale);
 
+/* ------------------------------------------------------------ pixel_rays.c */
+
+/* Rays of n pixel correspondences of a rig of m undistorted pinhole cameras,
+ * and (optionally) the pixels per radian of each pair's Sampson residual.
+ * Camera i: intr[5i..5i+4] = fx, fy, cx, cy, skew (pixels), rot[9i..9i+8]
+ * its rotation cam_from_rig (row-major; row 2 is the optical axis in the rig
+ * frame), centres[3i..3i+2] its centre (rig frame, metres), focal[i] its
+ * mean focal length (fx + fy) / 2 (pixels; read only when ppr is not NULL).
+ * Pair k: pixel px1[2k..] (u, v) of camera ids1[k] at time 1, px2[2k..] of
+ * camera ids2[k] at time 2. Outputs (n x 3 each, rig frame): o1, o2 the
+ * camera centres and d1, d2 the unit bearings R_i^T normalize(K_i^-1 (u, v,
+ * 1)); ppr (n, or NULL) 1 / sqrt(var) with var the mean of the two
+ * bearings' pixel-noise variances per unit pixel noise, each
+ * (cos^4 + cos^2) / (2 f^2) at cos = (bearing . axis) clipped to [1e-3, 1]
+ * (radial cos^2 / f and tangential cos / f, averaged). n = 0 is valid.
+ * MCG_EINVAL: NULL pointers (focal only with ppr), n outside [0, 2^26], m
+ * outside [1, 2^20], NaN/inf in a table or a pixel, fx or fy zero, focal not
+ * > 0, an id outside [0, m), or a pixel without a finite bearing (|K^-1 (u,
+ * v, 1)| overflows, or R^T of it for a rot of huge entries): *bad is then its index (k at time 1, n + k at time 2),
+ * else -1; also MCG_EINVAL when a pixels-per-radian value is not finite and
+ * > 0 (focal lengths beyond ~1e+-150 px, whose squares overflow or vanish).
+ * Outputs are unspecified on error. */
+int mcg_pinhole_ray_pairs(int n, int m, const double *intr, const double *rot,
+                          const double *centres, const double *focal, const long long *ids1,
+                          const long long *ids2, const double *px1, const double *px2,
+                          double *o1, double *d1, double *o2, double *d2, double *ppr,
+                          int *bad);
+
 /* ------------------------------------------------------------ essential5.c */
 
 /* The minimal 5-point relative pose of a central camera (Nister, PAMI 2004):
