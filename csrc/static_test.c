@@ -658,33 +658,52 @@ static int level_at(int n, const double *o1, const double *d1, const double *o2,
     return st;
 }
 
-/* the statistic at out->noise_level: at R_given (else R_fit), then --
- * without R_given -- at R_est; out->is_static and the figures of the last
- * rotation tried (u1, u2: the unit bearings of the intra-camera pairs) */
+/* the rotation tried i-th by the statistic: R_given (else R_fit), then --
+ * without R_given -- R_est; NULL when there is no i-th */
+static const double *rotation_tried(int i, const double *R_est, const double *R_given,
+                                    const double *R_fit)
+{
+    if (i == 0)
+        return R_given ? R_given : R_fit;
+    return i == 1 && R_est && !R_given ? R_est : NULL;
+}
+
+/* the rotation-only statistic at R_test and out->noise_level into out (its
+ * figures, R and decided_at = i); 1 if enough angles are explained (the
+ * necessary condition of a static answer) */
+static int explained_at(int n, const double *u1, const double *u2, const int *group,
+                        const double *R_test, int i, const mcg_static_options *o,
+                        mcg_static_result *out)
+{
+    int r;
+    rotation_statistic(n, u1, u2, group, R_test, o->parallax_factor * out->noise_level,
+                       &out->n_intra, &out->explained);
+    out->decided_at = i;
+    for (r = 0; r < 9; r++)
+        out->R[r] = R_test[r];
+    return out->n_intra >= o->min_pairs && out->n_intra > 0 && out->explained >= o->fraction;
+}
+
+/* the statistic at out->noise_level at each rotation tried, until one gives
+ * a static answer (also min_distinct distinct intra-camera pairs);
+ * out->is_static and the figures of the last rotation tried (u1, u2: the
+ * unit bearings of the intra-camera pairs) */
 static void explained_anywhere(int n, const double *o1, const double *d1, const double *o2,
                                const double *d2, const double *u1, const double *u2,
                                const int *group, const double *R_est,
                                const double *R_given, const mcg_static_options *o,
                                mcg_static_result *out, double *ang)
 {
-    double lim = o->parallax_factor * out->noise_level;
-    int i, r, distinct = -1, seen[64];
+    const double *R_test;
+    int i, distinct = -1, seen[64];
     out->is_static = 0;
-    for (i = 0; i < 2 && !out->is_static; i++) {
-        const double *R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
-        if (i == 1 && (!R_est || R_given))
-            break;
-        rotation_statistic(n, u1, u2, group, R_test, lim, &out->n_intra, &out->explained);
-        out->decided_at = i;
-        for (r = 0; r < 9; r++)
-            out->R[r] = R_test[r];
-        out->is_static = out->n_intra >= o->min_pairs && out->n_intra > 0 &&
-                         out->explained >= o->fraction;
-        if (out->is_static) {
-            if (distinct < 0)
-                distinct = distinct_at_least(n, o1, d1, o2, d2, group, o->min_distinct, seen);
-            out->is_static = distinct;
-        }
+    for (i = 0; !out->is_static && (R_test = rotation_tried(i, R_est, R_given, out->R_fit));
+         i++) {
+        if (!explained_at(n, u1, u2, group, R_test, i, o, out))
+            continue;
+        if (distinct < 0)
+            distinct = distinct_at_least(n, o1, d1, o2, d2, group, o->min_distinct, seen);
+        out->is_static = distinct;
     }
     /* the median angle only for the answer that reports it (a static rig) */
     out->median_angle =
@@ -693,28 +712,20 @@ static void explained_anywhere(int n, const double *o1, const double *d1, const 
 
 /* explained_anywhere's statistic without its distinct-pairs condition and
  * median angle (a necessary condition of a static answer, for the bound of
- * mcg_static_check): 1 if enough angles are within the bound at R_given
- * (else R_fit) or, without R_given, at R_est; out gets the figures of the
- * last rotation tried, as explained_anywhere reports a moving rig */
+ * mcg_static_check): 1 if enough angles are explained at some rotation
+ * tried; out gets the figures of the last rotation tried, as
+ * explained_anywhere reports a moving rig */
 static int explained_somewhere(int n, const double *u1, const double *u2, const int *group,
                                const double *R_est, const double *R_given,
                                const mcg_static_options *o, mcg_static_result *out)
 {
-    double lim = o->parallax_factor * out->noise_level;
-    int i, r;
+    const double *R_test;
+    int i;
     out->is_static = 0;
     out->median_angle = NAN;
-    for (i = 0; i < 2; i++) {
-        const double *R_test = i == 0 ? (R_given ? R_given : out->R_fit) : R_est;
-        if (i == 1 && (!R_est || R_given))
-            break;
-        rotation_statistic(n, u1, u2, group, R_test, lim, &out->n_intra, &out->explained);
-        out->decided_at = i;
-        for (r = 0; r < 9; r++)
-            out->R[r] = R_test[r];
-        if (out->n_intra >= o->min_pairs && out->n_intra > 0 && out->explained >= o->fraction)
+    for (i = 0; (R_test = rotation_tried(i, R_est, R_given, out->R_fit)); i++)
+        if (explained_at(n, u1, u2, group, R_test, i, o, out))
             return 1;
-    }
     return 0;
 }
 
