@@ -922,9 +922,10 @@ int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const dou
  * MCG_EINVAL: NULL pointers (focal only with ppr), n outside [0, 2^26], m
  * outside [1, 2^20], NaN/inf in a table or a pixel, fx or fy zero, focal not
  * > 0, an id outside [0, m), or a pixel without a finite bearing (|K^-1 (u,
- * v, 1)| overflows, or R^T of it for a rot of huge entries): *bad is then its index (k at time 1, n + k at time 2),
- * else -1; also MCG_EINVAL when a pixels-per-radian value is not finite and
- * > 0 (focal lengths beyond ~1e+-150 px, whose squares overflow or vanish).
+ * v, 1)| overflows, or R^T of it for a rot of huge entries): *bad is then
+ * its index (k at time 1, n + k at time 2), else -1; also MCG_EINVAL when a
+ * pixels-per-radian value is not finite and > 0 (focal lengths beyond
+ * ~1e+-150 px, whose squares overflow or vanish).
  * Outputs are unspecified on error. */
 int mcg_pinhole_ray_pairs(int n, int m, const double *intr, const double *rot,
                           const double *centres, const double *focal, const long long *ids1,
