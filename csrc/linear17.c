@@ -1350,6 +1350,12 @@ static int solve_case(int n, const double *origins1, const double *dirs1,
             res->cost_final = sqrt(sampson_pass(&rays, mo.r, mo.t, NULL, NULL) / n);
         }
     }
+    /* rays of extreme magnitudes (~1e200: found by fuzz_linear17) can
+     * overflow the Sampson terms of the refinement: a NaN or inf cost is
+     * no estimate, and a NaN would also lose every comparison with the
+     * other kind's solution in mcg_linear17 */
+    if (!isfinite(res->cost_final) || !isfinite(res->cost_linear))
+        return MCG_ENUMERIC;
     if (mo.cost < 0.0)
         mo.cost = 0.0; /* rounding of x^T M x, as above */
     st = scale_evidence(m, opt, n, &mo, res);
