@@ -49,6 +49,45 @@ static void test_qr_graded_columns(void)
     check(e <= 1e-14, "qr of a graded matrix: |Q^T Q - I|", e, 1e-14);
 }
 
+/* fuzz_linear17: 15 rays of one central camera (centre (-1, -1, -1) at both
+ * times) of which one has a component of 1e150 in both directions: the
+ * Sampson terms of the refinement overflowed, cost_final was NaN with MCG_OK
+ * (and a NaN cost lost the comparison with the other camera kind's
+ * solution). The kernel must answer an error or a finite cost. */
+static void test_linear17_overflowing_direction(void)
+{
+    static const double dd[15][6] = {
+        {-4.0999999999999996, -4.0666666666666664, 1.9666666666666666, 0.2535726228569315, 4.297991319002084, -3.2310096112774858},
+        {-4, -3.9666666666666668, 2.0666666666666669, 0.2535726228569315, 4.297991319002084, -3.2310096112774858},
+        {-3.8999999999999999, -4.0999999999999996, 1.9333333333333333, 0.2535726228569315, 4.297991319002084, -3.2310096112774858},
+        {-4.0333333333333332, -4, 2.0333333333333332, 0.2535726228569315, 4.297991319002084, -3.2310096112774858},
+        {-3.9333333333333331, -3.8999999999999999, 1.8999999999999999, 0.2535726228569315, 4.297991319002084, -3.2310096112774858},
+        {-4.0666666666666664, -4.0333333333333332, 19.360784313725489, -15.90208535980647, 10.584769117971284, -4.1626597823660081},
+        {-1.5482642862592508, 5.2039215686274503, 19.46078431372549, -17.492563030809123, 7.8159283449408843, 4.7335191034598054},
+        {5.0372549019607842, 5.0705882352941174, 19.327450980392154, -19.893523455561599, 1.5647157720538107, 4.1851491428173206},
+        {5.1372549019607838, 5.170588235294117, 19.427450980392155, -19.893523455561599, 1.5647157720538107, 4.1851491428173206},
+        {5.2372549019607835, 5.0372549019607842, 19.294117647058822, -19.893523455561599, 1.5647157720538107, 4.1851491428173206},
+        {5.1039215686274506, 1e150, 19.394117647058824, -19.893523455561599, 1e150, 4.1851491428173206},
+        {5.2039215686274503, 6.0966430151827264, 20.899999999999999, -21.487258347891995, 2.1095258792951332, 4.9524607061942181},
+        {5.9333333333333336, -4.0311970702677957, 2, -3.3200651417843545, -5.0061183372946143, -4.0450496559657374},
+        {6.0333333333333332, 6.0666666666666664, 21.100000000000001, -21.795824372837167, 1.3066382525994662, 4.8853873084400057},
+        {5.9000000000000004, 5.9333333333333336, 20.966666666666665, -21.795824372837167, 1.3066382525994662, 4.8853873084400057},
+    };
+    double o1[45], d1[45], o2[45], d2[45];
+    mcg_linear17_result res;
+    int i, k, st;
+    for (i = 0; i < 15; ++i)
+        for (k = 0; k < 3; ++k) {
+            o1[3 * i + k] = o2[3 * i + k] = -1.0;
+            d1[3 * i + k] = dd[i][k];
+            d2[3 * i + k] = dd[i][3 + k];
+        }
+    st = mcg_linear17(15, o1, d1, o2, d2, NULL, &res);
+    check(st != MCG_OK || (isfinite(res.cost_final) && isfinite(res.cost_linear)),
+          "linear17: a direction of 1e150 gives an error or a finite cost",
+          st == MCG_OK ? res.cost_final : (double)st, 0.0);
+}
+
 /* fuzz_linear17: a central camera (all rays through one centre, gc_case
  * CENTRAL) with exact correspondences: the algebraic cost x^T M x rounds to
  * slightly below 0 and cost_final = sqrt(cost / n) was NaN with MCG_OK. */
@@ -625,6 +664,7 @@ int main(void)
     test_bnb_polish_nonnegative();
     test_linf_local_negative_n();
     test_linear17_central_exact_cost();
+    test_linear17_overflowing_direction();
     test_angle_axis_overflow();
     test_qr_graded_columns();
     printf("%d checks, %d failed\n", n_checks, n_failed);
