@@ -80,7 +80,9 @@ def ray_pairs_per_radian(rig: Rig, px1: np.ndarray, px2: np.ndarray, ids1: np.nd
                          ids2: np.ndarray) -> tuple[RayPairs, np.ndarray]:
     """:meth:`mcgeom.rig.Rig.ray_pairs_prechecked` and :func:`pixels_per_radian`
     of its rays, for the same checked input (its preconditions: finite
-    float64 C-contiguous (N, 2) pixels, (N,) int64 ids of the rig's cameras).
+    float64 C-contiguous (N, 2) pixels, (N,) int64 ids of the rig's cameras,
+    arrays made by the caller's checks, not the user's own, as the result
+    keeps them).
 
     Returns the rays (rig frame, metres, unit bearings, camera ids) and (N,)
     pixels per radian. When every camera of ``rig`` is an undistorted pinhole
@@ -99,8 +101,9 @@ def ray_pairs_per_radian(rig: Rig, px1: np.ndarray, px2: np.ndarray, ids1: np.nd
         return rays, pixels_per_radian(rig, rays)
     o1, d1, o2, d2, ppr = out
     # made here from checked ids: float64 C-contiguous (N, 3); ids2 may be
-    # ids1 (the same cameras at both times): its own array, as the rig's
-    return RayPairs.prechecked(o1, d1, o2, d2, ids1, ids2.copy()), ppr
+    # ids1 (the same cameras at both times): then its own array, as the rig's
+    return RayPairs.prechecked(o1, d1, o2, d2, ids1,
+                               ids2.copy() if ids2 is ids1 else ids2), ppr
 
 
 def sampson_pixel_scale(rig: Rig) -> MotionFocal:
