@@ -1499,6 +1499,65 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
         "n_in_front": out.n_in_front,
         "t_direction": np.frombuffer(ffi.buffer(out.t_direction), dtype=np.float64).copy(),
     }
+# ------------------------------------------------------ calibration_std.c
+
+__all__ += ["calibration_scale_std"]
+
+
+def calibration_scale_std(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: Any,
+                          cam2: Any, extrinsic_std: Any, R: Any, t: Any,
+                          weights: Any = None, loss: str = "none",
+                          loss_scale: float = 1e-3) -> tuple[float, np.ndarray]:
+    """Relative std of ``|tau|`` induced by the rig's extrinsic calibration
+    error (``mcg_calibration_scale_std``; the model:
+    :func:`mcgeom.observability.calibration_scale_std`).
+
+    Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins
+    the camera centres in metres), ``cam1``/``cam2`` (N,) camera ids in
+    ``[0, M)``, ``extrinsic_std`` (M, 2) per-camera 1-sigma position (metres
+    per axis) and rotation (radians per axis), ``(R, t)`` rig2_from_rig1
+    (metres), ``weights`` (N,) >= 0 or None, ``loss`` a name of
+    ``LOSS_NAMES`` with its ``loss_scale`` (radians). Returns ``(rel_std,
+    cov)``: the relative std of ``|tau|`` (``tau = t + R c - c``, c the
+    centroid of the origins) and the (6, 6) covariance of ``[w rad, tau m]``
+    the calibration error induces; ``(inf, inf)`` when the rays do not
+    determine the motion. Raises ValueError naming the bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 1)
+    n = rays[0].shape[0]
+    sig = _arr("extrinsic_std", extrinsic_std, (-1, 2))
+    m = sig.shape[0]
+    c1, c2 = _camera_id_arrays(cam1, cam2, n, m)
+    Rm, tv = _f64("R", R, (3, 3)), _f64("t", t, (3,))
+    w_ptr = ffi.NULL
+    if weights is not None:
+        w = _arr("weights", weights, (n,))
+        if (w < 0).any():
+            raise ValueError("weights must be >= 0")
+        w_ptr = _p(w)
+    if not isinstance(loss, str) or loss not in LOSS_NAMES:
+        raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
+    if (sig < 0).any():
+        raise ValueError("extrinsic_std must be >= 0")
+    cov = np.empty((6, 6))
+    rel = ffi.new("double *")
+    work = _work(lib.mcg_calibration_std_work_size(m))
+    st = lib.mcg_calibration_scale_std(
+        n, *map(_p, rays), ffi.from_buffer("int[]", c1), ffi.from_buffer("int[]", c2), m,
+        _p(sig), _p(Rm), _p(tv), w_ptr, LOSS_NAMES[loss], float(loss_scale), rel, _p(cov),
+        _p(work), work.size)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL:
+            _camera_id_error((c1, c2), m)
+            for name, a in (("R", Rm), ("t", tv)):
+                if not np.isfinite(a).all():
+                    raise ValueError(f"{name} contains NaN or inf")
+            if loss != "none" and not (np.isfinite(loss_scale) and loss_scale > 0):
+                raise ValueError(f"loss_scale must be > 0 (radians), got {loss_scale!r}")
+        _ray_error(st, "calibration_scale_std", rays)
+    return float(rel[0]), cov
+
+
 # ------------------------------------------------------------- upright4.c
 
 def upright4(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, gravity1: Any,

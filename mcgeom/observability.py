@@ -311,24 +311,6 @@ def _verdict(n_in: int, n_cross: int, n_centres: int, crit: float, rel_std: floa
 
 # ------------------------------------------------ calibration error of the rig
 
-def _rotvec(w: np.ndarray) -> np.ndarray:
-    """Rotation matrix of the rotation vector ``w`` (radians; Rodrigues)."""
-    th = float(np.linalg.norm(w))
-    if th < 1e-300:
-        return np.eye(3)
-    k = w / th
-    Kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + np.sin(th) * Kx + (1.0 - np.cos(th)) * (Kx @ Kx)
-
-
-#: angular step (radians) of the central differences of :func:`calibration_scale_std`
-_H_ANG = 1e-6
-#: the +-step perturbations of one axis after another (6, 3): +x, -x, +y, ...
-_STEPS = np.repeat(np.eye(3), 2, axis=0) * np.tile([1.0, -1.0], 3)[:, None]
-#: their rotations by _H_ANG (6, 3, 3), made once
-_TURNS = np.stack([_rotvec(_H_ANG * v) for v in _STEPS])
-
-
 def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
                           extrinsic_std, weights: np.ndarray | None = None,
                           loss: str = "none", loss_scale: float = 1e-3
@@ -353,8 +335,8 @@ def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     |tau|`` and ``sigma_j`` from ``extrinsic_std``: an (M, 2) array (or one
     pair) of per-camera 1-sigma position (metres per axis) and rotation
     (radians per axis) errors, independent across cameras and axes. Jacobians
-    by central differences (the residuals are smooth; 6 + 6 M evaluations of
-    one C call each).
+    by central differences (the residuals are smooth), in one C pass over the
+    pairs (``_core.calibration_scale_std``, csrc/calibration_std.c).
 
     Returns ``(rel_std, cov)``: the relative std of ``|tau|`` (0 when every
     std is 0, inf when the motion is not determined by the rays: singular
@@ -378,87 +360,10 @@ def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
                          f"(the cameras of the rays), got {sig.shape}")
     if not np.any(sig[:m] > 0) or len(rays) == 0:
         return 0.0, np.zeros((6, 6))
-    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
-    o1, o2 = rays.origins1 - c, rays.origins2 - c
-    d1 = rays.dirs1 / np.linalg.norm(rays.dirs1, axis=1, keepdims=True)
-    d2 = rays.dirs2 / np.linalg.norm(rays.dirs2, axis=1, keepdims=True)
-    tau = t + R @ c - c
-
-    # the rotations of the differences, made once (were one Rodrigues per
-    # residual call, issue 19): R unturned (as I @ R), then +-h_ang about
-    # each axis, as _rotvec(+-h_ang e_k) @ R
-    R_at = {None: np.eye(3) @ R}
-    for k in range(3):
-        for sgn in (1, -1):
-            R_at[k, sgn] = _TURNS[2 * k + (sgn < 0)] @ R
-
-    def res(o1_, d1_, o2_, d2_, w=None, dtau=np.zeros(3)) -> np.ndarray:
-        return _core.gec_residuals(o1_, d1_, o2_, d2_, R_at[w], tau + dtau)
-
-    r0 = res(o1, d1, o2, d2)
-    w = np.ones(len(rays)) if weights is None else np.asarray(weights, dtype=np.float64)
-    if loss == "cauchy":
-        w = w / (1.0 + (r0 / loss_scale) ** 2)
-    elif loss == "huber":
-        w = w * np.minimum(1.0, loss_scale / np.maximum(np.abs(r0), 1e-300))
-    elif loss == "soft_l1":
-        w = w / np.sqrt(1.0 + (r0 / loss_scale) ** 2)
-    h_ang, scale = _H_ANG, max(float(np.linalg.norm(tau)), 1e-9)
-    e = np.eye(3)
-    J = np.empty((len(rays), 6))
-    for k in range(3):
-        J[:, k] = (res(o1, d1, o2, d2, w=(k, 1)) - res(o1, d1, o2, d2, w=(k, -1))) \
-            / (2 * h_ang)
-        h = 1e-6 * scale
-        J[:, 3 + k] = (res(o1, d1, o2, d2, dtau=h * e[k]) - res(o1, d1, o2, d2, dtau=-h * e[k])) \
-            / (2 * h)
-    H = J.T @ (w[:, None] * J)
-    try:
-        Hinv = np.linalg.inv(H)
-    except np.linalg.LinAlgError:
-        return float("inf"), np.full((6, 6), np.inf)
-    if not np.all(np.isfinite(Hinv)):
-        return float("inf"), np.full((6, 6), np.inf)
-    cov = np.zeros((6, 6))
-    h_pos = 1e-6 * max(1.0, float(np.abs(o1).max(initial=0.0)))
-    # the +-step perturbations of one extrinsic axis after another: position
-    # (metres, rig frame) and orientation (rotation about the camera's centre)
-    steps = _STEPS
-    turns = _TURNS
-    for cam in range(m):
-        # only the rays of this camera (at either time) move with its
-        # extrinsics: the other residuals do not change (dr = 0), so the
-        # differences are taken on its rows alone, all 12 perturbations in
-        # one residual call (issue 19: 12 calls on all N rays per camera were
-        # the bulk of the verdict's time)
-        rows = np.flatnonzero((cam1 == cam) | (cam2 == cam))
-        kinds = [kind for kind in (0, 1) if sig[cam, kind] != 0]
-        if rows.size == 0 or not kinds:
-            continue
-        s1, s2 = (cam1[rows] == cam)[None, :, None], (cam2[rows] == cam)[None, :, None]
-        o1r, d1r, o2r, d2r = o1[rows][None], d1[rows][None], o2[rows][None], d2[rows][None]
-        blocks = []
-        for kind in kinds:
-            if kind == 0:   # the camera's centre moves (rig frame)
-                move = h_pos * steps[:, None, :]
-                a1, a2 = o1r + s1 * move, o2r + s2 * move
-                b1, b2 = np.broadcast_to(d1r, a1.shape), np.broadcast_to(d2r, a2.shape)
-            else:           # the camera turns about its centre (rig frame)
-                b1 = np.where(s1, np.einsum("qij,rj->qri", turns, d1r[0]), d1r)
-                b2 = np.where(s2, np.einsum("qij,rj->qri", turns, d2r[0]), d2r)
-                a1, a2 = np.broadcast_to(o1r, b1.shape), np.broadcast_to(o2r, b2.shape)
-            blocks.append((a1, b1, a2, b2))
-        stacked = [np.concatenate([b[i] for b in blocks]).reshape(-1, 3) for i in range(4)]
-        r = res(*stacked).reshape(len(kinds), 6, rows.size)   # kind, (axis, sign), row
-        Jw = J[rows].T * w[rows]
-        for j, kind in enumerate(kinds):
-            step = h_pos if kind == 0 else h_ang
-            dr = (r[j, 0::2] - r[j, 1::2]) / (2 * step)          # (3 axes, rows)
-            G = -Hinv @ (Jw @ dr.T)                              # d theta / d p_j, columns
-            cov += sig[cam, kind] ** 2 * (G @ G.T)
-    u = tau / scale
-    var = float(u @ cov[3:, 3:] @ u)
-    return float(np.sqrt(max(var, 0.0)) / scale), cov
+    # the propagation in one C pass over the pairs (csrc/calibration_std.c;
+    # issue 19: in numpy it cost 2-4 ms per robust estimate, 3-4x the search)
+    return _core.calibration_scale_std(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                       cam1, cam2, sig[:m], R, t, weights, loss, loss_scale)
 
 
 def combine_rel_std(noise: float, calibration: float) -> float:

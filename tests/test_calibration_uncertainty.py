@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import mcgeom
-from mcgeom import synth
+from mcgeom import _core, synth
 from mcgeom.cv import estimate as cv_estimate
 from mcgeom.experiments import calibration_coverage
 from mcgeom.io.mcgeom_json import rig_from_dict, rig_to_dict
@@ -124,3 +124,79 @@ def test_with_calibration_reason_quotes_the_total_rel_std():
     assert c.scale.observable and c.scale.rel_std > m.scale.rel_std
     assert f"{c.scale.rel_std:.3g}" in c.scale.reason
     assert f"{m.scale.rel_std:.3g}" in c.scale.reason   # the noise part is still named
+
+
+def _refit_tau(rays, R, t, c, cam, kind, axis, delta):
+    """The least-squares motion of ``rays`` refitted after camera ``cam``'s
+    centre moved (kind 0) or the camera turned about its centre (kind 1) by
+    ``delta`` along/about ``axis``: (rotation vector of R' R^T, tau' = t' +
+    R' c - c) -- the definition the first-order propagation approximates."""
+    o1, d1, o2, d2 = (np.array(a, dtype=float) for a in
+                      (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2))
+    s1, s2 = rays.cam1 == cam, rays.cam2 == cam
+    e = np.zeros(3)
+    e[axis] = delta
+    if kind == 0:
+        o1[s1] += e
+        o2[s2] += e
+    else:
+        turn = synth.rotation_about(np.eye(3)[axis], delta)
+        d1[s1] = d1[s1] @ turn.T
+        d2[s2] = d2[s2] @ turn.T
+    out = _core.refine_motion(o1, d1, o2, d2, R, t, max_iterations=200,
+                              cost_tolerance=1e-30, step_tolerance=1e-16)
+    Rr, tr = out["R"], out["t"]
+    dR = Rr @ R.T
+    w = 0.5 * np.array([dR[2, 1] - dR[1, 2], dR[0, 2] - dR[2, 0], dR[1, 0] - dR[0, 1]])
+    return np.concatenate([w, tr + Rr @ c - c])
+
+
+@pytest.mark.parametrize("kind", [0, 1])
+def test_c_propagation_matches_refitting_with_moved_extrinsics(kind):
+    """mcg_calibration_scale_std against the definition it linearises:
+    refit the motion of exact data after one camera's extrinsics moved by
+    +-delta about each axis (central differences of the refitted theta);
+    sum sigma^2 G G^T over the axes is the covariance it reports."""
+    rng = np.random.default_rng(7 + kind)
+    rig = synth.vehicle8()
+    Rw = synth.rotation_about([0, 0, 1], np.radians(12))
+    R, t = Rw.T, -Rw.T @ np.array([1.2, 0.1, 0.0])
+    p = synth.make_problem(rig, R, t, 240, rng, cross_fraction=0.15)
+    rays = p.rays
+    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    cam, sigma, delta = 3, (2e-3 if kind == 0 else np.radians(0.1)), 1e-5
+    std = np.zeros((len(rig.cameras), 2))
+    std[cam, kind] = sigma
+    rel, cov = _core.calibration_scale_std(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
+                                           rays.cam1, rays.cam2, std, R, t)
+    G = np.stack([(_refit_tau(rays, R, t, c, cam, kind, k, delta)
+                   - _refit_tau(rays, R, t, c, cam, kind, k, -delta)) / (2 * delta)
+                  for k in range(3)], axis=1)
+    ref = sigma ** 2 * G @ G.T
+    tau = t + R @ c - c
+    u = tau / np.linalg.norm(tau)
+    rel_ref = np.sqrt(u @ ref[3:, 3:] @ u) / np.linalg.norm(tau)
+    assert rel > 0
+    assert rel == pytest.approx(rel_ref, rel=1e-3)
+    np.testing.assert_allclose(cov, ref, rtol=0, atol=1e-3 * np.abs(ref).max())
+
+
+def test_c_propagation_refuses_bad_input_by_name():
+    rng = np.random.default_rng(4)
+    rig = synth.vehicle8()
+    p = synth.make_problem(rig, np.eye(3), np.array([1.0, 0.0, 0.0]), 60, rng)
+    r = p.rays
+    std = np.full((8, 2), 1e-3)
+    args = [r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1, r.cam2]
+    with pytest.raises(ValueError, match="cam1"):
+        _core.calibration_scale_std(*args[:4], np.full(60, 9), r.cam2, std, np.eye(3), np.ones(3))
+    with pytest.raises(ValueError, match="extrinsic_std"):
+        _core.calibration_scale_std(*args, -std, np.eye(3), np.ones(3))
+    with pytest.raises(ValueError, match="t contains NaN"):
+        _core.calibration_scale_std(*args, std, np.eye(3), np.array([np.nan, 0, 0]))
+    bad = r.dirs2.copy()
+    bad[5] = 0.0
+    with pytest.raises(ValueError, match="dirs2"):
+        _core.calibration_scale_std(*args[:3], bad, *args[4:], std, np.eye(3), np.ones(3))
+    with pytest.raises(ValueError, match="loss"):
+        _core.calibration_scale_std(*args, std, np.eye(3), np.ones(3), loss="l7")

@@ -1160,6 +1160,38 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
                       const unsigned char *inlier, const double R[9], const double t[3],
                       double still_angle, mcg_verdict_stats_result *out, double *work,
                       size_t lwork);
+/* ------------------------------------------------------ calibration_std.c */
+
+/* Doubles of workspace of mcg_calibration_scale_std (0 for n_cameras outside
+ * [1, 4096]): 36 n_cameras. */
+size_t mcg_calibration_std_work_size(int n_cameras);
+
+/* The relative std of |tau| (tau = t + R c - c, the translation of the
+ * centroid c of the origins, metres) that the rig's extrinsic calibration
+ * error induces in the least-squares motion (R, t) of the n pairs (o1, d1)
+ * <-> (o2, d2) (as for mcg_gec_residuals: rig frames at times 1 and 2,
+ * origins the camera centres in metres, directions of any non-zero length)
+ * of cameras cam1[k], cam2[k] in [0, n_cameras): first-order propagation
+ * d theta / d p = -(J^T W J)^-1 J^T W dr/dp, theta = (w, tau), through the
+ * Sampson residuals, W = weights (NULL: 1) times the IRLS weights of loss
+ * (MCG_LOSS_*, scale loss_scale radians) at (R, t); p the centre (metres,
+ * rig frame) and the orientation (radians, about the centre) of each
+ * camera, with 1-sigma errors extrinsic_std[2 k] (metres per axis) and
+ * extrinsic_std[2 k + 1] (radians per axis), >= 0. Out: *rel_std and cov
+ * (6 x 6, row-major, order [w, tau]: the covariance of theta that the
+ * calibration error induces). A singular J^T W J (the rays do not determine
+ * the motion): *rel_std and cov HUGE_VAL, MCG_OK. Cost: one pass over the
+ * pairs, 13 residuals each plus 6 per camera end and error kind.
+ * MCG_EINVAL: NULL pointers, n outside [1, 2^20], n_cameras, ids out of
+ * range, NaN/inf, a zero direction, a negative std or weight, loss, a
+ * loss_scale not > 0; MCG_ENOMEM: lwork below mcg_calibration_std_work_size;
+ * MCG_ENUMERIC: overflow. */
+int mcg_calibration_scale_std(int n, const double *o1, const double *d1, const double *o2,
+                              const double *d2, const int *cam1, const int *cam2,
+                              int n_cameras, const double *extrinsic_std, const double R[9],
+                              const double t[3], const double *weights, int loss,
+                              double loss_scale, double *rel_std, double cov[36],
+                              double *work, size_t lwork);
 /* ------------------------------------------------------------- upright4.c */
 
 /* Upper bound on the solutions of mcg_upright4 (the degree of its polynomial). */
