@@ -177,6 +177,37 @@ def test_distorted_rig_takes_the_general_input_path():
     assert m.inliers.sum() > 100
 
 
+@pytest.mark.parametrize("model", ["pinhole", "fisheye"])
+@pytest.mark.parametrize("same_ids", [False, True])
+def test_distorted_pairs_in_one_call_per_camera_are_the_per_time_ones(model, same_ids):
+    """Rig._distorted_pairs (both times in one OpenCV call per camera) gives
+    the bearings of one call per camera and time bit for bit, and a pixel
+    without a ray is named as before (the per-time path names it)."""
+    from dataclasses import replace
+    from mcgeom.rig import Rig
+    rig, p = _problem(6)
+    dist = np.array([0.004, 0.001, 0.0, 0.0]) if model == "fisheye" else \
+        np.array([0.03, -0.01, 0.001, 0.0005, 0.0])
+    cams = [c if k == 2 else replace(c, model=model, dist=dist) for k, c in enumerate(rig.cameras)]
+    drig = Rig(tuple(cams), rig.calibration_std)
+    px1, px2 = (np.ascontiguousarray(a, dtype=np.float64) for a in (p.pixels1, p.pixels2))
+    ids1 = np.asarray(p.cam1, np.int64)
+    ids2 = ids1 if same_ids else np.asarray(p.cam2, np.int64)
+    rays = drig.ray_pairs_prechecked(px1, px2, ids1, ids2)
+    o1, d1 = drig._rays_checked(ids1, px1, {})
+    o2, d2 = drig._rays_checked(ids2, px2, None)
+    for a, b in ((rays.dirs1, d1), (rays.dirs2, d2), (rays.origins1, o1), (rays.origins2, o2)):
+        assert a.flags.c_contiguous and np.array_equal(a, b)
+    assert rays.cam2 is not rays.cam1 and rays.origins2 is not rays.origins1
+    far = px2.copy()
+    far[9] = (1e300, 1e300) if model == "pinhole" else (1e7, 1e7)
+    with pytest.raises(ValueError) as got:
+        drig.ray_pairs_prechecked(px1, far, ids1, ids2)
+    with pytest.raises(ValueError) as want:
+        drig._rays_checked(ids2, far, None)
+    assert str(got.value) == str(want.value)
+
+
 def test_c_input_stage_refuses_what_the_numpy_path_names():
     """Input the C pass refuses (an id outside the rig, a pixel without a
     finite bearing) returns None from _core: the rig's path names it."""
