@@ -247,9 +247,11 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         # the checks above: the search need not check them again (issue 19)
         # (pixels per radian are per pair: those of the kept pairs are theirs)
         focal = focal_all if keep is None else focal_all[keep]
+        # an exactly known calibration (every std 0) adds nothing to rel_std:
+        # None skips gathering the refinement's rays for its propagation
         m = _robust.ransac_prechecked(rays, name, opts, focal,
-                                      sampson_pixel_scale(rig), cal, camera_table(rig),
-                                      prior or None)
+                                      sampson_pixel_scale(rig), cal if cal.any() else None,
+                                      camera_table(rig), prior or None)
         m.info.setdefault("sampler", name)
         if keep is None:
             inl = np.asarray(m.inliers, bool).copy()

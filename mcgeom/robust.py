@@ -930,12 +930,14 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     if out["refinement"] is not None:
         used = out["used"]
         w = out["weights"][used]
+        # (w.max() == w.min(): np.ptp's Python layers cost more than its two passes)
         fit = (out["refinement"], used, out["loss_scale"],
-               None if focal is None or np.ptp(w) == 0 else w)
+               None if focal is None or w.size == 0 or w.max() == w.min() else w)
     # the RMS residual of the inliers and the verdict's evidence come from C
     # (no Python pass over the rays: issue 19)
     return _conclude(rays, R, t, None, inl, fit, out["loss_scale"],
-                     float(np.linalg.norm(out["t_hypothesis"])), options, method, info, t_start,
+                     math.sqrt(float(out["t_hypothesis"] @ out["t_hypothesis"])), options, method,
+                     info, t_start,
                      out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
                      c_ids=(cam1, cam2, n_cameras, out["mask"]),
                      zero_profile=float(out["zero_profile"]))
