@@ -97,6 +97,17 @@ def _work(size: int) -> np.ndarray:
     return np.empty(max(int(size), 1), dtype=np.float64)
 
 
+def _weights(weights: Any, n: int) -> tuple[Optional[np.ndarray], Any]:
+    """``weights`` (None, or (n,) values >= 0) as (array, pointer); NULL for None.
+    The array is returned so that it outlives the call that reads the pointer."""
+    if weights is None:
+        return None, ffi.NULL
+    w = _arr("weights", weights, (n,))
+    if (w < 0).any():
+        raise ValueError("weights must be >= 0")
+    return w, _p(w)
+
+
 def _first_zero_row(a: np.ndarray) -> Optional[int]:
     """Index of the first row of ``a`` with (numerically) zero length, or None."""
     bad = np.flatnonzero(np.einsum("ij,ij->i", a, a) <= 1e-200)
@@ -700,12 +711,7 @@ def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
     opt.fix_scale = 1 if fix_scale else 0
     if fix_scale and not np.linalg.norm(t) > 0:
         raise ValueError("fix_scale needs a non-zero t0 (the sphere |t| = |t0| to stay on)")
-    w_ptr = ffi.NULL
-    if weights is not None:
-        w = _arr("weights", weights, (n,))
-        if (w < 0).any():
-            raise ValueError("weights must be >= 0")
-        w_ptr = _p(w)
+    w, w_ptr = _weights(weights, n)
     res = ffi.new("mcg_refine_result *")
     st = lib.mcg_refine_motion(n, *map(_p, rays), w_ptr, opt, _p(R), _p(t), res)
     if st != lib.MCG_OK:
@@ -1529,12 +1535,7 @@ def calibration_scale_std(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, 
     m = sig.shape[0]
     c1, c2 = _camera_id_arrays(cam1, cam2, n, m)
     Rm, tv = _f64("R", R, (3, 3)), _f64("t", t, (3,))
-    w_ptr = ffi.NULL
-    if weights is not None:
-        w = _arr("weights", weights, (n,))
-        if (w < 0).any():
-            raise ValueError("weights must be >= 0")
-        w_ptr = _p(w)
+    w, w_ptr = _weights(weights, n)
     if not isinstance(loss, str) or loss not in LOSS_NAMES:
         raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
     if (sig < 0).any():
