@@ -241,12 +241,14 @@ def _bench_robust(args: argparse.Namespace) -> int:
           f"PoseLib estimate_generalized_relative_pose, {_problems(args)} problems per case, "
           f"1 px threshold; medians")
     print(f"{'case':<22} {'method':<19} {'rot deg':>8} {'scale err':>9} {'ms':>7} "
-          f"{'mcgeom/this':>11} {'outside C':>9}")
+          f"{'mcgeom/this':>11} {'outside C':>9} {'mcgeom better rot/scale (paired)':>32}")
     ms = {(r.case, r.method): r.ms for r in rows}
     for r in rows:
         out = "" if r.method != "mcgeom" else f"{100 * r.outside_c:8.0f}%"
+        paired = "" if r.method == "mcgeom" else \
+            f"{100 * r.mcgeom_rot_better:3.0f}% / {100 * r.mcgeom_scale_better:3.0f}%"
         print(f"{r.case:<22} {r.method:<19} {r.rot_deg:8.4f} {r.scale_err:9.4f} {r.ms:7.3f} "
-              f"{ms[(r.case, 'mcgeom')] / r.ms:10.2f}x {out:>9}")
+              f"{ms[(r.case, 'mcgeom')] / r.ms:10.2f}x {out:>9} {paired:>32}")
     print("\nscaling: 4-camera ring, 20 % outliers, rays in (mcgeom.robust.ransac)")
     print(f"{'N':>8} {'seconds':>8} {'us/corr':>8} {'peak MB':>8} {'input MB':>8} "
           f"{'peak/input':>10} {'rot deg':>8} {'inliers':>7} {'C ms':>9} {'outside C':>9}")

@@ -18,8 +18,10 @@ mcgeom runs :func:`mcgeom.cv.estimate` (pixels in, verdict out, threshold
 defaults. Printed per case and method: median rotation error (deg), median
 scale error ``| |t| / |t_true| - 1 |`` (mcgeom's metric estimate
 ``info["t_metric"]``, whatever its verdict), median wall time, the ratio of
-mcgeom's median time to each PoseLib setting, and the fraction of mcgeom's
-time spent outside the C entry point (``info["c_seconds"]``).
+mcgeom's median time to each PoseLib setting, the fraction of mcgeom's
+time spent outside the C entry point (``info["c_seconds"]``), and, paired
+per problem, how often mcgeom's rotation and scale errors are below each
+PoseLib setting's.
 
 Scaling: the robust estimate on 1e3 .. 1e6 correspondences of a 4-camera
 ring with 20 % outliers (rays in, :func:`mcgeom.robust.ransac`): seconds,
@@ -81,6 +83,12 @@ class SpeedRow:
     scale_err: float
     ms: float
     outside_c: float   # fraction of the time outside the C entry point (mcgeom only)
+    # paired, per problem: the fraction where mcgeom's rotation / scale error
+    # is below this method's (NaN on mcgeom's own row). A median over 100
+    # problems moves by several % between seeds; the paired count says which
+    # method is more accurate on the same data.
+    mcgeom_rot_better: float = float("nan")
+    mcgeom_scale_better: float = float("nan")
 
 
 def _errors(R, t, Rt, tt) -> tuple[float, float]:
@@ -121,11 +129,15 @@ def bench_speed(problems: int = 100, seed: int = 0,
                 err[meth].append(_errors(Re, te, R, t))
                 if opt is None:
                     outside.append(1.0 - m.info.get("c_seconds", 0.0) / dt)
+        own = np.array(err["mcgeom"])
         for meth in methods:
             e = np.array(err[meth])
+            mine = meth == "mcgeom"
+            better = (float("nan"), float("nan")) if mine else \
+                tuple(float(np.mean(own[:, j] < e[:, j])) for j in (0, 1))
             rows.append(SpeedRow(name, meth, float(np.median(e[:, 0])),
                                  float(np.median(e[:, 1])), 1e3 * float(np.median(secs[meth])),
-                                 float(np.median(outside)) if meth == "mcgeom" else float("nan")))
+                                 float(np.median(outside)) if mine else float("nan"), *better))
     return rows
 
 
