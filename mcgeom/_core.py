@@ -1505,6 +1505,8 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
         "n_in_front": out.n_in_front,
         "t_direction": np.frombuffer(ffi.buffer(out.t_direction), dtype=np.float64).copy(),
     }
+
+
 # ------------------------------------------------------ calibration_std.c
 
 __all__ += ["calibration_scale_std"]

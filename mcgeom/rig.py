@@ -671,8 +671,11 @@ class Rig:
         n = px1.shape[0]
         px = np.concatenate([px1, px2])
         ids = np.concatenate([ids1, ids2])
+        used = np.flatnonzero(np.bincount(ids, minlength=len(self.cameras)))
+        if self._plain[used].all():  # type: ignore[attr-defined]
+            return None  # only undistorted cameras used: the all-at-once pinhole path
         dirs = np.empty((2 * n, 3))
-        for i in np.flatnonzero(np.bincount(ids, minlength=len(self.cameras))):
+        for i in used:
             sel = np.flatnonzero(ids == i)
             dirs[sel] = self.cameras[i]._bearings_checked(px[sel], strict=False)
         # unit bearings have squared length 1 (NaN rows: no ray, fail too)

@@ -199,6 +199,11 @@ def test_distorted_pairs_in_one_call_per_camera_are_the_per_time_ones(model, sam
     for a, b in ((rays.dirs1, d1), (rays.dirs2, d2), (rays.origins1, o1), (rays.origins2, o2)):
         assert a.flags.c_contiguous and np.array_equal(a, b)
     assert rays.cam2 is not rays.cam1 and rays.origins2 is not rays.origins1
+    # only the undistorted camera 2 used: the all-at-once pinhole arithmetic
+    sel = np.flatnonzero((ids1 == 2) & (ids2 == 2))
+    assert sel.size >= 6
+    plain = drig.ray_pairs_prechecked(px1[sel], px2[sel], ids1[sel], ids2[sel])
+    assert np.array_equal(plain.dirs1, drig._rays_checked(ids1[sel], px1[sel], {})[1])
     far = px2.copy()
     far[9] = (1e300, 1e300) if model == "pinhole" else (1e7, 1e7)
     with pytest.raises(ValueError) as got:
