@@ -731,3 +731,29 @@ def test_pathological_nesting_is_a_value_error_not_a_crash(tmp_path, name, text)
     path.write_text(text)
     for fmt in (None,) + C.FORMATS:
         raises(str(path), C.load_rig, path, format=fmt)
+
+
+#: fuzz_calibration's finding in CI (fuzz/README.md, finding 17), reduced: two
+#: flow sequences over several lines, then a sequence item indented less than
+#: the mapping before it. OpenCV's FileStorage parser never returns on it.
+_OPENCV_HANG = ("%YAML:1.0\n"
+                "         data: [ -2.2204460492503131e-16, 0., -1.0000000000000002e+00, 0.,\n"
+                "             -2.2204460492503131e-16 ]\n"
+                "         datb: [ -1.6000000000000003e+00, -1.0000000000000001e-01,\n"
+                "             -9.5000000000000051e-01 ]\n"
+                "   -\n"
+                "      name: back\n")
+
+
+def test_yaml_that_hangs_opencvs_parser_is_refused_by_line(tmp_path):
+    """Refused with the line PyYAML stopped at, before OpenCV sees it (in a
+    child process with a time limit: the unfixed loader never returns)."""
+    import subprocess
+    path = tmp_path / "hang.yml"
+    path.write_text(_OPENCV_HANG)
+    code = ("import sys\nfrom mcgeom import io as C\n"
+            "try:\n    C.load_rig(sys.argv[1])\nexcept ValueError as e:\n    print(e)\n")
+    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                         text=True, timeout=120, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert f"{path}: line 6: malformed or truncated YAML" in out.stdout

@@ -60,6 +60,7 @@ from typing import Any
 
 import cv2
 import numpy as np
+import yaml
 
 from mcgeom.io._common import (IDENTITY_POSE, integer, make_camera, make_rig, read_text,
                                rotation, vector, describe_path)
@@ -134,6 +135,33 @@ def _max_nesting(text: str) -> int:
     return deepest
 
 
+_YAML_DIRECTIVE = re.compile(r"\A\s*%YAML[^\n]*(\n|\Z)")
+
+
+def _check_yaml_syntax(text: str, where: str) -> None:
+    """ValueError naming the line when PyYAML cannot read the YAML structure.
+
+    OpenCV's FileStorage parser can loop forever on malformed YAML (found by
+    fuzz_calibration in CI: two flow sequences spread over several lines,
+    then a sequence item indented less than the mapping before it; the call
+    never returns). The structure is read by PyYAML first (``compose``:
+    nodes only, so tags such as ``!!opencv-matrix`` need no constructor),
+    and a file it cannot read never reaches OpenCV. The ``%YAML:1.0``
+    directive, which PyYAML does not know, is left out."""
+    m = _YAML_DIRECTIVE.match(text)
+    skipped = text[:m.end()].count("\n") if m else 0
+    try:
+        for _ in yaml.compose_all(text[m.end():] if m else text, Loader=yaml.SafeLoader):
+            pass
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        at = f"line {mark.line + 1 + skipped}: " if mark is not None else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ValueError(f"{where}: {at}malformed or truncated YAML ({problem})") from None
+    except RecursionError:
+        raise ValueError(f"{where}: YAML nested too deeply to be a calibration file") from None
+
+
 def _read_filestorage(path: Any) -> dict:
     where = describe_path(path)
     text = read_text(path)
@@ -145,6 +173,8 @@ def _read_filestorage(path: Any) -> dict:
             or head.startswith("{")):
         raise ValueError(f"{where}: not an OpenCV FileStorage file (it must start with a "
                          f"'%YAML:1.0' or '%YAML 1.2' header, or '<?xml'; got {head[:20]!r})")
+    if head.startswith("%YAML"):
+        _check_yaml_syntax(text, where)
     try:
         fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
     except (cv2.error, SystemError) as exc:
