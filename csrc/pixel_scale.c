@@ -23,6 +23,9 @@
 #define MAX_PAIRS (1 << 26)
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction */
 
+/* (MCG_AVX2_CLONE, internal.h: the same bits, a quarter fewer instructions
+ * on an AVX2 CPU; issue 19) */
+MCG_AVX2_CLONE
 int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const double *o2,
                             const double *d2, const double R[9], const double t[3],
                             const double *axis1, const double *axis2, const double *f1,
