@@ -76,19 +76,16 @@
 
 /* ------------------------------------------------------------- residuals */
 
+/* The pass itself, cloned for AVX2 (MCG_AVX2_CLONE). It is static behind a
+ * plain mcg_gec_residuals: a cloned public function would export its ifunc
+ * resolver too (mcg_gec_residuals.resolver), and libmcgeom.so exports the
+ * functions of mcgeom.h and nothing else (.ci/c_checks). */
 MCG_AVX2_CLONE
-int mcg_gec_residuals(int n, const double *o1, const double *d1,
-                      const double *o2, const double *d2, const double R[9],
-                      const double t[3], double *res)
+static int gec_residuals(int n, const double *o1, const double *d1, const double *o2,
+                         const double *d2, const double R[9], const double t[3],
+                         double *res)
 {
     int k, bad = 0;
-
-    if (!o1 || !d1 || !o2 || !d2 || !R || !t || !res)
-        return MCG_EINVAL;
-    if (n < 0 || n > MAX_RAYS)
-        return MCG_EINVAL;
-    if (!all_finite(R, 9) || !all_finite(t, 3))
-        return MCG_EINVAL;
 
     /* One branch-free pass: one square root and one division per pair. */
     for (k = 0; k < n; k++) {
@@ -101,6 +98,19 @@ int mcg_gec_residuals(int n, const double *o1, const double *d1,
     if (bad)
         return MCG_EINVAL;
     return MCG_OK;
+}
+
+int mcg_gec_residuals(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2, const double R[9],
+                      const double t[3], double *res)
+{
+    if (!o1 || !d1 || !o2 || !d2 || !R || !t || !res)
+        return MCG_EINVAL;
+    if (n < 0 || n > MAX_RAYS)
+        return MCG_EINVAL;
+    if (!all_finite(R, 9) || !all_finite(t, 3))
+        return MCG_EINVAL;
+    return gec_residuals(n, o1, d1, o2, d2, R, t, res);
 }
 
 /* ------------------------------------------------------ one evaluation */

@@ -479,10 +479,13 @@ REFINE_STOP_NAMES = {
 def _f64(name: str, a: Any, shape: tuple) -> np.ndarray:
     """:func:`_arr` without the finiteness pass (the kernels check it), with a
     fast path for arrays that are already float64, C-contiguous and shaped."""
-    if (type(a) is np.ndarray and a.dtype == np.float64 and a.flags.c_contiguous
-            and a.ndim == len(shape)
-            and all(s == -1 or s == d for s, d in zip(shape, a.shape))):
-        return a
+    if type(a) is np.ndarray and a.dtype == np.float64 and a.flags.c_contiguous:
+        # (tuple comparisons: a generator over the axes cost more than the
+        # rest of this check; -1 is only ever the first axis)
+        have = a.shape
+        if have == shape or (shape[0] == -1 and len(have) == len(shape)
+                             and have[1:] == shape[1:]):
+            return a
     return _arr(name, a, shape, check_finite=False)
 
 
@@ -1330,13 +1333,13 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         f_ptr = _p(f)
     if (cam_axes is None) != (cam_focal is None):
         raise ValueError("cam_axes and cam_focal go together (both or neither)")
+    ax = cf = None
     if cam_axes is not None:
         if focal is None:
             raise ValueError("cam_axes and cam_focal need focal (thresholds in pixels)")
-        ax = _arr("cam_axes", cam_axes, (int(n_cameras), 3))
-        cf = _arr("cam_focal", cam_focal, (int(n_cameras),))
-        if not (cf > 0).all():
-            raise ValueError("cam_focal must be > 0 (pixels)")
+        # (finiteness and sign: the kernel's checks, named on its error path)
+        ax = _f64("cam_axes", cam_axes, (int(n_cameras), 3))
+        cf = _f64("cam_focal", cam_focal, (int(n_cameras),))
         ax_ptr, cf_ptr = _p(ax), _p(cf)
     if not isinstance(loss, str) or loss not in LOSS_NAMES:
         raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
@@ -1402,6 +1405,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
             _camera_id_error(ids, int(n_cameras))
             if f is not None and not (np.isfinite(f).all() and (f > 0).all()):
                 raise ValueError("focal must be finite and > 0 (pixels per radian)")
+            if ax is not None and not np.isfinite(ax).all():
+                raise ValueError("cam_axes contains NaN or inf")
+            if cf is not None and not (np.isfinite(cf).all() and (cf > 0).all()):
+                raise ValueError("cam_focal must be finite and > 0 (pixels)")
         _ray_error(st, "robust_rig_motion", rays)
     R = np.frombuffer(ffi.buffer(res.R), dtype=np.float64).reshape(3, 3).copy()
     t = np.frombuffer(ffi.buffer(res.t), dtype=np.float64).copy()

@@ -85,11 +85,20 @@ def test_no_camera_with_five_pairs_is_degenerate():
     (dict(max_seconds=float("nan")), "max_seconds"),
     (dict(focal=-1.0), "focal"),
     (dict(cam_axes=np.zeros((6, 3))), "cam_axes"),
+    # (finiteness and sign of the per-camera axes and focal lengths are the
+    # kernel's checks; the error path names them)
+    (dict(cam_axes=np.full((6, 3), np.nan), cam_focal=np.full(6, 800.0)),
+     "cam_axes contains NaN"),
+    (dict(cam_axes=np.tile([0.0, 0.0, 1.0], (6, 1)),
+          cam_focal=np.array([800.0, 0.0, 800.0, 800.0, 800.0, 800.0])),
+     "cam_focal must be finite and > 0"),
+    (dict(cam_axes=np.tile([0.0, 0.0, 1.0], (6, 1)), cam_focal=np.full(6, np.inf)),
+     "cam_focal must be finite and > 0"),
 ])
 def test_bad_arguments_are_named(kw, name):
     rig, p, R, t = _problem(7, n=60)
-    if "focal" in kw:
-        kw = dict(kw, focal=np.full(len(p.rays), kw["focal"]))
+    if "focal" in kw or "cam_focal" in kw:
+        kw = dict(kw, focal=np.full(len(p.rays), kw.get("focal", 800.0)))
     with pytest.raises(ValueError, match=name):
         _call(p.rays, **kw)
 
