@@ -230,6 +230,67 @@ static void loss_eval(const lossfn *l, double z, double *rho, double *drho)
 /* Below this u = r^2 / s^2 a term's log1p(u) is its series to u^4 (error
  * < u^5 / 5 < 1e-17 u), above it a factor of the block's product. */
 #define CAUCHY_SERIES 5e-4
+/* 1 + u above this is left to log1p per pair (log_ge1 needs a finite normal
+ * argument; a residual this large is an outlier whose cost is anyway flat) */
+#define LOG_GE1_MAX 1e300
+
+/* The bits of a double and back. For doubles >= 0 (and +inf, NaN above all)
+ * the order of the bits as unsigned integers is that of the values: the
+ * comparisons of log_ge1 and cauchy_block are made on the bits, as integer
+ * selects (a floating-point compare-and-select kept GCC from vectorising
+ * the loop under its default -ftrapping-math). */
+static inline uint64_t bits_of(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+static inline double of_bits(uint64_t b)
+{
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* 1.0 where the integer condition c holds, else 0.0, without a branch */
+static inline double one_if(int c)
+{
+    return of_bits(-(uint64_t)(c != 0) & bits_of(1.0));
+}
+
+/* log(x) for finite x >= 1 in a form the vectoriser takes (log1p is a call
+ * per pair): x = m 2^e with m in [sqrt(1/2), sqrt(2)), log m = 2 atanh(s),
+ * s = (m - 1) / (m + 1), |s| <= 0.1716, by its series to s^21 (the next
+ * term is below 3e-17 of the sum), plus e log 2. The exponent goes to a
+ * double by the 2^52 bias trick (integer ops only: AVX2 has no int64 ->
+ * double conversion). Relative error a few 1e-16 (tested against log by
+ * csrc/tests/test_refine.c through the Cauchy cost), far below the 2.2e-13
+ * of a term that the cost's other shortcut already accepts (cauchy_block). */
+static inline double log_ge1(double x)
+{
+    const uint64_t b = bits_of(x);
+    double m = of_bits((b & 0x000FFFFFFFFFFFFFull) | bits_of(1.0)); /* [1, 2) */
+    double e = of_bits((b >> 52) | bits_of(4503599627370496.0));   /* 2^52 + biased e */
+    const double big = one_if(bits_of(m) > bits_of(1.4142135623730951)); /* m > sqrt 2 */
+    double z, s, p;
+    m *= 1.0 - 0.5 * big;
+    e = e - (4503599627370496.0 + 1023.0) + big;
+    s = (m - 1.0) / (m + 1.0);
+    z = s * s;
+    p = 1.0 / 21.0;
+    p = p * z + 1.0 / 19.0;
+    p = p * z + 1.0 / 17.0;
+    p = p * z + 1.0 / 15.0;
+    p = p * z + 1.0 / 13.0;
+    p = p * z + 1.0 / 11.0;
+    p = p * z + 1.0 / 9.0;
+    p = p * z + 1.0 / 7.0;
+    p = p * z + 1.0 / 5.0;
+    p = p * z + 1.0 / 3.0;
+    p = p * z + 1.0;
+    return e * 0.69314718055994530942 + 2.0 * s * p;
+}
 
 /* The Cauchy loss of nb <= BLK residuals rb (weights wts, NULL = 1): the
  * IRLS weights ob = w / (1 + u), u = r^2 / s^2 (thesis ch. 8.5's robust
@@ -242,9 +303,9 @@ static void loss_eval(const lossfn *l, double z, double *rho, double *drho)
  * <= 2.2e-13 of its term, is far below the cost differences LM decides
  * on), plus the series u - u^2/2 + u^3/3 - u^4/4 of the smaller ones
  * (where 1 + u would lose u's digits); a block of equal weights (all 1
- * when none are given, the common case) is that times its weight. A
- * product that overflows (huge u), unequal weights or a NaN take log1p
- * per pair. */
+ * when none are given, the common case) is that times its weight;
+ * unequal weights take the series or log_ge1 per pair. A residual beyond
+ * LOG_GE1_MAX, an overflowing product or a NaN take log1p per pair. */
 MCG_AVX2_CLONE
 static double cauchy_block(int nb, const double *restrict rb, const double *restrict wts,
                            const double *restrict okb, const lossfn *restrict l,
@@ -274,6 +335,28 @@ static double cauchy_block(int nb, const double *restrict rb, const double *rest
     *used_n += used;
     if (same && prod < DBL_MAX && series == series) /* (prod >= 1 or NaN) */
         return w0 * l->s2 * (series + log(prod));
+    if (wts) {
+        /* unequal weights (the pixel scaling of the final refinement: every
+         * pair its own): the same split per pair, log(1 + u) by log_ge1
+         * (log1p per pair was ~9 % of a façade call's instructions) */
+        double term[BLK], acc = 0.0;
+        int fine = 1;
+        /* the terms elementwise (this loop vectorises; a sum in it would not,
+         * as floating-point addition is not associative), then their sum */
+        for (k = 0; k < nb; k++) {
+            /* (u >= 0 or NaN: the comparisons on the bits, see bits_of) */
+            const double u = rb[k] * rb[k] * l->inv_s2;
+            const double small = one_if(bits_of(u) < bits_of(CAUCHY_SERIES));
+            const double x = 1.0 + (1.0 - small) * u; /* log_ge1(1) = 0 exactly */
+            fine &= bits_of(u) < bits_of(LOG_GE1_MAX); /* (NaN, inf: 0) */
+            term[k] = wts[k] * (small * u * (1.0 - u * (0.5 - u * (1.0 / 3.0 - 0.25 * u))) +
+                                log_ge1(x));
+        }
+        for (k = 0; k < nb; k++)
+            acc += term[k];
+        if (fine)
+            return l->s2 * acc;
+    }
     series = 0.0;
     for (k = 0; k < nb; k++)
         series += (wts ? wts[k] : 1.0) * log1p(rb[k] * rb[k] * l->inv_s2);

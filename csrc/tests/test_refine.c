@@ -6,7 +6,8 @@
  * the analytic Jacobian against finite differences (through the information
  * matrix and the Gauss-Newton step), exact recovery from perturbed starts on
  * noise-free data of a 4-camera rig, robust losses with 30 % gross outliers,
- * fix_scale, the critical-motion evidence, and the status codes of invalid
+ * the weighted Cauchy cost against log1p, fix_scale, the critical-motion
+ * evidence, and the status codes of invalid
  * arguments. Timings are printed, not asserted.
  * Exit status 0 iff every check passes.
  */
@@ -510,6 +511,47 @@ static void test_robust(void)
            "translation error %.3g m)\n", err_none, terr_none);
 }
 
+/* The Cauchy cost with unequal weights (refine.c's cauchy_block takes its
+ * logarithms from its own vectorisable log there, not from log1p): the
+ * initial cost of mcg_refine_motion (max_iterations = 0) against
+ * sum w s^2 log1p(r^2 / s^2) from mcg_gec_residuals and libm here, for loss
+ * scales that put the residuals of 30 % outliers and of a perturbed motion
+ * on both sides of the series cut, and across many octaves of 1 + u. */
+static void test_cauchy_cost(void)
+{
+    static const double scales[4] = {1e-6, 1e-3, 3e-2, 1.0};
+    double r[9], t[3] = {0.3, -0.35, 0.2}, rs[9], ts[3], w[3] = {0.01, -0.02, 0.015};
+    double dt[3] = {0.04, 0.02, -0.03}, res[NMAX], wt[NMAX];
+    mcg_refine_options opt;
+    mcg_refine_result rr;
+    char what[128];
+    int n = 300, k, j, st;
+    random_rotation(0.25, r);
+    make_rays(n, 1, r, t, o1, d1, o2, d2);
+    add_outliers(n, 0.3, d2);
+    perturb(r, t, w, dt, rs, ts);
+    for (k = 0; k < n; k++)
+        wt[k] = 0.25 + 2.0 * urand();
+    st = mcg_gec_residuals(n, o1, d1, o2, d2, rs, ts, res);
+    check(st == MCG_OK, "residuals for the Cauchy cost", 0.0, 0.0);
+    for (j = 0; j < 4; j++) {
+        double s = scales[j], ref = 0.0, rel;
+        double R0[9], t0[3];
+        memcpy(R0, rs, sizeof R0);
+        memcpy(t0, ts, sizeof t0);
+        for (k = 0; k < n; k++)
+            ref += wt[k] * s * s * log1p(res[k] * res[k] / (s * s));
+        mcg_refine_default_options(&opt);
+        opt.loss = MCG_LOSS_CAUCHY;
+        opt.loss_scale = s;
+        opt.max_iterations = 0;
+        st = mcg_refine_motion(n, o1, d1, o2, d2, wt, &opt, R0, t0, &rr);
+        rel = fabs(rr.initial_cost - ref) / ref;
+        snprintf(what, sizeof what, "weighted Cauchy cost, s = %g: relative error vs log1p", s);
+        check(st == MCG_OK && rel < 1e-13, what, rel, 1e-13);
+    }
+}
+
 static void test_fix_scale(void)
 {
     double r[9], t[3] = {0.3, 0.1, -0.2}, rs[9], ts[3], w[3] = {0.01, 0.02, -0.01};
@@ -760,6 +802,7 @@ int main(void)
     run_recovery("4-camera rig, cross-camera rays", 1, 0.05, 0.1);
     run_recovery("4-camera rig, far start (0.3 rad, 50% t)", 1, 0.3, 0.5);
     test_robust();
+    test_cauchy_cost();
     test_fix_scale();
     test_invalid();
     test_budget();
