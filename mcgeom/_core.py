@@ -11,6 +11,7 @@ sees a pointer.
 from __future__ import annotations
 
 import importlib.util
+import math
 import os
 from pathlib import Path
 from typing import Any, Optional
@@ -1359,13 +1360,13 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi:
             raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
         setattr(opt, name, int(v))
-    if not (np.isfinite(opt.threshold) and opt.threshold > 0):
+    if not (math.isfinite(opt.threshold) and opt.threshold > 0):
         raise ValueError(f"threshold must be a finite number > 0, got {threshold!r}")
     if not 0.0 < opt.prob < 1.0:
         raise ValueError(f"prob must be in (0, 1), got {prob!r}")
-    if not (np.isfinite(opt.max_seconds) and 0.0 <= opt.max_seconds <= 1e9):
+    if not (math.isfinite(opt.max_seconds) and 0.0 <= opt.max_seconds <= 1e9):
         raise ValueError(f"max_seconds must be in [0, 1e9] (0: no limit), got {max_seconds!r}")
-    if not (np.isfinite(opt.max_scale_rel_std) and 0.0 <= opt.max_scale_rel_std <= 10.0):
+    if not (math.isfinite(opt.max_scale_rel_std) and 0.0 <= opt.max_scale_rel_std <= 10.0):
         raise ValueError(f"max_scale_rel_std must be in [0, 10], got {max_scale_rel_std!r}")
     if opt.min_iterations > opt.max_iterations:
         raise ValueError(f"min_iterations {min_iterations} exceeds max_iterations "

@@ -23,6 +23,7 @@ The verdict is "observable" when the statistics say so (relative std at most
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -284,12 +285,12 @@ def _verdict(n_in: int, n_cross: int, n_centres: int, crit: float, rel_std: floa
                                    f"{_MOTION_DOF} unknowns of the motion; other exact "
                                    "solutions may exist and no uncertainty can be estimated",
                             float("nan"), float("inf"), crit)
-    evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {np.degrees(crit):.3g} deg "
+    evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {math.degrees(crit):.3g} deg "
                 f"over {n_centres} cameras, {n_cross} cross-camera inliers")
-    if np.isfinite(profile):
+    if math.isfinite(profile):
         evidence += f", |t| x/ {1 + 3 * max_rel_std:.2g} excluded at {np.sqrt(profile):.2g} sigma"
-    if (direction_only or not np.isfinite(rel_std) or rel_std > max_rel_std
-            or (np.isfinite(profile) and profile < 9.0)):
+    if (direction_only or not math.isfinite(rel_std) or rel_std > max_rel_std
+            or (math.isfinite(profile) and profile < 9.0)):
         if n_cross == 0 and n_centres < 2:
             why = "one camera only and no cross-camera correspondence"
         elif n_cross == 0 and crit < np.radians(0.05):

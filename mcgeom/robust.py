@@ -667,7 +667,7 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         info.update(parts)
     info.update(inlier_ratio=float(_ratio(inl)), time_s=time.perf_counter() - t_start)
     if fit is not None and rel_std <= options.max_scale_rel_std:
-        if given is not None and np.isfinite(given):
+        if given is not None and math.isfinite(given):
             profile = float(given)
         else:
             k = 1.0 + 3.0 * options.max_scale_rel_std
@@ -721,7 +721,7 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         zero = float("nan")
         if fit is not None and not slid and scale_determined(rel_std):
             zero = zero_profile
-            if not np.isfinite(zero):
+            if not math.isfinite(zero):
                 zero = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
                                      (ZERO_FACTOR,), options.loss, scale_used, w_used)
         if slid or not scale_determined(rel_std, zero_profile=zero):
