@@ -230,6 +230,14 @@ static void loss_eval(const lossfn *l, double z, double *rho, double *drho)
 /* Below this u = r^2 / s^2 a term's log1p(u) is its series to u^4 (error
  * < u^5 / 5 < 1e-17 u), above it a factor of the block's product. */
 #define CAUCHY_SERIES 5e-4
+/* log1p(u) for 0 <= u < CAUCHY_SERIES by its series to u^4. The callers
+ * pass small * u (0 above the cut): the series of a large u overflows
+ * (u^4 > DBL_MAX from u ~ 1e77, and 0 * inf is NaN). */
+static inline double cauchy_series(double u)
+{
+    return u * (1.0 - u * (0.5 - u * (1.0 / 3.0 - 0.25 * u)));
+}
+
 /* 1 + u above this is left to log1p per pair (log_ge1 needs a finite normal
  * argument; a residual this large is an outlier whose cost is anyway flat) */
 #define LOG_GE1_MAX 1e300
@@ -325,7 +333,7 @@ static double cauchy_block(int nb, const double *restrict rb, const double *rest
         c += om;
         d += om * z;
         used += okb[k] != 0.0 && w > 0.0;
-        series += small * u * (1.0 - u * (0.5 - u * (1.0 / 3.0 - 0.25 * u)));
+        series += cauchy_series(small * u);
         prod *= small != 0.0 ? 1.0 : 1.0 + u;
     }
     *sw += a;
@@ -349,8 +357,7 @@ static double cauchy_block(int nb, const double *restrict rb, const double *rest
             const double small = one_if(bits_of(u) < bits_of(CAUCHY_SERIES));
             const double x = 1.0 + (1.0 - small) * u; /* log_ge1(1) = 0 exactly */
             fine &= bits_of(u) < bits_of(LOG_GE1_MAX); /* (NaN, inf: 0) */
-            term[k] = wts[k] * (small * u * (1.0 - u * (0.5 - u * (1.0 / 3.0 - 0.25 * u))) +
-                                log_ge1(x));
+            term[k] = wts[k] * (cauchy_series(small * u) + log_ge1(x));
         }
         for (k = 0; k < nb; k++)
             acc += term[k];

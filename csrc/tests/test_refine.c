@@ -516,10 +516,11 @@ static void test_robust(void)
  * initial cost of mcg_refine_motion (max_iterations = 0) against
  * sum w s^2 log1p(r^2 / s^2) from mcg_gec_residuals and libm here, for loss
  * scales that put the residuals of 30 % outliers and of a perturbed motion
- * on both sides of the series cut, and across many octaves of 1 + u. */
+ * on both sides of the series cut, and across many octaves of 1 + u (up to
+ * u ~ 1e120 at s = 1e-60, where the series of u itself would overflow). */
 static void test_cauchy_cost(void)
 {
-    static const double scales[4] = {1e-6, 1e-3, 3e-2, 1.0};
+    static const double scales[5] = {1e-60, 1e-6, 1e-3, 3e-2, 1.0};
     double r[9], t[3] = {0.3, -0.35, 0.2}, rs[9], ts[3], w[3] = {0.01, -0.02, 0.015};
     double dt[3] = {0.04, 0.02, -0.03}, res[NMAX], wt[NMAX];
     mcg_refine_options opt;
@@ -534,7 +535,7 @@ static void test_cauchy_cost(void)
         wt[k] = 0.25 + 2.0 * urand();
     st = mcg_gec_residuals(n, o1, d1, o2, d2, rs, ts, res);
     check(st == MCG_OK, "residuals for the Cauchy cost", 0.0, 0.0);
-    for (j = 0; j < 4; j++) {
+    for (j = 0; j < 5; j++) {
         double s = scales[j], ref = 0.0, rel;
         double R0[9], t0[3];
         memcpy(R0, rs, sizeof R0);
