@@ -23,19 +23,6 @@
 #define MAX_PAIRS (1 << 26)
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction */
 
-static int pixel_scale(int n, const double *o1, const double *d1, const double *o2,
-                       const double *d2, const double R[9], const double t[3],
-                       const double *axis1, const double *axis2, const double *f1,
-                       const double *f2, double min_var_ratio, double *scale);
-
-int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const double *o2,
-                            const double *d2, const double R[9], const double t[3],
-                            const double *axis1, const double *axis2, const double *f1,
-                            const double *f2, double min_var_ratio, double *scale)
-{
-    return pixel_scale(n, o1, d1, o2, d2, R, t, axis1, axis2, f1, f2, min_var_ratio, scale);
-}
-
 /* (MCG_AVX2_CLONE, internal.h: the same bits, a quarter fewer instructions
  * on an AVX2 CPU; issue 19. Static behind the plain public function: a
  * cloned public function would export its ifunc resolver too, and
@@ -101,4 +88,12 @@ static int pixel_scale(int n, const double *o1, const double *d1, const double *
         scale[k] = var > min_var_ratio * (n1 + n2) && isfinite(x) ? sqrt(x) : 0.0;
     }
     return MCG_OK;
+}
+
+int mcg_sampson_pixel_scale(int n, const double *o1, const double *d1, const double *o2,
+                            const double *d2, const double R[9], const double t[3],
+                            const double *axis1, const double *axis2, const double *f1,
+                            const double *f2, double min_var_ratio, double *scale)
+{
+    return pixel_scale(n, o1, d1, o2, d2, R, t, axis1, axis2, f1, f2, min_var_ratio, scale);
 }
