@@ -101,6 +101,12 @@ def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) ->
 
 
 def _points(name: str, p: Any) -> np.ndarray:
+    if type(p) is np.ndarray and p.dtype == np.float64 and p.ndim == 2 and p.shape[1] == 2 \
+            and p.flags.c_contiguous:
+        # already what the checks below make of it (one finiteness pass left)
+        if not np.isfinite(p).all():
+            raise ValueError(f"{name} contains NaN or inf")
+        return p
     try:
         a = np.asarray(p)
     except ValueError as exc:   # ragged nested lists
@@ -114,7 +120,7 @@ def _points(name: str, p: Any) -> np.ndarray:
     if a.ndim != 2 or a.shape[1] != 2:
         raise ValueError(f"{name} must have shape (N, 2) or (N, 1, 2), got {a.shape}")
     a = np.ascontiguousarray(a, dtype=np.float64)
-    if not np.all(np.isfinite(a)):
+    if not np.isfinite(a).all():
         raise ValueError(f"{name} contains NaN or inf")
     return a
 
@@ -126,10 +132,13 @@ def _ids(name: str, ids: Any, n: int, rig: Rig) -> np.ndarray:
     if n == 0:                                     # [] is float64 for numpy
         return np.zeros(0, np.int64)
     a = integral_camera_ids(name, a)   # the one rule of Rig.ray_pairs and RayPairs
-    bad = (a < 0) | (a >= len(rig.cameras))
-    if bad.any():
+    m = len(rig.cameras)
+    # (two reductions; the mask of the offenders only to name the first)
+    if a.min() < 0 or a.max() >= m:
+        bad = (a < 0) | (a >= m)
         raise ValueError(f"{name} holds camera id {int(a[bad][0])}, but the rig has cameras "
-                         f"0..{len(rig.cameras) - 1}")
+                         f"0..{m - 1}")
+    # (a copy: the rays keep the ids, not the caller's array)
     return a.astype(np.int64)
 
 
@@ -208,7 +217,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         raise ValueError(f"points2 has {p2.shape[0]} points but points1 has {n}")
     ids1 = _ids("cameraIds1", cameraIds1, n, rig)
     ids2 = ids1 if cameraIds2 is None else _ids("cameraIds2", cameraIds2, n, rig)
-    use = np.ones(n, bool)
+    use = None     # (no mask: every correspondence)
     if mask is not None:
         m = np.asarray(mask).reshape(-1)
         if m.shape[0] != n:
@@ -230,7 +239,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     # rig), in one C pass for a pinhole rig (issue 19)
     rays_all, focal_all = ray_pairs_per_radian(rig, p1, p2, ids1, ids2)
     # without a mask every correspondence is used: no copy of the rays
-    keep = None if use.all() else np.flatnonzero(use)
+    keep = None if use is None or use.all() else np.flatnonzero(use)
     rays = rays_all if keep is None else rays_all.take(keep)
     if run_robust and method == RIG_5P1_RANSAC:
         name = choose_sampler(rays.cam1, rays.cam2)   # (the used correspondences')
@@ -262,7 +271,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         if "calibration_std" in registry.get(name).options:
             options = {"calibration_std": cal, **options}
         m = registry.get(name)(rays, **options)
-        inl = use.copy()
+        inl = np.ones(n, bool) if use is None else use.copy()
     return RigMotion(m.R, m.t, m.scale, m.method, m.residual_rms, inl, m.info)
 
 

@@ -30,6 +30,7 @@ from typing import Any, Callable, Iterable, Optional, Protocol, Union
 
 import numpy as np
 
+from .errors import DegenerateError
 from .types import RayPairs, RigMotion
 
 __all__ = [
@@ -201,6 +202,11 @@ def _first_rows_distinct(rays: RayPairs, need: int) -> bool:
     distinct ones: the common case answered by one (need, need) comparison
     instead of a sort (issue 19: the robust façade asks this of every
     problem)."""
+    # first one column: rows whose first time-1 direction components already
+    # differ pairwise are distinct (one slice and a set of ``need`` floats;
+    # the whole rows only when two of those components are equal)
+    if len(set(rays.dirs1[:need, 0].tolist())) == need:
+        return True
     cols = [a[:need] for a in (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)]
     cols += [ids[:need, None] for ids in (rays.cam1, rays.cam2) if ids is not None]
     r = np.concatenate(cols, axis=1, dtype=np.float64)
@@ -215,7 +221,6 @@ def check_distinct(rays: RayPairs, need: int, name: str) -> None:
     than ``need`` (the minimal sample): copies of one correspondence constrain
     no more than it does, and estimators would otherwise return a motion the
     data do not determine (or search for one at length)."""
-    from .errors import DegenerateError
     if not isinstance(rays, RayPairs) or len(rays) < need:
         return  # the estimator's own checks name the problem
     if _first_rows_distinct(rays, need):
