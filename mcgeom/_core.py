@@ -1285,7 +1285,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                       max_seconds: float = 0.0, seed: int = 0, lo_rounds: int = 2,
                       refine: bool = True, loss: str = "cauchy",
                       max_scale_rel_std: float = 0.0, sampler: str = "five_plus_one",
-                      gravity1: Any = None, gravity2: Any = None) -> Optional[dict]:
+                      gravity1: Any = None, gravity2: Any = None,
+                      prechecked: bool = False) -> Optional[dict]:
     """The whole robust estimate in C (``mcg_robust_rig_motion``).
 
     Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins the
@@ -1320,17 +1321,29 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     :func:`mcgeom.observability.scale_determined`), ``inlier_rms`` (RMS residual of the
     inliers, pixels with ``focal``, else radians), ``mask`` (N,) uint8 (bit 0
     inlier, bit 1 used).
-    Raises ValueError naming the bad argument.
+    Raises ValueError naming the bad argument. ``prechecked``: the caller
+    made the arrays itself (:func:`mcgeom.robust.ransac_prechecked`): the
+    rays (N, 3) and ``focal`` (N,) float64 C-contiguous, ``cam1``/``cam2``
+    (N,) int32 C-contiguous, N in 6..2^26, ``n_cameras`` an int in
+    1..4096; their shapes and types are then not checked again (their
+    values still are, by the kernel).
     """
-    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
-    n = rays[0].shape[0]
-    ids = _camera_id_arrays(cam1, cam2, n, n_cameras)
+    if prechecked:
+        rays = (origins1, dirs1, origins2, dirs2)
+        n = origins1.shape[0]
+        if not 6 <= n <= 1 << 26:
+            raise ValueError(f"origins1 has {n} rows, 6 to 2^26 correspondences supported")
+        ids = (cam1, cam2)
+    else:
+        rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+        n = rays[0].shape[0]
+        ids = _camera_id_arrays(cam1, cam2, n, n_cameras)
     f_ptr = ax_ptr = cf_ptr = ffi.NULL
     f = None
     if focal is not None:
         # finiteness and sign are checked by the kernel (no extra passes
         # here); the error path below names the argument
-        f = _arr("focal", focal, (n,), check_finite=False)
+        f = focal if prechecked else _arr("focal", focal, (n,), check_finite=False)
         f_ptr = _p(f)
     if (cam_axes is None) != (cam_focal is None):
         raise ValueError("cam_axes and cam_focal go together (both or neither)")
@@ -1463,7 +1476,8 @@ def _id_range_error(name: str, a: np.ndarray, n_cameras: int) -> None:
 # ------------------------------------------------------------- verdict.c
 
 def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: Any, cam2: Any,
-                  n_cameras: int, inliers: Any, R: Any, t: Any, still_angle: float) -> dict:
+                  n_cameras: int, inliers: Any, R: Any, t: Any, still_angle: float,
+                  prechecked: bool = False) -> dict:
     """The O(N) evidence of the scale verdict in one C call (``mcg_verdict_stats``).
 
     Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins
@@ -1478,16 +1492,23 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
     ``still_angle``), ``critical_angle`` (radians), ``n_in_front``
     (cheirality at (R, t)) and ``t_direction`` (unit direction of travel as
     :func:`mcgeom.estimators._common.travel_direction`). Raises ValueError
-    naming the bad argument.
+    naming the bad argument. ``prechecked``: as for :func:`robust_rig_motion`
+    (the rays float64 C-contiguous (N, 3), the ids int32 C-contiguous,
+    ``inliers`` the uint8 mask of that call, ``n_cameras`` an int in 1..4096).
     """
-    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
-    n = rays[0].shape[0]
-    c1, c2 = _camera_id_arrays(cam1, cam2, n, n_cameras)
-    m = np.asarray(inliers)
-    if m.shape != (n,) or m.dtype.kind not in "bu":
-        raise ValueError(f"inliers must be {n} booleans (or uint8 with bit 0 the inlier), "
-                         f"got shape {m.shape} and dtype {m.dtype}")
-    m = np.ascontiguousarray(m.view(np.uint8) if m.dtype == bool else m, dtype=np.uint8)
+    if prechecked:
+        rays = (origins1, dirs1, origins2, dirs2)
+        n = origins1.shape[0]
+        c1, c2, m = cam1, cam2, inliers
+    else:
+        rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+        n = rays[0].shape[0]
+        c1, c2 = _camera_id_arrays(cam1, cam2, n, n_cameras)
+        m = np.asarray(inliers)
+        if m.shape != (n,) or m.dtype.kind not in "bu":
+            raise ValueError(f"inliers must be {n} booleans (or uint8 with bit 0 the inlier), "
+                             f"got shape {m.shape} and dtype {m.dtype}")
+        m = np.ascontiguousarray(m.view(np.uint8) if m.dtype == bool else m, dtype=np.uint8)
     # (finiteness of R and t: the kernel checks it, the error path names them)
     Rm, tv = _f64("R", R, (3, 3)), _f64("t", t, (3,))
     if not (isinstance(still_angle, (int, float, np.floating)) and 0.0 <= still_angle < 4.0):

@@ -230,7 +230,8 @@ def _static_verdict(ang: np.ndarray) -> ScaleVerdict:
 def scale_verdict_stats(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int,
                         inliers: np.ndarray, R: np.ndarray, t: np.ndarray, rel_std: float,
                         max_rel_std: float = 0.1, noise_level: float = float("nan"),
-                        profile: float = float("nan")) -> tuple[ScaleVerdict, np.ndarray]:
+                        profile: float = float("nan"), prechecked: bool = False
+                        ) -> tuple[ScaleVerdict, np.ndarray]:
     """:func:`scale_verdict` with its O(N) evidence from one C call
     (``_core.verdict_stats``, csrc/verdict.c: the rotation-only fit and its
     angles, the cameras with intra-camera inliers, the critical angle, the
@@ -243,14 +244,16 @@ def scale_verdict_stats(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_ca
     (bit 0: inlier), (R, t) rig2_from_rig1 (metres); the other arguments as
     for :func:`scale_verdict`. The same verdict as :func:`scale_verdict` on
     these rays (all inliers: no subsample), without a Python pass over them
-    (issue 19). Returns ``(verdict, t_direction)``.
+    (issue 19). Returns ``(verdict, t_direction)``. ``prechecked``: ``cam1``,
+    ``cam2`` are int32 and ``inliers`` the uint8 mask of
+    :func:`mcgeom._core.robust_rig_motion` (see :func:`mcgeom._core.verdict_stats`).
     """
     still = NO_PARALLAX_FACTOR * noise_level if np.isfinite(noise_level) else 0.0
     if not 0.0 <= still < 4.0:
         # beyond any angle between two bearings: every angle is explained
         still = 3.5 if still >= 4.0 else 0.0
     s = _core.verdict_stats(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2,
-                            n_cameras, inliers, R, t, still)
+                            n_cameras, inliers, R, t, still, prechecked=prechecked)
     n_intra = s["n_intra"]
     if np.isfinite(noise_level) and noise_level > 0 and n_intra >= NO_PARALLAX_MIN:
         # the numpy fit decides where C's fit failed (the bearings span rank

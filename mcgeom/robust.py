@@ -123,7 +123,8 @@ def _focal_array(focal: Union[None, float, np.ndarray], n: int) -> Optional[np.n
     # min > 0 and max < inf: NaN fails both (two reductions, no temporaries)
     if f.shape != (n,) or (n and not (f.min() > 0 and f.max() < np.inf)):
         raise ValueError(f"focal must be a positive number or {n} positive numbers")
-    return f
+    # (C-contiguous: the C search takes it as it is, prechecked)
+    return np.ascontiguousarray(f)
 
 
 def residuals(rays: RayPairs, R: np.ndarray, t: np.ndarray,
@@ -680,7 +681,8 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         cam1, cam2, n_cameras, mask = c_ids
         verdict, direction = scale_verdict_stats(rays, cam1, cam2, n_cameras, mask, R, t,
                                                  rel_std, options.max_scale_rel_std,
-                                                 noise_level=noise_level, profile=profile)
+                                                 noise_level=noise_level, profile=profile,
+                                                 prechecked=cam1.dtype == np.int32)
     else:
         v_rays, v_inl = _verdict_sample(rays, inl, options.seed)
         verdict = scale_verdict(v_rays, v_inl, R, t, rel_std, options.max_scale_rel_std,
@@ -875,9 +877,13 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             raise ValueError(f"pixel_cameras describes {len(cam_focal)} cameras, the rays "
                              f"use camera ids up to {n_cameras - 1}")
         n_cameras = len(cam_focal)
-    if n_cameras <= _MAX_CAMERAS:
+    ids32 = n_cameras <= _MAX_CAMERAS
+    if ids32:
         # int32 once for both C calls (the search and the verdict's evidence);
-        # ids are >= 0 and below n_cameras here, so nothing wraps
+        # ids are >= 0 and below n_cameras here, so nothing wraps. The rays
+        # of a RayPairs are float64 C-contiguous (N, 3) and focal was checked
+        # (ransac_prechecked, _focal_array): the wrappers need not check
+        # their shapes and types again (prechecked)
         cam1, cam2 = cam1.astype(np.int32), cam2.astype(np.int32)
     intra = cam1 == cam2
     if method == "five_plus_one" and not np.bincount(cam1[intra], minlength=1).max(initial=0) >= 5:
@@ -903,7 +909,8 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             max_iterations=int(options.max_iters), max_seconds=options.max_seconds,
             seed=seed, lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
             refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
-            sampler=method, **gravity)
+            sampler=method, prechecked=ids32 and (focal is None or focal.flags.c_contiguous),
+            **gravity)
 
     out = search(options.threshold, options.refine)
     if out is not None and len(rays) > 6 and np.count_nonzero(out["inliers"]) <= 6:
