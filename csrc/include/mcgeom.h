@@ -1064,9 +1064,9 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * 6; with an intra-camera pair in the sample, a new best gets the 1-point
  * scale search of 5+1 on that camera's line), and the local optimisation
  * and final refinement are the same (all six degrees of freedom: an error
- * of the vertical does not bias the result), except that the upright
- * sampler's local optimisation also frees |t| and starts from the pairs
- * within 4 thresholds (its hypotheses carry the vertical's error). The default,
+ * of the vertical does not bias the result), except that the first round
+ * of the upright sampler's local optimisation gathers the pairs within 4
+ * thresholds (its hypotheses carry the vertical's error). The default,
  * MCG_SAMPLER_5P1: camera-balanced 5+1 sampling (5 intra-camera
  * correspondences of one camera -> mcg_essential5 -> rotation and
  * translation direction by cheirality; the metric scale from a sixth
