@@ -618,18 +618,6 @@ static void local_optimise(ctx *c, const double *w)
     }
 }
 
-/* Score a hypothesis on the line t(lam) = t0 + lam u of its 5-point camera
- * (t = t0 + lam u); keep and locally optimise it if it is the best. A new
- * best first has its scale searched again on the cross-camera pairs (or,
- * with fewer than MIN_CROSS of them, on the pairs not of its 5-point camera
- * a, as the Python proposer did: one noisy sixth pair is a poor start where
- * |t| is weakly observable; measured on the car rig driving forward, 40
- * problems, median scale error of the metric estimate 0.35 -> 0.26)
- * (thesis ch. 7.4: the 1-point scale RANSAC of mcg_scale_ransac, scored on
- * those pairs only): they fix the scale whatever the motion, while the
- * intra-camera pairs, usually most of the data, hardly depend on it near
- * the critical motion and let a wrong scale win the MSAC over all pairs
- * (seen on the DGP surround rig: 4109 vs 4227 inliers, |t| 22 % short). */
 static int gather_others(ctx *c, int a);
 static int unit3(const double *v, double u[3]);
 
@@ -676,6 +664,18 @@ static void scale_search(ctx *c, const double R[9], const double t0[3], const do
     }
 }
 
+/* Score a hypothesis on the line t(lam) = t0 + lam u of its 5-point camera
+ * (t = t0 + lam u); keep and locally optimise it if it is the best. A new
+ * best first has its scale searched again on the cross-camera pairs (or,
+ * with fewer than MIN_CROSS of them, on the pairs not of its 5-point camera
+ * a, as the Python proposer did: one noisy sixth pair is a poor start where
+ * |t| is weakly observable; measured on the car rig driving forward, 40
+ * problems, median scale error of the metric estimate 0.35 -> 0.26)
+ * (thesis ch. 7.4: the 1-point scale RANSAC of mcg_scale_ransac, scored on
+ * those pairs only): they fix the scale whatever the motion, while the
+ * intra-camera pairs, usually most of the data, hardly depend on it near
+ * the critical motion and let a wrong scale win the MSAC over all pairs
+ * (seen on the DGP surround rig: 4109 vs 4227 inliers, |t| 22 % short). */
 static int offer(ctx *c, const double R[9], const double t0[3], const double u[3],
                  double lam, const double *w, int a)
 {
