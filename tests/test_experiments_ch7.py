@@ -41,6 +41,20 @@ def test_wrong_scale_near_the_critical_motion_is_flagged():
     assert s["bad"] <= 2
 
 
+def test_upright_rows_and_the_unflagged_count():
+    """``--vertical-error-deg`` runs the upright sampler on the same trials;
+    ``unflagged_bad`` counts the bad estimates called observable."""
+    rows = experiment_ch7.run(6, seed=3, cross=0.1, vertical_error_deg=0.2)
+    s = experiment_ch7.summary(rows)
+    assert s["trials"] == 6 and s["median_rot_err_deg"] < 0.1
+    assert s["unflagged_bad"] == sum(r["scale_err"] > 0.3 and r["observable"] for r in rows)
+    import argparse
+    from mcgeom.experiments.common import fraction
+    assert fraction("0.3") == 0.3
+    with pytest.raises(argparse.ArgumentTypeError, match="fraction"):
+        fraction("1.5")
+
+
 def test_minimal_5p1_recovers_noise_free_motion():
     """Target 99.9 % over 10,000 configurations (measured: 99.92 %); 300 here."""
     s = experiment_minimal_5p1.run(300, seed=3, with_poselib=False)

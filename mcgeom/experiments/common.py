@@ -107,6 +107,14 @@ def non_negative_float(text: str) -> float:
     return _number(text, float, 0.0, False, "a non-negative number")
 
 
+def fraction(text: str) -> float:
+    """A number in [0, 1] (shares of correspondences)."""
+    value = non_negative_float(text)
+    if value > 1.0:
+        raise argparse.ArgumentTypeError(f"expected a fraction in [0, 1], got {text!r}")
+    return value
+
+
 def positive_int_list(text: str) -> tuple[int, ...]:
     """A comma-separated list of integers >= 1, e.g. ``17,100,1000``."""
     parts = [p.strip() for p in text.split(",")]
