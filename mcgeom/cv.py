@@ -101,12 +101,17 @@ def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) ->
 
 
 def _points(name: str, p: Any) -> np.ndarray:
-    if type(p) is np.ndarray and p.dtype == np.float64 and p.ndim == 2 and p.shape[1] == 2 \
-            and p.flags.c_contiguous:
-        # already what the checks below make of it (one finiteness pass left)
-        if not np.isfinite(p).all():
-            raise ValueError(f"{name} contains NaN or inf")
-        return p
+    # (a float64 C-contiguous (N, 2) array is already what _pixel_array makes)
+    a = p if (type(p) is np.ndarray and p.dtype == np.float64 and p.ndim == 2
+              and p.shape[1] == 2 and p.flags.c_contiguous) else _pixel_array(name, p)
+    if not np.isfinite(a).all():
+        raise ValueError(f"{name} contains NaN or inf")
+    return a
+
+
+def _pixel_array(name: str, p: Any) -> np.ndarray:
+    """``p`` as a float64 C-contiguous (N, 2) array (OpenCV's (N, 1, 2) and an
+    empty list accepted); ValueError naming ``name`` otherwise."""
     try:
         a = np.asarray(p)
     except ValueError as exc:   # ragged nested lists
@@ -119,10 +124,7 @@ def _points(name: str, p: Any) -> np.ndarray:
         a = a.reshape(0, 2)
     if a.ndim != 2 or a.shape[1] != 2:
         raise ValueError(f"{name} must have shape (N, 2) or (N, 1, 2), got {a.shape}")
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    if not np.isfinite(a).all():
-        raise ValueError(f"{name} contains NaN or inf")
-    return a
+    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 def _ids(name: str, ids: Any, n: int, rig: Rig) -> np.ndarray:

@@ -34,6 +34,7 @@ __all__ = [
     "stereo_head", "axial_rig", "ladybug2", "vehicle8", "generic_rig",
     "rotation_about", "random_rotation", "random_motion", "figure_eight_path",
     "relative_motion", "SyntheticProblem", "make_problem", "perturb_directions",
+    "GRAVITY", "tilted",
 ]
 
 RngLike = Union[np.random.Generator, int, None]
@@ -74,6 +75,17 @@ def rotation_about(axis: Sequence[float], angle: float) -> np.ndarray:
         raise ValueError(f"rotation axis must be a finite non-zero 3-vector, got {axis!r}")
     S = _skew(a / n)
     return np.eye(3) + np.sin(angle) * S + (1.0 - np.cos(angle)) * (S @ S)
+
+
+#: the direction of gravity in the frame of the synthetic rigs (their z is up)
+GRAVITY = np.array([0.0, 0.0, -1.0])
+
+
+def tilted(g: np.ndarray, deg: float, rng: RngLike = None) -> np.ndarray:
+    """``g`` (a 3-vector) turned by ``deg`` degrees about a random axis
+    perpendicular to it: a vertical known to that error (an IMU's gravity)."""
+    gen = as_rng(rng)
+    return rotation_about(np.cross(g, gen.normal(size=3)), np.radians(deg)) @ g
 
 
 def _random_unit(gen: np.random.Generator, n: Optional[int] = None) -> np.ndarray:

@@ -6,11 +6,14 @@ asserted, never a timing."""
 
 from __future__ import annotations
 
+import argparse
+
 import numpy as np
 import pytest
 
 from mcgeom.experiments import ch7 as experiment_ch7
 from mcgeom.experiments import minimal_5p1 as experiment_minimal_5p1
+from mcgeom.experiments.common import fraction
 
 
 @pytest.mark.parametrize("cross", [0.0, 0.1])
@@ -48,8 +51,6 @@ def test_upright_rows_and_the_unflagged_count():
     s = experiment_ch7.summary(rows)
     assert s["trials"] == 6 and s["median_rot_err_deg"] < 0.1
     assert s["unflagged_bad"] == sum(r["scale_err"] > 0.3 and r["observable"] for r in rows)
-    import argparse
-    from mcgeom.experiments.common import fraction
     assert fraction("0.3") == 0.3
     with pytest.raises(argparse.ArgumentTypeError, match="fraction"):
         fraction("1.5")

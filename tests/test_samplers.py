@@ -136,13 +136,14 @@ def test_upright_with_a_vertical_off_by_a_fifth_of_a_degree():
     known to 0.2 deg: the upright search must reach 5+1's answer. (Without
     cheirality for the upright solutions a backward t of 4 % of the truth
     won on the first problem: 74 % inliers, 0.14 deg.)"""
-    from mcgeom.experiments.peer_solvers import _GRAVITY, _car_turning, _tilted
+    from mcgeom.experiments.peer_solvers import _car_turning
     rng = np.random.default_rng(1)
     rig = synth.vehicle8()
     R, t = _car_turning(rng)
     p = synth.make_problem(rig, R, t, 320, rng, pixel_noise=0.5)
     # the fifth and sixth tilts of this stream are the ones that failed
-    g = [_tilted(v, deg, rng) for deg in (0.0, 0.05, 0.2) for v in (_GRAVITY, R @ _GRAVITY)]
+    g = [synth.tilted(v, deg, rng) for deg in (0.0, 0.05, 0.2)
+         for v in (synth.GRAVITY, R @ synth.GRAVITY)]
     g1, g2 = g[4], g[5]
     m5 = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig)
     mu = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, gravity1=g1, gravity2=g2)

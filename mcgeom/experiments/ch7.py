@@ -48,9 +48,8 @@ def trial(rng: np.random.Generator, noise_px: float = 1.0, n: int = 400,
     seed = int(rng.integers(1 << 31))
     prior = {}
     if vertical_error_deg is not None:
-        up = np.array([0.0, 0.0, -1.0])     # gravity in the rig frame (z up)
-        prior = {"gravity1": _turned(up, vertical_error_deg, rng),
-                 "gravity2": _turned(R @ up, vertical_error_deg, rng)}
+        prior = {"gravity1": synth.tilted(synth.GRAVITY, vertical_error_deg, rng),
+                 "gravity2": synth.tilted(R @ synth.GRAVITY, vertical_error_deg, rng)}
     m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=2.0 * noise_px + 0.5,
                  seed=seed, **prior)
     t_metric = m.info["t_metric"]
@@ -58,11 +57,6 @@ def trial(rng: np.random.Generator, noise_px: float = 1.0, n: int = 400,
             "observable": m.scale.observable, "rel_std": m.scale.rel_std,
             "critical_deg": np.degrees(m.scale.critical_angle),
             "rot_err_deg": np.degrees(metrics.rotation_error(m.R, R))}
-
-
-def _turned(g: np.ndarray, deg: float, rng: np.random.Generator) -> np.ndarray:
-    """``g`` turned by ``deg`` degrees about a random axis perpendicular to it."""
-    return synth.rotation_about(np.cross(g, rng.normal(size=3)), np.radians(deg)) @ g
 
 
 def run(trials: int = 200, seed: int = 0, progress: Progress = no_progress,

@@ -309,16 +309,9 @@ RANSAC_CASES: dict = {
     "car8 320c turning <=10deg": (synth.vehicle8, 320, 0.0, 0.5, 0.0, _car_turning),
 }
 
-_GRAVITY = np.array([0.0, 0.0, -1.0])   # the vertical of the rig frame (rigs' z is up)
-
 #: PoseLib's settings: with the iteration floor of issue 19's comparison, and its defaults
 POSELIB_SETTINGS = {"poselib min_it=100": {"max_epipolar_error": 1.0, "min_iterations": 100},
                     "poselib defaults": {"max_epipolar_error": 1.0}}
-
-
-def _tilted(g: np.ndarray, deg: float, rng: np.random.Generator) -> np.ndarray:
-    axis = np.cross(g, rng.normal(size=3))
-    return synth.rotation_about(axis, np.radians(deg)) @ g
 
 
 def _errors(R, t, Rt, tt) -> tuple[float, float]:
@@ -365,8 +358,8 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
             R, t = motion(rng)
             p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl,
                                    cross_fraction=cross, require_visible=cross == 0.0)
-            g1 = _tilted(_GRAVITY, gravity_error_deg, rng)
-            g2 = _tilted(R @ _GRAVITY, gravity_error_deg, rng)
+            g1 = synth.tilted(synth.GRAVITY, gravity_error_deg, rng)
+            g2 = synth.tilted(R @ synth.GRAVITY, gravity_error_deg, rng)
             runs = _methods(rig, setup, p, g1, g2, gravity_error_deg)
             if k == 0:      # untimed warm-up: first calls load plugins and caches
                 for meth, fn in runs.items():
