@@ -1286,6 +1286,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                       refine: bool = True, loss: str = "cauchy",
                       max_scale_rel_std: float = 0.0, sampler: str = "five_plus_one",
                       gravity1: Any = None, gravity2: Any = None,
+                      verdict_still_factor: float = 0.0,
                       prechecked: bool = False) -> Optional[dict]:
     """The whole robust estimate in C (``mcg_robust_rig_motion``).
 
@@ -1320,7 +1321,12 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     bound: the fit stops once under the bound of
     :func:`mcgeom.observability.scale_determined`), ``inlier_rms`` (RMS residual of the
     inliers, pixels with ``focal``, else radians), ``mask`` (N,) uint8 (bit 0
-    inlier, bit 1 used).
+    inlier, bit 1 used), ``covariance`` (6, 6: the final refinement's
+    ``sigma2`` times its inverse information, order [w rad, tau m]; inf
+    where not defined) and ``verdict``: with ``verdict_still_factor`` > 0
+    the dict of :func:`verdict_stats` over the inliers at (R, t) with
+    ``still_angle`` = that factor x ``loss_scale`` (3.5 from 4 up), from
+    the same call (None otherwise, or beyond 2^20 pairs).
     Raises ValueError naming the bad argument. ``prechecked``: the caller
     made the arrays itself (:func:`mcgeom.robust.ransac_prechecked`): the
     rays (N, 3) and ``focal`` (N,) float64 C-contiguous, ``cam1``/``cam2``
@@ -1359,6 +1365,11 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
     opt = ffi.new("mcg_robust_options *")
     lib.mcg_robust_default_options(opt)
+    if not (isinstance(verdict_still_factor, (int, float)) and
+            0.0 <= verdict_still_factor <= 1e6):
+        raise ValueError(f"verdict_still_factor must be a number in [0, 1e6], got "
+                         f"{verdict_still_factor!r}")
+    opt.verdict_still_factor = verdict_still_factor
     try:
         opt.threshold = float(threshold)
         opt.prob = float(prob)
@@ -1437,6 +1448,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         "scale_profile": res.scale_profile, "zero_profile": res.zero_profile,
         "inlier_rms": res.inlier_rms,
         "refinement": _refine_dict(res.refinement, R, t) if res.refined else None,
+        "covariance": np.frombuffer(ffi.buffer(res.covariance),
+                                    dtype=np.float64).reshape(6, 6).copy(),
+        "verdict": _verdict_dict(res.verdict) if res.have_verdict else None,
     }
 
 
@@ -1526,6 +1540,11 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
                 if not np.isfinite(a).all():
                     raise ValueError(f"{name} contains NaN or inf")
         _ray_error(st, "verdict_stats", rays)
+    return _verdict_dict(out)
+
+
+def _verdict_dict(out: Any) -> dict:
+    """The dict of :func:`verdict_stats` from an ``mcg_verdict_stats_result``."""
     return {
         "n_inliers": out.n_inliers, "n_intra": out.n_intra, "n_cross": out.n_cross,
         "n_cameras_intra": out.n_cameras_intra, "fit_ok": bool(out.fit_ok),

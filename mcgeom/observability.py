@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Optional
 
 import numpy as np
 
@@ -230,8 +231,8 @@ def _static_verdict(ang: np.ndarray) -> ScaleVerdict:
 def scale_verdict_stats(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int,
                         inliers: np.ndarray, R: np.ndarray, t: np.ndarray, rel_std: float,
                         max_rel_std: float = 0.1, noise_level: float = float("nan"),
-                        profile: float = float("nan"), prechecked: bool = False
-                        ) -> tuple[ScaleVerdict, np.ndarray]:
+                        profile: float = float("nan"), prechecked: bool = False,
+                        stats: Optional[dict] = None) -> tuple[ScaleVerdict, np.ndarray]:
     """:func:`scale_verdict` with its O(N) evidence from one C call
     (``_core.verdict_stats``, csrc/verdict.c: the rotation-only fit and its
     angles, the cameras with intra-camera inliers, the critical angle, the
@@ -247,13 +248,18 @@ def scale_verdict_stats(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_ca
     (issue 19). Returns ``(verdict, t_direction)``. ``prechecked``: ``cam1``,
     ``cam2`` are int32 and ``inliers`` the uint8 mask of
     :func:`mcgeom._core.robust_rig_motion` (see :func:`mcgeom._core.verdict_stats`).
+    ``stats``: that call's ``verdict`` (the same evidence, gathered by the C
+    search with ``verdict_still_factor`` = :data:`NO_PARALLAX_FACTOR` and
+    ``noise_level`` its ``loss_scale``): not gathered again.
     """
-    still = NO_PARALLAX_FACTOR * noise_level if np.isfinite(noise_level) else 0.0
-    if not 0.0 <= still < 4.0:
-        # beyond any angle between two bearings: every angle is explained
-        still = 3.5 if still >= 4.0 else 0.0
-    s = _core.verdict_stats(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2,
-                            n_cameras, inliers, R, t, still, prechecked=prechecked)
+    s = stats
+    if s is None:
+        still = NO_PARALLAX_FACTOR * noise_level if np.isfinite(noise_level) else 0.0
+        if not 0.0 <= still < 4.0:
+            # beyond any angle between two bearings: every angle is explained
+            still = 3.5 if still >= 4.0 else 0.0
+        s = _core.verdict_stats(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1,
+                                cam2, n_cameras, inliers, R, t, still, prechecked=prechecked)
     n_intra = s["n_intra"]
     if np.isfinite(noise_level) and noise_level > 0 and n_intra >= NO_PARALLAX_MIN:
         # the numpy fit decides where C's fit failed (the bearings span rank
@@ -385,8 +391,9 @@ def total_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray, refined: dict,
     """Relative std of ``|t|`` of a refined motion, noise and calibration error together.
 
     ``refined`` is the result of :func:`mcgeom.geometry.refine_centred` on
-    ``rays`` (its ``scale_rel_std``, ``sigma2`` and ``information``: the
-    noise part); ``calibration_std`` the rig's extrinsic error (see
+    ``rays`` (its ``scale_rel_std``, ``sigma2`` and ``information``, or
+    ``sigma2`` times the inverse information as ``covariance``: the noise
+    part); ``calibration_std`` the rig's extrinsic error (see
     :func:`calibration_scale_std`; None = known exactly); ``weights``,
     ``loss``, ``loss_scale`` those of the refinement. Returns the total (in
     quadrature, :func:`combine_rel_std`) and a dict for ``info``:
@@ -396,10 +403,13 @@ def total_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray, refined: dict,
     the calibration part).
     """
     rel_noise = float(refined["scale_rel_std"])
-    try:
-        cov = refined["sigma2"] * np.linalg.inv(refined["information"])
-    except (np.linalg.LinAlgError, KeyError, ValueError):
-        cov = np.full((6, 6), np.inf)
+    # (the C search gives it: mcgeom._core.robust_rig_motion's "covariance")
+    cov = refined.get("covariance")
+    if cov is None:
+        try:
+            cov = refined["sigma2"] * np.linalg.inv(refined["information"])
+        except (np.linalg.LinAlgError, KeyError, ValueError):
+            cov = np.full((6, 6), np.inf)
     rel_cal = 0.0
     if calibration_std is not None:
         rel_cal, cov_cal = calibration_scale_std(rays, R, t, calibration_std, weights, loss,

@@ -41,8 +41,8 @@ from .estimators.five_plus_one import minimal_answer
 # the vertical's checks (the messages name gravity1/gravity2) of the upright solver
 from .estimators.upright_four_point import check_gravity
 from .geometry import refine_centred, rotation_only_fit, rotation_only_residuals
-from .observability import (ZERO_FACTOR, scale_determined, scale_profile, scale_verdict,
-                            scale_verdict_stats, total_scale_std)
+from .observability import (NO_PARALLAX_FACTOR, ZERO_FACTOR, scale_determined, scale_profile,
+                            scale_verdict, scale_verdict_stats, total_scale_std)
 from .types import MotionFocal, RayPairs, RigMotion, ScaleVerdict
 from .validation import check_seed
 
@@ -650,10 +650,10 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
     statistic of :func:`scale_profile`, when already computed (by C);
     ``calibration_std`` as in :func:`ransac` (its effect enters ``rel_std``);
     ``rms`` the RMS residual of the inliers when the caller has it (``r`` may
-    then be None). ``c_ids = (cam1, cam2, n_cameras, mask)`` (the C search's
-    camera ids and its inlier mask, bit 0) switches the verdict's evidence
-    and the travel direction to one C pass over all the rays
-    (:func:`scale_verdict_stats`); ``zero_profile`` the statistic of
+    then be None). ``c_ids = (cam1, cam2, n_cameras, mask, stats)`` (the C
+    search's camera ids, its inlier mask, bit 0, and the verdict's evidence
+    it gathered, or None) switches the verdict's evidence and the travel
+    direction to one C pass over all the rays (:func:`scale_verdict_stats`); ``zero_profile`` the statistic of
     :func:`scale_profile` at ``ZERO_FACTOR`` when already computed (by C).
     """
     rel_std = float("inf")
@@ -678,11 +678,12 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
     noise_level = fit[2] if fit is not None else loss_scale
     direction = None
     if c_ids is not None:
-        cam1, cam2, n_cameras, mask = c_ids
+        cam1, cam2, n_cameras, mask, stats = c_ids
         verdict, direction = scale_verdict_stats(rays, cam1, cam2, n_cameras, mask, R, t,
                                                  rel_std, options.max_scale_rel_std,
                                                  noise_level=noise_level, profile=profile,
-                                                 prechecked=cam1.dtype == np.int32)
+                                                 prechecked=cam1.dtype == np.int32,
+                                                 stats=stats)
     else:
         v_rays, v_inl = _verdict_sample(rays, inl, options.seed)
         verdict = scale_verdict(v_rays, v_inl, R, t, rel_std, options.max_scale_rel_std,
@@ -910,7 +911,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             seed=seed, lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
             refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
             sampler=method, prechecked=ids32 and (focal is None or focal.flags.c_contiguous),
-            **gravity)
+            verdict_still_factor=NO_PARALLAX_FACTOR, **gravity)
 
     out = search(options.threshold, options.refine)
     if out is not None and len(rays) > 6 and np.count_nonzero(out["inliers"]) <= 6:
@@ -935,6 +936,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     info["sampler"] = method
     fit = None
     if out["refinement"] is not None:
+        out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)
         used = out["used"]
         w = out["weights"][used]
         # (w.max() == w.min(): np.ptp's Python layers cost more than its two passes)
@@ -946,5 +948,5 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
                      math.sqrt(float(out["t_hypothesis"] @ out["t_hypothesis"])), options, method,
                      info, t_start,
                      out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
-                     c_ids=(cam1, cam2, n_cameras, out["mask"]),
+                     c_ids=(cam1, cam2, n_cameras, out["mask"], out["verdict"]),
                      zero_profile=float(out["zero_profile"]))

@@ -70,6 +70,30 @@ def test_scale_profile_in_c_matches_the_python_statistic():
     assert out["scale_profile"] == pytest.approx(py, rel=1e-3, abs=1e-6)
 
 
+@pytest.mark.parametrize("seed", [0, 3])
+def test_covariance_and_verdict_evidence_from_the_same_call(seed):
+    # issue 19: the refinement's covariance and the verdict's evidence come
+    # out of the search's call; they must equal the separate computations
+    rig, p, R, t = _problem(seed, outliers=0.2)
+    f = pixels_per_radian(rig, p.rays)
+    out = _call(p.rays, focal=f, threshold=1.0, seed=seed, verdict_still_factor=1.5)
+    ref = out["refinement"]
+    cov = ref["sigma2"] * np.linalg.inv(ref["information"])
+    assert np.allclose(out["covariance"], cov, rtol=1e-9, atol=1e-12 * np.abs(cov).max())
+    r = p.rays
+    n_cam = int(max(r.cam1.max(), r.cam2.max())) + 1
+    sep = _core.verdict_stats(r.origins1, r.dirs1, r.origins2, r.dirs2, r.cam1, r.cam2, n_cam,
+                              out["mask"], out["R"], out["t"], 1.5 * out["loss_scale"])
+    got = out["verdict"]
+    assert got is not None and got.keys() == sep.keys()
+    for k in sep:
+        assert np.array_equal(got[k], sep[k]), k
+    # not asked for: not gathered; a factor outside [0, 1e6] is named
+    assert _call(p.rays, focal=f, threshold=1.0, seed=seed)["verdict"] is None
+    with pytest.raises(ValueError, match="verdict_still_factor"):
+        _call(p.rays, focal=f, threshold=1.0, verdict_still_factor=-1.0)
+
+
 def test_no_camera_with_five_pairs_is_degenerate():
     rig, p, R, t = _problem(6, outliers=0.0, cross=0.0)
     keep = np.concatenate([np.flatnonzero(p.rays.cam1 == k)[:4] for k in range(6)])

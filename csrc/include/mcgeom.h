@@ -962,6 +962,55 @@ int mcg_essential5(const double d1[15], const double d2[15], double E[90], int *
  * [1, 2^26], NaN/inf. MCG_EDEGENERATE: E = 0 or of rank <= 1. */
 int mcg_essential_decompose(const double E[9], const double *d1, const double *d2, int n,
                             double R[9], double t[3], int *n_front);
+/* ------------------------------------------------------------- verdict.c */
+
+/* Result of mcg_verdict_stats: the O(n) evidence of the scale verdict
+ * (mcgeom.observability.scale_verdict, thesis ch. 7.3.2) of an estimate. */
+typedef struct {
+    int n_inliers;          /* pairs with inlier bit 0 set */
+    int n_intra;            /* of which intra-camera (cam1 == cam2) */
+    int n_cross;            /* of which cross-camera */
+    int n_cameras_intra;    /* cameras with an intra-camera inlier */
+    int fit_ok;             /* 1: R_fit is the Wahba rotation (>= 2 intra
+                               inliers whose bearings span rank >= 2) */
+    double R_fit[9];        /* best pure rotation of the unit intra-camera
+                               inlier bearings (nearest to sum d2 d1^T);
+                               identity when fit_ok = 0 */
+    int n_still;            /* intra inliers whose angle between d2 and
+                               R_fit d1 is below still_angle (0 if !fit_ok) */
+    double critical_angle;  /* radians in [0, pi/2]: the largest angle between
+                               the displacement lines R^T (c - t) - c of the
+                               cameras with intra inliers (c: the time-1
+                               origin of each one's first intra inlier);
+                               0 for fewer than two */
+    int n_in_front;         /* inliers whose rays (the time-1 one moved by
+                               (R, t)) meet in front of both origins */
+    double t_direction[3];  /* unit direction of travel when |t| is not
+                               observable (travel_direction of
+                               mcgeom/estimators/_common.py) */
+} mcg_verdict_stats_result;
+
+/* Doubles of workspace of mcg_verdict_stats (0 for n_cameras outside
+ * [1, 4096]): about 3.5 n_cameras. */
+size_t mcg_verdict_stats_work_size(int n_cameras);
+
+/* The evidence of the scale verdict of the motion (R, t) (rig2_from_rig1,
+ * metres) over the pairs k with (inlier[k] & 1): pairs (o1, d1) <-> (o2,
+ * d2) as for mcg_gec_residuals (n x 3 each, rig frames at times 1 and 2,
+ * origins the camera centres in metres, directions of any non-zero length),
+ * cameras cam1[k], cam2[k] in [0, n_cameras). still_angle (radians, in
+ * [0, 4)): the no-parallax threshold of the rotation-only angles. One pass
+ * over the pairs for the counts and the fit, one for the angles, three for
+ * cheirality (cost O(n + n_cameras^2)). MCG_EINVAL: NULL pointers, n
+ * outside [0, 2^20], n_cameras, ids out of range, NaN/inf, a zero
+ * direction, origins, R or t
+ * entries above 1e150 in magnitude, still_angle; MCG_ENOMEM: lwork below
+ * mcg_verdict_stats_work_size. */
+int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o2,
+                      const double *d2, const int *cam1, const int *cam2, int n_cameras,
+                      const unsigned char *inlier, const double R[9], const double t[3],
+                      double still_angle, mcg_verdict_stats_result *out, double *work,
+                      size_t lwork);
 /* --------------------------------------------------------------- robust.c */
 
 /* Options of mcg_robust_rig_motion (mcg_robust_default_options in brackets). */
@@ -991,6 +1040,12 @@ typedef struct {
     double g1[3], g2[3]; /* MCG_SAMPLER_UPRIGHT4 only: the vertical (gravity)
                             direction in rig frame 1 and rig frame 2 (any
                             non-zero length, finite; R g1 = g2) [0, 0, 0] */
+    /* issue 19 (ABI: one more appended field, see above): */
+    double verdict_still_factor; /* > 0: also gather the scale verdict's
+                            evidence at the result (mcg_verdict_stats on the
+                            inliers, res->verdict) with still_angle = this
+                            factor x res->loss_scale (3.5 from 4 up), in the
+                            same call; 0 = not, finite in [0, 1e6] [0] */
 } mcg_robust_options;
 
 /* mcg_robust_options.sampler: how hypotheses are drawn */
@@ -1043,14 +1098,25 @@ typedef struct {
     double inlier_rms;      /* RMS of the inliers' residuals at (R, t)
                                (pixels with focal, else radians; NaN when
                                there is no inlier) */
+    /* issue 19 (ABI: appended fields): */
+    double covariance[36];  /* refinement.sigma2 x refinement.info^-1 (6 x 6,
+                               [dw, dt] of the centred frame, rad and m):
+                               the noise covariance of the final refinement;
+                               HUGE_VAL everywhere when info is not positive
+                               definite or refined = 0 */
+    int have_verdict;       /* 1 when verdict holds the evidence
+                               (opt->verdict_still_factor > 0, the result
+                               refined or not, n <= 2^20) */
+    mcg_verdict_stats_result verdict; /* mcg_verdict_stats at (R, t) over the
+                               inliers (mask bit 0) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
 void mcg_robust_default_options(mcg_robust_options *opt);
 
 /* Doubles of workspace for mcg_robust_rig_motion: about 17.5 n + 300 up to
- * 4096 pairs, 16.5 n + 4400 up to 16383, 16.5 n + 62000 beyond (0 for n
- * outside [6, 2^26] or n_cameras outside [1, 4096]). */
+ * 4096 pairs, 16.5 n + 4400 up to 16383, 16.5 n + 62000 beyond, plus
+ * 3.5 n_cameras (0 for n outside [6, 2^26] or n_cameras outside [1, 4096]). */
 size_t mcg_robust_work_size(int n, int n_cameras);
 
 /* Robust rig motion rig2_from_rig1 from n ray correspondences with
@@ -1113,55 +1179,6 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                           const double *cam_focal, const mcg_robust_options *opt,
                           mcg_robust_result *res, unsigned char *mask, double *weights,
                           double *work, size_t lwork);
-/* ------------------------------------------------------------- verdict.c */
-
-/* Result of mcg_verdict_stats: the O(n) evidence of the scale verdict
- * (mcgeom.observability.scale_verdict, thesis ch. 7.3.2) of an estimate. */
-typedef struct {
-    int n_inliers;          /* pairs with inlier bit 0 set */
-    int n_intra;            /* of which intra-camera (cam1 == cam2) */
-    int n_cross;            /* of which cross-camera */
-    int n_cameras_intra;    /* cameras with an intra-camera inlier */
-    int fit_ok;             /* 1: R_fit is the Wahba rotation (>= 2 intra
-                               inliers whose bearings span rank >= 2) */
-    double R_fit[9];        /* best pure rotation of the unit intra-camera
-                               inlier bearings (nearest to sum d2 d1^T);
-                               identity when fit_ok = 0 */
-    int n_still;            /* intra inliers whose angle between d2 and
-                               R_fit d1 is below still_angle (0 if !fit_ok) */
-    double critical_angle;  /* radians in [0, pi/2]: the largest angle between
-                               the displacement lines R^T (c - t) - c of the
-                               cameras with intra inliers (c: the time-1
-                               origin of each one's first intra inlier);
-                               0 for fewer than two */
-    int n_in_front;         /* inliers whose rays (the time-1 one moved by
-                               (R, t)) meet in front of both origins */
-    double t_direction[3];  /* unit direction of travel when |t| is not
-                               observable (travel_direction of
-                               mcgeom/estimators/_common.py) */
-} mcg_verdict_stats_result;
-
-/* Doubles of workspace of mcg_verdict_stats (0 for n_cameras outside
- * [1, 4096]): about 3.5 n_cameras. */
-size_t mcg_verdict_stats_work_size(int n_cameras);
-
-/* The evidence of the scale verdict of the motion (R, t) (rig2_from_rig1,
- * metres) over the pairs k with (inlier[k] & 1): pairs (o1, d1) <-> (o2,
- * d2) as for mcg_gec_residuals (n x 3 each, rig frames at times 1 and 2,
- * origins the camera centres in metres, directions of any non-zero length),
- * cameras cam1[k], cam2[k] in [0, n_cameras). still_angle (radians, in
- * [0, 4)): the no-parallax threshold of the rotation-only angles. One pass
- * over the pairs for the counts and the fit, one for the angles, three for
- * cheirality (cost O(n + n_cameras^2)). MCG_EINVAL: NULL pointers, n
- * outside [0, 2^20], n_cameras, ids out of range, NaN/inf, a zero
- * direction, origins, R or t
- * entries above 1e150 in magnitude, still_angle; MCG_ENOMEM: lwork below
- * mcg_verdict_stats_work_size. */
-int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o2,
-                      const double *d2, const int *cam1, const int *cam2, int n_cameras,
-                      const unsigned char *inlier, const double R[9], const double t[3],
-                      double still_angle, mcg_verdict_stats_result *out, double *work,
-                      size_t lwork);
 /* ------------------------------------------------------ calibration_std.c */
 
 /* Doubles of workspace of mcg_calibration_scale_std (0 for n_cameras outside

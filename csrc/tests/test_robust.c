@@ -203,11 +203,38 @@ static void outliers_case(void)
     check(st == MCG_OK && res2.scale_profile > 25.0, "scale profile: |t| x/ 1.3 excluded (chi^2)",
           res2.scale_profile, 25.0);
     opt.max_scale_rel_std = 0.0;
+    opt.verdict_still_factor = 1.5;
     st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res2, mask, NULL, work, lwork);
     check(st == MCG_OK && memcmp(res.R, res2.R, sizeof res.R) == 0 &&
               memcmp(res.t, res2.t, sizeof res.t) == 0,
           "same seed, same motion", 0.0, 0.0);
+    opt.verdict_still_factor = 0.0;
+    {
+        /* covariance x information = sigma2 I; the verdict's evidence equals
+         * a separate mcg_verdict_stats call on the same mask and motion */
+        double worst = 0.0, vw[64];
+        mcg_verdict_stats_result v;
+        int i, j, l;
+        for (i = 0; i < 6; i++)
+            for (j = 0; j < 6; j++) {
+                double acc = 0.0;
+                for (l = 0; l < 6; l++)
+                    acc += res2.covariance[6 * i + l] * res2.refinement.info[6 * l + j];
+                acc = acc / res2.refinement.sigma2 - (i == j);
+                worst = fabs(acc) > worst ? fabs(acc) : worst;
+            }
+        check(worst < 1e-8, "covariance = sigma2 info^-1", worst, 1e-8);
+        check(!res.have_verdict, "no verdict evidence unless asked", res.have_verdict, 0.0);
+        st = mcg_verdict_stats(n, o1, d1, o2, d2, cam1, cam2, NCAM, mask, res2.R, res2.t,
+                               1.5 * res2.loss_scale, &v, vw, 64);
+        check(st == MCG_OK && res2.have_verdict && v.n_inliers == res2.verdict.n_inliers &&
+                  v.n_cross == res2.verdict.n_cross && v.n_in_front == res2.verdict.n_in_front &&
+                  v.n_still == res2.verdict.n_still &&
+                  v.critical_angle == res2.verdict.critical_angle &&
+                  memcmp(v.t_direction, res2.verdict.t_direction, sizeof v.t_direction) == 0,
+              "verdict evidence of the same call", res2.verdict.n_inliers, v.n_inliers);
+    }
 
     /* pixels: threshold 2 px with ~1 px noise; the camera table path */
     {
