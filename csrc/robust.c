@@ -1059,7 +1059,8 @@ static int offer_motion(ctx *c, const double R[9], const double t[3], const doub
  * finite vertical of non-zero length at both times. */
 static int check_sampler(const mcg_robust_options *o)
 {
-    if (o->sampler == MCG_SAMPLER_5P1 || o->sampler == MCG_SAMPLER_6PT)
+    if (o->sampler == MCG_SAMPLER_5P1 || o->sampler == MCG_SAMPLER_6PT ||
+        o->sampler == MCG_SAMPLER_AUTO)
         return 1;
     if (o->sampler != MCG_SAMPLER_UPRIGHT4)
         return 0;
@@ -1713,9 +1714,18 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     c.rng = (uint64_t)c.opt.seed;
     c.refine_target = -HUGE_VAL;
     c.lo_rounds = c.opt.lo_rounds;
-    c.sample_size = c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4 : 6;
     carve(&c, work);
     group(&c);
+    if (c.opt.sampler == MCG_SAMPLER_AUTO) {
+        /* mcgeom.cv.choose_sampler's rule, from the group counts (issue
+         * 19: its numpy passes cost ~60 us of a cold call's Python) */
+        int has5 = 0;
+        for (k = 0; k < n_cameras; k++)
+            has5 |= c.off[k + 1] - c.off[k] >= 5;
+        c.opt.sampler = has5 ? MCG_SAMPLER_5P1 : MCG_SAMPLER_6PT;
+    }
+    res->sampler = c.opt.sampler;
+    c.sample_size = c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4 : 6;
     c.med_focal = 1.0;
     c.const_focal = 1;
     if (focal) {

@@ -1269,6 +1269,7 @@ SAMPLER_NAMES = {
     "upright_four_point": lib.MCG_SAMPLER_UPRIGHT4,
     "six_point": lib.MCG_SAMPLER_6PT,
 }
+_SAMPLER_OF = {v: k for k, v in SAMPLER_NAMES.items()}
 
 #: why the search of :func:`robust_rig_motion` ended
 ROBUST_STOP_NAMES = {
@@ -1300,7 +1301,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     ``max_scale_rel_std`` > 0: when the refinement's ``scale_rel_std`` is at
     most this, the result's ``scale_profile`` is computed (the statistic of
     :func:`mcgeom.observability.scale_profile` at ``1 +- 3 max_scale_rel_std``).
-    ``sampler`` (a name of ``SAMPLER_NAMES``) picks the minimal solver of the
+    ``sampler`` (a name of ``SAMPLER_NAMES``, or ``"auto"``: 5+1 when some
+    camera has 5 intra-camera pairs, else ``six_point``; the result's
+    ``sampler`` names the one used) picks the minimal solver of the
     hypotheses: 5+1 (5 intra-camera pairs of one camera and a sixth),
     ``upright_four_point`` (4 pairs of any cameras and the vertical
     ``gravity1``/``gravity2``: 3-vectors in rig frames 1 and 2, any non-zero
@@ -1399,9 +1402,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     opt.lo_rounds = int(lo_rounds)
     opt.refine = 1 if refine else 0
     opt.loss = LOSS_NAMES[loss]
-    if not isinstance(sampler, str) or sampler not in SAMPLER_NAMES:
-        raise ValueError(f"sampler must be one of {sorted(SAMPLER_NAMES)}, got {sampler!r}")
-    opt.sampler = SAMPLER_NAMES[sampler]
+    if not isinstance(sampler, str) or (sampler not in SAMPLER_NAMES and sampler != "auto"):
+        raise ValueError(f"sampler must be 'auto' or one of {sorted(SAMPLER_NAMES)}, got "
+                         f"{sampler!r}")
+    opt.sampler = lib.MCG_SAMPLER_AUTO if sampler == "auto" else SAMPLER_NAMES[sampler]
     if sampler == "upright_four_point":
         for name, g, field in (("gravity1", gravity1, opt.g1), ("gravity2", gravity2, opt.g2)):
             if g is None:
@@ -1435,11 +1439,12 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
             if cf is not None and not (np.isfinite(cf).all() and (cf > 0).all()):
                 raise ValueError("cam_focal must be finite and > 0 (pixels)")
         _ray_error(st, "robust_rig_motion", rays)
-    R = np.frombuffer(ffi.buffer(res.R), dtype=np.float64).reshape(3, 3).copy()
-    t = np.frombuffer(ffi.buffer(res.t), dtype=np.float64).copy()
+    # R[9], t[3], t_hypothesis[3] lead the struct: one copy, three views
+    rt = np.frombuffer(ffi.buffer(res, 15 * 8), dtype=np.float64).copy()
+    R, t = rt[:9].reshape(3, 3), rt[9:12]
     return {
         "R": R, "t": t,
-        "t_hypothesis": np.frombuffer(ffi.buffer(res.t_hypothesis), dtype=np.float64).copy(),
+        "t_hypothesis": rt[12:],
         "inliers": (mask & 1).view(bool), "used": (mask >> 1).view(bool), "mask": mask,
         "weights": weights, "loss_scale": res.loss_scale, "score": res.score,
         "n_inliers": res.n_inliers, "iterations": res.iterations,
@@ -1451,6 +1456,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         "covariance": np.frombuffer(ffi.buffer(res.covariance),
                                     dtype=np.float64).reshape(6, 6).copy(),
         "verdict": _verdict_dict(res.verdict) if res.have_verdict else None,
+        "sampler": _SAMPLER_OF[res.sampler],
     }
 
 

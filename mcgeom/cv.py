@@ -33,7 +33,8 @@ import numpy as np
 from . import registry
 from . import robust as _robust   # (the name robust is estimate()'s flag)
 from .errors import ScaleNotObservableWarning
-from .pixel_noise import camera_table, ray_pairs_per_radian, sampson_pixel_scale
+from .pixel_noise import (camera_table, pinhole_ray_pairs, ray_pairs_per_radian,
+                          sampson_pixel_scale)
 from .rig import Rig
 from .types import RigMotion
 from .validation import integral_camera_ids
@@ -234,6 +235,12 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
+    if (method == RIG_5P1_RANSAC and mask is None and robust is None and not options
+            and calibration_std is None and gravity1 is None and gravity2 is None):
+        m = _estimate_pinhole(points1, points2, cameraIds1, cameraIds2, rig, threshold, prob,
+                              maxIters, seed)
+        if m is not None:
+            return m
     p1, p2 = _points("points1", points1), _points("points2", points2)
     n = p1.shape[0]
     if p2.shape[0] != n:
@@ -297,6 +304,44 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         m = registry.get(name)(rays, **options)
         inl = np.ones(n, bool) if use is None else use.copy()
     return RigMotion(m.R, m.t, m.scale, m.method, m.residual_rms, inl, m.info)
+
+
+def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
+                      threshold: Any, prob: Any, maxIters: Any, seed: Any) -> Optional[RigMotion]:
+    """:func:`estimate` with its defaults (no mask, vertical, options or
+    calibration override) for the common input -- a rig of undistorted
+    pinholes, float64 C-contiguous (N, 2) pixels and int64 (N,) camera ids --
+    in the fewest Python steps (issue 19: a call after other work pays ~5x
+    the warm cost of each step): the ray kernel checks the pixels and ids
+    itself, then :func:`mcgeom.robust.ransac_rig_c`. None for any other input
+    or whatever those decline (a refused pixel or id, too few or repeated
+    correspondences, no consensus ...): the general path of :func:`estimate`
+    then runs, whose checks name what is wrong. The same RigMotion as that
+    path."""
+    ids2 = cameraIds1 if cameraIds2 is None else cameraIds2
+    if not (_plain(points1, np.float64, 2) and _plain(points2, np.float64, 2)):
+        return None
+    n = points1.shape[0]
+    if not (points2.shape[0] == n and _plain(cameraIds1, np.int64, 1) and
+            _plain(ids2, np.int64, 1) and cameraIds1.shape[0] == n and ids2.shape[0] == n):
+        return None
+    # (the kernel checks the pixels and the ids against the rig)
+    out = pinhole_ray_pairs(rig, points1, points2, cameraIds1, ids2)
+    if out is None:
+        return None
+    rays, ppr = out
+    opts = _ransac_options(threshold, prob, maxIters, seed)
+    cal = rig.extrinsic_std
+    # (the sampler of choose_sampler, picked by the C search: "auto")
+    return _robust.ransac_rig_c(rays, "auto", opts, ppr, camera_table(rig),
+                                cal if cal.any() else None)
+
+
+def _plain(a: Any, dtype: type, ndim: int) -> bool:
+    """Is ``a`` a C-contiguous ndarray of ``dtype`` with ``ndim`` dimensions
+    (the last of size 2 when ``ndim`` is 2)?"""
+    return (type(a) is np.ndarray and a.dtype == dtype and a.ndim == ndim
+            and (ndim == 1 or a.shape[1] == 2) and a.flags.c_contiguous)
 
 
 def estimateRigMotion(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,

@@ -253,15 +253,16 @@ def scale_verdict_stats(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_ca
     ``noise_level`` its ``loss_scale``): not gathered again.
     """
     s = stats
+    noise_level = float(noise_level)
     if s is None:
-        still = NO_PARALLAX_FACTOR * noise_level if np.isfinite(noise_level) else 0.0
+        still = NO_PARALLAX_FACTOR * noise_level if math.isfinite(noise_level) else 0.0
         if not 0.0 <= still < 4.0:
             # beyond any angle between two bearings: every angle is explained
             still = 3.5 if still >= 4.0 else 0.0
         s = _core.verdict_stats(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1,
                                 cam2, n_cameras, inliers, R, t, still, prechecked=prechecked)
     n_intra = s["n_intra"]
-    if np.isfinite(noise_level) and noise_level > 0 and n_intra >= NO_PARALLAX_MIN:
+    if math.isfinite(noise_level) and noise_level > 0 and n_intra >= NO_PARALLAX_MIN:
         # the numpy fit decides where C's fit failed (the bearings span rank
         # < 2: one direction repeated), and gives the angles that the rare
         # static answer's message quotes
@@ -380,9 +381,12 @@ def combine_rel_std(noise: float, calibration: float) -> float:
     """Total relative std of ``|t|``: the noise part (from the refinement's
     residuals) and the calibration part (:func:`calibration_scale_std`),
     independent, in quadrature; inf if either is."""
-    if not (np.isfinite(noise) and np.isfinite(calibration)):
+    # (math on Python floats: numpy's scalar ufuncs cost more than the
+    # arithmetic, on every estimate)
+    noise, calibration = float(noise), float(calibration)
+    if not (math.isfinite(noise) and math.isfinite(calibration)):
         return float("inf")
-    return float(np.hypot(noise, calibration))
+    return math.hypot(noise, calibration)
 
 
 def total_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray, refined: dict,

@@ -22,13 +22,16 @@ Only the public API of :class:`mcgeom.rig.Rig` is used (``intrinsics``,
 
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 from . import _core
 from .rig import Rig
 from .types import MotionFocal, RayPairs
 
-__all__ = ["pixels_per_radian", "sampson_pixel_scale", "camera_table", "ray_pairs_per_radian"]
+__all__ = ["pixels_per_radian", "sampson_pixel_scale", "camera_table", "ray_pairs_per_radian",
+           "pinhole_ray_pairs"]
 
 
 def camera_table(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
@@ -91,19 +94,39 @@ def ray_pairs_per_radian(rig: Rig, px1: np.ndarray, px2: np.ndarray, ids1: np.nd
     a pixel has no finite bearing (its ValueError names it), from the rig
     and :func:`pixels_per_radian`.
     """
-    tables = rig.pinhole_tables
-    out = None
-    if tables is not None:
-        intr, rot, centres, focal = tables
-        out = _core.pinhole_ray_pairs(intr, rot, centres, focal, ids1, ids2, px1, px2)
+    out = pinhole_ray_pairs(rig, px1, px2, ids1, ids2)
     if out is None:
         rays = rig.ray_pairs_prechecked(px1, px2, ids1, ids2)
         return rays, pixels_per_radian(rig, rays)
+    # ids2 may be ids1 (the same cameras at both times): then its own
+    # array, as the rig's
+    rays, ppr = out
+    if ids2 is ids1:
+        rays = RayPairs.prechecked(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, ids1,
+                                   ids2.copy())
+    return rays, ppr
+
+
+def pinhole_ray_pairs(rig: Rig, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
+                      ids2: np.ndarray) -> Optional[tuple[RayPairs, np.ndarray]]:
+    """The rays and pixels per radian of :func:`ray_pairs_per_radian` from the
+    C pass alone (``_core.pinhole_ray_pairs``), which checks the pixels
+    (finite bearings) and the ids (cameras of ``rig``) itself: ``px1``,
+    ``px2`` float64 C-contiguous (N, 2) pixels and ``ids1``, ``ids2`` int64
+    C-contiguous (N,) ids (their types are the caller's to guarantee, their
+    values need not be checked). None when a camera of ``rig`` is not an
+    undistorted pinhole or the kernel refuses a pixel or an id (the general
+    path names which). The rays keep ``ids1``/``ids2`` as their camera ids."""
+    tables = rig.pinhole_tables
+    if tables is None:
+        return None
+    intr, rot, centres, focal = tables
+    out = _core.pinhole_ray_pairs(intr, rot, centres, focal, ids1, ids2, px1, px2)
+    if out is None:
+        return None
     o1, d1, o2, d2, ppr = out
-    # made here from checked ids: float64 C-contiguous (N, 3); ids2 may be
-    # ids1 (the same cameras at both times): then its own array, as the rig's
-    return RayPairs.prechecked(o1, d1, o2, d2, ids1,
-                               ids2.copy() if ids2 is ids1 else ids2), ppr
+    # made here: float64 C-contiguous (N, 3)
+    return RayPairs.prechecked(o1, d1, o2, d2, ids1, ids2), ppr
 
 
 def sampson_pixel_scale(rig: Rig) -> MotionFocal:

@@ -261,3 +261,55 @@ def test_facade_with_mask_and_calibration_is_the_general_path(seed):
     assert a.scale.observable == c.scale.observable and a.scale.reason == c.scale.reason
     for key in ("t_metric", "scale_rel_std_noise", "scale_rel_std_calibration", "covariance"):
         assert np.array_equal(a.info[key], c.info[key], equal_nan=True), key
+
+
+@pytest.mark.parametrize("seed,make_rig", [(2, synth.ladybug2), (3, synth.vehicle8)])
+def test_plain_input_takes_the_one_call_path_with_the_same_answer(seed, make_rig, monkeypatch):
+    """float64 pixels and int64 ids of a pinhole rig go through
+    robust.ransac_rig_c (one C call, the sampler picked in C); anything else
+    (here: ids as lists) through ransac_prechecked. Same answer, bit for bit."""
+    rig, p = _problem(seed, make_rig)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        general = cv.estimate(p.pixels1, p.pixels2, list(p.cam1), list(p.cam2), rig,
+                              threshold=1.0, seed=seed)
+        calls = []
+        monkeypatch.setattr(robust, "ransac_prechecked",
+                            lambda *a, **k: calls.append(1) or pytest.fail("general path"))
+        fast = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, seed=seed)
+    assert not calls
+    _same(general, fast)
+    assert fast.info["sampler"] == general.info["sampler"] == "five_plus_one"
+
+
+def test_one_call_path_picks_the_six_point_sampler_as_choose_sampler():
+    """Four correspondences per camera: no 5+1 sample; the C search's "auto"
+    picks the 6-point solver, as cv.choose_sampler does."""
+    rig, p = _problem(4, synth.ladybug2, n=300, outliers=0.0)
+    keep = np.concatenate([np.flatnonzero((p.cam1 == k) & (p.cam2 == k))[:4] for k in range(6)]
+                          + [np.flatnonzero(p.cam1 != p.cam2)[:20]])
+    px1, px2 = p.pixels1[keep], p.pixels2[keep]
+    c1, c2 = p.cam1[keep], p.cam2[keep]
+    assert cv.choose_sampler(c1, c2) == "six_point"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = cv.estimate(px1, px2, c1, c2, rig, threshold=1.0, seed=1, maxIters=3)
+    assert m.info["sampler"] == "six_point"
+
+
+def test_one_call_path_declines_and_the_general_path_names():
+    """A NaN pixel or an id outside the rig in otherwise plain input: the
+    ray kernel refuses, and the general path's message names it."""
+    rig, p = _problem(6)
+    px = p.pixels2.copy()
+    px[5] = np.nan
+    with pytest.raises(ValueError, match="points2 contains NaN"):
+        cv.estimate(p.pixels1, px, p.cam1, p.cam2, rig)
+    ids = p.cam2.copy()
+    ids[3] = len(rig)
+    with pytest.raises(ValueError, match="cameraIds2 holds camera id 6"):
+        cv.estimate(p.pixels1, p.pixels2, p.cam1, ids, rig)
+    # repeated correspondences: the DegenerateError of check_distinct, as before
+    rep = np.zeros(len(p.cam1), np.int64)
+    with pytest.raises(DegenerateError, match="distinct"):
+        cv.estimate(p.pixels1[rep], p.pixels2[rep], p.cam1[rep], p.cam2[rep], rig)

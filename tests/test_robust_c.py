@@ -94,6 +94,14 @@ def test_covariance_and_verdict_evidence_from_the_same_call(seed):
         _call(p.rays, focal=f, threshold=1.0, verdict_still_factor=-1.0)
 
 
+def test_result_layout_read_in_one_copy():
+    # _core.robust_rig_motion reads R, t and t_hypothesis as the first 15
+    # doubles of mcg_robust_result
+    ffi = _core.ffi
+    assert [ffi.offsetof("mcg_robust_result", k) for k in ("R", "t", "t_hypothesis")] == \
+        [0, 72, 96]
+
+
 def test_no_camera_with_five_pairs_is_degenerate():
     rig, p, R, t = _problem(6, outliers=0.0, cross=0.0)
     keep = np.concatenate([np.flatnonzero(p.rays.cam1 == k)[:4] for k in range(6)])

@@ -119,7 +119,7 @@ def test_solver_options_are_checked():
                       solver_options={"gravity1": [0, 0, 1], "gravity2": [0, 0, 0]})
     with pytest.raises(ValueError, match=r"solver_options \['gravity1'\] are not options"):
         robust.ransac(p.rays, "five_plus_one", solver_options={"gravity1": [0, 0, 1]})
-    with pytest.raises(ValueError, match="sampler must be one of"):
+    with pytest.raises(ValueError, match="sampler must be .auto. or one of"):
         _core.robust_rig_motion(p.rays.origins1, p.rays.dirs1, p.rays.origins2, p.rays.dirs2,
                                 p.cam1, p.cam2, 8, sampler="seven_point")
     with pytest.raises(ValueError, match="gravity1/gravity2 are for the upright"):

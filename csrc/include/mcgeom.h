@@ -1036,7 +1036,7 @@ typedef struct {
     /* issue 21 (ABI: appended fields; the struct grew by 7 values -- fill
      * it with mcg_robust_default_options and rebuild callers): */
     int sampler;         /* MCG_SAMPLER_* minimal solver of the search
-                            [MCG_SAMPLER_5P1] */
+                            [MCG_SAMPLER_5P1] (MCG_SAMPLER_AUTO: issue 19) */
     double g1[3], g2[3]; /* MCG_SAMPLER_UPRIGHT4 only: the vertical (gravity)
                             direction in rig frame 1 and rig frame 2 (any
                             non-zero length, finite; R g1 = g2) [0, 0, 0] */
@@ -1054,8 +1054,11 @@ enum {
                                  + a sixth for the metric scale (thesis ch. 7) */
     MCG_SAMPLER_UPRIGHT4 = 1, /* 4 pairs of any cameras with the vertical known
                                  (mcg_upright4; opt.g1, opt.g2) */
-    MCG_SAMPLER_6PT = 2       /* 6 pairs not all of one camera, the generic
+    MCG_SAMPLER_6PT = 2,      /* 6 pairs not all of one camera, the generic
                                  minimal solver (mcg_sixpt) */
+    MCG_SAMPLER_AUTO = 3      /* MCG_SAMPLER_5P1 when some camera has 5
+                                 intra-camera pairs, else MCG_SAMPLER_6PT
+                                 (res->sampler says which) */
 };
 
 /* mcg_robust_result.stop: why the search ended */
@@ -1109,6 +1112,8 @@ typedef struct {
                                refined or not, n <= 2^20) */
     mcg_verdict_stats_result verdict; /* mcg_verdict_stats at (R, t) over the
                                inliers (mask bit 0) */
+    int sampler;            /* the MCG_SAMPLER_* the search used
+                               (MCG_SAMPLER_AUTO resolved) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */

@@ -211,6 +211,17 @@ static void outliers_case(void)
           "same seed, same motion", 0.0, 0.0);
     opt.verdict_still_factor = 0.0;
     {
+        /* cameras with 5 intra-camera pairs: AUTO is 5+1, the same motion */
+        mcg_robust_result r3;
+        opt.sampler = MCG_SAMPLER_AUTO;
+        st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                                   &r3, mask, NULL, work, lwork);
+        check(st == MCG_OK && r3.sampler == MCG_SAMPLER_5P1 && res.sampler == MCG_SAMPLER_5P1 &&
+                  memcmp(res.R, r3.R, sizeof res.R) == 0 && memcmp(res.t, r3.t, sizeof res.t) == 0,
+              "AUTO sampler with 5 intra-camera pairs: 5+1, same motion", r3.sampler, 0.0);
+        opt.sampler = MCG_SAMPLER_5P1;
+    }
+    {
         /* covariance x information = sigma2 I; the verdict's evidence equals
          * a separate mcg_verdict_stats call on the same mask and motion */
         double worst = 0.0, vw[64];
@@ -473,9 +484,11 @@ static void six_point_case(void)
     st = mcg_robust_rig_motion(20, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EDEGENERATE, "few pairs: 5+1 has no 5-point camera");
-    opt.sampler = MCG_SAMPLER_6PT;
+    opt.sampler = MCG_SAMPLER_AUTO; /* no 5-point camera: AUTO is the 6-point sampler */
     st = run_checked(20, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
     check_status(st, MCG_OK, "few pairs: 6-point status");
+    check(res.sampler == MCG_SAMPLER_6PT, "few pairs: AUTO picked the 6-point sampler",
+          res.sampler, MCG_SAMPLER_6PT);
     check(rerr < 0.2, "few pairs, 6-point: rotation error (deg)", rerr, 0.2);
     check(terr < 0.05, "few pairs, 6-point: relative t error", terr, 0.05);
     check(caught == 2 && agree, "few pairs, 6-point: both outliers flagged", caught, 2);
@@ -523,7 +536,7 @@ static void status_case(void)
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "focal <= 0");
     mcg_robust_default_options(&opt);
-    opt.sampler = 3;
+    opt.sampler = MCG_SAMPLER_AUTO + 1;
     st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "unknown sampler");

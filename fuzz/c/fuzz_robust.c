@@ -8,8 +8,8 @@
  * camera table, options valid or not (threshold, prob, iteration budgets,
  * LO rounds, loss), the sampler (a byte: 5+1, upright 4-point with the
  * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
- * huge --, 6-point, or 1 in 16 an unknown one), and a workspace 1 double
- * short 1 in 16 times.
+ * huge --, 6-point, AUTO, or 1 in 16 an unknown one), the verdict's
+ * evidence asked for or not, and a workspace 1 double short 1 in 16 times.
  * Invariants: the status is known; bad sizes give MCG_EINVAL and a work
  * size of 0, a short workspace MCG_ENOMEM, bad options, ids or focal
  * lengths, an unknown sampler or an upright one without a finite non-zero
@@ -18,7 +18,10 @@
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
  * of the threshold excepted), n_inliers counts it, n_used counts bit 1 and
- * the scale profile is NaN (not asked) or >= 0.
+ * the scale profile is NaN (not asked) or >= 0, the sampler used is the
+ * one asked for (AUTO: 5+1 or 6-point), the verdict's evidence is there
+ * exactly when asked for and counts the mask's inliers, and the covariance
+ * is finite (or HUGE_VAL everywhere).
  * Bounded time: max_iterations <= 200 (<= 3 with the 6-point sampler,
  * whose solver takes about a second per sample under the sanitizers) and
  * max_seconds = 0.5 here, and
@@ -107,7 +110,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     opt_ok = 1;
     {
         const int sb = fz_u8(&in);
-        opt.sampler = sb % 16 == 15 ? 3 + sb % 5 : sb % 3;
+        opt.sampler = sb % 16 == 15 ? 4 + sb % 5 : sb % 4;
         if (opt.sampler == MCG_SAMPLER_UPRIGHT4) {
             if (mode == 0) { /* the true vertical: g2 = R g1 */
                 double g[3];
@@ -126,12 +129,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                      opt.g2[0] * opt.g2[0] + opt.g2[1] * opt.g2[1] + opt.g2[2] * opt.g2[2] >=
                          1e-100;
         }
-        opt_ok &= opt.sampler <= MCG_SAMPLER_6PT;
-        if (opt.sampler == MCG_SAMPLER_6PT) { /* mcg_sixpt: ~1 s a sample here */
+        opt_ok &= opt.sampler <= MCG_SAMPLER_AUTO;
+        /* (AUTO picks the 6-point sampler where no camera has 5 intra pairs) */
+        if (opt.sampler == MCG_SAMPLER_6PT || opt.sampler == MCG_SAMPLER_AUTO) {
+            /* mcg_sixpt: ~1 s a sample here */
             opt.max_iterations = 1 + opt.max_iterations % 3;
             opt.min_iterations = opt.min_iterations % (opt.max_iterations + 1);
         }
     }
+    opt.verdict_still_factor = fz_u8(&in) & 1 ? fz_range(&in, 0.0, 10.0) : 0.0;
     if (fz_u8(&in) % 16 == 0) {
         switch (fz_u8(&in) % 4) {
         case 0: opt.threshold = fz_double(&in); break;
@@ -190,5 +196,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              res.n_used, cnt1);
     FZ_CHECK(isnan(res.scale_profile) || res.scale_profile >= 0.0,
              "scale profile %g is negative", res.scale_profile);
+    FZ_CHECK(res.sampler >= MCG_SAMPLER_5P1 && res.sampler <= MCG_SAMPLER_6PT &&
+                 (opt.sampler == MCG_SAMPLER_AUTO ? res.sampler != MCG_SAMPLER_UPRIGHT4
+                                                  : res.sampler == opt.sampler),
+             "sampler used %d for the option %d", res.sampler, opt.sampler);
+    /* the verdict's evidence (asked for, n <= 2^20 here): over the inliers */
+    FZ_CHECK((opt.verdict_still_factor > 0.0) == (res.have_verdict != 0),
+             "verdict evidence %d with factor %g", res.have_verdict, opt.verdict_still_factor);
+    FZ_CHECK(!res.have_verdict || (res.verdict.n_inliers == res.n_inliers &&
+                                   res.verdict.n_in_front <= res.n_inliers),
+             "verdict counts %d inliers (%d in front), the mask %d", res.verdict.n_inliers,
+             res.verdict.n_in_front, res.n_inliers);
+    /* the covariance: finite, or HUGE_VAL everywhere (no SPD information) */
+    {
+        int n_huge = 0, n_fin = 0;
+        for (i = 0; i < 36; ++i) {
+            n_huge += res.covariance[i] == HUGE_VAL;
+            n_fin += isfinite(res.covariance[i]) != 0;
+        }
+        FZ_CHECK(n_fin == 36 || n_huge == 36, "covariance: %d finite, %d HUGE_VAL entries",
+                 n_fin, n_huge);
+    }
     return 0;
 }
