@@ -646,7 +646,7 @@ def pinhole_ray_pairs(intr: np.ndarray, rot: np.ndarray, centres: np.ndarray,
     what is wrong.
     """
     n, m = px1.shape[0], intr.shape[0]
-    o1, d1, o2, d2 = (np.empty((n, 3)) for _ in range(4))
+    o1, d1, o2, d2 = np.empty((4, n, 3))    # (one allocation: four C-contiguous views)
     ppr = None if focal is None else np.empty(n)
     bad = ffi.new("int *")
     st = lib.mcg_pinhole_ray_pairs(
@@ -1334,8 +1334,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     made the arrays itself (:func:`mcgeom.robust.ransac_prechecked`): the
     rays (N, 3) and ``focal`` (N,) float64 C-contiguous, ``cam1``/``cam2``
     (N,) int32 C-contiguous, N in 6..2^26, ``n_cameras`` an int in
-    1..4096; their shapes and types are then not checked again (their
-    values still are, by the kernel).
+    1..4096, ``cam_axes``/``cam_focal`` (if given) float64 C-contiguous
+    (n_cameras, 3) and (n_cameras,) (the rig's camera table); their shapes
+    and types are then not checked again (their values still are, by the
+    kernel).
     """
     if prechecked:
         rays = (origins1, dirs1, origins2, dirs2)
@@ -1361,8 +1363,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         if focal is None:
             raise ValueError("cam_axes and cam_focal need focal (thresholds in pixels)")
         # (finiteness and sign: the kernel's checks, named on its error path)
-        ax = _f64("cam_axes", cam_axes, (int(n_cameras), 3))
-        cf = _f64("cam_focal", cam_focal, (int(n_cameras),))
+        ax, cf = (cam_axes, cam_focal) if prechecked else \
+            (_f64("cam_axes", cam_axes, (int(n_cameras), 3)),
+             _f64("cam_focal", cam_focal, (int(n_cameras),)))
         ax_ptr, cf_ptr = _p(ax), _p(cf)
     if not isinstance(loss, str) or loss not in LOSS_NAMES:
         raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
@@ -1419,9 +1422,11 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     elif gravity1 is not None or gravity2 is not None:
         raise ValueError(f"gravity1/gravity2 are for the upright_four_point sampler, not "
                          f"{sampler!r}")
-    work = _work(lib.mcg_robust_work_size(n, int(n_cameras)))
+    # the weights and the workspace in one allocation
+    lwork = lib.mcg_robust_work_size(n, int(n_cameras))
+    buf = np.empty(n + max(lwork, 1))
+    weights, work = buf[:n], buf[n:]
     mask = np.empty(n, dtype=np.uint8)
-    weights = np.empty(n)
     res = ffi.new("mcg_robust_result *")
     st = lib.mcg_robust_rig_motion(
         n, *map(_p, rays), ffi.from_buffer("int[]", ids[0]), ffi.from_buffer("int[]", ids[1]),

@@ -910,7 +910,9 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
             max_iterations=int(options.max_iters), max_seconds=options.max_seconds,
             seed=seed, lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
             refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
-            sampler=method, prechecked=ids32 and (focal is None or focal.flags.c_contiguous),
+            sampler=method,
+            prechecked=ids32 and (focal is None or focal.flags.c_contiguous) and
+            (pixel_cameras is None or from_rig),   # (a caller's camera table: checked there)
             verdict_still_factor=NO_PARALLAX_FACTOR, **gravity)
 
     out = search(options.threshold, options.refine)
