@@ -135,8 +135,9 @@ int mcg_scale_ransac_indexed(int n, const int *idx, const double *o1, const doub
                              double *work);
 
 /* mcg_refine_motion (refine.c) that also stops, converged with reason
- * MCG_REFINE_STOP_COST, once its cost is at most cost_target (-HUGE_VAL:
- * never; mcg_refine_motion itself). */
+ * MCG_REFINE_STOP_COST, once its cost is at most cost_target, or evidently
+ * above it (more than 100 times the last accepted step's decrease above)
+ * (-HUGE_VAL: never; mcg_refine_motion itself). */
 int mcg_refine_motion_until(int n, const double *o1, const double *d1, const double *o2,
                             const double *d2, const double *weights,
                             const mcg_refine_options *opt, double cost_target, double R[9],

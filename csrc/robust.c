@@ -111,7 +111,12 @@
 #define ZERO_FACTOR 0.01
 /* observability.scale_determined's bound on the zero profile (a vanishing
  * translation not excluded at 3 sigma): the zero profile is only compared
- * with it, so its fit stops once below (the value is then an upper bound) */
+ * with it, so its fit stops once below (the value is then an upper bound),
+ * or once evidently above (mcg_refine_motion_until: more than 100 times
+ * its last step's decrease above; issue 19, the fits crept down for up to
+ * 50 steps 10-20x above the bound: C instructions per estimate, 20
+ * problems of `mcgeom bench robust`, ladybug6 8.98 -> 8.22 M, car8
+ * 5.17 -> 4.55 M) */
 #define ZERO_PROFILE_BOUND 9.0
 #define UNDETERMINED_REL_STD 1.0
 #define FINAL_POLISH 3

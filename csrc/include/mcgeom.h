@@ -1097,7 +1097,9 @@ typedef struct {
                                is at most 1 but above max_scale_rel_std or
                                scale_profile < 9; NaN otherwise. Only its
                                side of 9 is exact: below 9 it is an upper
-                               bound (the fit stops there) */
+                               bound (the fit stops there), and above 9 too
+                               where the fit stopped once 100 times its last
+                               step's decrease could not bring it under 9 */
     double inlier_rms;      /* RMS of the inliers' residuals at (R, t)
                                (pixels with focal, else radians; NaN when
                                there is no inlier) */
