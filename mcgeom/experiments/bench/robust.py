@@ -31,7 +31,8 @@ blocks of :data:`WARM_BLOCK`, each method on the whole block in turn (the
 blocks alternate, so load drift still falls on all), as in a loop over
 the frames of a sequence. The difference is mostly mcgeom's: its Python
 layer (the input checks, the verdict) is code that a cold call fetches
-again (measured: ring4 0.67 ms warm, 0.99 ms cold; PoseLib 2.54 / 2.62 ms).
+again (measured, session 10: ring4 0.54 ms warm, 0.76 ms cold; PoseLib
+2.71 / 2.77 ms).
 
 Scaling: the robust estimate on 1e3 .. 1e6 correspondences of a 4-camera
 ring with 20 % outliers (rays in, :func:`mcgeom.robust.ransac`): seconds,
