@@ -236,9 +236,9 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
     if (method == RIG_5P1_RANSAC and mask is None and robust is None and not options
-            and calibration_std is None and gravity1 is None and gravity2 is None):
+            and calibration_std is None and (gravity1 is None) == (gravity2 is None)):
         m = _estimate_pinhole(points1, points2, cameraIds1, cameraIds2, rig, threshold, prob,
-                              maxIters, seed)
+                              maxIters, seed, gravity1, gravity2)
         if m is not None:
             return m
     p1, p2 = _points("points1", points1), _points("points2", points2)
@@ -307,10 +307,12 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
 
 
 def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
-                      threshold: Any, prob: Any, maxIters: Any, seed: Any) -> Optional[RigMotion]:
-    """:func:`estimate` with its defaults (no mask, vertical, options or
-    calibration override) for the common input -- a rig of undistorted
-    pinholes, float64 C-contiguous (N, 2) pixels and int64 (N,) camera ids --
+                      threshold: Any, prob: Any, maxIters: Any, seed: Any,
+                      gravity1: Any = None, gravity2: Any = None) -> Optional[RigMotion]:
+    """:func:`estimate` with its defaults (no mask, options or calibration
+    override; a vertical prior or none) for the common input -- a rig of
+    undistorted pinholes, float64 C-contiguous (N, 2) pixels and int64 (N,)
+    camera ids --
     in the fewest Python steps (issue 19: a call after other work pays ~5x
     the warm cost of each step): the ray kernel checks the pixels and ids
     itself, then :func:`mcgeom.robust.ransac_rig_c`. None for any other input
@@ -332,9 +334,14 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     rays, ppr = out
     opts = _ransac_options(threshold, prob, maxIters, seed)
     cal = rig.extrinsic_std
-    # (the sampler of choose_sampler, picked by the C search: "auto")
-    return _robust.ransac_rig_c(rays, "auto", opts, ppr, camera_table(rig),
-                                cal if cal.any() else None)
+    # (the sampler of choose_sampler, picked by the C search: "auto"; with a
+    # vertical prior the upright 4-point one, as _gravity_method picks)
+    if gravity1 is None:
+        return _robust.ransac_rig_c(rays, "auto", opts, ppr, camera_table(rig),
+                                    cal if cal.any() else None)
+    return _robust.ransac_rig_c(rays, RIG_UPRIGHT_RANSAC, opts, ppr, camera_table(rig),
+                                cal if cal.any() else None,
+                                {"gravity1": gravity1, "gravity2": gravity2})
 
 
 def _plain(a: Any, dtype: type, ndim: int) -> bool:

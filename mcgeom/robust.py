@@ -936,8 +936,8 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
 
 
 def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.ndarray,
-                 pixel_cameras: tuple[np.ndarray, np.ndarray], calibration_std: Any
-                 ) -> Optional[RigMotion]:
+                 pixel_cameras: tuple[np.ndarray, np.ndarray], calibration_std: Any,
+                 solver_options: Optional[dict] = None) -> Optional[RigMotion]:
     """The ordinary case of :func:`ransac_prechecked` with a C sampler, in
     the fewest Python steps (issue 19: every step of a call that follows
     other work, e.g. a feature matcher, costs ~5x its warm time; this path
@@ -945,8 +945,9 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
     0.6 ms): one C call, then the verdict.
 
     Same preconditions as :func:`ransac_prechecked` (``pixel_cameras`` and
-    ``focal`` given); ``method`` a name of :data:`C_SAMPLERS` other than
-    the upright one, or ``"auto"``: the C search picks as
+    ``focal`` given); ``method`` a name of :data:`C_SAMPLERS` (the upright
+    one with its vertical in ``solver_options``, checked and named as by
+    :func:`ransac`), or ``"auto"``: the C search picks as
     :func:`mcgeom.cv.choose_sampler` does (5+1 when a camera has 5
     intra-camera correspondences, else the 6-point solver).
     Returns the same RigMotion as :func:`ransac_prechecked`, or None where
@@ -959,7 +960,9 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
     if n <= 6 or options.strategy != "auto" or \
             options.threshold > MAX_THRESHOLD_RAD * float(focal.min()):
         return None
-    registry.check_distinct(rays, 6, "five_plus_one" if method == "auto" else method)
+    gravity = _solver_gravity(method, solver_options or {})
+    registry.check_distinct(rays, 6 if method == "auto" else C_SAMPLERS[method],
+                            "five_plus_one" if method == "auto" else method)
     t_start = time.perf_counter()
     cam_focal, cam_axes = pixel_cameras
     n_cameras = len(cam_focal)
@@ -974,7 +977,7 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
         max_iterations=int(options.max_iters), max_seconds=options.max_seconds, seed=seed,
         lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
         refine=options.refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
-        sampler=method, prechecked=True, verdict_still_factor=NO_PARALLAX_FACTOR)
+        sampler=method, prechecked=True, verdict_still_factor=NO_PARALLAX_FACTOR, **gravity)
     if out is None or out["n_inliers"] <= 6:
         return None
     return _c_conclude(rays, out, focal, options, out["sampler"], t_start, calibration_std,

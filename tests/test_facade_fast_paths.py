@@ -313,3 +313,24 @@ def test_one_call_path_declines_and_the_general_path_names():
     rep = np.zeros(len(p.cam1), np.int64)
     with pytest.raises(DegenerateError, match="distinct"):
         cv.estimate(p.pixels1[rep], p.pixels2[rep], p.cam1[rep], p.cam2[rep], rig)
+
+
+def test_one_call_path_with_a_vertical_prior_is_the_general_upright_search(monkeypatch):
+    """gravity1/gravity2 with plain input: the upright sampler on the one-call
+    path, the same answer as the general path; a bad vertical is named."""
+    rig, p = _problem(7, synth.vehicle8, n=320, outliers=0.2)
+    g1 = np.array([0.0, 0.0, -9.81])
+    g2 = g1.copy()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        general = cv.estimate(p.pixels1, p.pixels2, list(p.cam1), list(p.cam2), rig,
+                              threshold=1.0, seed=3, gravity1=g1, gravity2=g2)
+        monkeypatch.setattr(robust, "ransac_prechecked",
+                            lambda *a, **k: pytest.fail("general path"))
+        fast = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, seed=3,
+                           gravity1=g1, gravity2=g2)
+    _same(general, fast)
+    assert fast.info["sampler"] == general.info["sampler"] == "upright_four_point"
+    with pytest.raises(ValueError, match="gravity2 has zero length"):
+        cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, gravity1=g1,
+                    gravity2=np.zeros(3))
