@@ -333,14 +333,13 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
         return None
     rays, ppr = out
     opts = _ransac_options(threshold, prob, maxIters, seed)
-    cal = rig.extrinsic_std
     # (the sampler of choose_sampler, picked by the C search: "auto"; with a
     # vertical prior the upright 4-point one, as _gravity_method picks)
     if gravity1 is None:
         return _robust.ransac_rig_c(rays, "auto", opts, ppr, camera_table(rig),
-                                    cal if cal.any() else None)
+                                    rig.calibration_error)
     return _robust.ransac_rig_c(rays, RIG_UPRIGHT_RANSAC, opts, ppr, camera_table(rig),
-                                cal if cal.any() else None,
+                                rig.calibration_error,
                                 {"gravity1": gravity1, "gravity2": gravity2})
 
 

@@ -447,6 +447,8 @@ class Rig:
         object.__setattr__(self, "_extrinsic_std", _frozen(
             np.tile(DEFAULT_EXTRINSIC_STD, (len(cams), 1)) if self.calibration_std is None
             else np.array(self.calibration_std, dtype=np.float64)))
+        object.__setattr__(self, "_calibration_error",
+                           self._extrinsic_std if self._extrinsic_std.any() else None)
 
     def __len__(self) -> int:
         return len(self.cameras)
@@ -486,6 +488,14 @@ class Rig:
         axis), rotation (radians, per axis); :data:`DEFAULT_EXTRINSIC_STD` for
         every camera when ``calibration_std`` is None."""
         return self._extrinsic_std.copy()  # type: ignore[attr-defined]
+
+    @property
+    def calibration_error(self) -> np.ndarray | None:
+        """:attr:`extrinsic_std` (read-only, made once), or None when every
+        std is 0 (the calibration known exactly: it adds nothing to the
+        scale's uncertainty). What the robust façade passes on, once per
+        estimate."""
+        return self._calibration_error  # type: ignore[attr-defined]
 
     @property
     def focal_axes(self) -> tuple[np.ndarray, np.ndarray]:

@@ -1006,7 +1006,7 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
     # the RMS residual of the inliers and the verdict's evidence come from C
     # (no Python pass over the rays: issue 19)
     return _conclude(rays, R, t, None, inl, fit, out["loss_scale"],
-                     math.sqrt(float(out["t_hypothesis"] @ out["t_hypothesis"])), options, method,
+                     math.hypot(*out["t_hypothesis"].tolist()), options, method,
                      info, t_start,
                      out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
                      c_ids=(cam1, cam2, n_cameras, out["mask"], out["verdict"]),
