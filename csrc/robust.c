@@ -1441,7 +1441,7 @@ static const double *final_weights(ctx *c, const double R[9], const double t[3],
  * refinement that succeeded (bit 2, the set to fit next, is scratch). */
 static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *weights_out)
 {
-    double R[9], t[3], cen[3], scale;
+    double R[9], t[3], cen[3], scale, R0[9], t0[3];
     const double wide = WIDE * c->opt.threshold;
     int round, k, m, n_inl, moved = 1, st;
     const double *w;
@@ -1466,20 +1466,14 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
          * as before (issue 19: the tight first fit took 7-11 of the ~20 LM
          * evaluations of an estimate on ring4 / Ladybug, 45 % of the C
          * instructions on ring4) */
-        if (round == 0) {
-            double R0[9], t0[3];
-            memcpy(R0, R, sizeof R0);
-            memcpy(t0, t, sizeof t0);
-            c->final_stage = 0;
-            st = refine_capped(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr);
-            if (st == MCG_OK && !(rr.scale_rel_std <= UNDETERMINED_REL_STD)) {
-                memcpy(R, R0, sizeof R0);
-                memcpy(t, t0, sizeof t0);
-                c->final_stage = 1;
-                st = refine_capped(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr);
-            }
-        } else {
-            c->final_stage = !(res->refinement.scale_rel_std <= UNDETERMINED_REL_STD);
+        memcpy(R0, R, sizeof R0);
+        memcpy(t0, t, sizeof t0);
+        c->final_stage = round > 0 && !(res->refinement.scale_rel_std <= UNDETERMINED_REL_STD);
+        st = refine_capped(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr);
+        if (round == 0 && st == MCG_OK && !(rr.scale_rel_std <= UNDETERMINED_REL_STD)) {
+            memcpy(R, R0, sizeof R0);
+            memcpy(t, t0, sizeof t0);
+            c->final_stage = 1;
             st = refine_capped(c, m, cen, w != NULL, c->opt.loss, scale, 0, R, t, &rr);
         }
         if (st != MCG_OK)

@@ -298,7 +298,8 @@ def _verdict(n_in: int, n_cross: int, n_centres: int, crit: float, rel_std: floa
     evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {math.degrees(crit):.3g} deg "
                 f"over {n_centres} cameras, {n_cross} cross-camera inliers")
     if math.isfinite(profile):
-        evidence += f", |t| x/ {1 + 3 * max_rel_std:.2g} excluded at {math.sqrt(max(profile, 0.0)):.2g} sigma"
+        sigmas = math.sqrt(max(profile, 0.0))
+        evidence += f", |t| x/ {1 + 3 * max_rel_std:.2g} excluded at {sigmas:.2g} sigma"
     if (direction_only or not math.isfinite(rel_std) or rel_std > max_rel_std
             or (math.isfinite(profile) and profile < 9.0)):
         if n_cross == 0 and n_centres < 2:

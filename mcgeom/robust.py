@@ -653,8 +653,9 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
     then be None). ``c_ids = (cam1, cam2, n_cameras, mask, stats)`` (the C
     search's camera ids, its inlier mask, bit 0, and the verdict's evidence
     it gathered, or None) switches the verdict's evidence and the travel
-    direction to one C pass over all the rays (:func:`scale_verdict_stats`); ``zero_profile`` the statistic of
-    :func:`scale_profile` at ``ZERO_FACTOR`` when already computed (by C).
+    direction to one C pass over all the rays (:func:`scale_verdict_stats`);
+    ``zero_profile`` the statistic of :func:`scale_profile` at
+    ``ZERO_FACTOR`` when already computed (by C).
     """
     rel_std = float("inf")
     given, profile = profile, float("nan")
@@ -899,21 +900,14 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     elif options.threshold > MAX_THRESHOLD_RAD * float(focal.min()):
         _check_threshold_angle(options.threshold, options.threshold / float(np.median(focal)),
                                focal)
-    seed = options.seed if options.seed is not None else \
-        int(np.random.SeedSequence().entropy % (1 << 63))
+    seed = _c_seed(options)
+    # (a caller's camera table is checked there)
+    prechecked = ids32 and (focal is None or focal.flags.c_contiguous) and \
+        (pixel_cameras is None or from_rig)
 
     def search(threshold: float, refine: bool) -> Optional[dict]:
-        return _core.robust_rig_motion(
-            rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
-            focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=threshold,
-            prob=options.prob, min_iterations=min(options.min_iters, options.max_iters),
-            max_iterations=int(options.max_iters), max_seconds=options.max_seconds,
-            seed=seed, lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
-            refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
-            sampler=method,
-            prechecked=ids32 and (focal is None or focal.flags.c_contiguous) and
-            (pixel_cameras is None or from_rig),   # (a caller's camera table: checked there)
-            verdict_still_factor=NO_PARALLAX_FACTOR, **gravity)
+        return _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
+                         threshold, refine, method, seed, prechecked, gravity)
 
     out = search(options.threshold, options.refine)
     if out is not None and len(rays) > 6 and np.count_nonzero(out["inliers"]) <= 6:
@@ -968,20 +962,36 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
     n_cameras = len(cam_focal)
     # (ids of the rig's cameras, checked by its ray kernel: int32 for C)
     cam1, cam2 = rays.cam1.astype(np.int32), rays.cam2.astype(np.int32)
-    seed = options.seed if options.seed is not None else \
-        int(np.random.SeedSequence().entropy % (1 << 63))
-    out = _core.robust_rig_motion(
-        rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
-        focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=options.threshold,
-        prob=options.prob, min_iterations=min(options.min_iters, options.max_iters),
-        max_iterations=int(options.max_iters), max_seconds=options.max_seconds, seed=seed,
-        lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
-        refine=options.refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
-        sampler=method, prechecked=True, verdict_still_factor=NO_PARALLAX_FACTOR, **gravity)
+    out = _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
+                    options.threshold, options.refine, method, _c_seed(options), True, gravity)
     if out is None or out["n_inliers"] <= 6:
         return None
     return _c_conclude(rays, out, focal, options, out["sampler"], t_start, calibration_std,
                        cam1, cam2, n_cameras)
+
+
+def _c_seed(options: RansacOptions) -> int:
+    """The C search's seed: the options' one, else fresh entropy."""
+    return options.seed if options.seed is not None else \
+        int(np.random.SeedSequence().entropy % (1 << 63))
+
+
+def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int,
+              focal: Optional[np.ndarray], cam_axes: Optional[np.ndarray],
+              cam_focal: Optional[np.ndarray], options: RansacOptions, threshold: float,
+              refine: bool, method: str, seed: int, prechecked: bool,
+              gravity: dict) -> Optional[dict]:
+    """One C search (``_core.robust_rig_motion``) with ``options`` at
+    ``threshold``, the verdict's evidence gathered in the same call."""
+    return _core.robust_rig_motion(
+        rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
+        focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=threshold,
+        prob=options.prob, min_iterations=min(options.min_iters, options.max_iters),
+        max_iterations=int(options.max_iters), max_seconds=options.max_seconds, seed=seed,
+        lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
+        refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
+        sampler=method, prechecked=prechecked, verdict_still_factor=NO_PARALLAX_FACTOR,
+        **gravity)
 
 
 def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options: RansacOptions,
