@@ -92,10 +92,13 @@ def test_straight_without_overlap_never_invents_a_scale():
     assert all(np.isnan(s.length) for s in traj.steps)
     assert traj.status_counts == {"metric": 0, "carried": 0, "unknown": 6}
     assert traj.metric_path_length == 0.0
-    # the directions are still right: the rig drives along its x axis
+    # the directions are still right: the rig drives along its x axis. Each
+    # step's direction is its two-frame estimate's (within 0.05 deg on 20
+    # such sequences); the tracks' own shape bent steps by 7.9 deg on
+    # average (median 2.4, up to 94), and passed 0.99 (8 deg) here by luck
     seg = traj.segments[0]
     d = np.diff(seg.poses[:, :3, 3], axis=0)
-    assert np.all(d[:, 0] / np.linalg.norm(d, axis=1) > 0.99)
+    assert np.all(d[:, 0] / np.linalg.norm(d, axis=1) > np.cos(np.radians(0.5)))
     assert np.isclose(np.linalg.norm(d, axis=1).sum(), 1.0)   # normalised, no unit
 
 

@@ -20,8 +20,9 @@ Segments. Steps whose lengths are tied by tracks form a *segment* (a maximal
 run of frames; consecutive segments share their boundary frame). A segment
 with at least one observed step is metric (its steps are ``metric`` or
 ``carried``); a segment without one is **direction-only**: its steps are
-``unknown``, its poses hold rotations and translation *directions* (relative
-step lengths from the tracks, normalised to a path length of 1, no unit).
+``unknown``, its poses hold rotations and translation *directions* (each
+step's direction from its two-frame estimate, the relative step lengths
+from the tracks, normalised to a path length of 1, no unit).
 
 How poses are stored:
 
