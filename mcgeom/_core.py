@@ -1320,9 +1320,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     of ``ROBUST_STOP_NAMES``), ``seconds`` and ``refinement`` (the dict of
     :func:`refine_motion` of the final refinement, or None if it did not run),
     ``scale_profile`` (NaN if not computed), ``zero_profile`` (the same at the
-    factor 0.01, NaN if not computed; exact from 9 up, below 9 only an upper
-    bound: the fit stops once under the bound of
-    :func:`mcgeom.observability.scale_determined`), ``inlier_rms`` (RMS residual of the
+    factor 0.01, NaN if not computed; only its side of 9, the bound of
+    :func:`mcgeom.observability.scale_determined`, is exact: the fit stops
+    once under 9, or once evidently above it, so the value is an upper
+    bound), ``inlier_rms`` (RMS residual of the
     inliers, pixels with ``focal``, else radians), ``mask`` (N,) uint8 (bit 0
     inlier, bit 1 used), ``covariance`` (6, 6: the final refinement's
     ``sigma2`` times its inverse information, order [w rad, tau m]; inf
