@@ -194,7 +194,7 @@
  *    estimates more than 30 % off 753 / 10 / 14 -> 726 / 3 / 6, of them
  *    called observable 1 / 3 / 0 -> 0 / 2 / 0;
  *  - tests/test_robust.c two_stage_case (80 % of the sixth draws outliers,
- *    20 samples): the motion in 52 of 60 runs, against 25 for one stage.
+ *    20 samples): the motion in 44 of 60 runs, against 25 for one stage.
  * Counting at WIDE thresholds: at one threshold a 5-point motion fitted to
  * its own camera beat the best's count on clean data (ring4: two
  * needless searches and LOs per estimate). */
