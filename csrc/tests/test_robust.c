@@ -620,8 +620,8 @@ static void large_case(void)
  * 1 - (1 - 0.7^5)^20 = 0.975; a clean 6-sample (a clean sixth too) only
  * with 1 - (1 - 0.2 x 0.7^5)^20 = 0.50. Measured (rotation within 0.1 deg,
  * |t| within 2 %): 44 of the 60 runs, against 25 for the one-stage search
- * (the sixth's scale, searched again only for a new best). Most misses
- * (9 of 16) are near: rotation within 0.11 deg, |t| 2.6-11 % off. */
+ * (the sixth's scale, searched again only for a new best). Half the
+ * misses (8 of 16) are near: rotation within 0.11 deg, |t| 2.6-11 % off. */
 static void two_stage_case(void)
 {
     const int n = 200, runs = 60;
