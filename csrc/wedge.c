@@ -45,6 +45,7 @@
 
 #define HALF_PI 1.5707963267948966
 #define NORM2_MIN 1e-200
+#define WEDGE_MIN_SIN 1e-6 /* sin of the smallest angle between the axes */
 
 int mcg_wedge_normals(const double v[3], const double vp[3], double eps,
                       double epsp, double n1[3], double n2[3])
@@ -91,8 +92,15 @@ int mcg_wedge_unit(const double a[3], const double b[3], double sa, double sb,
 
     cross3(a, b, w); /* = v x v' / (|v| |v'|) */
     nw = sqrt(dot3(w, w)); /* sin alpha, accurate from the cross product */
-    if (!(nw > 1e-12))
-        return MCG_EDEGENERATE; /* v parallel or anti-parallel to v' */
+    /* v (anti-)parallel to v' within WEDGE_MIN_SIN: the normals' rounding
+     * error grows as ~1e-16 / sin alpha (the directions w and a - b are
+     * differences of nearly equal unit vectors), beyond what the enlarged
+     * half-angles cover: at sin alpha = 1.4e-8 a t in the cones violated a
+     * plane by 1.3e-8 |t| (fuzz_rays, found in CI). Such nearly parallel
+     * axes carry no wedge worth keeping: any half-angle above
+     * WEDGE_MIN_SIN makes the cones overlap. */
+    if (!(nw > WEDGE_MIN_SIN))
+        return MCG_EDEGENERATE;
     /* y (y.a = sa, y.b = sb, y in the plane of a and b) in the orthonormal
      * basis u1 = (a - b) / |a - b|, u2 = (a + b) / |a + b| of that plane:
      * a.u1 = -b.u1 = |a - b| / 2, a.u2 = b.u2 = |a + b| / 2, so

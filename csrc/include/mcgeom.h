@@ -577,7 +577,9 @@ int mcg_cone_linf(int n, const double *apex, const double *axis,
  * For camera k of a rig (centre c_k in the rig frame, d1 and d2 the rig-frame
  * directions of the two rays, v = R d1, vp = d2) the constraint on the rig
  * translation is n.t >= n.(c_k - R c_k), one row of the LP below.
- * MCG_EDEGENERATE (n1, n2 untouched, no constraint): v parallel to vp, the
+ * MCG_EDEGENERATE (n1, n2 untouched, no constraint): v parallel or
+ * anti-parallel to vp within 1e-6 rad (sin of the angle; the normals'
+ * rounding would exceed the kernel's conservative margin), the
  * error cones overlapping (angle(v, vp) <= eps + epsp: every direction is
  * compatible) or nested (v close to -vp). MCG_EINVAL: NULL, NaN/inf, a zero
  * vector, eps or epsp outside [0, pi/2). */

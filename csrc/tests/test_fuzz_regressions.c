@@ -261,6 +261,36 @@ static void test_wedge_near_parallel(void)
     check(worst <= 1e-12, "wedge: unit normals there", worst, 1e-12);
 }
 
+/* fuzz_rays (CI, session 11): axes 1.4e-8 rad from parallel (v = -0.33 x,
+ * vp = (1, 1e-8, 1e-8), eps 1e-8, epsp 0) gave MCG_OK with normals whose
+ * rounding (~1e-16 / sin alpha) put a t of the cones 1.3e-8 |t| on the wrong
+ * side of both planes. Within 1e-6 rad of parallel there is now no wedge;
+ * just above it the planes still hold every t of the cones. */
+static void test_wedge_tiny_angle(void)
+{
+    const double v[3] = {-0.325927734375, 0.0, 0.0}, vp[3] = {1.0, 1e-8, 1e-8};
+    const double vq[3] = {-0.325927734375, 0.0, 0.0}, vpq[3] = {1.0, 3e-6, 0.0};
+    const double nv = 0.325927734375, nvp = sqrt(1.0 + 9e-12), l = 9.06;
+    double n1[3], n2[3], worst = INFINITY;
+    int k;
+    check(mcg_wedge_normals(v, vp, 1e-8, 0.0, n1, n2) == MCG_EDEGENERATE,
+          "wedge: axes 1.4e-8 rad apart give no wedge", 0.0, 0.0);
+    check(mcg_wedge_normals(vq, vpq, 1e-7, 0.0, n1, n2) == MCG_OK,
+          "wedge: axes 3e-6 rad apart, half-angle 1e-7: a wedge", 0.0, 0.0);
+    /* t = lp vp / |vp| - l v / |v| (the cones' axes), lp = 1 .. 10, l = 9.06:
+     * the harness's bound is -1e-9 (l + lp) */
+    for (k = 1; k <= 10; ++k) {
+        double t[3], lp = (double)k;
+        int i;
+        for (i = 0; i < 3; ++i)
+            t[i] = lp * vpq[i] / nvp - l * vq[i] / nv;
+        worst = fmin(worst, fmin(n1[0] * t[0] + n1[1] * t[1] + n1[2] * t[2],
+                                 n2[0] * t[0] + n2[1] * t[1] + n2[2] * t[2]) / (l + lp));
+    }
+    check(worst >= -1e-9, "wedge: the axes' t on the inner side of both planes (/ (l + lp))",
+          worst, -1e-9);
+}
+
 /* fuzz_linear17: exact data that hardly move a cross-camera rig (R = I,
  * |t| ~ 1e-4 of the rig) or repeat rays (a decoder out of bytes: the tail of
  * the points identical) gave MCG_OK, an "observable" scale and residuals up to
@@ -659,6 +689,7 @@ int main(void)
     test_lp_native_duplicated_rows();
     test_linear17_near_static_and_repeated();
     test_wedge_near_parallel();
+    test_wedge_tiny_angle();
     test_cone_iteration_budget();
     test_svd_near_dbl_max();
     test_bnb_polish_nonnegative();
