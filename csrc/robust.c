@@ -744,6 +744,26 @@ static int line_scale(ctx *c, const double R[9], const double t0[3], const doubl
            *lam2 != lam && *lam2 > 1e-9 * (c->size + sqrt(dot3(t0, t0)));
 }
 
+/* The pair (o1, d1) -> (o2, d2) triangulated under (R, t): s1 R d1 +
+ * (R o1 + t - o2) = s2 d2 at the closest points. 1 when both depths are
+ * positive, 0 when not, -1 for parallel rays (a point at infinity: no
+ * depth), -2 for a zero direction. */
+static int pair_in_front(const double R[9], const double t[3], const double *o1,
+                         const double *d1, const double *o2, const double *d2)
+{
+    double e1[3], e2[3], A[3], g[3], s1, s2;
+    int i;
+    if (!unit3(d1, e1) || !unit3(d2, e2))
+        return -2;
+    mat_vec(R, e1, A);
+    mat_vec(R, o1, g);
+    for (i = 0; i < 3; i++)
+        g[i] += t[i] - o2[i];
+    if (!depths(A, e2, g, &s1, &s2))
+        return -1;
+    return s1 > 0.0 && s2 > 0.0;
+}
+
 /* Are most of the scale search's pairs that (R, t) explains (residual
  * within the threshold) in front of both their rays? The sixth pair of a
  * 5+1 sample is checked so (candidate); a scale searched for a motion the
@@ -755,41 +775,36 @@ static int scale_in_front(const ctx *c, const double R[9], const double t[3])
     int j, front = 0, behind = 0;
     for (j = 0; j < c->nx; j++) {
         const size_t k = (size_t)c->xidx[j];
-        double r = fabs(sampson_residual(R, t, c->o1 + 3 * k, c->d1 + 3 * k, c->o2 + 3 * k,
-                                         c->d2 + 3 * k)) *
-                   (c->focal ? c->focal[k] : 1.0);
-        double e1[3], e2[3], A[3], g[3], ro1[3], s1, s2;
-        int i;
-        if (!(r < c->opt.threshold) || !unit3(c->d1 + 3 * k, e1) || !unit3(c->d2 + 3 * k, e2))
+        const double *o1 = c->o1 + 3 * k, *d1 = c->d1 + 3 * k, *o2 = c->o2 + 3 * k,
+                     *d2 = c->d2 + 3 * k;
+        int f;
+        if (!(fabs(sampson_residual(R, t, o1, d1, o2, d2)) * (c->focal ? c->focal[k] : 1.0) <
+              c->opt.threshold))
             continue;
-        mat_vec(R, e1, A);
-        mat_vec(R, c->o1 + 3 * k, ro1);
-        for (i = 0; i < 3; i++)
-            g[i] = ro1[i] + t[i] - c->o2[3 * k + i];
-        if (!depths(A, e2, g, &s1, &s2))
-            continue; /* parallel rays: a point at infinity */
-        if (s1 > 0.0 && s2 > 0.0)
-            front++;
-        else
-            behind++;
+        f = pair_in_front(R, t, o1, d1, o2, d2);
+        front += f == 1;
+        behind += f == 0; /* (no depth: neither) */
     }
     return front > behind;
 }
 
 /* The scale search of a new best (R, t0 + lam u) on camera a's line (see
- * offer): the motion it finds becomes the best if it scores better. */
+ * offer), or of a record (from_record: REC_PROPOSALS, its scale's pairs in
+ * front, scored on the preemptive subset first): the motion it finds
+ * becomes the best if it scores better; 1 when it did. */
 static int scale_search(ctx *c, const double R[9], const double t0[3], const double u[3],
-                        double lam, int a, int front)
+                        double lam, int a, int from_record)
 {
     double sc, t[3], lam2, bound = c->have ? c->score : INFINITY;
     int n_inl = 0, n_wide = 0, i, took = 0;
     if (c->nx > 0 || (a >= 0 && gather_others(c, a) > 0)) {
-        if (line_scale(c, R, t0, u, lam, front ? REC_PROPOSALS : SCALE_PROPOSALS, &lam2)) {
+        if (line_scale(c, R, t0, u, lam, from_record ? REC_PROPOSALS : SCALE_PROPOSALS,
+                       &lam2)) {
             for (i = 0; i < 3; i++)
                 t[i] = t0[i] + lam2 * u[i];
             /* (a record's motion is first scored on the preemptive subset,
              * as offer's are: at 1e6 pairs a full score costs ~6 ms) */
-            if (!front || (scale_in_front(c, R, t) &&
+            if (!from_record || (scale_in_front(c, R, t) &&
                            !(c->nsub > 0 && c->have &&
                              !(msac_sub(c, R, t, c->best_sub) < c->best_sub)))) {
                 c->n_hyp++;
@@ -1331,16 +1346,10 @@ static int trivial(const ctx *c, const double R[9], const double t[3], const dou
 static int in_front(const double R[9], const double t[3], const double *a1, const double *b1,
                     const double *a2, const double *b2, int m)
 {
-    int k, i;
+    int k;
     for (k = 0; k < m; k++) {
-        double e1[3], e2[3], A[3], g[3], s1, s2;
-        if (!unit3(b1 + 3 * k, e1) || !unit3(b2 + 3 * k, e2))
-            return 0;
-        mat_vec(R, e1, A);
-        mat_vec(R, a1 + 3 * k, g);
-        for (i = 0; i < 3; i++)
-            g[i] += t[i] - a2[3 * k + i];
-        if (depths(A, e2, g, &s1, &s2) && !(s1 > 0.0 && s2 > 0.0))
+        int f = pair_in_front(R, t, a1 + 3 * k, b1 + 3 * k, a2 + 3 * k, b2 + 3 * k);
+        if (f == 0 || f == -2) /* (parallel rays pass) */
             return 0;
     }
     return 1;

@@ -335,12 +335,10 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     opts = _ransac_options(threshold, prob, maxIters, seed)
     # (the sampler of choose_sampler, picked by the C search: "auto"; with a
     # vertical prior the upright 4-point one, as _gravity_method picks)
-    if gravity1 is None:
-        return _robust.ransac_rig_c(rays, "auto", opts, ppr, camera_table(rig),
-                                    rig.calibration_error)
-    return _robust.ransac_rig_c(rays, RIG_UPRIGHT_RANSAC, opts, ppr, camera_table(rig),
-                                rig.calibration_error,
-                                {"gravity1": gravity1, "gravity2": gravity2})
+    method, prior = ("auto", None) if gravity1 is None else \
+        (RIG_UPRIGHT_RANSAC, {"gravity1": gravity1, "gravity2": gravity2})
+    return _robust.ransac_rig_c(rays, method, opts, ppr, camera_table(rig),
+                                rig.calibration_error, prior)
 
 
 def _plain(a: Any, dtype: type, ndim: int) -> bool:
