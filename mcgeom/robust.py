@@ -332,7 +332,12 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     Returns a ``RigMotion`` with the boolean ``inliers`` mask, the scale verdict
     (from the covariance of the final refinement, plus the estimator's own
     evidence such as the critical angle of ch. 7) and ``info`` with the number
-    of iterations, hypotheses, local optimisations, the inlier ratio and the time.
+    of iterations, hypotheses, local optimisations, the inlier ratio and the time;
+    ``info["t_metric"]`` is the metric guess of t whatever the verdict, and
+    ``info["t_slid"]`` is True when the refinement's |t| left the data (grew
+    over 10x, or crossed zero into the mirrored minimum): ``t_metric`` is then
+    the robust hypothesis' length along the travel direction, and the verdict,
+    never observable, was judged at the refined motion.
     Raises ValueError for bad input or when no hypothesis could be formed
     (e.g. too few correspondences), DegenerateError when no motion explains
     enough correspondences.
@@ -722,6 +727,7 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         slid = slid or float(np.dot(direction, t)) < -0.9 * nt
         if slid:
             nt = n0
+        info["t_slid"] = slid
         zero = float("nan")
         if fit is not None and not slid and scale_determined(rel_std):
             zero = zero_profile

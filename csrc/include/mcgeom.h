@@ -389,7 +389,10 @@ typedef struct {
     int max_iterations;    /* trial steps, accepted or not, 0..10000 [50];
                               0 only evaluates the statistics at the start */
     double cost_tolerance; /* stop when an accepted step lowers the cost by
-                              less than this fraction [1e-10] */
+                              less than this fraction, or when the next step
+                              is expected to (its model decrease, corrected
+                              by the last step's gain, once that step matched
+                              the model) [1e-10] */
     double step_tolerance; /* stop when |dw| <= tol (radians) and
                               |dt| <= tol (|t| + L), L = the rig size (RMS
                               distance of the origins from their centroid)
