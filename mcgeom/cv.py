@@ -166,23 +166,26 @@ _RANSAC_DEFAULTS = {"prob": 0.999, "threshold": 1.0, "maxIters": 1000, "seed": 0
 
 
 @functools.lru_cache(maxsize=64, typed=True)
-def _cached_ransac_options(threshold: Any, prob: Any, max_iters: Any, seed: Any
+def _cached_ransac_options(threshold: Any, prob: Any, max_iters: Any
                            ) -> "_robust.RansacOptions":
-    return _robust.RansacOptions(threshold=threshold, prob=prob, max_iters=max_iters, seed=seed)
+    return _robust.RansacOptions(threshold=threshold, prob=prob, max_iters=max_iters)
 
 
 def _ransac_options(threshold: Any, prob: Any, max_iters: Any, seed: Any
                     ) -> "_robust.RansacOptions":
     """The (frozen) RansacOptions of :func:`estimate`'s four RANSAC arguments
-    (threshold None: 1 px), made once per distinct set (typed: ``True`` is no
-    ``1``): its checks cost ~15 us of a ~0.5 ms call (issue 19). Unhashable
-    arguments are checked afresh (and named) every time."""
+    (threshold None: 1 px): the first three made once per distinct set
+    (typed: ``True`` is no ``1``), the seed -- often a new one per estimate --
+    set on a copy (:meth:`RansacOptions.with_seed`): the constructor's checks
+    cost ~15 us of a ~0.5 ms call (issue 19). Unhashable arguments are
+    checked afresh (and named) every time."""
     threshold = 1.0 if threshold is None else threshold
     try:
-        return _cached_ransac_options(threshold, prob, max_iters, seed)
+        base = _cached_ransac_options(threshold, prob, max_iters)
     except TypeError:           # unhashable: no cache
         return _robust.RansacOptions(threshold=threshold, prob=prob, max_iters=max_iters,
                                      seed=seed)
+    return base if type(seed) is int and seed == base.seed else base.with_seed(seed)
 
 
 def _no_ransac_options(name: str, **given: Any) -> None:

@@ -69,6 +69,30 @@ def test_ransac_is_deterministic_with_a_seed():
     assert np.array_equal(a.inliers, b.inliers)
 
 
+def test_options_with_seed_are_the_options_made_with_it():
+    base = robust.RansacOptions(threshold=0.7, prob=0.99, max_iters=300)
+    for seed in (0, 7, 2 ** 40, np.int64(3), None):
+        assert base.with_seed(seed) == robust.RansacOptions(threshold=0.7, prob=0.99,
+                                                            max_iters=300, seed=seed)
+    assert base.seed == 0   # (a copy: base unchanged)
+    for bad in (-1, True, 1.5, "3"):
+        with pytest.raises(ValueError, match="seed"):
+            base.with_seed(bad)
+    # the façade's per-call seed reaches the search as the constructor's would:
+    # its options (1 px, seed 11) give the same estimate through ransac
+    rig = synth.ladybug2()
+    rng = np.random.default_rng(3)
+    R, t = turning_motion(rng)
+    p = synth.make_problem(rig, R, t, 120, rng, pixel_noise=0.5, outlier_fraction=0.2)
+    a = cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, seed=np.int64(11))
+    b = robust.ransac(p.rays, threshold=1.0, seed=11,
+                      focal=mcgeom.pixel_noise.pixels_per_radian(rig, p.rays),
+                      pixel_cameras=mcgeom.pixel_noise.camera_table(rig),
+                      calibration_std=rig.calibration_error)
+    assert np.array_equal(a.R, b.R) and np.array_equal(a.inliers, b.inliers)
+    assert a.info["iterations"] == b.info["iterations"]
+
+
 def test_ransac_with_linear17_samples():
     p = _vehicle_problem(3, outliers=0.1, noise=0.2)
     m = robust.ransac(p.rays, "linear17", threshold=1.0, focal=800.0, seed=0, max_iters=300)
