@@ -802,6 +802,13 @@ static double curvature_ratio(double a, double gain)
     return den > 0.0 ? a / den : HUGE_VAL;
 }
 
+/* The step length a of the next step: the ratio clamped to [1, CURV_MAX]
+ * (NaN, no measurement: 1) */
+static double relaxation(double ratio)
+{
+    return ratio > CURV_MAX ? CURV_MAX : (ratio > 1.0 ? ratio : 1.0);
+}
+
 /* Below this damping the Marquardt step is the Gauss-Newton one to 0.1 %:
  * its predicted decrease may stop the loop (lm_iteration). */
 #define TRUST_LAMBDA 1e-3
@@ -810,11 +817,11 @@ static double curvature_ratio(double a, double gain)
 typedef struct {
     double lambda, nu;
     double ratio; /* the IRLS model's curvature over the cost's along the
-                     last accepted step (curvature_ratio) */
-    double curv;  /* ratio clamped to [1, CURV_MAX]: the next step is
-                     lengthened by it */
-    int trusted;  /* the last step was accepted and its decrease matched the
-                     model's to a factor 2 in curvature */
+                     last accepted step (curvature_ratio); NaN after a
+                     rejected step and at the start. The next step is
+                     lengthened by relaxation(ratio); the model is trusted
+                     (its prediction may stop the loop) when the ratio is
+                     within a factor 2 of 1 */
     int reason, converged;
     int trials; /* steps tried, accepted or not (res->iterations) */
 } lm_state;
@@ -823,9 +830,7 @@ typedef struct {
  * damping (Nielsen's rule); 1 when it exceeds LAMBDA_MAX (stalled). */
 static int lm_reject(lm_state *lm)
 {
-    lm->ratio = 1.0;
-    lm->curv = 1.0;
-    lm->trusted = 0;
+    lm->ratio = NAN;
     lm->lambda = lm->lambda > 0.0 ? lm->lambda * lm->nu : 1e-12;
     lm->nu *= 2.0;
     if (lm->lambda > LAMBDA_MAX) {
@@ -845,7 +850,7 @@ static int lm_iteration(int n, const double *o1, const double *d1, const double 
                         double tv[3], accum *cur, lm_state *lm)
 {
     double pm[6][6], hm[36], gm[6], dx[6], dfull[6], rn[9], tn[3];
-    double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual;
+    double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual, a = relaxation(lm->ratio);
     int i, m, accepted, small, fix = o->fix_scale;
     accum trial;
 
@@ -876,16 +881,15 @@ static int lm_iteration(int n, const double *o1, const double *d1, const double 
      * damping no longer shortens the step (the stop of an accepted step
      * below the tolerance, one evaluation earlier) */
     pred = predicted_decrease(hm, gm, dx, m);
-    if (lm->trusted && lm->lambda <= TRUST_LAMBDA &&
-        (2.0 * lm->curv - lm->curv * lm->curv / lm->ratio) * pred <=
-            o->cost_tolerance * cur->cost) {
+    if (lm->ratio >= 0.5 && lm->ratio <= 2.0 && lm->lambda <= TRUST_LAMBDA &&
+        (2.0 * a - a * a / lm->ratio) * pred <= o->cost_tolerance * cur->cost) {
         lm->converged = 1;
         lm->reason = MCG_REFINE_STOP_COST;
         return 1;
     }
     lm->trials++;
     for (i = 0; i < m; i++)
-        dx[i] *= lm->curv;
+        dx[i] *= a;
     limit_step(pm, m, tv, ell, dx, dfull);
     pred = predicted_decrease(hm, gm, dx, m);
     if (!candidate_motion(dfull, r, tv, fix, rho0, rn, tn)) {
@@ -902,12 +906,10 @@ static int lm_iteration(int n, const double *o1, const double *d1, const double 
     accepted = !trial.bad && trial.cost <= cur->cost;
     if (accepted) {
         double gain = pred > 0.0 ? actual / pred : 0.0, f;
-        double c0 = cur->cost, cr = curvature_ratio(lm->curv, gain);
-        lm->trusted = cr >= 0.5 && cr <= 2.0;
-        lm->ratio = cr;
-        lm->curv = cr < 1.0 ? 1.0 : (cr > CURV_MAX ? CURV_MAX : cr);
+        double c0 = cur->cost;
+        lm->ratio = curvature_ratio(a, gain);
         /* (a step short even at CURV_MAX: the line search) */
-        if (cr > CURV_MAX && gain > EXTRAP_GAIN)
+        if (lm->ratio > CURV_MAX && gain > EXTRAP_GAIN)
             extrapolate(n, o1, d1, o2, d2, weights, lf, gm, dx, m, dfull, r, tv, fix, rho0,
                         0.5 * (nt > ell ? nt : ell), cur->cost, rn, tn, &trial);
         actual = cur->cost - trial.cost;
@@ -1039,9 +1041,7 @@ int mcg_refine_motion_until(int n, const double *o1, const double *d1, const dou
     lm.reason = MCG_REFINE_STOP_MAX_ITERATIONS;
     lm.converged = 0;
     lm.trials = 0;
-    lm.ratio = 1.0;
-    lm.curv = 1.0;
-    lm.trusted = 0;
+    lm.ratio = NAN;
     for (it = 0; it < o.max_iterations; it++) {
         const double before = cur.cost;
         if (cur.cost <= cost_target) {

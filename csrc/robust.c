@@ -531,6 +531,13 @@ static double msac_sub(ctx *c, const double R[9], const double t[3], double boun
     return s;
 }
 
+/* Preemptive rejection (from PREEMPT_MIN pairs, once there is a best): is
+ * (R, t) no better than the best on the subset? */
+static int preempted(ctx *c, const double R[9], const double t[3])
+{
+    return c->nsub > 0 && c->have && !(msac_sub(c, R, t, c->best_sub) < c->best_sub);
+}
+
 /* --------------------------------------------------- refinement on a subset */
 
 /* Gather the pairs with sel(k) into the subset buffers, shifted to their
@@ -744,6 +751,15 @@ static int line_scale(ctx *c, const double R[9], const double t0[3], const doubl
            *lam2 != lam && *lam2 > 1e-9 * (c->size + sqrt(dot3(t0, t0)));
 }
 
+/* |residual| of pair k at (R, t), in the threshold's unit (pixels with
+ * focal); NaN for a pair without one (never below a threshold) */
+static double pair_residual(const ctx *c, const double R[9], const double t[3], size_t k)
+{
+    return fabs(sampson_residual(R, t, c->o1 + 3 * k, c->d1 + 3 * k, c->o2 + 3 * k,
+                                 c->d2 + 3 * k)) *
+           (c->focal ? c->focal[k] : 1.0);
+}
+
 /* The pair (o1, d1) -> (o2, d2) triangulated under (R, t): s1 R d1 +
  * (R o1 + t - o2) = s2 d2 at the closest points. 1 when both depths are
  * positive, 0 when not, -1 for parallel rays (a point at infinity: no
@@ -775,13 +791,10 @@ static int scale_in_front(const ctx *c, const double R[9], const double t[3])
     int j, front = 0, behind = 0;
     for (j = 0; j < c->nx; j++) {
         const size_t k = (size_t)c->xidx[j];
-        const double *o1 = c->o1 + 3 * k, *d1 = c->d1 + 3 * k, *o2 = c->o2 + 3 * k,
-                     *d2 = c->d2 + 3 * k;
         int f;
-        if (!(fabs(sampson_residual(R, t, o1, d1, o2, d2)) * (c->focal ? c->focal[k] : 1.0) <
-              c->opt.threshold))
+        if (!(pair_residual(c, R, t, k) < c->opt.threshold))
             continue;
-        f = pair_in_front(R, t, o1, d1, o2, d2);
+        f = pair_in_front(R, t, c->o1 + 3 * k, c->d1 + 3 * k, c->o2 + 3 * k, c->d2 + 3 * k);
         front += f == 1;
         behind += f == 0; /* (no depth: neither) */
     }
@@ -804,9 +817,7 @@ static int scale_search(ctx *c, const double R[9], const double t0[3], const dou
                 t[i] = t0[i] + lam2 * u[i];
             /* (a record's motion is first scored on the preemptive subset,
              * as offer's are: at 1e6 pairs a full score costs ~6 ms) */
-            if (!from_record || (scale_in_front(c, R, t) &&
-                           !(c->nsub > 0 && c->have &&
-                             !(msac_sub(c, R, t, c->best_sub) < c->best_sub)))) {
+            if (!from_record || (scale_in_front(c, R, t) && !preempted(c, R, t))) {
                 c->n_hyp++;
                 sc = msac2(c, R, t, bound, &n_inl, &n_wide);
                 if (sc < bound) {
@@ -834,11 +845,7 @@ static void record(ctx *c, const double R[9], const double t0[3], const double u
         t[i] = t0[i] + u[i]; /* (camera a's residuals do not depend on lam > 0) */
     /* (stops once the rest cannot make a record) */
     for (j = c->rec_off[a]; j < end && m + (end - j) > c->rec[a]; j++) {
-        const size_t k = (size_t)c->rec_idx[j];
-        double r = fabs(sampson_residual(R, t, c->o1 + 3 * k, c->d1 + 3 * k, c->o2 + 3 * k,
-                                         c->d2 + 3 * k)) *
-                   (c->focal ? c->focal[k] : 1.0);
-        m += r < WIDE * c->opt.threshold; /* (NaN: an outlier) */
+        m += pair_residual(c, R, t, (size_t)c->rec_idx[j]) < WIDE * c->opt.threshold;
     }
     if (!(m > c->rec[a]))
         return;
@@ -867,8 +874,8 @@ static int offer(ctx *c, const double R[9], const double t0[3], const double u[3
     for (i = 0; i < 3; i++)
         t[i] = t0[i] + lam * u[i];
     c->n_hyp++;
-    if (c->nsub > 0 && c->have && !(msac_sub(c, R, t, c->best_sub) < c->best_sub))
-        return 0; /* preemptive: worse than the best on the subset */
+    if (preempted(c, R, t))
+        return 0;
     sc = msac2(c, R, t, c->have ? c->score : INFINITY, &n_inl, &n_wide);
     if (!(sc < (c->have ? c->score : INFINITY)))
         return 0;
