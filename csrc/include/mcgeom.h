@@ -1178,7 +1178,7 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * stop once a step lowers the cost by less than 1e-3 of its mean per pair
  * (~1e-3 sigma^2), the final fit at mcg_refine_motion's tolerance. Cost
  * O(n) per hypothesis scored (early exit once its score exceeds the best)
- * and per refinement iteration. Large n (issue 19): from 16384 pairs a
+ * and per refinement iteration. Large n (issue 19): from 4096 pairs a
  * hypothesis is first scored on a fixed random subset of 2048 pairs and on
  * all of them only if it beats the best there too; a final refinement or
  * scale profile on more than 4096 pairs converges on a random 4096 of them
