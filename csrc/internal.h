@@ -134,6 +134,17 @@ int mcg_scale_ransac_indexed(int n, const int *idx, const double *o1, const doub
                              double prob, double *lam, double *score, int *n_inliers,
                              double *work);
 
+/* upright4.c: the central upright 3-point solver (rays of one camera, the
+ * vertical g1, g2 known at both times, any lengths): up to 6 rotations R
+ * (rig frames, 6 x 9) and unit directions u (6 x 3, sign arbitrary) of the
+ * camera centre's travel with d2^T [u]x R d1 = 0 for the 3 bearing pairs
+ * d1 -> d2 (any non-zero lengths). MCG_OK (possibly 0 solutions),
+ * MCG_EINVAL for a zero or non-finite bearing or vertical, MCG_EDEGENERATE
+ * where every yaw fits (e.g. repeated pairs). No allocation. */
+#define MCG_UPRIGHT3_MAX_SOLUTIONS 6
+int mcg_upright3_central(const double d1[9], const double d2[9], const double g1[3],
+                         const double g2[3], double R[54], double u[18], int *n_solutions);
+
 /* mcg_refine_motion (refine.c) that also stops, converged with reason
  * MCG_REFINE_STOP_COST, once its cost is at most cost_target, or evidently
  * above it (more than 100 times the last accepted step's decrease above)

@@ -43,13 +43,16 @@
  * polished on all (FINAL_POLISH steps); the workspace stays ~16.5 n.
  *
  * Other samplers (opt.sampler, issue 21; "the upright and 6-point samples"
- * below): MCG_SAMPLER_UPRIGHT4 draws 4 pairs of any cameras and solves them
- * with the known vertical (mcg_upright4), MCG_SAMPLER_6PT draws 6 and solves
- * them with the generic minimal solver (mcg_sixpt); each real solution with
- * its own metric t is scored, locally optimised and finished as above, the
- * adaptive stop uses w^4 or w^6. Solutions that satisfy a sample pair
- * trivially (its camera only rotated about its centre, e.g. the static rig)
- * are dropped.
+ * below): MCG_SAMPLER_UPRIGHT4 with the vertical known draws, when some
+ * camera has 3 intra-camera pairs, 3+1 samples as the two-stage 5+1 does
+ * (3 pairs of a camera -> mcg_upright3_central: its rotation and direction
+ * of travel; the scale as for 5+1; w^3), else 4 pairs of any cameras solved
+ * with the known vertical (mcg_upright4); MCG_SAMPLER_6PT draws 6 and
+ * solves them with the generic minimal solver (mcg_sixpt); each real
+ * solution with its own metric t is scored, locally optimised and finished
+ * as above, the adaptive stop uses w^4 or w^6. Solutions that satisfy a
+ * sample pair trivially (its camera only rotated about its centre, e.g.
+ * the static rig) are dropped.
  *
  * The sixth correspondence is drawn among the cross-camera ones when there
  * are at least MIN_CROSS of them (they fix the scale whatever the motion,
@@ -372,7 +375,8 @@ typedef struct {
     /* workspace */
     double *rbest, *rcur, *fsc, *sub, *wsub;
     int *perm, *off; /* indices grouped: intra of camera 0, 1, ..., cross */
-    int *usable;     /* per camera: 1 if it can be the 5-point camera */
+    int *usable;     /* per camera: 1 if it can be the central sample's camera */
+    int central_m;   /* pairs of a central sample: 5 (5+1), 3 (upright 3+1), 0 */
     int *xidx;       /* the scale search's pairs (indices of the input) */
     double *xwork;   /* its mcg_scale_ransac workspace */
     int *xorder;     /* its proposal order */
@@ -1133,9 +1137,9 @@ static int decompose(const double E[9], double R1[9], double R2[9], double u[3])
     return orthonormalise(R2);
 }
 
-/* The motion of one rotation candidate of a 5+1 sample: the sign of the
- * camera's translation direction u from the cheirality of its five points
- * (all in front), the scale lam > 0 from the sixth correspondence (eq. 7.4:
+/* The motion of one rotation candidate of a 5+1 (or upright 3+1) sample:
+ * the sign of the camera's translation direction u from the cheirality of
+ * its m = 5 (3) points (all in front), the scale lam > 0 from the sixth correspondence (eq. 7.4:
  * a + lam b = 0 with a = d2.((t0 + R o1 - o2) x R d1), b = d2.((u) x R d1),
  * unit bearings), then the sixth point in front of both its rays.
  * `six` < 0: a rig with one camera, lam = 1 (direction only). Returns 1
@@ -1143,12 +1147,12 @@ static int decompose(const double E[9], double R1[9], double R2[9], double u[3])
  * no scale (no offer: the two-stage's record() may still search it), 0
  * when the five are not in front. */
 static int candidate(const ctx *c, const double R[9], const double u_in[3],
-                     const double b1[15], const double b2[15], const double ca[3], int six,
-                     double t0[3], double u[3], double *lam_out)
+                     const double b1[15], const double b2[15], int m, const double ca[3],
+                     int six, double t0[3], double u[3], double *lam_out)
 {
     double rca[3], A[3], t_out[3];
     int k, plus = 0, minus = 0, usable = 0, i;
-    for (k = 0; k < 5; k++) {
+    for (k = 0; k < m; k++) {
         double s1, s2;
         mat_vec(R, b1 + 3 * k, A);
         if (!depths(A, b2 + 3 * k, u_in, &s1, &s2))
@@ -1202,15 +1206,25 @@ static int candidate(const ctx *c, const double R[9], const double u_in[3],
     return 1;
 }
 
-/* One 5+1 sample: returns the number of hypotheses offered. */
+/* One central sample: m = c->central_m intra-camera pairs of one camera a
+ * and a sixth pair. 5+1 (thesis ch. 7): 5 pairs -> mcg_essential5 -> both
+ * rotations of each E; upright 3+1 (the vertical known, opt.g1/g2): 3
+ * pairs -> mcg_upright3_central (Fraundorfer et al. 2010), the rotation
+ * and the direction of camera a's travel -- the two-stage search of
+ * REC_PAIRS then as for 5+1 (the sixth pair's scale, the 1-point scale
+ * search of a new best, the records), with 3-samples in the adaptive stop
+ * (w^3: half the samples of w^5 at 30 % outliers). Returns the number of
+ * hypotheses offered, -1 when no camera has m usable pairs. */
+#define CENTRAL_CANDIDATES 20 /* 10 essential matrices x 2 rotations */
 static int sample(ctx *c, const double *w)
 {
-    int total = 0, a, k, m, cnt, start, six = -1, n_e = 0, j, offered = 0;
-    double b1[15], b2[15], E[90], ca[3];
+    const int mm = c->central_m;
+    int total = 0, a, k, m, cnt, start, six = -1, n_e = 0, j, offered = 0, nc = 0;
+    double b1[15], b2[15], E[90], ca[3], Rc[9 * CENTRAL_CANDIDATES], uc[3 * CENTRAL_CANDIDATES];
     const int *off = c->off;
     for (k = 0; k < c->ncam; k++) {
         cnt = off[k + 1] - off[k];
-        total += cnt >= 5 && c->usable[k] ? cnt : 0;
+        total += cnt >= mm && c->usable[k] ? cnt : 0;
     }
     if (total == 0)
         return -1;
@@ -1218,7 +1232,7 @@ static int sample(ctx *c, const double *w)
     m = rng_below(&c->rng, total);
     for (a = 0; a < c->ncam; a++) {
         cnt = off[a + 1] - off[a];
-        if (cnt < 5 || !c->usable[a])
+        if (cnt < mm || !c->usable[a])
             continue;
         if (m < cnt)
             break;
@@ -1226,8 +1240,8 @@ static int sample(ctx *c, const double *w)
     }
     start = off[a];
     cnt = off[a + 1] - start;
-    /* five distinct ones: a partial Fisher-Yates shuffle of camera a's group */
-    for (j = 0; j < 5; j++) {
+    /* mm distinct ones: a partial Fisher-Yates shuffle of camera a's group */
+    for (j = 0; j < mm; j++) {
         int r = j + rng_below(&c->rng, cnt - j), tmp = c->perm[start + j], idx;
         c->perm[start + j] = c->perm[start + r];
         c->perm[start + r] = tmp;
@@ -1248,27 +1262,34 @@ static int sample(ctx *c, const double *w)
             six = c->perm[r < start ? r : r + cnt];
         }
     }
-    if (mcg_essential5(b1, b2, E, &n_e) != MCG_OK)
-        return 0;
-    for (j = 0; j < n_e; j++) {
-        double R1[9], R2[9], u[3], t0[3], us[3], lam;
-        const double *Rs[2];
-        int h;
-        if (!decompose(E + 9 * j, R1, R2, u))
-            continue;
-        Rs[0] = R1;
-        Rs[1] = R2;
-        for (h = 0; h < 2; h++) {
-            int got = candidate(c, Rs[h], u, b1, b2, ca, six, t0, us, &lam), best = 0;
-            if (got == 0)
-                continue; /* not in front of camera a */
-            if (got == 1) {
-                best = offer(c, Rs[h], t0, us, lam, w, six >= 0 ? a : -1);
-                offered++;
-            }
-            if (!best && c->records)
-                record(c, Rs[h], t0, us, w, a);
+    /* the candidates (R, u) of camera a's motion */
+    if (mm == 5) {
+        if (mcg_essential5(b1, b2, E, &n_e) != MCG_OK)
+            return 0;
+        for (j = 0; j < n_e; j++) {
+            double R1[9], R2[9], u[3];
+            if (!decompose(E + 9 * j, R1, R2, u))
+                continue;
+            memcpy(Rc + 9 * nc, R1, sizeof R1);
+            memcpy(uc + 3 * nc++, u, sizeof u);
+            memcpy(Rc + 9 * nc, R2, sizeof R2);
+            memcpy(uc + 3 * nc++, u, sizeof u);
         }
+    } else if (mcg_upright3_central(b1, b2, c->opt.g1, c->opt.g2, Rc, uc, &nc) != MCG_OK) {
+        return 0;
+    }
+    for (j = 0; j < nc; j++) {
+        double t0[3], us[3], lam;
+        int got = candidate(c, Rc + 9 * j, uc + 3 * j, b1, b2, mm, ca, six, t0, us, &lam);
+        int best = 0;
+        if (got == 0)
+            continue; /* not in front of camera a */
+        if (got == 1) {
+            best = offer(c, Rc + 9 * j, t0, us, lam, w, six >= 0 ? a : -1);
+            offered++;
+        }
+        if (!best && c->records)
+            record(c, Rc + 9 * j, t0, us, w, a);
     }
     return offered;
 }
@@ -1462,7 +1483,7 @@ static int sample_minimal(ctx *c, const double *w)
  * the data can never give one (5+1: no camera with 5 intra-camera pairs). */
 static int draw(ctx *c, const double *w)
 {
-    return c->opt.sampler == MCG_SAMPLER_5P1 ? sample(c, w) : sample_minimal(c, w);
+    return c->central_m > 0 ? sample(c, w) : sample_minimal(c, w);
 }
 
 /* ------------------------------------------------------------ phases */
@@ -1579,7 +1600,7 @@ static void mark_usable(ctx *c)
 {
     int g;
     for (g = 0; g < c->ncam; g++)
-        c->usable[g] = c->off[g + 1] - c->off[g] >= 5 &&
+        c->usable[g] = c->off[g + 1] - c->off[g] >= (c->central_m > 0 ? c->central_m : 5) &&
                        plane_rms(c, g, 0) > c->loss_scale && plane_rms(c, g, 1) > c->loss_scale;
 }
 
@@ -1952,9 +1973,14 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         c.opt.sampler = has5 ? MCG_SAMPLER_5P1 : MCG_SAMPLER_6PT;
     }
     res->sampler = c.opt.sampler;
-    /* (the two-stage 5+1 counts 5-samples: REC_PAIRS) */
-    c.records = c.opt.sampler == MCG_SAMPLER_5P1;
-    c.sample_size = c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4 : c.records ? 5 : 6;
+    /* central samples: 5+1; the upright sampler's 3+1 when a camera has 3
+     * intra-camera pairs (else, and when none of those cameras is usable
+     * below, the 4-point samples of any cameras) */
+    c.central_m = c.opt.sampler == MCG_SAMPLER_5P1 ? 5 : 0;
+    if (c.opt.sampler == MCG_SAMPLER_UPRIGHT4)
+        for (k = 0; k < n_cameras; k++)
+            if (c.off[k + 1] - c.off[k] >= 3)
+                c.central_m = 3;
     c.med_focal = 1.0;
     c.const_focal = 1;
     if (focal) {
@@ -1975,6 +2001,15 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     c.size = origin_spread(n, o1, o2, cen);
     c.size += sqrt(dot3(cen, cen));
     mark_usable(&c);
+    if (c.central_m == 3) {
+        int any = 0;
+        for (k = 0; k < n_cameras; k++)
+            any |= c.usable[k];
+        c.central_m = any ? 3 : 0;
+    }
+    /* (the two-stage search counts central samples: REC_PAIRS) */
+    c.records = c.central_m > 0;
+    c.sample_size = c.records ? c.central_m : c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4 : 6;
     if (c.records)
         setup_records(&c);
     gather_cross(&c);

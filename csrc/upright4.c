@@ -636,3 +636,132 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
     *n_solutions = ns;
     return MCG_OK;
 }
+
+/* ------------------------------------------- the central 3-point solver
+ *
+ * One camera (rays through one centre) whose vertical is known at both
+ * times: its rotation R (the rig's) and the direction u of its centre's
+ * travel (s2 d2 = s1 R d1 + u, the essential matrix [u]x R) from 3
+ * correspondences (Fraundorfer, Tanskanen, Pollefeys, "A minimal case
+ * solution to the calibrated relative pose problem for the case of two
+ * known orientation angles", ECCV 2010; Kalantari, Hashemi, Jung, Guedon,
+ * "A new solution to the relative orientation problem using only 3 points
+ * and the vertical direction", JMIV 2011). Our own derivation, in the
+ * upright frames of mcg_upright4 (step 1 above):
+ *
+ *   C1. The epipolar constraint d2'^T [u']x Rz(theta) d1' = 0 reads
+ *       u' . (Rz d1' x d2') = 0, one row of u's 3 x 3 system per
+ *       correspondence; with q = tan(theta / 2) each row times 1 + q^2 is
+ *       (P0 d1' x d2') + q (P1 d1' x d2') + q^2 (P2 d1' x d2') (P_j of (U2),
+ *       the first three entries of rows_of).
+ *   C2. A direction u' != 0 exists iff det M(q) = 0: by multilinearity in
+ *       the rows, det M(q) = sum over (j0, j1, j2) of q^(j0 + j1 + j2)
+ *       det[row0_j0; row1_j1; row2_j2], a polynomial of degree <= 6 (up to
+ *       6 real roots; the papers' elimination reaches a quartic, the two
+ *       extra roots of ours being spurious only where every row vanishes).
+ *   C3. Real roots by real_roots; u' the longest cross product of two rows
+ *       of M(q) (normalised), R = Q2^T Rz(theta) Q1 and u = Q2^T u' as in
+ *       mcg_upright4. The sign of u is the caller's (cheirality). A root
+ *       whose rows all vanish (the camera only rotated: every direction
+ *       fits) gives no direction and is dropped.
+ */
+int mcg_upright3_central(const double d1[9], const double d2[9], const double g1[3],
+                         const double g2[3], double R[54], double u[18], int *n_solutions)
+{
+    double Q1[9], Q2[9], v1[3], v2[3], rows[3][3][3], poly[7], roots[6], lead = 0.0, size = 0.0;
+    int k, i, j0, j1, j2, deg, nr, ns = 0;
+    *n_solutions = 0;
+    {
+        double a = dot3(g1, g1), b = dot3(g2, g2);
+        if (!(a >= DIR2_MIN && b >= DIR2_MIN && isfinite(a) && isfinite(b)))
+            return MCG_EINVAL;
+        for (i = 0; i < 3; ++i) {
+            v1[i] = g1[i] / sqrt(a);
+            v2[i] = g2[i] / sqrt(b);
+        }
+    }
+    upright_rotation(v1, Q1);
+    upright_rotation(v2, Q2);
+    for (k = 0; k < 3; ++k) { /* C1: the rows' coefficients of q^0, q^1, q^2 */
+        double e1[3], e2[3], a[3], b[3], x = dot3(d1 + 3 * k, d1 + 3 * k),
+                                          y = dot3(d2 + 3 * k, d2 + 3 * k);
+        if (!(x >= DIR2_MIN && y >= DIR2_MIN && isfinite(x) && isfinite(y)))
+            return MCG_EINVAL;
+        for (i = 0; i < 3; ++i) {
+            a[i] = d1[3 * k + i] / sqrt(x);
+            b[i] = d2[3 * k + i] / sqrt(y);
+        }
+        mat_vec(Q1, a, e1);
+        mat_vec(Q2, b, e2);
+        {
+            const double pe1[3] = {-2.0 * e1[1], 2.0 * e1[0], 0.0};
+            const double qe1[3] = {-e1[0], -e1[1], e1[2]};
+            cross3(e1, e2, rows[k][0]);
+            cross3(pe1, e2, rows[k][1]);
+            cross3(qe1, e2, rows[k][2]);
+        }
+        for (j0 = 0; j0 < 3; ++j0)
+            size = fmax(size, dot3(rows[k][j0], rows[k][j0]));
+    }
+    for (i = 0; i < 7; ++i) /* C2 */
+        poly[i] = 0.0;
+    for (j0 = 0; j0 < 3; ++j0)
+        for (j1 = 0; j1 < 3; ++j1)
+            for (j2 = 0; j2 < 3; ++j2)
+                poly[j0 + j1 + j2] += det3_rows(rows[0][j0], rows[1][j1], rows[2][j2]);
+    for (i = 0; i < 7; ++i)
+        lead = fmax(lead, fabs(poly[i]));
+    /* (det M is a product of three rows of length <= ~2 sqrt(size)) */
+    if (!isfinite(lead) || !(lead > 1e-13 * size * sqrt(size)))
+        return MCG_EDEGENERATE; /* det M identically 0 (e.g. repeated pairs) */
+    for (i = 0; i < 7; ++i)
+        poly[i] /= lead;
+    deg = 6;
+    while (deg > 0 && fabs(poly[deg]) <= 1e-14)
+        --deg;
+    if (deg == 0)
+        return MCG_EDEGENERATE;
+    nr = real_roots(poly, deg, roots);
+    for (k = 0; k < nr; ++k) { /* C3 */
+        double q = roots[k], M[3][3], c01[3], c02[3], c12[3], *best, nb, cs, sn, w, A[9],
+               up[3];
+        for (i = 0; i < 3; ++i) {
+            int j;
+            for (j = 0; j < 3; ++j)
+                M[i][j] = rows[i][0][j] + q * (rows[i][1][j] + q * rows[i][2][j]);
+        }
+        cross3(M[0], M[1], c01);
+        cross3(M[0], M[2], c02);
+        cross3(M[1], M[2], c12);
+        best = c01;
+        if (dot3(c02, c02) > dot3(best, best))
+            best = c02;
+        if (dot3(c12, c12) > dot3(best, best))
+            best = c12;
+        nb = sqrt(dot3(best, best));
+        /* rows of length ~ (1 + q^2) sqrt(size): their cross product is
+         * that squared times the sine of their angle */
+        if (!(nb > 1e-10 * (1.0 + q * q) * (1.0 + q * q) * size))
+            continue;
+        w = 1.0 / (1.0 + q * q);
+        cs = (1.0 - q * q) * w;
+        sn = 2.0 * q * w;
+        for (i = 0; i < 3; ++i) {
+            A[i] = cs * Q1[i] - sn * Q1[3 + i];
+            A[3 + i] = sn * Q1[i] + cs * Q1[3 + i];
+            A[6 + i] = Q1[6 + i];
+            up[i] = best[i] / nb;
+        }
+        for (i = 0; i < 3; ++i) {
+            int j;
+            for (j = 0; j < 3; ++j)
+                R[9 * ns + 3 * i + j] = Q2[i] * A[j] + Q2[3 + i] * A[3 + j] + Q2[6 + i] * A[6 + j];
+            u[3 * ns + i] = Q2[i] * up[0] + Q2[3 + i] * up[1] + Q2[6 + i] * up[2];
+        }
+        if (!all_finite(R + 9 * ns, 9) || !all_finite(u + 3 * ns, 3))
+            continue;
+        ++ns;
+    }
+    *n_solutions = ns;
+    return MCG_OK;
+}

@@ -1305,9 +1305,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     camera has 5 intra-camera pairs, else ``six_point``; the result's
     ``sampler`` names the one used) picks the minimal solver of the
     hypotheses: 5+1 (5 intra-camera pairs of one camera and a sixth),
-    ``upright_four_point`` (4 pairs of any cameras and the vertical
-    ``gravity1``/``gravity2``: 3-vectors in rig frames 1 and 2, any non-zero
-    length; required for it and refused otherwise) or ``six_point`` (6 pairs,
+    ``upright_four_point`` (the vertical ``gravity1``/``gravity2`` known:
+    3-vectors in rig frames 1 and 2, any non-zero length, required for it
+    and refused otherwise; 3 intra-camera pairs of one camera and a fourth,
+    as 5+1, when a camera has 3, else 4 pairs of any cameras) or ``six_point`` (6 pairs,
     the generic minimal solver).
 
     Returns None when no motion explains 6 correspondences (degenerate data),

@@ -81,8 +81,10 @@ def choose_sampler(cam1: np.ndarray, cam2: np.ndarray) -> str:
 
 def _gravity_method(method: str, gravity1: Any, gravity2: Any, options: dict) -> str:
     """The method to run when a vertical prior may be given: the default 5+1
-    becomes the upright 4-point (4-samples instead of 6: fewer iterations at
-    a given outlier rate); the prior goes into ``options``. ValueError when
+    becomes the upright sampler (3+1 samples when a camera has 3
+    intra-camera correspondences, else 4 of any cameras, instead of 5+1:
+    fewer iterations at a given outlier rate); the prior goes into
+    ``options``. ValueError when
     only one of the two is given, or the named method does not take it."""
     if gravity1 is None and gravity2 is None:
         return method

@@ -56,7 +56,7 @@ def test_facade_reports_the_sampler_it_chose():
     mu = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, gravity1=g1, gravity2=R @ g1)
     assert mu.info["sampler"] == "upright_four_point"
     assert _rot_deg(mu.R, R) < 0.1
-    # the vertical known: 4-samples, far fewer drawn than 6-samples at 30 % outliers
+    # the vertical known: 3+1 samples, far fewer drawn than 6-samples at 30 % outliers
     assert mu.info["iterations"] < m.info["iterations"]
 
 

@@ -1057,8 +1057,10 @@ typedef struct {
 enum {
     MCG_SAMPLER_5P1 = 0,      /* 5 intra-camera pairs of one camera (mcg_essential5)
                                  + a sixth for the metric scale (thesis ch. 7) */
-    MCG_SAMPLER_UPRIGHT4 = 1, /* 4 pairs of any cameras with the vertical known
-                                 (mcg_upright4; opt.g1, opt.g2) */
+    MCG_SAMPLER_UPRIGHT4 = 1, /* the vertical known (opt.g1, opt.g2): 3 intra-
+                                 camera pairs of one camera + a fourth for the
+                                 scale when a camera has 3, else 4 pairs of
+                                 any cameras (mcg_upright4) */
     MCG_SAMPLER_6PT = 2,      /* 6 pairs not all of one camera, the generic
                                  minimal solver (mcg_sixpt) */
     MCG_SAMPLER_AUTO = 3      /* MCG_SAMPLER_5P1 when some camera has 5
@@ -1132,9 +1134,12 @@ void mcg_robust_default_options(mcg_robust_options *opt);
 size_t mcg_robust_work_size(int n, int n_cameras);
 
 /* Robust rig motion rig2_from_rig1 from n ray correspondences with
- * outliers, in one call. Hypotheses by opt->sampler: MCG_SAMPLER_UPRIGHT4
- * draws 4 distinct pairs uniformly (any cameras) -> mcg_upright4 with
- * opt->g1, opt->g2; MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
+ * outliers, in one call. Hypotheses by opt->sampler: MCG_SAMPLER_UPRIGHT4,
+ * when some camera has 3 intra-camera pairs, draws as 5+1 below with 3
+ * pairs of one camera solved with the vertical (the central upright
+ * 3-point solver: rotation and the camera's direction of travel, adaptive
+ * stop with sample size 3), else 4 distinct pairs uniformly (any cameras)
+ * -> mcg_upright4 with opt->g1, opt->g2; MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
  * redrawn when all six are intra-camera pairs of one camera (a central
  * camera: no metric scale) -> mcg_sixpt; every real solution that puts
  * its sample in front of the cameras and satisfies no pair trivially (e.g.

@@ -17,8 +17,8 @@
  * all the pairs the result says it used, from the true motion) within a
  * fraction of its noise; the two-stage 5+1 finds the motion in 20 samples
  * where most sixth pairs are outliers. The other samplers (issue
- * 21): the upright 4-point one with the true vertical on the outlier scene
- * (same checks, and fewer samples than 5+1: 4-samples), and with a vertical
+ * 21): the upright one with the true vertical on the outlier scene (same
+ * checks, and fewer samples than 5+1: its 3+1 samples), and with a vertical
  * 0.2 deg off (the free final refinement absorbs it); the 6-point one on the
  * outlier scene and on a rig where no camera has 5 intra-camera pairs (5+1
  * fails there); their option checks. Exit status 0 iff every check passes.
@@ -424,7 +424,7 @@ static void upright_case(void)
     }
     st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
     check_outlier_run("upright", st, &res, rerr, terr, agree, caught);
-    check(res.iterations < r5.iterations, "upright: fewer samples than 5+1 (4-samples)",
+    check(res.iterations < r5.iterations, "upright: fewer samples than 5+1 (3+1 samples)",
           res.iterations, r5.iterations);
     /* the vertical 0.2 deg off at time 2: the samples' yaw is slightly
      * wrong, the final refinement (all six degrees of freedom) is not */

@@ -10,13 +10,18 @@
  * direct LU of the 4 x 4 matrix of rows [ (R d1 x d2)^T, d2.R m1 + m2.R d1 ]
  * on a fine grid of yaws (no polynomial, no upright frames: the rotations
  * with R g1 = g2 are built by Rodrigues' formula, yaw_rotation()); (4) status codes of
- * invalid and degenerate input. Exit status 0 iff every check passes.
+ * invalid and degenerate input. The central 3-point solver of the same file
+ * (mcg_upright3_central, internal.h) is checked likewise: the truth among
+ * its solutions, every solution on the constraints, and its count against
+ * the sign changes of det [R(theta) d1_k x d2_k]_k on a grid of yaws.
+ * Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
 #define TEST_SEED 0x0b417f4a11ULL
 #include "testutil.h"
 #include "../so3.h" /* dot3, cross3, mat_vec, mul33 */
+#include "../internal.h" /* mcg_upright3_central */
 
 #include <math.h>
 #include <stdio.h>
@@ -350,6 +355,138 @@ static void timing(void)
            1e6 * el / (reps * NP), reps * NP, (double)total / (reps * NP));
 }
 
+/* det [R(theta) a_k x b_k]_k of the central problem (unit bearings) */
+static double det3_at(const double g1[3], const double g2[3], double th, const double *a,
+                      const double *b)
+{
+    double R[9], M[9], Ra[3];
+    int k;
+    yaw_rotation(g1, g2, th, R);
+    for (k = 0; k < 3; k++) {
+        mat_vec(R, a + 3 * k, Ra);
+        cross3(Ra, b + 3 * k, M + 3 * k);
+    }
+    return M[0] * (M[4] * M[8] - M[5] * M[7]) - M[1] * (M[3] * M[8] - M[5] * M[6]) +
+           M[2] * (M[3] * M[7] - M[4] * M[6]);
+}
+
+/* The central upright 3-point solver on random noise-free cameras: centre
+ * c, rig motion (R, t) with R g1 = g2, bearings d1 = X - c, d2 = R X + t - c
+ * (both times the camera's own centre c), so d2^T [u]x R d1 = 0 with
+ * u = R c + t - c. */
+static void test_central3(int trials)
+{
+    int trial, found = 0, count_ok = 0, counted = 0, sat = 1, st_ok = 1;
+    double worst_gec = 0.0, worst_g = 0.0;
+    for (trial = 0; trial < trials; trial++) {
+        double R[9], t[3], c[3], g1[3], g2[3], d1[9], d2[9], a[9], b[9], u[3], Rs[54], us[18];
+        int k, i, ns = 0, st, hit = 0;
+        random_rotation(R, 1.0);
+        randn(g1, 3);
+        randn(t, 3);
+        randn(c, 3);
+        {
+            double n = sqrt(dot3(g1, g1));
+            for (i = 0; i < 3; i++)
+                g1[i] /= n;
+        }
+        mat_vec(R, g1, g2);
+        for (i = 0; i < 3; i++)
+            c[i] *= 0.5;
+        for (k = 0; k < 3; k++) {
+            double X[3], X2[3], na, nb;
+            randn(X, 3);
+            for (i = 0; i < 3; i++)
+                X[i] = c[i] + 6.0 * X[i];
+            mat_vec(R, X, X2);
+            for (i = 0; i < 3; i++) {
+                d1[3 * k + i] = X[i] - c[i];
+                d2[3 * k + i] = X2[i] + t[i] - c[i];
+            }
+            na = sqrt(dot3(d1 + 3 * k, d1 + 3 * k));
+            nb = sqrt(dot3(d2 + 3 * k, d2 + 3 * k));
+            for (i = 0; i < 3; i++) {
+                a[3 * k + i] = d1[3 * k + i] / na;
+                b[3 * k + i] = d2[3 * k + i] / nb;
+            }
+        }
+        mat_vec(R, c, u);
+        for (i = 0; i < 3; i++)
+            u[i] += t[i] - c[i];
+        {
+            double n = sqrt(dot3(u, u));
+            for (i = 0; i < 3; i++)
+                u[i] /= n;
+        }
+        st = mcg_upright3_central(d1, d2, g1, g2, Rs, us, &ns);
+        st_ok &= st == MCG_OK;
+        for (k = 0; k < ns; k++) {
+            double e = 0.0, x[3], Rg[3], dg, cu[3], du;
+            for (i = 0; i < 9; i++)
+                e = fmax(e, fabs(Rs[9 * k + i] - R[i]));
+            cross3(us + 3 * k, u, cu);
+            du = sqrt(dot3(cu, cu));
+            hit |= e < 1e-8 && du < 1e-8;
+            for (i = 0; i < 3; i++) { /* the constraints, unit bearings */
+                double Ra[3];
+                mat_vec(Rs + 9 * k, a + 3 * i, Ra);
+                cross3(us + 3 * k, Ra, x);
+                worst_gec = fmax(worst_gec, fabs(dot3(b + 3 * i, x)));
+            }
+            mat_vec(Rs + 9 * k, g1, Rg);
+            dg = 0.0;
+            for (i = 0; i < 3; i++)
+                dg = fmax(dg, fabs(Rg[i] - g2[i]));
+            worst_g = fmax(worst_g, dg);
+            sat &= fabs(sqrt(dot3(us + 3 * k, us + 3 * k)) - 1.0) < 1e-12;
+        }
+        found += hit;
+        /* the count against det's sign changes on 20000 yaws (trials whose
+         * smallest |det| on the grid is not near a tangency) */
+        if (trial < trials / 4) {
+            int changes = 0, g;
+            double prev = det3_at(g1, g2, -3.14159265358979, a, b), tiny = fabs(prev);
+            for (g = 1; g <= 20000; g++) {
+                double th = -3.14159265358979 + 6.28318530717958 * g / 20000.0;
+                double v = det3_at(g1, g2, th, a, b);
+                changes += (v < 0.0) != (prev < 0.0);
+                tiny = fmin(tiny, fabs(v));
+                prev = v;
+            }
+            if (tiny > 1e-9) {
+                counted++;
+                count_ok += changes == ns;
+            }
+        }
+    }
+    check(st_ok, "central 3-point: MCG_OK on generic data", 0.0, 0.0);
+    check(found == trials, "central 3-point: the truth among the solutions (of trials)", found,
+          trials);
+    check(worst_gec < 1e-9, "central 3-point: every solution on the 3 constraints", worst_gec,
+          1e-9);
+    check(worst_g < 1e-12, "central 3-point: every solution maps g1 to g2", worst_g, 1e-12);
+    check(sat, "central 3-point: unit directions", 0.0, 0.0);
+    check(counted > trials / 5 && count_ok == counted,
+          "central 3-point: solutions = sign changes of det on the yaw grid (of counted)",
+          count_ok, counted);
+    {
+        double d1[9] = {0, 0, 1, 0.1, 0, 1, 0, 0.1, 1}, d2[9], g[3] = {0, 0, 1}, Rs[54],
+               us[18];
+        int ns = -1;
+        memcpy(d2, d1, sizeof d2);
+        d2[5] = 0.0; /* a zero bearing */
+        d2[3] = d2[4] = 0.0;
+        check(mcg_upright3_central(d1, d2, g, g, Rs, us, &ns) == MCG_EINVAL,
+              "central 3-point: zero bearing -> MCG_EINVAL", 0.0, 0.0);
+        memcpy(d2, d1, sizeof d2);
+        memcpy(d1 + 6, d1, 3 * sizeof *d1); /* a repeated pair */
+        memcpy(d2 + 6, d2, 3 * sizeof *d2);
+        st_ok = mcg_upright3_central(d1, d2, g, g, Rs, us, &ns);
+        check(st_ok == MCG_EDEGENERATE, "central 3-point: repeated pair -> MCG_EDEGENERATE",
+              st_ok, MCG_EDEGENERATE);
+    }
+}
+
 int main(void)
 {
     test_random(0, 1, scaled(3000), "generic 4-camera rig, cross-camera");
@@ -358,6 +495,7 @@ int main(void)
     test_random(1, 1, scaled(3000), "2-camera head, cross-camera");
     test_near_pi(scaled(2000));
     test_root_at_split();
+    test_central3(scaled(4000));
     test_status();
     timing();
     printf("%d checks, %d failed\n", n_checks, n_failed);

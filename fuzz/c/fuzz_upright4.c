@@ -9,13 +9,74 @@
  * MCG_EINVAL, the status is always a known one; on MCG_OK 0 <= n <= 8 and
  * every solution is finite, a rotation (orthonormal, det +1) and maps the
  * unit g1 onto the unit g2 (the constraint that defines the solver).
+ * Modes 2 and 3: the same for the central 3-point solver of upright4.c
+ * (mcg_upright3_central, internal.h; robust.c's upright 3+1 samples) on a
+ * one-camera scene (3 intra-camera pairs) and on arbitrary bearings: on
+ * MCG_OK 0 <= n <= 6, each rotation maps g1 onto g2 and each direction is
+ * finite and of unit length.
  */
 #include "fuzz_input.h"
 #include "mcgeom.h"
+#include "internal.h"
 
 /* routines selected by the first input byte (fuzz/make_corpus.py writes
  * seeds for each) */
-#define FUZZ_MODES 2
+#define FUZZ_MODES 4
+
+/* The central solver (modes 2 and 3): its invariants, as above. */
+static int central(fz_in *in, int mode)
+{
+    double o1[9], d1[9], o2[9], d2[9], g1[3], g2[3], Rm[9], t[3], Rs[54], us[18], n1, n2;
+    int st, n = -1, s, i;
+    if (mode == 2) {
+        fz_rotation(in, Rm);
+        for (i = 0; i < 3; ++i)
+            t[i] = fz_range(in, -2.0, 2.0);
+        fz_scene(in, 3, 1, 0, Rm, t, o1, d1, o2, d2, NULL);
+        for (i = 0; i < 3; ++i)
+            g1[i] = fz_range(in, -1.0, 1.0);
+        for (i = 0; i < 3; ++i)
+            g2[i] = Rm[3 * i] * g1[0] + Rm[3 * i + 1] * g1[1] + Rm[3 * i + 2] * g1[2];
+    } else {
+        fz_doubles(in, d1, 9);
+        fz_doubles(in, d2, 9);
+        fz_doubles(in, g1, 3);
+        fz_doubles(in, g2, 3);
+    }
+    st = mcg_upright3_central(d1, d2, g1, g2, Rs, us, &n);
+    FZ_CHECK(st == MCG_OK || st == MCG_EINVAL || st == MCG_EDEGENERATE,
+             "upright3_central status %d", st);
+    n1 = fz_dot3(g1, g1);
+    n2 = fz_dot3(g2, g2);
+    if (!fz_all_finite(d1, 9) || !fz_all_finite(d2, 9) || !fz_all_finite(g1, 3) ||
+        !fz_all_finite(g2, 3) || !(n1 >= 1e-100 && n2 >= 1e-100)) {
+        FZ_CHECK(st == MCG_EINVAL, "upright3_central of non-finite or zero input: %d", st);
+        return 0;
+    }
+    if (st != MCG_OK)
+        return 0;
+    FZ_CHECK(n >= 0 && n <= MCG_UPRIGHT3_MAX_SOLUTIONS, "upright3_central: %d solutions", n);
+    if (!isfinite(n1) || !isfinite(n2))
+        return 0;
+    n1 = sqrt(n1);
+    n2 = sqrt(n2);
+    for (s = 0; s < n; ++s) {
+        const double *R = Rs + 9 * s, *u = us + 3 * s;
+        double Rg[3], e = 0.0;
+        FZ_CHECK(fz_all_finite(R, 9) && fz_all_finite(u, 3),
+                 "upright3_central: solution %d not finite", s);
+        FZ_CHECK(fz_is_rotation(R, 1e-9), "upright3_central: solution %d not a rotation (%g)",
+                 s, fz_orth_err3(R));
+        FZ_CHECK(fabs(fz_dot3(u, u) - 1.0) < 1e-9, "upright3_central: |u| of %d is %g", s,
+                 sqrt(fz_dot3(u, u)));
+        for (i = 0; i < 3; ++i)
+            Rg[i] = (R[3 * i] * g1[0] + R[3 * i + 1] * g1[1] + R[3 * i + 2] * g1[2]) / n1;
+        for (i = 0; i < 3; ++i)
+            e = fmax(e, fabs(Rg[i] - g2[i] / n2));
+        FZ_CHECK(e < 1e-9, "upright3_central: solution %d maps g1 off g2 by %g", s, e);
+    }
+    return 0;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -23,6 +84,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int mode = fz_u8(&in) % FUZZ_MODES, st, n = -1, s, i;
     double o1[12], d1[12], o2[12], d2[12], g1[3], g2[3], Rm[9], t[3], Rs[72], ts[24];
     double n1, n2;
+    if (mode >= 2)
+        return central(&in, mode);
     if (mode == 0) {
         fz_rotation(&in, Rm);
         for (i = 0; i < 3; ++i)

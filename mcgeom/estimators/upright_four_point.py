@@ -19,6 +19,15 @@ them (Sweeney, Flynn, Turk, 3DV 2014; Lee, Fraundorfer, Pollefeys, CVPR 2014).
   degrees of freedom (so that an error of the IMU's vertical does not bias
   the result) and the scale verdict.
 
+In the C robust search (``mcgeom.cv.estimate`` with ``gravity1``/``gravity2``,
+:func:`mcgeom.robust.ransac` with this method) the samples are 3+1 wherever
+some camera has 3 intra-camera correspondences: the central upright 3-point
+solver (``mcg_upright3_central`` in ``csrc/upright4.c``; Fraundorfer,
+Tanskanen, Pollefeys, ECCV 2010) gives that camera's rotation and direction
+of travel, the metric scale comes from the other cameras' correspondences as
+in 5+1, and the adaptive stop counts 3-samples; elsewhere 4-samples of this
+solver.
+
 Frames and units (docs/architecture.md §3): rays in the rig frame (metres),
 gravity vectors in the rig frames at times 1 and 2 (any non-zero length),
 ``X2 = R X1 + t`` with ``t`` in metres.

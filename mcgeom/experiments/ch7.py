@@ -86,7 +86,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--cross", type=fraction, nargs="+", default=list(CROSS_FRACTIONS),
                     help="fractions of cross-camera correspondences, one table each")
     ap.add_argument("--vertical-error-deg", type=non_negative_float, default=None,
-                    help="run the upright 4-point sampler, given the vertical with this "
+                    help="run the upright sampler (3+1 or 4-point), given the vertical with this "
                          "error (degrees; default: the 5+1 search without a vertical)")
 
 

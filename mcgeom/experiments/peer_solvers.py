@@ -29,12 +29,13 @@ Part ``ransac``: the robust estimate from pixels with 1 px threshold, median
 rotation error (deg), scale error ``| |t| / |t_true| - 1 |`` (the metric
 estimate ``info["t_metric"]``, whatever the verdict), time per problem
 (ms) and, for mcgeom's C search, its time and the mean number of samples its
-adaptive stop drew (w^4 for the upright sampler, w^5 for the two-stage 5+1,
-w^6 for the 6-point) of: mcgeom's façade as it chooses its sampler (upright with a vertical
-prior, else 5+1 when a camera has 5 intra-camera correspondences, else
-6-point; the sampler column counts its choices), the C search forced to 5+1,
-to the generic 6-point, and to the upright 4-point with the vertical known
-to 0.2 deg (each gravity vector turned by 0.2 deg about a random axis),
+adaptive stop drew (w^3 for the upright 3+1, w^4 for the upright 4-point,
+w^5 for the two-stage 5+1, w^6 for the 6-point) of: mcgeom's façade as it
+chooses its sampler (upright with a vertical prior, else 5+1 when a camera
+has 5 intra-camera correspondences, else 6-point; the sampler column counts
+its choices), the C search forced to 5+1, to the generic 6-point, and to the
+upright sampler (3+1 where a camera has 3 intra-camera correspondences, else
+4-point) with the vertical known to 0.2 deg (each gravity vector turned by 0.2 deg about a random axis),
 17-point RANSAC (``ransac:linear17``), and PoseLib's
 ``estimate_generalized_relative_pose`` (its 5+1 sampler,
 :mod:`.poselib_peer`) with ``min_iterations=100`` and with its defaults; on
@@ -410,8 +411,8 @@ def ransac_table(res: dict) -> str:
     RANSAC (their median time / this one's), and the median time of the C
     search with its speed-up over 5+1's (the search alone, without the
     façade's Python conversions and verdict), and the mean number of samples
-    the C search drew (its adaptive stop: w^4 for the upright sampler, w^5
-    for the two-stage 5+1, w^6 for the 6-point)."""
+    the C search drew (its adaptive stop: w^3 for the upright 3+1, w^4 for
+    the upright 4-point, w^5 for the two-stage 5+1, w^6 for the 6-point)."""
     lines = [f"{'case':<30} {'method':<23} {'sampler':<18} {'rot med deg':>11} "
              f"{'scale med':>9} {'failed':>6} {'ms med':>8} {'vs 5+1':>7} {'vs 17-pt':>8} "
              f"{'C ms med':>8} {'C vs 5+1':>8} {'samples':>7}"]
