@@ -305,6 +305,42 @@ static void upright_rotation(const double g[3], double Q[9])
     }
 }
 
+/* The upright frames Q1, Q2 (Q g = e_z) of the verticals g1, g2 (any
+ * non-zero finite lengths); 0 when either is zero or not finite. */
+static int upright_frames(const double g1[3], const double g2[3], double Q1[9], double Q2[9])
+{
+    double a = dot3(g1, g1), b = dot3(g2, g2), u1[3], u2[3];
+    int i;
+    if (!(a >= DIR2_MIN && b >= DIR2_MIN && isfinite(a) && isfinite(b)))
+        return 0;
+    for (i = 0; i < 3; ++i) {
+        u1[i] = g1[i] / sqrt(a);
+        u2[i] = g2[i] / sqrt(b);
+    }
+    upright_rotation(u1, Q1);
+    upright_rotation(u2, Q2);
+    return 1;
+}
+
+/* R = Q2^T Rz(theta) Q1 (rig frames) for q = tan(theta / 2), without
+ * trigonometry: cos = (1 - q^2) / (1 + q^2), sin = 2 q / (1 + q^2). With
+ * A = Rz Q1 (rows: cos a - sin b, sin a + cos b, g1),
+ * R = sum_k (row k of Q2)^T (row k of A). */
+static void rig_rotation(const double Q1[9], const double Q2[9], double q, double R[9])
+{
+    const double w = 1.0 / (1.0 + q * q), cs = (1.0 - q * q) * w, sn = 2.0 * q * w;
+    double A[9];
+    int i, k;
+    for (i = 0; i < 3; ++i) {
+        A[i] = cs * Q1[i] - sn * Q1[3 + i];
+        A[3 + i] = sn * Q1[i] + cs * Q1[3 + i];
+        A[6 + i] = Q1[6 + i];
+    }
+    for (i = 0; i < 3; ++i)
+        for (k = 0; k < 3; ++k)
+            R[3 * i + k] = Q2[i] * A[k] + Q2[3 + i] * A[3 + k] + Q2[6 + i] * A[6 + k];
+}
+
 /* The rows (U2) of one correspondence (upright unit directions e1, e2,
  * moments n1, n2): the coefficients of q^0, q^1, q^2, i.e. (U1) with
  * P0 = I, P1 = 2 [e_z]x, P2 = diag(-1, -1, 1) in place of R', whose
@@ -511,7 +547,7 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
                  const double d2[12], const double g1[3], const double g2[3], double R[72],
                  double t[24], int *n_solutions)
 {
-    double Q1[9], Q2[9], u1[3], u2[3], c[3] = {0.0, 0.0, 0.0}, s = 0.0;
+    double Q1[9], Q2[9], c[3] = {0.0, 0.0, 0.0}, s = 0.0;
     double e1[12], n1[12], e2[12], n2[12]; /* upright unit directions and moments */
     double Mq[3][16], poly[9], roots[8], lead = 0.0;
     int k, i, j, deg, nr, ns = 0;
@@ -521,19 +557,9 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
         return MCG_EINVAL;
     *n_solutions = 0;
     if (!all_finite(o1, 12) || !all_finite(d1, 12) || !all_finite(o2, 12) ||
-        !all_finite(d2, 12) || !all_finite(g1, 3) || !all_finite(g2, 3))
+        !all_finite(d2, 12) || !all_finite(g1, 3) || !all_finite(g2, 3) ||
+        !upright_frames(g1, g2, Q1, Q2))
         return MCG_EINVAL;
-    {
-        double a = dot3(g1, g1), b = dot3(g2, g2);
-        if (!(a >= DIR2_MIN && b >= DIR2_MIN && isfinite(a) && isfinite(b)))
-            return MCG_EINVAL;
-        for (i = 0; i < 3; ++i) {
-            u1[i] = g1[i] / sqrt(a);
-            u2[i] = g2[i] / sqrt(b);
-        }
-    }
-    upright_rotation(u1, Q1);
-    upright_rotation(u2, Q2);
     /* centre c and scale s of the origins (both times, rig frames) */
     for (k = 0; k < 4; ++k)
         for (i = 0; i < 3; ++i)
@@ -595,7 +621,7 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
         return MCG_EDEGENERATE; /* det M identically 0: every yaw fits */
     nr = real_roots(poly, deg, roots);
     for (j = 0; j < nr; ++j) {
-        double q = roots[j], M[16], f[4], v[4], tu[3], cs, sn, w, A[9];
+        double q = roots[j], M[16], f[4], v[4], tu[3];
         matrix_at((const double(*)[16])Mq, q, M);
         if (!null4(M, v))
             continue;
@@ -605,22 +631,7 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
             tu[i] = v[i] / v[3];
         residual_of(M, tu, f);
         polish((const double(*)[16])Mq, &q, tu, M, f);
-        /* Rz(theta) from q = tan(theta / 2) without trigonometry:
-         * cos = (1 - q^2) / (1 + q^2), sin = 2 q / (1 + q^2) */
-        w = 1.0 / (1.0 + q * q);
-        cs = (1.0 - q * q) * w;
-        sn = 2.0 * q * w;
-        /* A = Rz Q1 (rows: cos a - sin b, sin a + cos b, g1), then
-         * R = Q2^T A = sum_k (row k of Q2)^T (row k of A) */
-        for (i = 0; i < 3; ++i) {
-            A[i] = cs * Q1[i] - sn * Q1[3 + i];
-            A[3 + i] = sn * Q1[i] + cs * Q1[3 + i];
-            A[6 + i] = Q1[6 + i];
-        }
-        for (i = 0; i < 3; ++i)
-            for (k = 0; k < 3; ++k)
-                R[9 * ns + 3 * i + k] = Q2[i] * A[k] + Q2[3 + i] * A[3 + k] +
-                                        Q2[6 + i] * A[6 + k];
+        rig_rotation(Q1, Q2, q, R + 9 * ns);
         /* t = s Q2^T t' + c - R c */
         {
             double Rc[3];
@@ -668,20 +679,11 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
 int mcg_upright3_central(const double d1[9], const double d2[9], const double g1[3],
                          const double g2[3], double R[54], double u[18], int *n_solutions)
 {
-    double Q1[9], Q2[9], v1[3], v2[3], rows[3][3][3], poly[7], roots[6], lead = 0.0, size = 0.0;
+    double Q1[9], Q2[9], rows[3][3][3], poly[7], roots[6], lead = 0.0, size = 0.0;
     int k, i, j0, j1, j2, deg, nr, ns = 0;
     *n_solutions = 0;
-    {
-        double a = dot3(g1, g1), b = dot3(g2, g2);
-        if (!(a >= DIR2_MIN && b >= DIR2_MIN && isfinite(a) && isfinite(b)))
-            return MCG_EINVAL;
-        for (i = 0; i < 3; ++i) {
-            v1[i] = g1[i] / sqrt(a);
-            v2[i] = g2[i] / sqrt(b);
-        }
-    }
-    upright_rotation(v1, Q1);
-    upright_rotation(v2, Q2);
+    if (!upright_frames(g1, g2, Q1, Q2))
+        return MCG_EINVAL;
     for (k = 0; k < 3; ++k) { /* C1: the rows' coefficients of q^0, q^1, q^2 */
         double e1[3], e2[3], a[3], b[3], x = dot3(d1 + 3 * k, d1 + 3 * k),
                                           y = dot3(d2 + 3 * k, d2 + 3 * k);
@@ -723,8 +725,7 @@ int mcg_upright3_central(const double d1[9], const double d2[9], const double g1
         return MCG_EDEGENERATE;
     nr = real_roots(poly, deg, roots);
     for (k = 0; k < nr; ++k) { /* C3 */
-        double q = roots[k], M[3][3], c01[3], c02[3], c12[3], *best, nb, cs, sn, w, A[9],
-               up[3];
+        double q = roots[k], M[3][3], c01[3], c02[3], c12[3], *best, nb, up[3];
         for (i = 0; i < 3; ++i) {
             int j;
             for (j = 0; j < 3; ++j)
@@ -743,21 +744,11 @@ int mcg_upright3_central(const double d1[9], const double d2[9], const double g1
          * that squared times the sine of their angle */
         if (!(nb > 1e-10 * (1.0 + q * q) * (1.0 + q * q) * size))
             continue;
-        w = 1.0 / (1.0 + q * q);
-        cs = (1.0 - q * q) * w;
-        sn = 2.0 * q * w;
-        for (i = 0; i < 3; ++i) {
-            A[i] = cs * Q1[i] - sn * Q1[3 + i];
-            A[3 + i] = sn * Q1[i] + cs * Q1[3 + i];
-            A[6 + i] = Q1[6 + i];
+        rig_rotation(Q1, Q2, q, R + 9 * ns);
+        for (i = 0; i < 3; ++i)
             up[i] = best[i] / nb;
-        }
-        for (i = 0; i < 3; ++i) {
-            int j;
-            for (j = 0; j < 3; ++j)
-                R[9 * ns + 3 * i + j] = Q2[i] * A[j] + Q2[3 + i] * A[3 + j] + Q2[6 + i] * A[6 + j];
+        for (i = 0; i < 3; ++i) /* u = Q2^T u' */
             u[3 * ns + i] = Q2[i] * up[0] + Q2[3 + i] * up[1] + Q2[6 + i] * up[2];
-        }
         if (!all_finite(R + 9 * ns, 9) || !all_finite(u + 3 * ns, 3))
             continue;
         ++ns;

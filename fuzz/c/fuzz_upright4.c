@@ -23,6 +23,22 @@
  * seeds for each) */
 #define FUZZ_MODES 4
 
+/* Solution s (rotation R) of `who`: a rotation mapping the unit g1 onto
+ * the unit g2 (|g1|, |g2| = n1, n2: the constraint of both solvers). */
+static void check_vertical(const char *who, int s, const double R[9], const double g1[3],
+                           const double g2[3], double n1, double n2)
+{
+    double Rg[3], e = 0.0;
+    int i;
+    FZ_CHECK(fz_is_rotation(R, 1e-9), "%s: solution %d not a rotation (%g)", who, s,
+             fz_orth_err3(R));
+    for (i = 0; i < 3; ++i)
+        Rg[i] = (R[3 * i] * g1[0] + R[3 * i + 1] * g1[1] + R[3 * i + 2] * g1[2]) / n1;
+    for (i = 0; i < 3; ++i)
+        e = fmax(e, fabs(Rg[i] - g2[i] / n2));
+    FZ_CHECK(e < 1e-9, "%s: solution %d maps g1 off g2 by %g", who, s, e);
+}
+
 /* The central solver (modes 2 and 3): its invariants, as above. */
 static int central(fz_in *in, int mode)
 {
@@ -61,19 +77,12 @@ static int central(fz_in *in, int mode)
     n1 = sqrt(n1);
     n2 = sqrt(n2);
     for (s = 0; s < n; ++s) {
-        const double *R = Rs + 9 * s, *u = us + 3 * s;
-        double Rg[3], e = 0.0;
-        FZ_CHECK(fz_all_finite(R, 9) && fz_all_finite(u, 3),
+        const double *u = us + 3 * s;
+        FZ_CHECK(fz_all_finite(Rs + 9 * s, 9) && fz_all_finite(u, 3),
                  "upright3_central: solution %d not finite", s);
-        FZ_CHECK(fz_is_rotation(R, 1e-9), "upright3_central: solution %d not a rotation (%g)",
-                 s, fz_orth_err3(R));
         FZ_CHECK(fabs(fz_dot3(u, u) - 1.0) < 1e-9, "upright3_central: |u| of %d is %g", s,
                  sqrt(fz_dot3(u, u)));
-        for (i = 0; i < 3; ++i)
-            Rg[i] = (R[3 * i] * g1[0] + R[3 * i + 1] * g1[1] + R[3 * i + 2] * g1[2]) / n1;
-        for (i = 0; i < 3; ++i)
-            e = fmax(e, fabs(Rg[i] - g2[i] / n2));
-        FZ_CHECK(e < 1e-9, "upright3_central: solution %d maps g1 off g2 by %g", s, e);
+        check_vertical("upright3_central", s, Rs + 9 * s, g1, g2, n1, n2);
     }
     return 0;
 }
@@ -126,17 +135,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     n1 = sqrt(n1);
     n2 = sqrt(n2);
     for (s = 0; s < n; ++s) {
-        const double *R = Rs + 9 * s;
-        double Rg[3], e = 0.0;
-        FZ_CHECK(fz_all_finite(R, 9) && fz_all_finite(ts + 3 * s, 3),
+        FZ_CHECK(fz_all_finite(Rs + 9 * s, 9) && fz_all_finite(ts + 3 * s, 3),
                  "upright4: solution %d not finite", s);
-        FZ_CHECK(fz_is_rotation(R, 1e-9), "upright4: solution %d not a rotation (%g)", s,
-                 fz_orth_err3(R));
-        for (i = 0; i < 3; ++i)
-            Rg[i] = (R[3 * i] * g1[0] + R[3 * i + 1] * g1[1] + R[3 * i + 2] * g1[2]) / n1;
-        for (i = 0; i < 3; ++i)
-            e = fmax(e, fabs(Rg[i] - g2[i] / n2));
-        FZ_CHECK(e < 1e-9, "upright4: solution %d maps g1 off g2 by %g", s, e);
+        check_vertical("upright4", s, Rs + 9 * s, g1, g2, n1, n2);
     }
     return 0;
 }

@@ -35,8 +35,8 @@ chooses its sampler (upright with a vertical prior, else 5+1 when a camera
 has 5 intra-camera correspondences, else 6-point; the sampler column counts
 its choices), the C search forced to 5+1, to the generic 6-point, and to the
 upright sampler (3+1 where a camera has 3 intra-camera correspondences, else
-4-point) with the vertical known to 0.2 deg (each gravity vector turned by 0.2 deg about a random axis),
-17-point RANSAC (``ransac:linear17``), and PoseLib's
+4-point) with the vertical known to 0.2 deg (each gravity vector turned by
+0.2 deg about a random axis), 17-point RANSAC (``ransac:linear17``), and PoseLib's
 ``estimate_generalized_relative_pose`` (its 5+1 sampler,
 :mod:`.poselib_peer`) with ``min_iterations=100`` and with its defaults; on
 the cases of ``robust_vs_poselib`` (ring4, ladybug6 with 30 % outliers, car8
