@@ -2010,6 +2010,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     /* (the two-stage search counts central samples: REC_PAIRS) */
     c.records = c.central_m > 0;
     c.sample_size = c.records ? c.central_m : c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4 : 6;
+    res->sample_size = c.sample_size;
     if (c.records)
         setup_records(&c);
     gather_cross(&c);

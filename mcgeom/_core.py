@@ -1331,7 +1331,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     where not defined) and ``verdict``: with ``verdict_still_factor`` > 0
     the dict of :func:`verdict_stats` over the inliers at (R, t) with
     ``still_angle`` = that factor x ``loss_scale`` (3.5 from 4 up), from
-    the same call (None otherwise, or beyond 2^20 pairs).
+    the same call (None otherwise, or beyond 2^20 pairs), ``sample_size``
+    (pairs per sample of the adaptive stop: 5 for 5+1, 3 and 4 for the
+    upright sampler's 3+1 and 4-point samples, 6 for the 6-point).
     Raises ValueError naming the bad argument. ``prechecked``: the caller
     made the arrays itself (:func:`mcgeom.robust.ransac_prechecked`): the
     rays (N, 3) and ``focal`` (N,) float64 C-contiguous, ``cam1``/``cam2``
@@ -1463,7 +1465,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         "covariance": np.frombuffer(ffi.buffer(res.covariance),
                                     dtype=np.float64).reshape(6, 6).copy(),
         "verdict": _verdict_dict(res.verdict) if res.have_verdict else None,
-        "sampler": _SAMPLER_OF[res.sampler],
+        "sampler": _SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
     }
 
 

@@ -333,7 +333,10 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
     entry point ``mcg_robust_rig_motion`` (csrc/robust.c: the method's
     minimal samples, MSAC, local optimisation, adaptive stop, final
     refinement of all six degrees of freedom); the verdict stays here;
-    ``info["sampler"]`` names the minimal solver. ``pixel_cameras = (focal,
+    ``info["sampler"]`` names the minimal solver and ``info["sample_size"]``
+    the pairs of its samples (5 for 5+1, 6 for the 6-point; the upright
+    sampler's 3 for its 3+1 samples, 4 for its 4-point ones: see
+    :mod:`mcgeom.estimators.upright_four_point`). ``pixel_cameras = (focal,
     axes)``, the (M,) focal lengths (pixels) and (M, 3) optical axes (rig
     frame) of the rig's cameras (see
     :func:`mcgeom.pixel_noise.camera_table`), is the camera table that
@@ -1022,6 +1025,7 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
                                 "stop")}
     info["c_seconds"] = out["seconds"]
     info["sampler"] = method
+    info["sample_size"] = out["sample_size"]
     fit = None
     if out["refinement"] is not None:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)

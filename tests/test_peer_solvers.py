@@ -36,7 +36,9 @@ def test_ransac_part_small():
     assert ring4["mcgeom upright (0.2 deg)"][3][0] > 0 and np.isnan(ring4["poselib defaults"][3][0])
     # samples drawn by the C search (an integer >= 1), none for PoseLib
     assert ring4["mcgeom upright (0.2 deg)"][4][0] >= 1 and np.isnan(ring4["poselib defaults"][4][0])
-    assert "vs 17-pt" in table and "C vs 5+1" in table and "upright_four_point" in table
+    # ring4's cameras have 50 intra-camera correspondences each: 3+1 samples
+    assert ring4["mcgeom upright (0.2 deg)"][2] == ["upright 3+1"]
+    assert "vs 17-pt" in table and "C vs 5+1" in table and "upright 3+1" in table
     assert "samples" in table
 
 

@@ -56,8 +56,33 @@ def test_facade_reports_the_sampler_it_chose():
     mu = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, gravity1=g1, gravity2=R @ g1)
     assert mu.info["sampler"] == "upright_four_point"
     assert _rot_deg(mu.R, R) < 0.1
-    # the vertical known: 3+1 samples, far fewer drawn than 6-samples at 30 % outliers
+    # the vertical known: 3+1 samples, far fewer drawn than 5+1's at 30 % outliers
+    assert m.info["sample_size"] == 5 and mu.info["sample_size"] == 3
     assert mu.info["iterations"] < m.info["iterations"]
+
+
+def test_upright_sampler_draws_3_plus_1_where_a_camera_has_3_intra_camera_pairs():
+    """The upright sampler's samples (issue 21): 3 intra-camera pairs of one
+    camera solved with the vertical (its rotation and direction of travel)
+    and a fourth pair for the scale where some camera has 3 of them
+    (``info["sample_size"]`` 3), else 4 pairs of any cameras (4); both find
+    the motion."""
+    rig, R, t, p = _ring12(1)
+    g1 = np.array([0.0, 0.0, -1.0])
+    up = {"gravity1": g1, "gravity2": R @ g1}
+    m3 = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, **up)
+    # at most 2 intra-camera correspondences per camera, all cross-camera ones
+    intra = p.cam1 == p.cam2
+    rank = np.array([np.count_nonzero(intra[:k] & (p.cam1[:k] == p.cam1[k]))
+                     for k in range(len(p.cam1))])
+    keep = ~intra | (rank < 2)
+    m4 = cv.estimate(p.pixels1[keep], p.pixels2[keep], p.cam1[keep], p.cam2[keep], rig, **up)
+    assert np.bincount(p.cam1[keep & intra]).max() == 2
+    assert m3.info["sampler"] == m4.info["sampler"] == "upright_four_point"
+    assert m3.info["sample_size"] == 3 and m4.info["sample_size"] == 4
+    for m in (m3, m4):
+        assert _rot_deg(m.R, R) < 0.2
+        assert abs(np.linalg.norm(m.info["t_metric"]) / np.linalg.norm(t) - 1) < 0.05
 
 
 def test_upright_with_a_level_vertical_is_not_the_static_rig():

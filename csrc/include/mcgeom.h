@@ -1123,6 +1123,9 @@ typedef struct {
                                inliers (mask bit 0) */
     int sampler;            /* the MCG_SAMPLER_* the search used
                                (MCG_SAMPLER_AUTO resolved) */
+    int sample_size;        /* issue 21: pairs per sample of the adaptive
+                               stop -- 5 (5+1), 3 (the upright sampler's 3+1),
+                               4 (its 4-point samples), 6 (6-point) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */

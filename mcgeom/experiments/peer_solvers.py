@@ -320,11 +320,21 @@ def _errors(R, t, Rt, tt) -> tuple[float, float]:
             abs(np.linalg.norm(t) / np.linalg.norm(tt) - 1.0))
 
 
+def _sampler_label(info: dict) -> str:
+    """The sampler column's name of a search: ``info["sampler"]``, and for the
+    upright sampler which samples it drew (``upright 3+1`` where a camera has
+    3 intra-camera correspondences, ``upright 4-pt`` elsewhere)."""
+    name = info.get("sampler", "")
+    if name == "upright_four_point" and info.get("sample_size") in (3, 4):
+        return "upright 3+1" if info["sample_size"] == 3 else "upright 4-pt"
+    return name
+
+
 def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: float) -> dict:
     """{row: call returning (R, t, sampler, seconds in C, samples drawn)} of one problem."""
     def facade(**kw):
         m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
-        return (m.R, m.info["t_metric"], m.info.get("sampler", ""),
+        return (m.R, m.info["t_metric"], _sampler_label(m.info),
                 m.info.get("c_seconds", np.nan), m.info.get("iterations", np.nan))
 
     def peer(opt):
