@@ -1139,13 +1139,13 @@ static int decompose(const double E[9], double R1[9], double R2[9], double u[3])
 
 /* The motion of one rotation candidate of a 5+1 (or upright 3+1) sample:
  * the sign of the camera's translation direction u from the cheirality of
- * its m = 5 (3) points (all in front), the scale lam > 0 from the sixth correspondence (eq. 7.4:
- * a + lam b = 0 with a = d2.((t0 + R o1 - o2) x R d1), b = d2.((u) x R d1),
+ * its m = 5 (3) points (all in front), the scale lam > 0 from the sixth
+ * correspondence (eq. 7.4: a + lam b = 0 with a = d2.((t0 + R o1 - o2) x R d1), b = d2.((u) x R d1),
  * unit bearings), then the sixth point in front of both its rays.
  * `six` < 0: a rig with one camera, lam = 1 (direction only). Returns 1
  * with (t0, u, lam), 2 with (t0, u) and lam = 1 when the sixth pair gives
  * no scale (no offer: the two-stage's record() may still search it), 0
- * when the five are not in front. */
+ * when the m are not in front. */
 static int candidate(const ctx *c, const double R[9], const double u_in[3],
                      const double b1[15], const double b2[15], int m, const double ca[3],
                      int six, double t0[3], double u[3], double *lam_out)
@@ -1600,7 +1600,7 @@ static void mark_usable(ctx *c)
 {
     int g;
     for (g = 0; g < c->ncam; g++)
-        c->usable[g] = c->off[g + 1] - c->off[g] >= (c->central_m > 0 ? c->central_m : 5) &&
+        c->usable[g] = c->off[g + 1] - c->off[g] >= c->central_m &&
                        plane_rms(c, g, 0) > c->loss_scale && plane_rms(c, g, 1) > c->loss_scale;
 }
 
@@ -2000,7 +2000,9 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     c.loss_scale = c.opt.threshold / c.med_focal;
     c.size = origin_spread(n, o1, o2, cen);
     c.size += sqrt(dot3(cen, cen));
-    mark_usable(&c);
+    /* (only central samples read usable: their camera, and the records) */
+    if (c.central_m > 0)
+        mark_usable(&c);
     if (c.central_m == 3) {
         int any = 0;
         for (k = 0; k < n_cameras; k++)

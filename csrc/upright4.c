@@ -663,8 +663,8 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
  *   C1. The epipolar constraint d2'^T [u']x Rz(theta) d1' = 0 reads
  *       u' . (Rz d1' x d2') = 0, one row of u's 3 x 3 system per
  *       correspondence; with q = tan(theta / 2) each row times 1 + q^2 is
- *       (P0 d1' x d2') + q (P1 d1' x d2') + q^2 (P2 d1' x d2') (P_j of (U2),
- *       the first three entries of rows_of).
+ *       (P0 d1' x d2') + q (P1 d1' x d2') + q^2 (P2 d1' x d2') (P_j of (U2):
+ *       the first three entries of rows_of's rows, with no moments).
  *   C2. A direction u' != 0 exists iff det M(q) = 0: by multilinearity in
  *       the rows, det M(q) = sum over (j0, j1, j2) of q^(j0 + j1 + j2)
  *       det[row0_j0; row1_j1; row2_j2], a polynomial of degree <= 6 (up to
@@ -679,7 +679,8 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
 int mcg_upright3_central(const double d1[9], const double d2[9], const double g1[3],
                          const double g2[3], double R[54], double u[18], int *n_solutions)
 {
-    double Q1[9], Q2[9], rows[3][3][3], poly[7], roots[6], lead = 0.0, size = 0.0;
+    static const double no_moment[3] = {0.0, 0.0, 0.0};
+    double Q1[9], Q2[9], rows[3][3][4], poly[7], roots[6], lead = 0.0, size = 0.0;
     int k, i, j0, j1, j2, deg, nr, ns = 0;
     *n_solutions = 0;
     if (!upright_frames(g1, g2, Q1, Q2))
@@ -695,13 +696,7 @@ int mcg_upright3_central(const double d1[9], const double d2[9], const double g1
         }
         mat_vec(Q1, a, e1);
         mat_vec(Q2, b, e2);
-        {
-            const double pe1[3] = {-2.0 * e1[1], 2.0 * e1[0], 0.0};
-            const double qe1[3] = {-e1[0], -e1[1], e1[2]};
-            cross3(e1, e2, rows[k][0]);
-            cross3(pe1, e2, rows[k][1]);
-            cross3(qe1, e2, rows[k][2]);
-        }
+        rows_of(e1, no_moment, e2, no_moment, rows[k][0], rows[k][1], rows[k][2]);
         for (j0 = 0; j0 < 3; ++j0)
             size = fmax(size, dot3(rows[k][j0], rows[k][j0]));
     }
