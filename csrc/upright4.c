@@ -281,6 +281,20 @@ static int real_roots(const double *a, int n, double *r)
     return nr;
 }
 
+/* The real roots of poly (degree <= n) divided by lead (> 0, its largest
+ * coefficient), leading coefficients lost in rounding dropped (roots near
+ * q = infinity); -1 when nothing but a constant is left (det M identically
+ * 0: every yaw fits). poly is scaled in place. */
+static int scaled_roots(double *poly, int n, double lead, double *roots)
+{
+    int i, deg = n;
+    for (i = 0; i <= n; ++i)
+        poly[i] /= lead;
+    while (deg > 0 && fabs(poly[deg]) <= 1e-14)
+        --deg;
+    return deg == 0 ? -1 : real_roots(poly, deg, roots);
+}
+
 /* ---------------------------------------------------------- the system */
 
 /* an orthonormal Q (rows a, g x a, g) with Q g = e_z, g unit */
@@ -550,7 +564,7 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
     double Q1[9], Q2[9], c[3] = {0.0, 0.0, 0.0}, s = 0.0;
     double e1[12], n1[12], e2[12], n2[12]; /* upright unit directions and moments */
     double Mq[3][16], poly[9], roots[8], lead = 0.0;
-    int k, i, j, deg, nr, ns = 0;
+    int k, i, j, nr, ns = 0;
     static const int pairs[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
     if (!o1 || !d1 || !o2 || !d2 || !g1 || !g2 || !R || !t || !n_solutions)
@@ -611,15 +625,9 @@ int mcg_upright4(const double o1[12], const double d1[12], const double o2[12],
         lead = fmax(lead, fabs(poly[i]));
     if (!(lead > 0.0) || !isfinite(lead))
         return isfinite(lead) ? MCG_EDEGENERATE : MCG_EINVAL;
-    for (i = 0; i < 9; ++i)
-        poly[i] /= lead;
-    /* drop leading coefficients lost in rounding (roots near q = infinity) */
-    deg = 8;
-    while (deg > 0 && fabs(poly[deg]) <= 1e-14)
-        --deg;
-    if (deg == 0)
-        return MCG_EDEGENERATE; /* det M identically 0: every yaw fits */
-    nr = real_roots(poly, deg, roots);
+    nr = scaled_roots(poly, 8, lead, roots);
+    if (nr < 0)
+        return MCG_EDEGENERATE;
     for (j = 0; j < nr; ++j) {
         double q = roots[j], M[16], f[4], v[4], tu[3];
         matrix_at((const double(*)[16])Mq, q, M);
@@ -681,7 +689,7 @@ int mcg_upright3_central(const double d1[9], const double d2[9], const double g1
 {
     static const double no_moment[3] = {0.0, 0.0, 0.0};
     double Q1[9], Q2[9], rows[3][3][4], poly[7], roots[6], lead = 0.0, size = 0.0;
-    int k, i, j0, j1, j2, deg, nr, ns = 0;
+    int k, i, j0, j1, j2, nr, ns = 0;
     *n_solutions = 0;
     if (!upright_frames(g1, g2, Q1, Q2))
         return MCG_EINVAL;
@@ -711,14 +719,9 @@ int mcg_upright3_central(const double d1[9], const double d2[9], const double g1
     /* (det M is a product of three rows of length <= ~2 sqrt(size)) */
     if (!isfinite(lead) || !(lead > 1e-13 * size * sqrt(size)))
         return MCG_EDEGENERATE; /* det M identically 0 (e.g. repeated pairs) */
-    for (i = 0; i < 7; ++i)
-        poly[i] /= lead;
-    deg = 6;
-    while (deg > 0 && fabs(poly[deg]) <= 1e-14)
-        --deg;
-    if (deg == 0)
+    nr = scaled_roots(poly, 6, lead, roots);
+    if (nr < 0)
         return MCG_EDEGENERATE;
-    nr = real_roots(poly, deg, roots);
     for (k = 0; k < nr; ++k) { /* C3 */
         double q = roots[k], M[3][3], c01[3], c02[3], c12[3], *best, nb, up[3];
         for (i = 0; i < 3; ++i) {
