@@ -204,6 +204,7 @@ def test_cross_camera_rays_fix_scale_without_rotation(name, seed):
 @pytest.mark.parametrize("noise", [0.0, 3e-4])
 @settings(max_examples=5, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=seeds)
+@example(seed=23129)  # Wahba's rotation of the 30 intra pairs 3.35e-4 rad off (cross 0.5)
 def test_static_rig_reports_no_translation(name, cross, noise, seed):
     """A rig that did not move (R = I, t = 0), noise-free or with angular noise
     (radians), with and without cross-camera rays: every estimator returns the
@@ -214,8 +215,16 @@ def test_static_rig_reports_no_translation(name, cross, noise, seed):
     p = synth.make_problem(synth.generic_rig(4, rng), np.eye(3), np.zeros(3), _n(name), rng,
                            cross_fraction=cross, angular_noise=noise, require_visible=False)
     m = mcgeom.estimate(p.rays, name, **_given(name, np.eye(3)))
-    # the rotation of N rays with angular noise sigma is good to ~sigma / sqrt(N)
-    assert rot_err(m.R, np.eye(3)) < 1e-8 + noise
+    # The static answer's rotation is fitted to the n intra-camera pairs. With
+    # angular noise sigma on each bearing, each pair fixes two of the three
+    # axes to ~sigma sqrt(2): per axis the error is ~sigma sqrt(3 / n). Bound
+    # at 6 per-axis standard deviations (the chi tail beyond is ~1e-7; the
+    # old bound, sigma, was 3.5 of them at n = 30 and failed on an unlucky
+    # draw under the explore profile: seed 23129, Wahba's own rotation of the
+    # 30 pairs 3.35e-4 rad off). A rotation from a minimal sample, or from
+    # fewer pairs, is several times worse and still fails.
+    n_intra = int(np.count_nonzero(p.rays.cam1 == p.rays.cam2))
+    assert rot_err(m.R, np.eye(3)) < 1e-8 + 6 * noise * np.sqrt(3 / n_intra)
     assert np.array_equal(m.t, np.zeros(3))
     assert not m.scale.observable
     assert m.scale.reason.startswith("no translation detected")
