@@ -34,3 +34,17 @@ def test_bench_robust_command_prints_both_ratios(capsys):
     rows = [line for line in out.splitlines() if "poselib min_it=100" in line]
     assert len(rows) == 3 and all(line.count("x ") >= 2 for line in rows)
     assert "warm: the same problems in blocks" in out
+    assert "min-max us/corr" in out and "largest / smallest median" not in out  # one size
+
+
+
+def test_scaling_rows_are_medians_over_several_problems():
+    from mcgeom.experiments.bench.robust import _scaling_problems, bench_scaling
+    assert _scaling_problems(1000) == 15 and _scaling_problems(10 ** 6) == 3
+    rows = bench_scaling(sizes=(300, 2000))
+    for r, n in zip(rows, (300, 2000)):
+        assert r.n == n and r.problems == _scaling_problems(n) >= 3
+        # the median lies within the spread of the problems it is taken over
+        assert 0 < r.us_per_corr_min <= r.us_per_corr <= r.us_per_corr_max
+        assert r.seconds == pytest.approx(r.us_per_corr * n / 1e6)
+        assert 0 < r.c_seconds < r.seconds and r.peak_mb > 0 and r.rot_deg < 0.5
