@@ -20,12 +20,6 @@ def _sample(kind: str, seed: int):
     return p, p.rays
 
 
-def _tilt(g: np.ndarray, angle: float, rng: np.random.Generator) -> np.ndarray:
-    """``g`` turned by ``angle`` radians about a random axis orthogonal to it."""
-    a = np.cross(g, rng.normal(size=3))
-    return synth.rotation_about(a, angle) @ g
-
-
 @pytest.mark.parametrize("kind", ["most-general", "locally-central", "axial",
                                   "locally-central-and-axial"])
 def test_minimal_recovers_truth(kind):
@@ -84,8 +78,8 @@ def test_estimator_with_imu_vertical():
     for seed in range(10):
         p = make("most-general", seed, n=60, angular_noise=np.radians(0.05))
         m = mcgeom.estimate(p.rays, "upright_four_point",
-                            gravity1=_tilt(G1, np.radians(0.2), rng),
-                            gravity2=_tilt(p.R @ G1, np.radians(0.2), rng))
+                            gravity1=synth.tilted(G1, 0.2, rng),
+                            gravity2=synth.tilted(p.R @ G1, 0.2, rng))
         errs.append(np.degrees(rot_err(m.R, p.R)))
         assert m.scale.observable
     assert np.median(errs) < 0.1
