@@ -26,7 +26,12 @@ PoseLib setting's.
 Two timings per method. *Cold*: the methods alternate on every problem (the
 errors come from this pass), so each call starts after the other library's:
 its code and data are out of the caches and branch predictors, as after a
-feature matcher in a real pipeline. *Warm*: the same problems again in
+feature matcher in a real pipeline. The problems are drawn first, and the
+order of the methods turns by one per problem, so that each follows each
+other one equally often (session 14: mcgeom always ran first, right after
+the problem's generation and PoseLib's 15 ms default run of the previous
+problem; its cold median on the Ladybug case was 1.19-1.24 ms in two runs,
+1.03-1.15 ms in three with the order turning). *Warm*: the same problems again in
 blocks of :data:`WARM_BLOCK`, each method on the whole block in turn (the
 blocks alternate, so load drift still falls on all), as in a loop over
 the frames of a sequence. The difference is mostly mcgeom's: its Python
@@ -141,14 +146,18 @@ def bench_speed(problems: int = 100, seed: int = 0,
         warm = {k: [] for k in methods}
         outside = []
         done = []
-        for _ in progress(range(problems), total=problems, desc=name):
+        for _ in range(problems):
             R, t = motion(rng)
             p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
-            seed_k = int(rng.integers(1 << 31))
-            done.append((p, seed_k))
-            for meth, opt in methods.items():
+            done.append((p, int(rng.integers(1 << 31)), R, t))
+        names = list(methods)
+        for k in progress(range(problems), total=problems, desc=name):
+            p, seed_k, R, t = done[k]
+            # the order turns by one method per problem: each method follows
+            # each other one (and the previous problem's last) equally often
+            for meth in names[k % len(names):] + names[:k % len(names)]:
                 t0 = time.perf_counter()
-                Re, te, m = _run(opt, p, rig, setup, seed_k)
+                Re, te, m = _run(methods[meth], p, rig, setup, seed_k)
                 dt = time.perf_counter() - t0
                 secs[meth].append(dt)
                 err[meth].append(_errors(Re, te, R, t))
@@ -156,7 +165,7 @@ def bench_speed(problems: int = 100, seed: int = 0,
                     outside.append(1.0 - m.info.get("c_seconds", 0.0) / dt)
         for b0 in range(0, len(done), WARM_BLOCK):
             for meth, opt in methods.items():
-                for p, seed_k in done[b0:b0 + WARM_BLOCK]:
+                for p, seed_k, _, _ in done[b0:b0 + WARM_BLOCK]:
                     t0 = time.perf_counter()
                     _run(opt, p, rig, setup, seed_k)
                     warm[meth].append(time.perf_counter() - t0)
