@@ -2139,10 +2139,15 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
             jump = final_scale_search(&c, cen, wlo);
             res->hypotheses = c.n_hyp;
             res->local_optimizations = c.n_lo;
-            if (jump == 1) {
+            if (jump == 1) { /* the final stage starts again from the jump */
+                memcpy(res->t_hypothesis, c.t, sizeof c.t);
+                res->score = c.score;
                 c.final_stage = 1;
                 finish(&c, res, mask, weights);
-            } else if (jump == 2) { /* (the best's own optimisation lost too) */
+            } else if (jump == 2) {
+                /* the jump lost to the refined motion's free local
+                 * optimisation, which replaced it as the best: the refined
+                 * motion and its residuals (the inlier mask below) back */
                 sc = msac2(&c, Rf, tf, INFINITY, &n_inl, &n_wide);
                 take_best(&c, Rf, tf, sc, n_inl, n_wide);
             }

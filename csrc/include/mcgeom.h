@@ -1160,7 +1160,13 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * front of its rays), MSAC scoring of the Sampson residuals of
  * mcg_gec_residuals, local optimisation of each new best by
  * mcg_refine_motion on its inliers, the adaptive stop from opt->prob, and
- * the final refinement (opt->loss) on the pairs within 2 thresholds.
+ * the final refinement (opt->loss) on the pairs within 2 thresholds. The
+ * scale of the best is searched once more on the cross-camera pairs (with
+ * the upright sampler and none of them: on all pairs) before the final
+ * refinement and, where that found |t| determined, after it: a scale that
+ * scores better once both are locally optimised with |t| free restarts the
+ * final stage (near the critical motion of thesis ch. 7.3.2 a wrong scale
+ * can otherwise win the search and be refined as if determined).
  * Pair k: rays (o1, d1) <-> (o2, d2) (n x 3 each, rig frames at times 1
  * and 2, origins the camera centres in metres, directions of any non-zero
  * length), cameras cam1[k], cam2[k] in [0, n_cameras) (intra-camera when
