@@ -941,7 +941,7 @@ static int offer(ctx *c, const double R[9], const double t0[3], const double u[3
  * estimates more than 30 % off 728 / 4 / 6 -> 728 / 2 / 2, observable
  * 0 / 1197 / 1194 -> 0 / 1198 / 1198, of the bad called observable
  * 0 / 1 / 0 -> 0 / 0 / 0; with --vertical-error-deg 0.2 (upright sampler)
- * 738 / 13 / 20 -> 714 / 14 / 19, called observable 2 / 0 / 1 -> 0 / 0 / 0.
+ * 738 / 13 / 20 -> 713 / 15 / 19, called observable 2 / 0 / 1 -> 0 / 0 / 0.
  * C instructions per estimate: 20 of those problems (5+1, cross 0.1)
  * 3.62 -> 3.87 M; 40 problems of `mcgeom experiment peer_solvers`' four
  * upright cases 4.07 -> 4.77 M (their scale search runs on all pairs); the
