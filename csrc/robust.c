@@ -500,6 +500,15 @@ static void take_best(ctx *c, const double R[9], const double t[3], double score
         records_of_best(c);
 }
 
+/* (R, t) made the best whatever its score, scored on all pairs (R, t must
+ * not be c->R, c->t) */
+static void set_best(ctx *c, const double R[9], const double t[3])
+{
+    int n_inl, n_wide;
+    double sc = msac2(c, R, t, INFINITY, &n_inl, &n_wide);
+    take_best(c, R, t, sc, n_inl, n_wide);
+}
+
 /* ------------------------------------------------------ preemptive scoring */
 
 /* Copy a stratified random subset of PREEMPT_SUB pairs (one from each of
@@ -951,8 +960,8 @@ static int offer(ctx *c, const double R[9], const double t0[3], const double u[3
  * when it lost (the best is its own free optimisation). */
 static int final_scale_search(ctx *c, const double cen[3], const double *w)
 {
-    double rc[3], t0[3], u[3], lam, lam2, R0[9], score0, t[3], sc, Rb[9], Tb[3];
-    int i, n_inl, n_wide, others = 0;
+    double rc[3], t0[3], u[3], lam, lam2, R0[9], score0, t[3], Rb[9], Tb[3];
+    int i, others = 0;
     if (!c->have || c->lo_rounds <= 0)
         return 0;
     if (c->nx <= 0) {
@@ -1002,12 +1011,10 @@ static int final_scale_search(ctx *c, const double cen[3], const double *w)
     c->n_hyp++;
     for (i = 0; i < 3; i++)
         t[i] = t0[i] + lam2 * u[i];
-    sc = msac2(c, R0, t, INFINITY, &n_inl, &n_wide);
-    take_best(c, R0, t, sc, n_inl, n_wide); /* (tentatively, to be optimised) */
+    set_best(c, R0, t); /* (tentatively, to be optimised) */
     local_optimise_held(c, w, 0);
     if (!(c->score < score0)) {
-        sc = msac2(c, Rb, Tb, INFINITY, &n_inl, &n_wide);
-        take_best(c, Rb, Tb, sc, n_inl, n_wide);
+        set_best(c, Rb, Tb);
         return 2;
     }
     return 1;
@@ -1770,6 +1777,50 @@ static void finish(ctx *c, mcg_robust_result *res, unsigned char *mask, double *
         mask[k] &= 2;
 }
 
+/* The scale searched once more at the refined motion, where the
+ * refinement found |t| determined (the verdict may call it metric): the
+ * search's best carried a rotation error that compensated its scale error,
+ * and at that rotation the cross-camera pairs pointed nowhere else; at the
+ * refined rotation they may point to another scale (trial 1023 of `mcgeom
+ * experiment ch7 --trials 1200 --seed 10 --cross 0.1`: refined at |t|
+ * 0.209 m with 22 cross-camera inliers, the line through it has 35 at
+ * 1.04 m, the truth 1.05 m). A jump that wins (see final_scale_search) is
+ * refined again; otherwise the refined motion stays as it was. Where |t| is
+ * not determined no scale is reported, and the search cost the upright
+ * sampler without cross-camera pairs, whose scale search runs on all
+ * pairs, 5.24 M C instructions per estimate against 4.77 M gated (40
+ * problems of `mcgeom experiment peer_solvers`' four upright cases; the
+ * same honesty). */
+static void rescale_refined(ctx *c, mcg_robust_result *res, unsigned char *mask,
+                            double *weights, const double cen[3], const double *w)
+{
+    double Rf[9], tf[3];
+    int jump;
+    if (!res->refined ||
+        !(res->refinement.scale_rel_std <= (c->opt.max_scale_rel_std > 0.0
+                                                ? c->opt.max_scale_rel_std
+                                                : UNDETERMINED_REL_STD)))
+        return;
+    memcpy(Rf, c->R, sizeof Rf);
+    memcpy(tf, c->t, sizeof tf);
+    c->final_stage = 0;
+    set_best(c, Rf, tf);
+    jump = final_scale_search(c, cen, w);
+    res->hypotheses = c->n_hyp;
+    res->local_optimizations = c->n_lo;
+    if (jump == 1) { /* the final stage starts again from the jump */
+        memcpy(res->t_hypothesis, c->t, sizeof c->t);
+        res->score = c->score;
+        c->final_stage = 1;
+        finish(c, res, mask, weights);
+    } else if (jump == 2) {
+        /* the jump lost to the refined motion's free local optimisation,
+         * which replaced it as the best: the refined motion and its
+         * residuals (the inlier mask) back */
+        set_best(c, Rf, tf);
+    }
+}
+
 /* The start of a profile fit: the free optimum (R, t) (rig frame; the
  * centroid's translation tc = t + shift, shift = R cen - cen) with tc
  * scaled to f |tc|, and the other five parameters (rotation, direction of
@@ -2109,49 +2160,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     c.final_stage = 1;
     if (c.opt.refine) {
         finish(&c, res, mask, weights);
-        if (res->refined &&
-            res->refinement.scale_rel_std <= (c.opt.max_scale_rel_std > 0.0
-                                                  ? c.opt.max_scale_rel_std
-                                                  : UNDETERMINED_REL_STD)) {
-            /* The scale searched once more at the refined motion: the
-             * search's best carried a rotation error that compensated its
-             * scale error, and at that rotation the cross-camera pairs
-             * pointed nowhere else; at the refined rotation they may point
-             * to another scale (trial 1023 of `mcgeom experiment ch7
-             * --trials 1200 --seed 10 --cross 0.1`: refined at |t| 0.209 m
-             * with 22 cross-camera inliers, the line through it has 35 at
-             * 1.04 m, the truth 1.05 m). A jump that wins (see
-             * final_scale_search) is refined again; otherwise the refined
-             * motion stays as it was. Only where the refinement found |t|
-             * determined (the verdict may call it metric): elsewhere no
-             * scale is reported, and on every estimate the search cost the
-             * upright sampler without cross-camera pairs, whose scale
-             * search runs on all pairs, 5.24 M C instructions per estimate
-             * against 4.77 M gated (40 problems of `mcgeom experiment
-             * peer_solvers`' four upright cases; the same honesty). */
-            double Rf[9], tf[3], sc;
-            int n_inl, n_wide, jump;
-            memcpy(Rf, c.R, sizeof Rf);
-            memcpy(tf, c.t, sizeof tf);
-            c.final_stage = 0;
-            sc = msac2(&c, Rf, tf, INFINITY, &n_inl, &n_wide);
-            take_best(&c, Rf, tf, sc, n_inl, n_wide);
-            jump = final_scale_search(&c, cen, wlo);
-            res->hypotheses = c.n_hyp;
-            res->local_optimizations = c.n_lo;
-            if (jump == 1) { /* the final stage starts again from the jump */
-                memcpy(res->t_hypothesis, c.t, sizeof c.t);
-                res->score = c.score;
-                c.final_stage = 1;
-                finish(&c, res, mask, weights);
-            } else if (jump == 2) {
-                /* the jump lost to the refined motion's free local
-                 * optimisation, which replaced it as the best: the refined
-                 * motion and its residuals (the inlier mask below) back */
-                sc = msac2(&c, Rf, tf, INFINITY, &n_inl, &n_wide);
-                take_best(&c, Rf, tf, sc, n_inl, n_wide);
-            }
-        }
+        rescale_refined(&c, res, mask, weights, cen, wlo);
     }
     c.final_stage = 0;
     memcpy(res->R, c.R, sizeof c.R);

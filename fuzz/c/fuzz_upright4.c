@@ -39,6 +39,28 @@ static void check_vertical(const char *who, int s, const double R[9], const doub
     FZ_CHECK(e < 1e-9, "%s: solution %d maps g1 off g2 by %g", who, s, e);
 }
 
+/* The status checks of both solvers: MCG_EINVAL exactly for non-finite
+ * input (inputs_finite 0) or a zero vertical, at most max_n solutions; 1
+ * when the solutions are to be checked, with n1, n2 = |g1|, |g2| (not for
+ * an overflowing |g|^2: the unit vertical would be 0). */
+static int solutions_to_check(const char *who, int st, int inputs_finite, const double g1[3],
+                              const double g2[3], int n, int max_n, double *n1, double *n2)
+{
+    const double a = fz_dot3(g1, g1), b = fz_dot3(g2, g2);
+    if (!inputs_finite || !(a >= 1e-100 && b >= 1e-100)) {
+        FZ_CHECK(st == MCG_EINVAL, "%s of non-finite input or a zero vertical: %d", who, st);
+        return 0;
+    }
+    if (st != MCG_OK)
+        return 0;
+    FZ_CHECK(n >= 0 && n <= max_n, "%s: %d solutions", who, n);
+    if (!isfinite(a) || !isfinite(b))
+        return 0;
+    *n1 = sqrt(a);
+    *n2 = sqrt(b);
+    return 1;
+}
+
 /* The central solver (modes 2 and 3): its invariants, as above. */
 static int central(fz_in *in, int mode)
 {
@@ -62,20 +84,11 @@ static int central(fz_in *in, int mode)
     st = mcg_upright3_central(d1, d2, g1, g2, Rs, us, &n);
     FZ_CHECK(st == MCG_OK || st == MCG_EINVAL || st == MCG_EDEGENERATE,
              "upright3_central status %d", st);
-    n1 = fz_dot3(g1, g1);
-    n2 = fz_dot3(g2, g2);
-    if (!fz_all_finite(d1, 9) || !fz_all_finite(d2, 9) || !fz_all_finite(g1, 3) ||
-        !fz_all_finite(g2, 3) || !(n1 >= 1e-100 && n2 >= 1e-100)) {
-        FZ_CHECK(st == MCG_EINVAL, "upright3_central of non-finite or zero input: %d", st);
+    if (!solutions_to_check("upright3_central", st,
+                            fz_all_finite(d1, 9) && fz_all_finite(d2, 9) &&
+                                fz_all_finite(g1, 3) && fz_all_finite(g2, 3),
+                            g1, g2, n, MCG_UPRIGHT3_MAX_SOLUTIONS, &n1, &n2))
         return 0;
-    }
-    if (st != MCG_OK)
-        return 0;
-    FZ_CHECK(n >= 0 && n <= MCG_UPRIGHT3_MAX_SOLUTIONS, "upright3_central: %d solutions", n);
-    if (!isfinite(n1) || !isfinite(n2))
-        return 0;
-    n1 = sqrt(n1);
-    n2 = sqrt(n2);
     for (s = 0; s < n; ++s) {
         const double *u = us + 3 * s;
         FZ_CHECK(fz_all_finite(Rs + 9 * s, 9) && fz_all_finite(u, 3),
@@ -116,24 +129,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     st = mcg_upright4(o1, d1, o2, d2, g1, g2, Rs, ts, &n);
     FZ_CHECK(fz_status_known(st), "upright4 status %d", st);
-    if (!fz_all_finite(o1, 12) || !fz_all_finite(d1, 12) || !fz_all_finite(o2, 12) ||
-        !fz_all_finite(d2, 12) || !fz_all_finite(g1, 3) || !fz_all_finite(g2, 3)) {
-        FZ_CHECK(st == MCG_EINVAL, "upright4 of non-finite input: %d", st);
+    if (!solutions_to_check("upright4", st,
+                            fz_all_finite(o1, 12) && fz_all_finite(d1, 12) &&
+                                fz_all_finite(o2, 12) && fz_all_finite(d2, 12) &&
+                                fz_all_finite(g1, 3) && fz_all_finite(g2, 3),
+                            g1, g2, n, MCG_UPRIGHT4_MAX_SOLUTIONS, &n1, &n2))
         return 0;
-    }
-    n1 = fz_dot3(g1, g1);
-    n2 = fz_dot3(g2, g2);
-    if (!(n1 >= 1e-100 && n2 >= 1e-100)) {
-        FZ_CHECK(st == MCG_EINVAL, "upright4 with zero gravity: %d", st);
-        return 0;
-    }
-    if (st != MCG_OK)
-        return 0;
-    FZ_CHECK(n >= 0 && n <= MCG_UPRIGHT4_MAX_SOLUTIONS, "upright4: %d solutions", n);
-    if (!isfinite(n1) || !isfinite(n2))
-        return 0; /* overflowing |g|^2: the unit vectors below would be 0 */
-    n1 = sqrt(n1);
-    n2 = sqrt(n2);
     for (s = 0; s < n; ++s) {
         FZ_CHECK(fz_all_finite(Rs + 9 * s, 9) && fz_all_finite(ts + 3 * s, 3),
                  "upright4: solution %d not finite", s);
