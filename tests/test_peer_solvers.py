@@ -54,3 +54,21 @@ def test_poselib_refuses_data_it_cannot_sample():
                            96, rng, cross_fraction=0.5, require_visible=False)
     with pytest.raises(ValueError, match="no camera pair has 5 matches"):
         poselib_motion(rig, p)
+
+
+def test_with_outliers_renames_and_overrides_the_fraction():
+    """``--outliers``: each case once per fraction, the fraction in its name
+    (the case's own one dropped) and in its entry; a fraction of 1 (no
+    inlier left) is refused by name."""
+    cases = {k: peer_solvers.RANSAC_CASES[k] for k in ("ladybug6 300c 30%out",
+                                                       "car8 320c turning <=10deg")}
+    out = peer_solvers.with_outliers(cases, [0.5, 0.6])
+    assert list(out) == ["ladybug6 300c @50%out", "ladybug6 300c @60%out",
+                         "car8 320c turning <=10deg @50%out",
+                         "car8 320c turning <=10deg @60%out"]
+    assert [v[2] for v in out.values()] == [0.5, 0.6, 0.5, 0.6]
+    # everything else is the case's own
+    assert out["ladybug6 300c @50%out"][:2] == cases["ladybug6 300c 30%out"][:2]
+    assert out["ladybug6 300c @50%out"][3:] == cases["ladybug6 300c 30%out"][3:]
+    with pytest.raises(ValueError, match="outlier fraction must be in"):
+        peer_solvers.with_outliers(cases, [1.0])
