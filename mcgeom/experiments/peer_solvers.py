@@ -501,7 +501,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--outliers", nargs="+", type=fraction, default=None, metavar="F",
                     help="run each case of the RANSAC part at these outlier fractions "
                          "instead of its own (e.g. 0.3 0.5 0.6: the regime where the "
-                         "upright sampler's smaller samples pay off)")
+                         "upright sampler's smaller samples pay off; default: each "
+                         "case's own)")
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
