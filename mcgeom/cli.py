@@ -250,6 +250,8 @@ def _bench_robust(args: argparse.Namespace) -> int:
           f"{'mcgeom/this':>11} {'ms warm':>7} {'mcgeom/this':>11} {'outside C':>9} "
           f"{'mcgeom better rot/scale (paired)':>32}")
     ms = {(r.case, r.method): (r.ms, r.ms_warm) for r in rows}
+    rot = {r.case: r.rot_deg for r in rows if r.method == "mcgeom"}
+    scale = {r.case: r.scale_err for r in rows if r.method == "mcgeom"}
     for r in rows:
         out = "" if r.method != "mcgeom" else f"{100 * r.outside_c:8.0f}%"
         paired = "" if r.method == "mcgeom" else \
@@ -261,6 +263,15 @@ def _bench_robust(args: argparse.Namespace) -> int:
     print(f"cold: the methods alternate on every problem (errors and 'outside C' from this "
           f"pass); warm: the same problems in blocks of {WARM_BLOCK}, each method on a block "
           f"in turn")
+    print("mcgeom / poselib min_it=100, medians' ratio with its 95 % bootstrap interval "
+          "(problems resampled):")
+    for r in rows:
+        if r.method == "poselib min_it=100":
+            print(f"  {r.case:<22} " + "; ".join(
+                f"{what} {ratio:.2f} [{ci[0]:.2f}, {ci[1]:.2f}]" for what, ratio, ci in (
+                    ("time cold", ms[(r.case, 'mcgeom')][0] / r.ms, r.time_ratio_ci),
+                    ("rotation error", rot[r.case] / r.rot_deg, r.rot_ratio_ci),
+                    ("scale error", scale[r.case] / r.scale_err, r.scale_ratio_ci))))
     print("\nscaling: 4-camera ring, 20 % outliers, rays in (mcgeom.robust.ransac); medians "
           "over the problems of each size, each drawn and solved with its own seed")
     print(f"{'N':>8} {'problems':>8} {'seconds':>8} {'us/corr':>8} {'min-max us/corr':>15} "

@@ -21,8 +21,11 @@ def test_speed_rows_have_cold_and_warm_times():
         assert np.isfinite(r.rot_deg) and r.rot_deg < 1.0
         if r.method == "mcgeom":
             assert 0.0 < r.outside_c < 1.0 and np.isnan(r.mcgeom_rot_better)
+            assert np.isnan(r.time_ratio_ci).all()
         else:
             assert 0.0 <= r.mcgeom_rot_better <= 1.0 and np.isnan(r.outside_c)
+            for lo, hi in (r.time_ratio_ci, r.rot_ratio_ci, r.scale_ratio_ci):
+                assert 0.0 < lo <= hi < np.inf
 
 
 def test_bench_robust_command_prints_both_ratios(capsys):
@@ -31,9 +34,13 @@ def test_bench_robust_command_prints_both_ratios(capsys):
     out = capsys.readouterr().out
     header = next(line for line in out.splitlines() if line.startswith("case"))
     assert "ms cold" in header and "ms warm" in header and header.count("mcgeom/this") == 2
-    rows = [line for line in out.splitlines() if "poselib min_it=100" in line]
+    rows = [line for line in out.splitlines() if "poselib min_it=100" in line
+            and not line.startswith("mcgeom / ")]      # (the intervals' heading)
     assert len(rows) == 3 and all(line.count("x ") >= 2 for line in rows)
     assert "warm: the same problems in blocks" in out
+    intervals = [line for line in out.splitlines() if "time cold" in line]
+    assert len(intervals) == 3 and all("scale error" in line and "[" in line
+                                       for line in intervals)
     assert "min-max us/corr" in out and "largest / smallest median" not in out  # one size
 
 
@@ -48,3 +55,18 @@ def test_scaling_rows_are_medians_over_several_problems():
         assert 0 < r.us_per_corr_min <= r.us_per_corr <= r.us_per_corr_max
         assert r.seconds == pytest.approx(r.us_per_corr * n / 1e6)
         assert 0 < r.c_seconds < r.seconds and r.peak_mb > 0 and r.rot_deg < 0.5
+
+
+def test_ratio_interval_brackets_the_ratio_of_medians():
+    """The bootstrap interval of median(a) / median(b) over paired problems:
+    it holds the ratio of the full medians, narrows with more problems, and
+    is a point where the two samples are the same."""
+    from mcgeom.experiments.bench.robust import _ratio_interval
+    rng = np.random.default_rng(1)
+    b = rng.lognormal(0.0, 0.3, 400)
+    a = 0.25 * b * rng.lognormal(0.0, 0.1, 400)     # a quarter of b, paired noise
+    lo, hi = _ratio_interval(a, b, np.random.default_rng(0))
+    assert lo < np.median(a) / np.median(b) < hi and 0.2 < lo < 0.25 < hi < 0.3
+    lo100, hi100 = _ratio_interval(a[:100], b[:100], np.random.default_rng(0))
+    assert hi100 - lo100 > hi - lo
+    assert _ratio_interval(b, b, np.random.default_rng(0)) == (1.0, 1.0)
