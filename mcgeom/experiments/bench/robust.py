@@ -24,7 +24,10 @@ per problem, how often mcgeom's rotation and scale errors are below each
 PoseLib setting's. Below the table, per case, the 95 % bootstrap intervals of
 mcgeom's median over PoseLib's (``min_iterations=100``): cold time, rotation
 and scale error (:func:`_ratio_interval`): a median over 100 problems moves by
-several % with the problems drawn, as much as the targets' margins.
+several % with the problems drawn, as much as the targets' margins. The
+machine's state moves the time ratio between runs by more than that interval
+(four runs in a row, session 15: ring4 0.23 / 0.27 / 0.25 / 0.29, each
+interval about +-0.01).
 
 Two timings per method. *Cold*: the methods alternate on every problem (the
 errors come from this pass), so each call starts after the other library's:
@@ -112,9 +115,9 @@ class SpeedRow:
     # 95 % bootstrap intervals (problems resampled in pairs, see
     # _ratio_interval) of mcgeom's median over this method's: cold time,
     # rotation error, scale error ((nan, nan) on mcgeom's own row)
-    time_ratio_ci: tuple = (float("nan"), float("nan"))
-    rot_ratio_ci: tuple = (float("nan"), float("nan"))
-    scale_ratio_ci: tuple = (float("nan"), float("nan"))
+    time_ratio_ci: tuple[float, float] = (float("nan"), float("nan"))
+    rot_ratio_ci: tuple[float, float] = (float("nan"), float("nan"))
+    scale_ratio_ci: tuple[float, float] = (float("nan"), float("nan"))
 
 
 #: problems per block of the warm timing (see the module docstring)
@@ -135,7 +138,6 @@ def _ratio_interval(a: np.ndarray, b: np.ndarray, rng: np.random.Generator,
     r = np.median(a[idx], axis=1) / np.median(b[idx], axis=1)
     lo, hi = np.percentile(r, [2.5, 97.5])
     return float(lo), float(hi)
-
 
 
 def _errors(R, t, Rt, tt) -> tuple[float, float]:
