@@ -42,43 +42,67 @@ BENCH_SIZES = {"linear17": (17, 100, 1000, 10000), "cone": (3, 6, 20, 100, 1000)
 BENCH_PROBLEMS = {"bnb": 10, "robust": 100, "essential5": 10000}
 
 
+#: the samplers the façade chooses from (``mcgeom methods``), in its order of preference
+_SAMPLERS = (
+    ("upright_four_point",
+     "when a vertical prior is passed (gravity1=, gravity2=: the gravity direction in the "
+     "rig frame at each time, e.g. from an IMU): 3 intra-camera correspondences of one "
+     "camera solved with the vertical (Fraundorfer et al. 2010) + 1 for the scale, as "
+     "5+1, when some camera has 3; else 4-samples of any cameras (Sweeney et al. 2014, "
+     "Lee et al. 2014); its smaller samples pay off where outliers are many: measured "
+     "2.5-5.5x faster than 5+1 at 50-60 % outliers, 1.0-1.5x at 30 % or fewer (mcgeom "
+     "experiment peer_solvers --part ransac --outliers 0.3 0.5 0.6)"),
+    ("five_plus_one",
+     "else, when some camera has >= 5 intra-camera correspondences: 5 of one camera + 1 "
+     "of another (thesis ch. 7)"),
+    ("six_point",
+     "else: 6-samples of any cameras, the generic minimal solver (Stewenius et al. 2005), "
+     "for rigs with many cameras and few or mostly cross-camera matches each; slow: its "
+     "solver tracks 64 homotopy paths, ~50 ms a sample, seconds per estimate"),
+)
+
+
+#: commands quoted in ``mcgeom methods``: never split over two lines (a reader copies them)
+_COMMANDS = ("mcgeom experiment peer_solvers --part ransac --outliers 0.3 0.5 0.6",
+             "pip install 'mcgeom[glpk]'")
+
+
+def _wrapped(text: str, indent: str, first: str = "") -> str:
+    """``text`` filled to the width of ``--help`` (100 columns), ``first`` then
+    ``indent`` at the start of its lines; the commands of :data:`_COMMANDS`
+    stay whole."""
+    for cmd in _COMMANDS:
+        text = text.replace(cmd, cmd.replace(" ", "\0"))
+    return textwrap.fill(text, width=100, initial_indent=first or indent,
+                         subsequent_indent=indent, break_on_hyphens=False).replace("\0", " ")
+
+
 def _cmd_methods(args: argparse.Namespace) -> int:
     for e in registry.list_estimators():
         print(f"{e.name}")
-        print(f"    {e.description}")
+        print(_wrapped(e.description, "    "))
         print(f"    family={e.family}  min_sample={e.min_sample}  "
               f"recovers_scale={e.recovers_scale}  needs_rotation={e.needs_rotation}")
-        print(f"    camera kinds: {', '.join(e.camera_kinds)}")
+        print(_wrapped(f"camera kinds: {', '.join(e.camera_kinds)}", "    "))
         for k, v in e.options.items():
-            print(f"    option {k}: {v}")
-    print("\nThe facade (mcgeom.cv.estimate, estimateRigMotion) chooses the minimal solver "
-          "of its LO-RANSAC from the data (info['sampler'] says which ran; all three run in "
-          "the C entry point mcg_robust_rig_motion):\n"
-          "    upright_four_point  when a vertical prior is passed (gravity1=, gravity2=: the "
-          "gravity direction in the rig frame at each time, e.g. from an IMU): 3 intra-camera "
-          "correspondences of one camera solved with the vertical (Fraundorfer et al. 2010) "
-          "+ 1 for the scale, as 5+1, when some camera has 3; else 4-samples of any cameras "
-          "(Sweeney et al. 2014, Lee et al. 2014); its smaller samples pay off where "
-          "outliers are many: measured 2.5-5.5x faster than 5+1 at 50-60 % outliers, "
-          "1.0-1.5x at 30 % or fewer (mcgeom experiment peer_solvers --part ransac "
-          "--outliers 0.3 0.5 0.6)\n"
-          "    five_plus_one       else, when some camera has >= 5 intra-camera "
-          "correspondences: 5 of one camera + 1 of another (thesis ch. 7)\n"
-          "    six_point           else: 6-samples of any cameras, the generic minimal "
-          "solver (Stewenius et al. 2005), for rigs with many cameras and few or mostly "
-          "cross-camera matches each; slow: its solver tracks 64 homotopy paths, ~50 ms "
-          "a sample, seconds per estimate\n"
-          "Any registered name, 'ransac:NAME' or 'direct:NAME' may be passed as method "
-          "instead ('ransac:five_plus_one' forces 5+1; 'ransac:linear17' is 17-point "
-          "RANSAC).")
+            print(_wrapped(f"option {k}: {v}", "        ", "    "))
+    print()
+    print(_wrapped("The facade (mcgeom.cv.estimate, estimateRigMotion) chooses the minimal "
+                   "solver of its LO-RANSAC from the data (info['sampler'] says which ran; all "
+                   "three run in the C entry point mcg_robust_rig_motion):", ""))
+    for name, text in _SAMPLERS:
+        print(_wrapped(text, " " * 24, f"    {name:<20}"))
+    print(_wrapped("Any registered name, 'ransac:NAME' or 'direct:NAME' may be passed as "
+                   "method instead ('ransac:five_plus_one' forces 5+1; 'ransac:linear17' is "
+                   "17-point RANSAC).", ""))
     # the LP backends of bnb_lp: the available ones, and why GLPK is not (with
     # the command that brings it) when it is not
     print(f"\nLP backends (bnb_lp, default {registry.default_lp_backend()}):")
     backends = registry.lp_backends()
     for name, what in backends.items():
-        print(f"    {name}: {what}")
+        print(_wrapped(f"{name}: {what}", "        ", "    "))
     if "glpk" not in backends:
-        print(f"    glpk: {registry.glpk_status()}")
+        print(_wrapped(f"glpk: {registry.glpk_status()}", "        ", "    "))
     return 0
 
 

@@ -199,6 +199,17 @@ def test_methods_lists_the_lp_backends_and_how_to_get_glpk(tmp_path):
     assert "glpk: unavailable" in backends and "pip install 'mcgeom[glpk]'" in backends
 
 
+def test_methods_fits_the_terminal_and_keeps_commands_whole(capsys):
+    """``mcgeom methods`` is filled to 100 columns, as ``--help`` is, and the
+    commands it quotes stay on one line (a reader copies them)."""
+    assert cli.main(["methods"]) == 0
+    out = capsys.readouterr().out
+    assert all(len(line) <= 100 for line in out.splitlines())
+    assert "mcgeom experiment peer_solvers --part ransac --outliers 0.3 0.5 0.6" in out
+    assert "upright_four_point  when a vertical prior is passed" in out
+    assert "\0" not in out
+
+
 def test_rig_frame_argument(tmp_path):
     """--rig-frame: names pass through, a file gives its checked 4x4 transform."""
     assert cli.rig_frame_arg("body") == "body"
