@@ -264,7 +264,7 @@ def _problems(args: argparse.Namespace) -> int:
 
 
 def _bench_robust(args: argparse.Namespace) -> int:
-    from .experiments.bench.robust import WARM_BLOCK, bench_scaling, bench_speed
+    from .experiments.bench.robust import TUNED_PEER, WARM_BLOCK, bench_scaling, bench_speed
 
     rows = bench_speed(_problems(args), progress=progress_bar)
     print(f"robust: mcgeom.cv.estimate (pixels in, 5+1 in one C call, verdict in Python) vs "
@@ -273,29 +273,28 @@ def _bench_robust(args: argparse.Namespace) -> int:
     print(f"{'case':<22} {'method':<19} {'rot deg':>8} {'scale err':>9} {'ms cold':>7} "
           f"{'mcgeom/this':>11} {'ms warm':>7} {'mcgeom/this':>11} {'outside C':>9} "
           f"{'mcgeom better rot/scale (paired)':>32}")
-    ms = {(r.case, r.method): (r.ms, r.ms_warm) for r in rows}
-    rot = {r.case: r.rot_deg for r in rows if r.method == "mcgeom"}
-    scale = {r.case: r.scale_err for r in rows if r.method == "mcgeom"}
+    own = {r.case: r for r in rows if r.method == "mcgeom"}   # (the ratios' numerators)
     for r in rows:
         out = "" if r.method != "mcgeom" else f"{100 * r.outside_c:8.0f}%"
         paired = "" if r.method == "mcgeom" else \
             f"{100 * r.mcgeom_rot_better:3.0f}% / {100 * r.mcgeom_scale_better:3.0f}%"
-        cold, warm = ms[(r.case, "mcgeom")]
+        m = own[r.case]
         print(f"{r.case:<22} {r.method:<19} {r.rot_deg:8.4f} {r.scale_err:9.4f} {r.ms:7.3f} "
-              f"{cold / r.ms:10.2f}x {r.ms_warm:7.3f} {warm / r.ms_warm:10.2f}x {out:>9} "
+              f"{m.ms / r.ms:10.2f}x {r.ms_warm:7.3f} {m.ms_warm / r.ms_warm:10.2f}x {out:>9} "
               f"{paired:>32}")
     print(f"cold: the methods alternate on every problem (errors and 'outside C' from this "
           f"pass); warm: the same problems in blocks of {WARM_BLOCK}, each method on a block "
           f"in turn")
-    print("mcgeom / poselib min_it=100, medians' ratio with its 95 % bootstrap interval "
-          "(problems resampled):")
+    print(f"mcgeom / {TUNED_PEER}, medians' ratio with its 95 % bootstrap interval "
+          f"(problems resampled):")
     for r in rows:
-        if r.method == "poselib min_it=100":
+        if r.method == TUNED_PEER:
+            m = own[r.case]
             print(f"  {r.case:<22} " + "; ".join(
                 f"{what} {ratio:.2f} [{ci[0]:.2f}, {ci[1]:.2f}]" for what, ratio, ci in (
-                    ("time cold", ms[(r.case, 'mcgeom')][0] / r.ms, r.time_ratio_ci),
-                    ("rotation error", rot[r.case] / r.rot_deg, r.rot_ratio_ci),
-                    ("scale error", scale[r.case] / r.scale_err, r.scale_ratio_ci))))
+                    ("time cold", m.ms / r.ms, r.time_ratio_ci),
+                    ("rotation error", m.rot_deg / r.rot_deg, r.rot_ratio_ci),
+                    ("scale error", m.scale_err / r.scale_err, r.scale_ratio_ci))))
     print("\nscaling: 4-camera ring, 20 % outliers, rays in (mcgeom.robust.ransac); medians "
           "over the problems of each size, each drawn and solved with its own seed")
     print(f"{'N':>8} {'problems':>8} {'seconds':>8} {'us/corr':>8} {'min-max us/corr':>15} "

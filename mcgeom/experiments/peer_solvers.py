@@ -80,7 +80,7 @@ from mcgeom.estimators.upright_four_point import upright_rotation
 from mcgeom.rig import Rig
 
 from .common import Progress, add_count_and_seed, fraction, import_peer, no_progress, positive_int
-from .poselib_peer import poselib_estimate, poselib_setup
+from .poselib_peer import POSELIB_SETTINGS, poselib_estimate, poselib_setup
 from .robust_vs_poselib import CASES as ROBUST_CASES, car_forward, random_motion
 
 #: e_z -> e_y: PoseLib's upright solvers rotate about y
@@ -333,11 +333,6 @@ def with_outliers(cases: dict, fractions: Sequence[float]) -> dict:
             base = re.sub(r"\s*\d+%out\b", "", name)
             out[f"{base} @{100 * f:g}%out"] = (make_rig, n, float(f), noise, cross, motion)
     return out
-
-
-#: PoseLib's settings: with the iteration floor of issue 19's comparison, and its defaults
-POSELIB_SETTINGS = {"poselib min_it=100": {"max_epipolar_error": 1.0, "min_iterations": 100},
-                    "poselib defaults": {"max_epipolar_error": 1.0}}
 
 
 def _errors(R, t, Rt, tt) -> tuple[float, float]:

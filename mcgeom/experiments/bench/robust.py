@@ -67,10 +67,11 @@ from mcgeom.cv import estimate
 from mcgeom.rig import Rig
 
 from ..common import Progress, no_progress
-from ..poselib_peer import poselib_estimate, poselib_setup
+from ..poselib_peer import POSELIB_SETTINGS, TUNED_PEER, poselib_estimate, poselib_setup
 from ..robust_vs_poselib import ring4
 
-__all__ = ["SpeedRow", "ScaleRow", "bench_speed", "bench_scaling", "CASES", "WARM_BLOCK"]
+__all__ = ["SpeedRow", "ScaleRow", "bench_speed", "bench_scaling", "CASES", "WARM_BLOCK",
+           "TUNED_PEER"]
 
 
 def _generic_motion(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -164,11 +165,7 @@ def bench_speed(problems: int = 100, seed: int = 0,
         rng = np.random.default_rng(seed)
         rig = make_rig()
         setup = poselib_setup(rig, "bench robust")
-        methods = {
-            "mcgeom": None,
-            "poselib min_it=100": {"max_epipolar_error": 1.0, "min_iterations": 100},
-            "poselib defaults": {"max_epipolar_error": 1.0},
-        }
+        methods = {"mcgeom": None, **POSELIB_SETTINGS}
         err = {k: [] for k in methods}
         secs = {k: [] for k in methods}
         warm = {k: [] for k in methods}
