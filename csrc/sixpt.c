@@ -33,10 +33,12 @@
  *    zero, and the 64 solution paths x(tau) of H(x, tau) = F(x; p(tau)) = 0
  *    end at every isolated solution of p1 (Morgan-Sommese). Each path is
  *    tracked by a fourth-order Runge-Kutta predictor on dx/dtau = -J^-1
- *    dH/dtau and Newton corrector steps, with step-size control: a step is
- *    accepted when the corrector converges (first correction below 1e-3 of
- *    |x|, last below 1e-8; a stricter last test stalls paths that pass near
- *    infinity, |x| ~ 1e3) -- the usual guard against jumping between paths.
+ *    dH/dtau and Newton corrector steps. A step is accepted when the
+ *    corrector converges (first correction below 1e-3 of 1 + |x|, last below
+ *    1e-5) -- the usual guard against jumping between paths; the first
+ *    correction, the predictor's error, also sets the next step (track()).
+ *    The data along the segment are polynomials in tau (d linear, m = o x d
+ *    quadratic), expanded once per problem (struct seg).
  *    Paths whose |x| exceeds 1e7 go to infinity (e.g. a rotation of 180
  *    degrees, or a degenerate problem) and are dropped.
  *
@@ -49,9 +51,10 @@
  *
  * 5. Back to the rig frames: with o = sc u + c, t = sc t_u + c - R c.
  *
- * Cost: 64 paths of about 100 steps (a third rejected), each four to seven
- * evaluations and complex 6 x 6 solves: some 60 ms per call on a 2-core
- * machine, far slower than an elimination template;
+ * Cost: 64 paths of about 65 steps (a sixth rejected), each about six
+ * evaluations and complex 6 x 6 solves: some 20 ms per call on a 2-core
+ * machine (60 ms before the step control of track() and struct seg), still
+ * far slower than an elimination template;
  * no allocation (all work is on the stack). Every solution returned is
  * checked (step 4); a miss (a path that failed or jumped) is possible in
  * ill-conditioned problems and its rate is measured by `mcgeom experiment
@@ -67,29 +70,51 @@
 
 #define DIR2_MIN 1e-100  /* smallest squared length of a direction */
 #define X_MAX 1e7        /* |x| beyond which a path goes to infinity */
-#ifndef H_MAX
 #define H_MAX 0.1        /* largest step in tau */
-#endif
-#ifndef GROW_AFTER
-#define GROW_AFTER 2     /* accepted steps in a row before the step doubles */
-#endif
-#ifndef LAST_TOL
-#define LAST_TOL 1e-8    /* corrector step that ends the corrector, relative to |x| */
-#endif
-#ifndef FIRST_TOL
-#define FIRST_TOL 1e-3   /* largest first corrector step, relative to |x| */
-#endif
 #define H_MIN 1e-9       /* smallest step in tau before a path is given up */
+#define H_GROW 2.0       /* largest growth of the step after an accepted one */
 #define MAX_STEPS 600    /* steps (accepted or not) per path: bounds the time */
+/* The corrector (step 3): its first Newton step measures the predictor's
+ * error, which decides the acceptance (FIRST_TOL) and the next step size
+ * (PRED_TOL); it ends when a Newton step is below LAST_TOL. All relative to
+ * 1 + |x|. Newton converges quadratically from within FIRST_TOL, so a last
+ * step of 1e-5 leaves the point some 1e-10 from its path. PRED_TOL was chosen
+ * from 2e-5..1e-3 by the evaluations per path (the fewest at 1e-4..3e-4), at
+ * an unchanged count of solutions found. */
+#define FIRST_TOL 1e-3
+#define PRED_TOL 3e-4
+#define LAST_TOL 1e-5
 
 typedef double complex cplx;
+
+/* re + i im, built from its parts: the C99 spelling re + im * I multiplies
+ * im by the complex I, which Annex G makes a full complex product (0 * im
+ * kept for infinities) and which costs about a tenth of this solver's time */
+#if defined(__GNUC__) && !defined(__clang__)
+#define MCG_BUILTIN_COMPLEX 1
+#elif defined(__has_builtin)
+#if __has_builtin(__builtin_complex)
+#define MCG_BUILTIN_COMPLEX 1
+#endif
+#endif
+static inline cplx mkc(double re, double im)
+{
+#ifdef MCG_BUILTIN_COMPLEX
+    return __builtin_complex(re, im);
+#else
+    cplx z; /* C99 6.2.5p13: a complex has the layout of double[2] */
+    ((double *)&z)[0] = re;
+    ((double *)&z)[1] = im;
+    return z;
+#endif
+}
 
 /* a b without the C99 Annex G infinity/NaN recovery (a library call per
  * product otherwise; the values here are finite) */
 static inline cplx cm(cplx a, cplx b)
 {
     double ar = creal(a), ai = cimag(a), br = creal(b), bi = cimag(b);
-    return (ar * br - ai * bi) + (ar * bi + ai * br) * I;
+    return mkc(ar * br - ai * bi, ar * bi + ai * br);
 }
 
 /* |re| + |im|: a cheap magnitude for pivoting */
@@ -132,84 +157,102 @@ static void cayley(const cplx *s, cplx Rt[9], cplx dR[3][9])
     dR[2][3] += 2.0;
 }
 
-/* G += u v^T (3 x 3 complex, row-major) */
-static void outer_add(cplx G[9], const cplx *u, const cplx *v)
+/* The problem along the segment, per correspondence, as polynomials in tau:
+ * d(tau) = D + tau dD, m(tau) = o(tau) x d(tau) = M0 + tau M1 + tau^2 M2 */
+struct seg {
+    cplx D1[6][3], dD1[6][3], D2[6][3], dD2[6][3];
+    cplx M10[6][3], M11[6][3], M12[6][3], M20[6][3], M21[6][3], M22[6][3];
+};
+
+static void seg_init(struct seg *sg, const cplx *p0, const cplx *dp)
 {
-    int a, b;
-    for (a = 0; a < 3; ++a)
-        for (b = 0; b < 3; ++b)
-            G[3 * a + b] += cm(u[a], v[b]);
+    int i, a;
+    for (i = 0; i < 6; ++i) {
+        const cplx *o1 = p0 + 12 * i, *d1 = o1 + 3, *o2 = o1 + 6, *d2 = o1 + 9;
+        const cplx *do1 = dp + 12 * i, *dd1 = do1 + 3, *do2 = do1 + 6, *dd2 = do1 + 9;
+        cplx u[3], v[3];
+        for (a = 0; a < 3; ++a) {
+            sg->D1[i][a] = d1[a];
+            sg->dD1[i][a] = dd1[a];
+            sg->D2[i][a] = d2[a];
+            sg->dD2[i][a] = dd2[a];
+        }
+        ccross(o1, d1, sg->M10[i]);
+        ccross(do1, d1, u);
+        ccross(o1, dd1, v);
+        for (a = 0; a < 3; ++a)
+            sg->M11[i][a] = u[a] + v[a];
+        ccross(do1, dd1, sg->M12[i]);
+        ccross(o2, d2, sg->M20[i]);
+        ccross(do2, d2, u);
+        ccross(o2, dd2, v);
+        for (a = 0; a < 3; ++a)
+            sg->M21[i][a] = u[a] + v[a];
+        ccross(do2, dd2, sg->M22[i]);
+    }
 }
 
-/* <A, B> = sum_ab A_ab B_ab */
-static cplx frob(const cplx A[9], const cplx B[9])
+static inline void mv3(const cplx A[9], const cplx *x, cplx *y)
 {
-    cplx r = 0.0;
-    int a;
-    for (a = 0; a < 9; ++a)
-        r += cm(A[a], B[a]);
-    return r;
+    y[0] = cm(A[0], x[0]) + cm(A[1], x[1]) + cm(A[2], x[2]);
+    y[1] = cm(A[3], x[0]) + cm(A[4], x[1]) + cm(A[5], x[2]);
+    y[2] = cm(A[6], x[0]) + cm(A[7], x[1]) + cm(A[8], x[2]);
 }
 
-/* H(x, tau) (S1) of the problem p = p0 + tau dp (72 complex: per
- * correspondence o1, d1, o2, d2): Fv (6), J (6 x 6 row-major, d/dx) and, when
- * Ft is not NULL, dH/dtau (6). */
-static void eval_h(const cplx *x, const cplx *p0, const cplx *dp, double tau, cplx Fv[6],
-                   cplx J[36], cplx *Ft)
+static inline cplx dot3c(const cplx *a, const cplx *b)
+{
+    return cm(a[0], b[0]) + cm(a[1], b[1]) + cm(a[2], b[2]);
+}
+
+/* H(x, tau) = F(x; p(tau)) (S1): Fv (6), J = dH/dx (6 x 6 row-major) and,
+ * when Ft is not NULL, dH/dtau (6). With a = d2 x t + m2,
+ *   F_i = a^T Rt d1 + d2^T Rt m1,   dF_i/dt = (Rt d1) x d2,
+ *   dF_i/ds_k = a^T dRt_k d1 + d2^T dRt_k m1 = <dRt_k, a d1^T + d2 m1^T>. */
+static void eval_h(const cplx *x, const struct seg *sg, double tau, cplx Fv[6], cplx J[36],
+                   cplx *Ft)
 {
     cplx Rt[9], dR[3][9];
     const cplx *t = x + 3;
-    int i, k;
+    int i, k, a;
+    double t2 = tau * tau;
     cayley(x, Rt, dR);
     for (i = 0; i < 6; ++i) {
-        cplx o1[3], d1[3], o2[3], d2[3], m1[3], m2[3], d2t[3], Rd1[3], w[3], G[9];
-        int a;
+        cplx d1[3], d2[3], m1[3], m2[3], av[3], u[3], v[3], G[9];
         for (a = 0; a < 3; ++a) {
-            /* real x complex products: no library call */
-            o1[a] = p0[12 * i + a] + tau * dp[12 * i + a];
-            d1[a] = p0[12 * i + 3 + a] + tau * dp[12 * i + 3 + a];
-            o2[a] = p0[12 * i + 6 + a] + tau * dp[12 * i + 6 + a];
-            d2[a] = p0[12 * i + 9 + a] + tau * dp[12 * i + 9 + a];
+            d1[a] = sg->D1[i][a] + tau * sg->dD1[i][a];
+            d2[a] = sg->D2[i][a] + tau * sg->dD2[i][a];
+            m1[a] = sg->M10[i][a] + tau * sg->M11[i][a] + t2 * sg->M12[i][a];
+            m2[a] = sg->M20[i][a] + tau * sg->M21[i][a] + t2 * sg->M22[i][a];
         }
-        ccross(o1, d1, m1);
-        ccross(o2, d2, m2);
-        ccross(d2, t, d2t);
-        /* F_i = <Rt, G_i>, G_i = d2t d1^T + d2 m1^T + m2 d1^T (S1) */
-        memset(G, 0, sizeof G);
-        outer_add(G, d2t, d1);
-        outer_add(G, d2, m1);
-        outer_add(G, m2, d1);
-        Fv[i] = frob(Rt, G);
-        for (k = 0; k < 3; ++k)
-            J[6 * i + k] = frob(dR[k], G);
+        ccross(d2, t, av);
         for (a = 0; a < 3; ++a)
-            Rd1[a] = cm(Rt[3 * a], d1[0]) + cm(Rt[3 * a + 1], d1[1]) + cm(Rt[3 * a + 2], d1[2]);
-        ccross(Rd1, d2, w); /* dF_i/dt = Rt d1 x d2 */
-        for (k = 0; k < 3; ++k)
-            J[6 * i + 3 + k] = w[k];
+            av[a] += m2[a];
+        mv3(Rt, d1, u);
+        mv3(Rt, m1, v);
+        Fv[i] = dot3c(av, u) + dot3c(d2, v);
+        for (a = 0; a < 3; ++a) {
+            G[3 * a] = cm(av[a], d1[0]) + cm(d2[a], m1[0]);
+            G[3 * a + 1] = cm(av[a], d1[1]) + cm(d2[a], m1[1]);
+            G[3 * a + 2] = cm(av[a], d1[2]) + cm(d2[a], m1[2]);
+        }
+        for (k = 0; k < 3; ++k) {
+            cplx r = 0.0;
+            for (a = 0; a < 9; ++a)
+                r += cm(dR[k][a], G[a]);
+            J[6 * i + k] = r;
+        }
+        ccross(u, d2, J + 6 * i + 3);
         if (Ft) {
-            /* the derivatives of the data along the segment: o' = dp_o, d' =
-             * dp_d, m' = o' x d + o x d' */
-            const cplx *do1 = dp + 12 * i, *dd1 = dp + 12 * i + 3, *do2 = dp + 12 * i + 6,
-                       *dd2 = dp + 12 * i + 9;
-            cplx dm1[3], dm2[3], u[3], v[3], dd2t[3];
-            ccross(do1, d1, u);
-            ccross(o1, dd1, v);
-            for (a = 0; a < 3; ++a)
-                dm1[a] = u[a] + v[a];
-            ccross(do2, d2, u);
-            ccross(o2, dd2, v);
-            for (a = 0; a < 3; ++a)
-                dm2[a] = u[a] + v[a];
-            ccross(dd2, t, dd2t);
-            memset(G, 0, sizeof G);
-            outer_add(G, dd2t, d1);
-            outer_add(G, d2t, dd1);
-            outer_add(G, dd2, m1);
-            outer_add(G, d2, dm1);
-            outer_add(G, dm2, d1);
-            outer_add(G, m2, dd1);
-            Ft[i] = frob(Rt, G);
+            /* d/dtau: d' = dD, m' = M1 + 2 tau M2, a' = d2' x t + m2' */
+            cplx ap[3], dm1[3], ud[3], vd[3];
+            ccross(sg->dD2[i], t, ap);
+            for (a = 0; a < 3; ++a) {
+                ap[a] += sg->M21[i][a] + 2.0 * tau * sg->M22[i][a];
+                dm1[a] = sg->M11[i][a] + 2.0 * tau * sg->M12[i][a];
+            }
+            mv3(Rt, sg->dD1[i], ud);
+            mv3(Rt, dm1, vd);
+            Ft[i] = dot3c(ap, u) + dot3c(av, ud) + dot3c(sg->dD2[i], v) + dot3c(d2, vd);
         }
     }
 }
@@ -220,8 +263,10 @@ static int csolve6(cplx J[36], cplx b[6])
 {
     int k, i, j;
     double big = 0.0;
-    for (i = 0; i < 36; ++i)
-        big = fmax(big, cabs1(J[i]));
+    for (i = 0; i < 36; ++i) {
+        double m = cabs1(J[i]);
+        big = m > big ? m : big;
+    }
     if (!(big > 0.0) || !isfinite(big))
         return 0;
     for (k = 0; k < 6; ++k) {
@@ -248,13 +293,11 @@ static int csolve6(cplx J[36], cplx b[6])
         }
         {
             double pr = creal(J[6 * k + k]), pi = cimag(J[6 * k + k]), q = pr * pr + pi * pi;
-            inv = (pr / q) - (pi / q) * I; /* 1 / pivot */
+            inv = mkc(pr / q, -pi / q); /* 1 / pivot */
             J[6 * k + k] = inv;            /* kept for the back substitution */
         }
         for (i = k + 1; i < 6; ++i) {
             cplx f = cm(J[6 * i + k], inv);
-            if (f == 0.0)
-                continue;
             for (j = k + 1; j < 6; ++j)
                 J[6 * i + j] -= cm(f, J[6 * k + j]);
             b[i] -= cm(f, b[k]);
@@ -279,11 +322,11 @@ static double cnorm6(const cplx *x)
 }
 
 /* dx/dtau at (x, tau); 0 when J is singular */
-static int velocity(const cplx *x, const cplx *p0, const cplx *dp, double tau, cplx v[6])
+static int velocity(const cplx *x, const struct seg *sg, double tau, cplx v[6])
 {
     cplx Fv[6], J[36];
     int i;
-    eval_h(x, p0, dp, tau, Fv, J, v);
+    eval_h(x, sg, tau, Fv, J, v);
     if (!csolve6(J, v))
         return 0;
     for (i = 0; i < 6; ++i)
@@ -292,69 +335,80 @@ static int velocity(const cplx *x, const cplx *p0, const cplx *dp, double tau, c
 }
 
 /* Newton corrector at tau: up to 3 steps; returns 1 when it converged
- * (first correction <= FIRST_TOL (1 + |x|), last <= LAST_TOL (1 + |x|)). */
-static int correct(cplx *x, const cplx *p0, const cplx *dp, double tau)
+ * (first correction <= FIRST_TOL (1 + |x|), last <= LAST_TOL (1 + |x|)).
+ * *d1 is the first correction relative to 1 + |x|. */
+static int correct(cplx *x, const struct seg *sg, double tau, double *d1)
 {
     int it, i;
+    *d1 = 1.0;
     for (it = 0; it < 3; ++it) {
         cplx Fv[6], J[36];
         double nd, nx;
-        eval_h(x, p0, dp, tau, Fv, J, NULL);
+        eval_h(x, sg, tau, Fv, J, NULL);
         if (!csolve6(J, Fv))
             return 0;
         for (i = 0; i < 6; ++i)
             x[i] -= Fv[i];
         nd = cnorm6(Fv);
         nx = 1.0 + cnorm6(x);
-        if (!(nd <= FIRST_TOL * nx) && it == 0)
-            return 0;
+        if (it == 0) {
+            *d1 = nd / nx;
+            if (!(nd <= FIRST_TOL * nx))
+                return 0;
+        }
         if (nd <= LAST_TOL * nx)
             return 1;
     }
     return 0;
 }
 
-/* Track one path from x (a solution at tau = 0) to tau = 1; 1 on success */
-static int track(cplx x[6], const cplx *p0, const cplx *dp)
+/* Track one path from x (a solution at tau = 0) to tau = 1; 1 on success.
+ * Fourth-order Runge-Kutta predictor and Newton corrector (step 3). The
+ * first corrector step d1 is the predictor's local error, O(h^5), so the next
+ * step is h (PRED_TOL / d1)^(1/5) (times 0.9 for safety, at most H_GROW h); a
+ * rejected step halves h. The velocity at the start of a step is kept when
+ * the step is rejected: x and tau have not moved. */
+static int track(cplx x[6], const struct seg *sg)
 {
     double tau = 0.0, h = 0.05;
-    int steps, i, streak = 0;
+    int steps, i, have_k1 = 0;
+    cplx k1[6];
     for (steps = 0; steps < MAX_STEPS && tau < 1.0; ++steps) {
-        cplx k1[6], k2[6], k3[6], k4[6], y[6];
-        double hh = fmin(h, 1.0 - tau);
-        int ok = velocity(x, p0, dp, tau, k1);
+        cplx k2[6], k3[6], k4[6], y[6];
+        double hh = fmin(h, 1.0 - tau), d1 = 1.0;
+        int ok = 1;
+        if (!have_k1)
+            ok = have_k1 = velocity(x, sg, tau, k1);
         if (ok) {
             for (i = 0; i < 6; ++i)
                 y[i] = x[i] + 0.5 * hh * k1[i];
-            ok = velocity(y, p0, dp, tau + 0.5 * hh, k2);
+            ok = velocity(y, sg, tau + 0.5 * hh, k2);
         }
         if (ok) {
             for (i = 0; i < 6; ++i)
                 y[i] = x[i] + 0.5 * hh * k2[i];
-            ok = velocity(y, p0, dp, tau + 0.5 * hh, k3);
+            ok = velocity(y, sg, tau + 0.5 * hh, k3);
         }
         if (ok) {
             for (i = 0; i < 6; ++i)
                 y[i] = x[i] + hh * k3[i];
-            ok = velocity(y, p0, dp, tau + hh, k4);
+            ok = velocity(y, sg, tau + hh, k4);
         }
         if (ok) {
             for (i = 0; i < 6; ++i)
                 y[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            ok = correct(y, p0, dp, tau + hh);
+            ok = correct(y, sg, tau + hh, &d1);
         }
         if (ok) {
+            double grow = 0.9 * pow(PRED_TOL / fmax(d1, 1e-300), 0.2);
             memcpy(x, y, sizeof y);
+            have_k1 = 0;
             tau = (1.0 - tau <= hh) ? 1.0 : tau + hh;
-            if (++streak >= GROW_AFTER) {
-                h = fmin(2.0 * h, H_MAX);
-                streak = 0;
-            }
+            h = fmin(hh * fmin(grow, H_GROW), H_MAX);
             if (cnorm6(x) > X_MAX)
                 return 0;
         } else {
             h *= 0.5;
-            streak = 0;
             if (h < H_MIN)
                 return 0;
         }
@@ -364,16 +418,15 @@ static int track(cplx x[6], const cplx *p0, const cplx *dp)
 
 /* Real Newton polish of x at the target (tau = 1); returns 0 when J is
  * singular (relative pivot below 1e-14) or the steps do not settle. */
-static int polish_real(double x[6], const cplx *p1)
+static int polish_real(double x[6], const struct seg *sg1)
 {
-    static const cplx zero[72]; /* dp = 0: the problem is p1 itself */
     int it, i;
     for (it = 0; it < 6; ++it) {
         cplx xc[6], Fv[6], J[36];
         double nd = 0.0, nx = 0.0;
         for (i = 0; i < 6; ++i)
             xc[i] = x[i];
-        eval_h(xc, p1, zero, 0.0, Fv, J, NULL);
+        eval_h(xc, sg1, 0.0, Fv, J, NULL);
         if (!csolve6(J, Fv))
             return 0;
         for (i = 0; i < 6; ++i) {
@@ -427,7 +480,8 @@ int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], con
               double R[576], double t[192], int *n_solutions)
 {
     double c[3], sc, p1r[72];
-    cplx p0[72], p1[72], dp[72];
+    cplx p0[72], p1[72], dp[72], zero[72];
+    struct seg sg, sg1;
     double sols[MCG_SIXPT_MAX_SOLUTIONS][6];
     int ns = 0, k, i, j;
 
@@ -457,17 +511,20 @@ int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], con
     if (!(sc > 0.0))
         return MCG_OK; /* one centre: a central camera, no metric scale */
     for (i = 0; i < 72; ++i) {
-        p0[i] = sixpt_p0_re[i] + I * sixpt_p0_im[i];
+        p0[i] = mkc(sixpt_p0_re[i], sixpt_p0_im[i]);
         p1[i] = p1r[i];
         dp[i] = p1[i] - p0[i];
+        zero[i] = 0.0;
     }
+    seg_init(&sg, p0, dp);
+    seg_init(&sg1, p1, zero);
     for (j = 0; j < SIXPT_N_START; ++j) {
         cplx x[6];
         double xr[6], Rn[9], nx = 0.0, ni = 0.0;
         int dup = 0;
         for (i = 0; i < 6; ++i)
-            x[i] = sixpt_x0_re[6 * j + i] + I * sixpt_x0_im[6 * j + i];
-        if (!track(x, p0, dp))
+            x[i] = mkc(sixpt_x0_re[6 * j + i], sixpt_x0_im[6 * j + i]);
+        if (!track(x, &sg))
             continue;
         for (i = 0; i < 6; ++i) {
             nx += creal(x[i]) * creal(x[i]) + cimag(x[i]) * cimag(x[i]);
@@ -477,7 +534,7 @@ int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], con
             continue; /* a complex solution */
         for (i = 0; i < 6; ++i)
             xr[i] = creal(x[i]);
-        if (!polish_real(xr, p1))
+        if (!polish_real(xr, &sg1))
             continue;
         rot_from_cayley(xr, Rn);
         if (!(gec_max(Rn, xr + 3, p1r) <= 1e-10 * (1.0 + sqrt(dot3(xr + 3, xr + 3)))))
