@@ -177,36 +177,38 @@ static void seg_put(struct seg *sg, int q, int i, const cplx *v)
     }
 }
 
+/* the moment m = o x d along the segment, o = o0 + tau do, d = d0 + tau dd:
+ * its coefficients M0 = o0 x d0, M1 = do x d0 + o0 x dd, M2 = do x dd stored
+ * as polynomials q, q + 1, q + 2 of correspondence i */
+static void seg_put_moment(struct seg *sg, int q, int i, const cplx *o0, const cplx *d0,
+                           const cplx *dlo, const cplx *dld)
+{
+    cplx u[3], v[3], w[3];
+    int a;
+    ccross(o0, d0, w);
+    seg_put(sg, q, i, w);
+    ccross(dlo, d0, u);
+    ccross(o0, dld, v);
+    for (a = 0; a < 3; ++a)
+        w[a] = u[a] + v[a];
+    seg_put(sg, q + 1, i, w);
+    ccross(dlo, dld, w);
+    seg_put(sg, q + 2, i, w);
+}
+
 static void seg_init(struct seg *sg, const cplx *p0, const cplx *dp)
 {
-    int i, a;
+    int i;
     memset(sg, 0, sizeof *sg);
     for (i = 0; i < 6; ++i) {
         const cplx *o1 = p0 + 12 * i, *d1 = o1 + 3, *o2 = o1 + 6, *d2 = o1 + 9;
         const cplx *do1 = dp + 12 * i, *dd1 = do1 + 3, *do2 = do1 + 6, *dd2 = do1 + 9;
-        cplx u[3], v[3], w[3];
         seg_put(sg, SD1, i, d1);
         seg_put(sg, SdD1, i, dd1);
         seg_put(sg, SD2, i, d2);
         seg_put(sg, SdD2, i, dd2);
-        ccross(o1, d1, w);
-        seg_put(sg, SM10, i, w);
-        ccross(do1, d1, u);
-        ccross(o1, dd1, v);
-        for (a = 0; a < 3; ++a)
-            w[a] = u[a] + v[a];
-        seg_put(sg, SM11, i, w);
-        ccross(do1, dd1, w);
-        seg_put(sg, SM12, i, w);
-        ccross(o2, d2, w);
-        seg_put(sg, SM20, i, w);
-        ccross(do2, d2, u);
-        ccross(o2, dd2, v);
-        for (a = 0; a < 3; ++a)
-            w[a] = u[a] + v[a];
-        seg_put(sg, SM21, i, w);
-        ccross(do2, dd2, w);
-        seg_put(sg, SM22, i, w);
+        seg_put_moment(sg, SM10, i, o1, d1, do1, dd1);
+        seg_put_moment(sg, SM20, i, o2, d2, do2, dd2);
     }
 }
 
