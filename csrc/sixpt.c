@@ -51,8 +51,8 @@
  *
  * 5. Back to the rig frames: with o = sc u + c, t = sc t_u + c - R c.
  *
- * Cost: 64 paths of about 65 steps (a sixth rejected), each about six
- * evaluations and complex 6 x 6 solves: some 15 ms per call on a 2-core
+ * Cost: 64 paths of about 65 steps (a sixth rejected), each about five
+ * evaluations and complex 6 x 6 solves: some 14 ms per call on a 2-core
  * machine (50 ms before the step control of track() and the vectorised
  * eval_h), still far slower than an elimination template;
  * no allocation (all work is on the stack). Every solution returned is
@@ -366,9 +366,23 @@ MCG_AVX2_CLONE static void eval_h(const cplx *x, const struct seg *sg, double ta
     }
 }
 
-/* Solve J y = b (6 x 6, partial pivoting; J and b are overwritten, y = b).
- * Returns 0 when a pivot vanishes relative to the largest entry. */
-static int csolve6(cplx J[36], cplx b[6])
+/* b := U^-1 b for the upper triangle U of csolve6's factors (the inverses of
+ * the pivots on its diagonal) */
+static void back_substitute(const cplx J[36], cplx b[6])
+{
+    int k, j;
+    for (k = 5; k >= 0; --k) {
+        cplx acc = b[k];
+        for (j = k + 1; j < 6; ++j)
+            acc -= cm(J[6 * k + j], b[j]);
+        b[k] = cm(acc, J[6 * k + k]);
+    }
+}
+
+/* Solve J y = b and, when c is not NULL, J z = c (6 x 6, partial pivoting;
+ * J, b and c are overwritten, y = b, z = c). Returns 0 when a pivot vanishes
+ * relative to the largest entry. */
+static int csolve6(cplx J[36], cplx b[6], cplx *c)
 {
     int k, i, j;
     double big = 0.0;
@@ -399,6 +413,11 @@ static int csolve6(cplx J[36], cplx b[6])
             tmp = b[k];
             b[k] = b[p];
             b[p] = tmp;
+            if (c) {
+                tmp = c[k];
+                c[k] = c[p];
+                c[p] = tmp;
+            }
         }
         {
             double pr = creal(J[6 * k + k]), pi = cimag(J[6 * k + k]), q = pr * pr + pi * pi;
@@ -410,14 +429,13 @@ static int csolve6(cplx J[36], cplx b[6])
             for (j = k + 1; j < 6; ++j)
                 J[6 * i + j] -= cm(f, J[6 * k + j]);
             b[i] -= cm(f, b[k]);
+            if (c)
+                c[i] -= cm(f, c[k]);
         }
     }
-    for (k = 5; k >= 0; --k) {
-        cplx acc = b[k];
-        for (j = k + 1; j < 6; ++j)
-            acc -= cm(J[6 * k + j], b[j]);
-        b[k] = cm(acc, J[6 * k + k]);
-    }
+    back_substitute(J, b);
+    if (c)
+        back_substitute(J, c);
     return 1;
 }
 
@@ -436,7 +454,7 @@ static int velocity(const cplx *x, const struct seg *sg, double tau, cplx v[6])
     cplx Fv[6], J[36];
     int i;
     eval_h(x, sg, tau, Fv, J, v);
-    if (!csolve6(J, v))
+    if (!csolve6(J, v, NULL))
         return 0;
     for (i = 0; i < 6; ++i)
         v[i] = -v[i];
@@ -445,17 +463,24 @@ static int velocity(const cplx *x, const struct seg *sg, double tau, cplx v[6])
 
 /* Newton corrector at tau: up to 3 steps; returns 1 when it converged
  * (first correction <= FIRST_TOL (1 + |x|), last <= LAST_TOL (1 + |x|)).
- * *d1 is the first correction relative to 1 + |x|. */
-static int correct(cplx *x, const struct seg *sg, double tau, double *d1)
+ * *d1 is the first correction relative to 1 + |x|. From the second step on,
+ * the evaluation also gives dH/dtau and the solve J^-1 dH/dtau with the same
+ * factors: when the corrector ends there (*have_vn), -vn is the velocity at
+ * the new point up to the last correction, the next step's first stage at
+ * no cost (14 % fewer evaluations per path). */
+static int correct(cplx *x, const struct seg *sg, double tau, double *d1, cplx vn[6],
+                   int *have_vn)
 {
     int it, i;
     *d1 = 1.0;
+    *have_vn = 0;
     for (it = 0; it < 3; ++it) {
         cplx Fv[6], J[36];
         double nd, nx;
-        eval_h(x, sg, tau, Fv, J, NULL);
-        if (!csolve6(J, Fv))
+        eval_h(x, sg, tau, Fv, J, it > 0 ? vn : NULL);
+        if (!csolve6(J, Fv, it > 0 ? vn : NULL))
             return 0;
+        *have_vn = it > 0;
         for (i = 0; i < 6; ++i)
             x[i] -= Fv[i];
         nd = cnorm6(Fv);
@@ -476,12 +501,13 @@ static int correct(cplx *x, const struct seg *sg, double tau, double *d1)
  * first corrector step d1 is the predictor's local error, O(h^5), so the next
  * step is h (PRED_TOL / d1)^(1/5) (times 0.9 for safety, at most H_GROW h); a
  * rejected step halves h. The velocity at the start of a step is kept when
- * the step is rejected: x and tau have not moved. */
+ * the step is rejected (x and tau have not moved) and comes from the
+ * corrector when it is accepted (correct()). */
 static int track(cplx x[6], const struct seg *sg)
 {
     double tau = 0.0, h = 0.05;
-    int steps, i, have_k1 = 0;
-    cplx k1[6];
+    int steps, i, have_k1 = 0, have_vn = 0;
+    cplx k1[6], vn[6];
     for (steps = 0; steps < MAX_STEPS && tau < 1.0; ++steps) {
         cplx k2[6], k3[6], k4[6], y[6];
         double hh = fmin(h, 1.0 - tau), d1 = 1.0;
@@ -506,12 +532,15 @@ static int track(cplx x[6], const struct seg *sg)
         if (ok) {
             for (i = 0; i < 6; ++i)
                 y[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            ok = correct(y, sg, tau + hh, &d1);
+            ok = correct(y, sg, tau + hh, &d1, vn, &have_vn);
         }
         if (ok) {
             double grow = 0.9 * pow(PRED_TOL / fmax(d1, 1e-300), 0.2);
             memcpy(x, y, sizeof y);
-            have_k1 = 0;
+            have_k1 = have_vn;
+            if (have_k1)
+                for (i = 0; i < 6; ++i)
+                    k1[i] = -vn[i];
             tau = (1.0 - tau <= hh) ? 1.0 : tau + hh;
             h = fmin(hh * fmin(grow, H_GROW), H_MAX);
             if (cnorm6(x) > X_MAX)
@@ -536,7 +565,7 @@ static int polish_real(double x[6], const struct seg *sg1)
         for (i = 0; i < 6; ++i)
             xc[i] = x[i];
         eval_h(xc, sg1, 0.0, Fv, J, NULL);
-        if (!csolve6(J, Fv))
+        if (!csolve6(J, Fv, NULL))
             return 0;
         for (i = 0; i < 6; ++i) {
             x[i] -= creal(Fv[i]);
