@@ -79,7 +79,7 @@
  * (PRED_TOL); it ends when a Newton step is below LAST_TOL. All relative to
  * 1 + |x|. Newton converges quadratically from within FIRST_TOL, so a last
  * step of 1e-5 leaves the point some 1e-10 from its path. PRED_TOL was chosen
- * from 2e-5..1e-3 by the evaluations per path (the fewest at 1e-4..3e-4), at
+ * from 3e-5..1e-3 by the evaluations per path (the fewest at 1e-4..3e-4), at
  * an unchanged count of solutions found. */
 #define FIRST_TOL 1e-3
 #define PRED_TOL 3e-4
