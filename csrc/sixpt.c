@@ -177,9 +177,9 @@ static void seg_put(struct seg *sg, int q, int i, const cplx *v)
     }
 }
 
-/* the moment m = o x d along the segment, o = o0 + tau do, d = d0 + tau dd:
- * its coefficients M0 = o0 x d0, M1 = do x d0 + o0 x dd, M2 = do x dd stored
- * as polynomials q, q + 1, q + 2 of correspondence i */
+/* the moment m = o x d along the segment, o = o0 + tau dlo, d = d0 + tau
+ * dld: its coefficients M0 = o0 x d0, M1 = dlo x d0 + o0 x dld and M2 = dlo x
+ * dld, stored as polynomials q, q + 1, q + 2 of correspondence i */
 static void seg_put_moment(struct seg *sg, int q, int i, const cplx *o0, const cplx *d0,
                            const cplx *dlo, const cplx *dld)
 {
