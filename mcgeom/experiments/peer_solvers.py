@@ -74,14 +74,14 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from mcgeom import _core, metrics, synth
+from mcgeom import _core, synth
 from mcgeom.cv import RIG_LINEAR17_RANSAC, estimate
 from mcgeom.estimators.upright_four_point import upright_rotation
 from mcgeom.rig import Rig
 
 from .common import Progress, add_count_and_seed, fraction, import_peer, no_progress, positive_int
 from .poselib_peer import POSELIB_SETTINGS, poselib_estimate, poselib_setup
-from .robust_vs_poselib import CASES as ROBUST_CASES, car_forward, random_motion
+from .robust_vs_poselib import CASES as ROBUST_CASES, car_forward, random_motion, rot_scale_errors
 
 #: e_z -> e_y: PoseLib's upright solvers rotate about y
 _Z_TO_Y = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
@@ -335,11 +335,6 @@ def with_outliers(cases: dict, fractions: Sequence[float]) -> dict:
     return out
 
 
-def _errors(R, t, Rt, tt) -> tuple[float, float]:
-    return (float(np.degrees(metrics.rotation_error(R, Rt))),
-            abs(np.linalg.norm(t) / np.linalg.norm(tt) - 1.0))
-
-
 def _sampler_label(info: dict) -> str:
     """The sampler column's name of a search: ``info["sampler"]``, and for the
     upright sampler which samples it drew (``upright 3+1`` where a camera has
@@ -413,7 +408,7 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                     t0 = time.perf_counter()
                     try:
                         Re, te, sampler, c_secs, iters = fn()
-                        err = _errors(Re, te, R, t)
+                        err = rot_scale_errors(Re, te, R, t)
                     except (ValueError, ArithmeticError):   # cannot sample / nothing found
                         err, sampler, c_secs, iters = (np.nan, np.nan), "-", np.nan, np.nan
                     secs = time.perf_counter() - t0

@@ -76,10 +76,22 @@ def _mcgeom(rig: Rig, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return m.R, m.t, m.info["t_metric"]
 
 
+def rot_scale_errors(R: np.ndarray, t: np.ndarray, R_true: np.ndarray,
+                     t_true: np.ndarray) -> tuple[float, float]:
+    """Errors of an estimate (R, t) of rig2_from_rig1 against the truth: the
+    rotation error (degrees) and the scale error ``| |t| / |t_true| - 1 |``
+    (relative; the metres of t and t_true cancel). The error pair of the
+    peer comparisons (this module, ``bench robust``, ``peer_solvers``)."""
+    return (float(np.degrees(metrics.rotation_error(R, R_true))),
+            abs(float(np.linalg.norm(t) / np.linalg.norm(t_true)) - 1.0))
+
+
 def _errors(R, t, Rt, tt) -> tuple[float, float, float]:
-    rot = np.degrees(metrics.rotation_error(R, Rt))
+    """:func:`rot_scale_errors` and, between them, the angle (degrees) between
+    t and the true translation."""
+    rot, scale = rot_scale_errors(R, t, Rt, tt)
     cosang = np.clip(t @ tt / (np.linalg.norm(t) * np.linalg.norm(tt) + 1e-300), -1, 1)
-    return rot, float(np.degrees(np.arccos(cosang))), abs(np.linalg.norm(t) / np.linalg.norm(tt) - 1)
+    return rot, float(np.degrees(np.arccos(cosang))), scale
 
 
 def run(trials: int = 50, seed: int = 0, cases=None, progress: Progress = no_progress) -> dict:

@@ -68,7 +68,7 @@ from mcgeom.rig import Rig
 
 from ..common import Progress, no_progress
 from ..poselib_peer import POSELIB_SETTINGS, TUNED_PEER, poselib_estimate, poselib_setup
-from ..robust_vs_poselib import ring4
+from ..robust_vs_poselib import ring4, rot_scale_errors
 
 __all__ = ["SpeedRow", "ScaleRow", "bench_speed", "bench_scaling", "CASES", "WARM_BLOCK",
            "TUNED_PEER"]
@@ -141,11 +141,6 @@ def _ratio_interval(a: np.ndarray, b: np.ndarray, rng: np.random.Generator,
     return float(lo), float(hi)
 
 
-def _errors(R, t, Rt, tt) -> tuple[float, float]:
-    return (float(np.degrees(metrics.rotation_error(R, Rt))),
-            abs(float(np.linalg.norm(t) / np.linalg.norm(tt)) - 1.0))
-
-
 def _run(opt: dict | None, p, rig: Rig, setup, seed: int):
     """One estimate: mcgeom's façade (``opt`` None) or PoseLib with ``opt``;
     returns (R, t, mcgeom's RigMotion or None)."""
@@ -185,7 +180,7 @@ def bench_speed(problems: int = 100, seed: int = 0,
                 Re, te, m = _run(methods[meth], p, rig, setup, seed_k)
                 dt = time.perf_counter() - t0
                 secs[meth].append(dt)
-                err[meth].append(_errors(Re, te, R, t))
+                err[meth].append(rot_scale_errors(Re, te, R, t))
                 if m is not None:
                     outside.append(1.0 - m.info.get("c_seconds", 0.0) / dt)
         for b0 in range(0, len(done), WARM_BLOCK):
