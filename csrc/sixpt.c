@@ -128,35 +128,6 @@ static void ccross(const cplx *a, const cplx *b, cplx *c)
     c[2] = cm(a[0], b[1]) - cm(a[1], b[0]);
 }
 
-/* Rt(s) (S1) and its derivatives dRt/ds_k (row-major 3 x 3 each) */
-static void cayley(const cplx *s, cplx Rt[9], cplx dR[3][9])
-{
-    cplx ss = cm(s[0], s[0]) + cm(s[1], s[1]) + cm(s[2], s[2]);
-    int a, b, k;
-    for (a = 0; a < 3; ++a)
-        for (b = 0; b < 3; ++b)
-            Rt[3 * a + b] = (a == b ? 1.0 - ss : 0.0) + 2.0 * cm(s[a], s[b]);
-    Rt[1] -= 2.0 * s[2];
-    Rt[2] += 2.0 * s[1];
-    Rt[5] -= 2.0 * s[0];
-    Rt[3] += 2.0 * s[2];
-    Rt[6] -= 2.0 * s[1];
-    Rt[7] += 2.0 * s[0];
-    for (k = 0; k < 3; ++k) {
-        for (a = 0; a < 3; ++a)
-            for (b = 0; b < 3; ++b)
-                dR[k][3 * a + b] = (a == b ? -2.0 * s[k] : 0.0) + (a == k ? 2.0 * s[b] : 0.0) +
-                                   (b == k ? 2.0 * s[a] : 0.0);
-    }
-    /* d[s]x/ds_k = [e_k]x */
-    dR[0][5] -= 2.0;
-    dR[0][7] += 2.0;
-    dR[1][2] += 2.0;
-    dR[1][6] -= 2.0;
-    dR[2][1] -= 2.0;
-    dR[2][3] += 2.0;
-}
-
 /* The problem along the segment, per correspondence, as polynomials in tau:
  * d(tau) = D + tau dD, m(tau) = o(tau) x d(tau) = M0 + tau M1 + tau^2 M2.
  * Stored by polynomial, component and part, the LANES = 6 correspondences
@@ -199,7 +170,6 @@ static void seg_put_moment(struct seg *sg, int q, int i, const cplx *o0, const c
 static void seg_init(struct seg *sg, const cplx *p0, const cplx *dp)
 {
     int i;
-    memset(sg, 0, sizeof *sg);
     for (i = 0; i < 6; ++i) {
         const cplx *o1 = p0 + 12 * i, *d1 = o1 + 3, *o2 = o1 + 6, *d2 = o1 + 9;
         const cplx *do1 = dp + 12 * i, *dd1 = do1 + 3, *do2 = do1 + 6, *dd2 = do1 + 9;
@@ -255,6 +225,47 @@ static inline cx cx_dot3(const cx *a, const cx *b)
 {
     return cx_fma(cx_fma(cx_mul(a[0], b[0]), a[1], b[1]), a[2], b[2]);
 }
+/* Rt(s) (S1) and its derivatives dRt/ds_k (row-major 3 x 3 each), in the
+ * two-double form of eval_h */
+static void cayley(const cx *s, cx Rt[9], cx dR[3][9])
+{
+    cx ss = cx_fma(cx_fma(cx_mul(s[0], s[0]), s[1], s[1]), s[2], s[2]);
+    int a, b, k;
+    for (a = 0; a < 3; ++a)
+        for (b = 0; b < 3; ++b) {
+            cx p = cx_mul(s[a], s[b]);
+            Rt[3 * a + b].r = (a == b ? 1.0 - ss.r : 0.0) + 2.0 * p.r;
+            Rt[3 * a + b].i = (a == b ? -ss.i : 0.0) + 2.0 * p.i;
+        }
+    /* + 2 [s]x */
+    for (k = 0; k < 3; ++k) {
+        int a1 = (k + 1) % 3, a2 = (k + 2) % 3;
+        Rt[3 * a2 + a1].r += 2.0 * s[k].r;
+        Rt[3 * a2 + a1].i += 2.0 * s[k].i;
+        Rt[3 * a1 + a2].r -= 2.0 * s[k].r;
+        Rt[3 * a1 + a2].i -= 2.0 * s[k].i;
+    }
+    for (k = 0; k < 3; ++k)
+        for (a = 0; a < 3; ++a)
+            for (b = 0; b < 3; ++b) {
+                cx d = {0.0, 0.0};
+                if (a == b)
+                    d = cx_add(d, (cx){-2.0 * s[k].r, -2.0 * s[k].i});
+                if (a == k)
+                    d = cx_add(d, (cx){2.0 * s[b].r, 2.0 * s[b].i});
+                if (b == k)
+                    d = cx_add(d, (cx){2.0 * s[a].r, 2.0 * s[a].i});
+                dR[k][3 * a + b] = d;
+            }
+    /* d[s]x/ds_k = [e_k]x */
+    dR[0][5].r -= 2.0;
+    dR[0][7].r += 2.0;
+    dR[1][2].r += 2.0;
+    dR[1][6].r -= 2.0;
+    dR[2][1].r -= 2.0;
+    dR[2][3].r += 2.0;
+}
+
 /* component a of polynomial q's coefficient at lane l */
 static inline cx seg_at(const struct seg *sg, int q, int a, int l)
 {
@@ -277,20 +288,16 @@ static inline cx lin(cx c0, cx c1, double tau)
 MCG_AVX2_CLONE static void eval_h(const cplx *x, const struct seg *sg, double tau, cplx Fv[6],
                                   cplx J[36], cplx *Ft)
 {
-    cplx Rtc[9], dRc[3][9];
-    cx Rt[9], dR[3][9], t[3];
+    cx Rt[9], dR[3][9], s[3], t[3];
     double fr[LANES], fi[LANES], jr[6][LANES], ji[6][LANES], ftr[LANES], fti[LANES];
     cx kept[4][3][LANES]; /* u, v, a, d2 of each correspondence, for dH/dtau */
     double t2 = tau * tau;
     int i, k, a, l;
-    cayley(x, Rtc, dRc);
-    for (a = 0; a < 9; ++a) {
-        Rt[a] = cx_of(Rtc[a]);
-        for (k = 0; k < 3; ++k)
-            dR[k][a] = cx_of(dRc[k][a]);
-    }
-    for (a = 0; a < 3; ++a)
+    for (a = 0; a < 3; ++a) {
+        s[a] = cx_of(x[a]);
         t[a] = cx_of(x[3 + a]);
+    }
+    cayley(s, Rt, dR);
     for (l = 0; l < LANES; ++l) {
         cx d1[3], d2[3], m1[3], m2[3], av[3], u[3], v[3], G[9], F, w[3];
         for (a = 0; a < 3; ++a) {
