@@ -72,3 +72,44 @@ def test_with_outliers_renames_and_overrides_the_fraction():
     assert out["ladybug6 300c @50%out"][3:] == cases["ladybug6 300c 30%out"][3:]
     with pytest.raises(ValueError, match="outlier fraction must be in"):
         peer_solvers.with_outliers(cases, [1.0])
+
+
+def _rows(fails: int, secs: float, n: int = 4) -> tuple:
+    e = np.full((n, 2), 0.01)
+    e[:fails] = np.nan
+    return e, np.full(n, secs)
+
+
+def test_equal_success_takes_the_smallest_cap_that_succeeds_as_often():
+    """The façade against the 17-point row with the smallest cap whose
+    failures are at most the façade's; a lower bound when no cap gets there."""
+    fac = "mcgeom façade (auto)"
+    methods = {fac: _rows(0, 1.0), "mcgeom 17-pt": _rows(3, 0.2),
+               "mcgeom 17-pt <=5000": _rows(0, 3.0), "mcgeom 17-pt <=20000": _rows(0, 9.0)}
+    line = peer_solvers.equal_success(methods)
+    assert "failed 0.00, 1000.0 ms" in line
+    assert "mcgeom 17-pt <=5000 failed 0.00 in 3000.0 ms: 3.00x faster" in line
+    methods["mcgeom 17-pt <=5000"] = _rows(1, 3.0)
+    methods["mcgeom 17-pt <=20000"] = _rows(1, 9.0)
+    line = peer_solvers.equal_success(methods)
+    assert "no cap got there" in line and "mcgeom 17-pt <=20000, failed 0.25" in line
+    assert ">= 9.00x faster" in line
+    # a façade failing as often as the default cap compares with that cap
+    methods[fac] = _rows(3, 1.0)
+    assert "mcgeom 17-pt failed 0.75 in 200.0 ms: 0.20x faster" in peer_solvers.equal_success(methods)
+
+
+def test_ransac_rows_per_17_point_cap():
+    """``caps17``: one 17-point row per cap (sorted, the default cap under its
+    usual name), each run with that cap; the table's equal-success line."""
+    pytest.importorskip("poselib")
+    case = {"ring4 4x50 0.5px": peer_solvers.RANSAC_CASES["ring4 4x50 0.5px"]}
+    res = peer_solvers.run_ransac(1, 0, case, caps17=(1000, 2))["ring4 4x50 0.5px"]
+    rows = [m for m in res if "17-pt" in m]
+    assert rows == ["mcgeom 17-pt <=2", "mcgeom 17-pt"]
+    # two samples of 17 pairs: at most 2 drawn, the default cap's search stops on its own
+    assert 1 <= res["mcgeom 17-pt <=2"][4][0] <= 2 or np.isnan(res["mcgeom 17-pt <=2"][4][0])
+    table = peer_solvers.ransac_table({"ring4 4x50 0.5px": res})
+    assert "against 17-point RANSAC at equal success" in table
+    with pytest.raises(ValueError, match="caps17"):
+        peer_solvers.run_ransac(1, 0, case, caps17=())

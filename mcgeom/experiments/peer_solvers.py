@@ -36,7 +36,8 @@ has 5 intra-camera correspondences, else 6-point; the sampler column counts
 its choices), the C search forced to 5+1, to the generic 6-point, and to the
 upright sampler (3+1 where a camera has 3 intra-camera correspondences, else
 4-point) with the vertical known to 0.2 deg (each gravity vector turned by
-0.2 deg about a random axis), 17-point RANSAC (``ransac:linear17``), and PoseLib's
+0.2 deg about a random axis), 17-point RANSAC (``ransac:linear17``, capped at
+the façade's 1000 samples, and at each cap of ``--caps17``), and PoseLib's
 ``estimate_generalized_relative_pose`` (its 5+1 sampler,
 :mod:`.poselib_peer`) with ``min_iterations=100`` and with its defaults; on
 the cases of ``robust_vs_poselib`` (ring4, ladybug6 with 30 % outliers, car8
@@ -54,11 +55,15 @@ instead of its own: the upright sampler's smaller samples (w^3 against
 searches draw a handful of samples and share the same local optimisation
 and final refinement (measured, 40 problems, vertical 0.2 deg off: Ladybug
 head upright vs 5+1 1.25x / 2.49x / 5.47x faster at 30 / 50 / 60 %
-outliers, the car rig turning 1.53x / 2.69x / 4.45x).
+outliers, the car rig turning 1.53x / 2.69x / 4.45x). After each case a line
+compares the façade with 17-point RANSAC at the same success rate
+(:func:`equal_success`): at 40 % outliers a 17-pair sample is all inliers
+once in ~6,000 draws, so 17-point RANSAC at the default cap mostly fails
+and its time is that of a failure.
 
 ``mcgeom experiment peer_solvers [--part minimal|minimal4|minimal6|ransac|all]
 [--configs 10000] [--configs6 N] [--chunk6 500] [--problems 50] [--seed 0]
-[--cases CASE ...] [--outliers F ...]`` (needs poselib). The 6-point table runs the families in
+[--cases CASE ...] [--outliers F ...] [--caps17 N ...]`` (needs poselib). The 6-point table runs the families in
 rounds of ``--chunk6`` configurations each and prints the table so far to
 stderr after every round (10,000 configurations of each of the 7 families
 take mcgeom's homotopy about 20 minutes on a 2-core machine).
@@ -345,7 +350,17 @@ def _sampler_label(info: dict) -> str:
     return name
 
 
-def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: float) -> dict:
+#: the façade's default sample cap (``maxIters`` of :func:`mcgeom.cv.estimate`)
+DEFAULT_CAP17 = 1000
+
+
+def row17(cap: int) -> str:
+    """The row name of 17-point RANSAC capped at ``cap`` samples."""
+    return "mcgeom 17-pt" if cap == DEFAULT_CAP17 else f"mcgeom 17-pt <={cap}"
+
+
+def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: float,
+             caps17: Sequence[int] = (DEFAULT_CAP17,)) -> dict:
     """{row: call returning (R, t, sampler, seconds in C, samples drawn)} of one problem."""
     def facade(**kw):
         m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
@@ -358,14 +373,16 @@ def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: flo
     runs = {"mcgeom façade (auto)": facade,
             "mcgeom 5+1": lambda: facade(method="ransac:five_plus_one"),
             "mcgeom 6-pt": lambda: facade(method="ransac:six_point"),
-            f"mcgeom upright ({deg:g} deg)": lambda: facade(gravity1=g1, gravity2=g2),
-            "mcgeom 17-pt": lambda: facade(method=RIG_LINEAR17_RANSAC)}
+            f"mcgeom upright ({deg:g} deg)": lambda: facade(gravity1=g1, gravity2=g2)}
+    for cap in caps17:
+        runs[row17(cap)] = lambda cap=cap: facade(method=RIG_LINEAR17_RANSAC, maxIters=cap)
     runs.update({name: peer(opt) for name, opt in POSELIB_SETTINGS.items()})
     return runs
 
 
 def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
-               gravity_error_deg: float = 0.2, progress: Progress = no_progress) -> dict:
+               gravity_error_deg: float = 0.2, progress: Progress = no_progress,
+               caps17: Sequence[int] = (DEFAULT_CAP17,)) -> dict:
     """{case: {method: (errors problems x 2, seconds per problem, samplers, seconds
     in C, samples drawn)}}: the rotation (deg) and scale errors, NaN where the
     method cannot sample the data (a ValueError, e.g. 5+1 without a 5-point
@@ -373,7 +390,16 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
     mcgeom's C search (``info["c_seconds"]``: sampling, scoring, LO, final
     refinement; NaN for the Python drivers and PoseLib) and its samples
     (``info["iterations"]``: the adaptive stop's count, NaN for PoseLib). Each gravity vector is turned by
-    ``gravity_error_deg`` about a random axis (the IMU's error)."""
+    ``gravity_error_deg`` about a random axis (the IMU's error). 17-point
+    RANSAC runs once per sample cap of ``caps17`` (rows :func:`row17`): its
+    17-pair samples are all inliers with probability w^17, so where outliers
+    are many it needs caps far above the default to succeed as often as the
+    minimal samplers (see :func:`equal_success`)."""
+    if not caps17 or any(int(c) < 1 for c in caps17):
+        raise ValueError(f"caps17 must be sample caps >= 1, got {list(caps17)!r}")
+    caps17 = sorted({int(c) for c in caps17})
+    # (a warm-up call of a high cap would take seconds: the default cap warms up)
+    slow17 = {row17(c) for c in caps17 if c > DEFAULT_CAP17}
     out = {}
     for name, (make_rig, n, outl, noise, cross, motion) in (cases or RANSAC_CASES).items():
         rng = np.random.default_rng(seed)
@@ -386,10 +412,10 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                                    cross_fraction=cross, require_visible=cross == 0.0)
             g1 = synth.tilted(synth.GRAVITY, gravity_error_deg, rng)
             g2 = synth.tilted(R @ synth.GRAVITY, gravity_error_deg, rng)
-            runs = _methods(rig, setup, p, g1, g2, gravity_error_deg)
+            runs = _methods(rig, setup, p, g1, g2, gravity_error_deg, caps17)
             if k == 0:      # untimed warm-up: first calls load plugins and caches
                 for meth, fn in runs.items():
-                    if meth == "mcgeom 6-pt":
+                    if meth == "mcgeom 6-pt" or meth in slow17:
                         continue
                     try:
                         fn()
@@ -447,7 +473,7 @@ def ransac_table(res: dict) -> str:
     for case, methods in res.items():
         ok5 = np.isfinite(methods["mcgeom 5+1"][0][:, 0])   # (rows not run are absent)
         base5 = np.median(methods["mcgeom 5+1"][1]) if ok5.any() else np.nan
-        base17 = np.median(methods["mcgeom 17-pt"][1])
+        base17 = np.median(methods[_rows17(methods)[0]][1])
         c5 = methods["mcgeom 5+1"][3]
         c5 = np.median(c5[np.isfinite(c5)]) if np.isfinite(c5).any() else np.nan
         for meth, (e, secs, used, c_secs, iters) in methods.items():
@@ -464,7 +490,36 @@ def ransac_table(res: dict) -> str:
                          f"{med[1]:9.4f} {np.mean(~ok):6.2f} {1e3 * ms:8.2f} "
                          f"{base5 / ms:6.2f}x {base17 / ms:7.2f}x {1e3 * cms:8.2f} "
                          f"{c5 / cms:7.2f}x {its:7.1f}")
+        lines.append(equal_success(methods))
     return "\n".join(lines)
+
+
+def _rows17(methods: dict) -> list[str]:
+    """The 17-point RANSAC rows of a case, in the order of their caps."""
+    return [m for m in methods if m.startswith("mcgeom 17-pt")]
+
+
+def equal_success(methods: dict, row: str = "mcgeom façade (auto)") -> str:
+    """One line: how much faster ``row`` is than 17-point RANSAC at the same
+    success. The reference is the 17-point row with the smallest cap that
+    failed at most as often as ``row`` (median times, theirs over ``row``'s);
+    when no cap got there, the largest cap's time gives a lower bound
+    (``>=``: 17-point RANSAC would need more samples still, and succeeds less
+    often even so). A 17-point sample of 17 pairs is all inliers with
+    probability w^17 (1.7e-4 at w = 0.6): at the default cap it fails where
+    a minimal sampler does not, and its time then measures a failure."""
+    e, secs = methods[row][0], methods[row][1]
+    fail = float(np.mean(~np.isfinite(e[:, 0])))
+    ms = 1e3 * float(np.median(secs))
+    head = f"  {row} against 17-point RANSAC at equal success (failed {fail:.2f}, {ms:.1f} ms):"
+    rows = _rows17(methods)
+    for name in rows:
+        f17 = float(np.mean(~np.isfinite(methods[name][0][:, 0])))
+        ms17 = 1e3 * float(np.median(methods[name][1]))
+        if f17 <= fail:
+            return f"{head} {name} failed {f17:.2f} in {ms17:.1f} ms: {ms17 / ms:.2f}x faster"
+    return (f"{head} no cap got there (the largest, {rows[-1]}, failed {f17:.2f} in "
+            f"{ms17:.1f} ms): >= {ms17 / ms:.2f}x faster")
 
 
 # ---------------------------------------------------------------------- CLI
@@ -493,6 +548,13 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                          "instead of its own (e.g. 0.3 0.5 0.6: the regime where the "
                          "upright sampler's smaller samples pay off; default: each "
                          "case's own)")
+    ap.add_argument("--caps17", nargs="+", type=positive_int, default=[DEFAULT_CAP17],
+                    metavar="N",
+                    help="sample caps of 17-point RANSAC, one row each (default: the "
+                         "façade's 1000); each case then says how much faster the façade "
+                         "is than 17-point RANSAC at the same success (e.g. 1000 5000 "
+                         "20000 100000 on the 12-camera case: at 40%% outliers 17-point "
+                         "samples are all inliers once in ~6,000 draws)")
 
 
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
@@ -516,5 +578,6 @@ def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
         cases = {k: RANSAC_CASES[k] for k in args.cases or RANSAC_CASES}
         if args.outliers:
             cases = with_outliers(cases, args.outliers)
-        print(ransac_table(run_ransac(args.problems, args.seed, cases, progress=progress)))
+        print(ransac_table(run_ransac(args.problems, args.seed, cases, progress=progress,
+                                      caps17=args.caps17)))
     return 0
