@@ -63,10 +63,11 @@ and its time is that of a failure.
 
 ``mcgeom experiment peer_solvers [--part minimal|minimal4|minimal6|ransac|all]
 [--configs 10000] [--configs6 N] [--chunk6 500] [--problems 50] [--seed 0]
-[--cases CASE ...] [--outliers F ...] [--caps17 N ...]`` (needs poselib). The 6-point table runs the families in
-rounds of ``--chunk6`` configurations each and prints the table so far to
-stderr after every round (10,000 configurations of each of the 7 families
-take mcgeom's homotopy about 20 minutes on a 2-core machine).
+[--cases CASE ...] [--outliers F ...] [--caps17 N ...]`` (needs poselib).
+The 6-point table runs the families in rounds of ``--chunk6`` configurations
+each and prints the table so far to stderr after every round (10,000
+configurations of each of the 7 families take mcgeom's homotopy about 20
+minutes on a 2-core machine).
 """
 
 from __future__ import annotations
