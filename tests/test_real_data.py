@@ -140,3 +140,27 @@ def test_ground_truth_convention():
     g = ev.gt_check(seq, corr, 30, 31)
     assert g["intra_med"] < 1.0 and g["cross_med"] < 1.0, g
     assert g["cross_med_wrong"] > 3 * g["cross_med"], g
+
+
+def test_kitti_raw_vertical_from_the_ins_and_the_upright_sampler_on_it():
+    """KITTI raw's vertical (OXTS roll and pitch, ``Sequence.vertical``) is the
+    same physical direction at both frames under the ground-truth motion, and
+    the façade given it runs the upright sampler with 5+1's answer: the
+    rotation within 0.05 deg of it, intra-camera only not observable (driving
+    straight), with the stereo pairs metric within 10 % of the truth."""
+    seq = ev.load_sequences(("kitti_raw",), pairs={"kitti_raw": [(2, 3)]})[0]
+    assert seq.vertical is not None and "OXTS" in seq.vertical_name
+    g1, g2 = seq.vertical(2), seq.vertical(3)
+    R_gt, _ = seq.gt_motion(2, 3)
+    np.testing.assert_allclose(np.linalg.norm(g1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(R_gt @ g1, g2, atol=1e-9)
+    corr = ev.correspondences(seq, 2, 3, ev.Features(seq.nfeatures))
+    for mode in ev.MODES:
+        up = ev.evaluate_pair(seq, corr, 2, 3, mode, gravity1=g1, gravity2=g2)
+        ref = ev.evaluate_pair(seq, corr, 2, 3, mode)
+        assert up["ok"] and up["sampler"] == "upright_four_point", _describe(up)
+        assert ref["sampler"] == "five_plus_one"
+        assert abs(up["rot_err"] - ref["rot_err"]) < 0.05, (_describe(up), _describe(ref))
+        assert up["observable"] == (mode == "intra+cross"), _describe(up)
+        if up["observable"]:
+            assert up["scale_err"] < MAX_SCALE_ERR, _describe(up)

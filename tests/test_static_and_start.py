@@ -186,3 +186,35 @@ def test_honesty_is_registered_and_names_a_bad_estimator():
     args = ap.parse_args(["--estimators", "linear17", "nope"])
     with pytest.raises(ValueError, match="--estimators"):
         honesty.run_cli(args)
+
+
+def test_oxts_gravity_follows_roll_and_pitch():
+    """KITTI raw's vertical from an OXTS packet (x forward, y left, z up; roll
+    positive = left side up, pitch positive = front down): level gives
+    (0, 0, -1), front down tips gravity forward, left side up tips it right."""
+    from mcgeom.experiments.real_data import oxts_gravity
+    packet = np.zeros(30)
+    np.testing.assert_allclose(oxts_gravity(packet), [0.0, 0.0, -1.0])
+    packet[4] = 0.1                                   # pitch: front down
+    g = oxts_gravity(packet)
+    assert g[0] > 0 and abs(g[1]) < 1e-15 and np.isclose(np.linalg.norm(g), 1.0)
+    packet[3], packet[4] = 0.1, 0.0                   # roll: left side up
+    g = oxts_gravity(packet)
+    assert g[1] < 0 and abs(g[0]) < 1e-15
+
+
+def test_honesty_gives_the_vertical_to_the_estimator_that_takes_it():
+    """upright_four_point takes the vertical (and is skipped on recordings
+    without one); evaluate passes it on, and the motion comes out right."""
+    assert honesty.needs_vertical("upright_four_point")
+    assert not honesty.needs_vertical("linear17")
+    assert "upright_four_point" in honesty.DEFAULT_ESTIMATORS
+    rng = np.random.default_rng(3)
+    rig = synth.generic_rig(4, rng)
+    R = synth.rotation_about([0, 0, 1], 0.2) @ synth.rotation_about([1, 0, 0], 0.05)
+    t = np.array([0.4, 0.1, 0.02])
+    p = synth.make_problem(rig, R, t, 120, rng, angular_noise=1e-4, require_visible=False)
+    g1 = synth.GRAVITY
+    r = honesty.evaluate(p.rays, "upright_four_point", R, t, vertical=(g1, R @ g1))
+    assert r["ok"] and r["rot_err"] < 0.05, r
+    assert not honesty.evaluate(p.rays, "upright_four_point", R, t)["ok"]   # needs it

@@ -7,7 +7,9 @@ intra-camera correspondences, and among intra- plus cross-camera ones; every
 requested estimator then runs on those inlier rays through
 :func:`mcgeom.estimate` with the rig's calibration error
 (``calibration_std``, the documented default where the file gives none;
-``known_rotation_translation`` is given the ground-truth rotation)::
+``known_rotation_translation`` is given the ground-truth rotation, and
+``upright_four_point`` the recording's own vertical where it has one --
+KITTI raw's OXTS roll and pitch -- and is skipped elsewhere)::
 
     mcgeom experiment honesty
     mcgeom experiment honesty --estimators refine e_socp --sets kitti_raw --max-pairs 3
@@ -27,7 +29,7 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from typing import Any, Sequence as Seq
+from typing import Any, Optional, Sequence as Seq
 
 import numpy as np
 
@@ -37,10 +39,11 @@ from .real_data import (MODES, SET_KEYS, STATIC_T, THRESHOLD_PX, Features, Seque
                         rot_angle_deg)
 
 #: the estimators evaluated by default (every registered one but bnb_lp, ~1 s a
-#: pair: ``--estimators bnb_lp`` adds it, and upright_four_point, which needs the
-#: vertical the recordings' loaders do not give)
+#: pair: ``--estimators bnb_lp`` adds it); upright_four_point runs on the
+#: recordings that give a vertical (:attr:`Sequence.vertical`: KITTI raw's OXTS
+#: roll and pitch) and is skipped, with a row saying so, on the others
 DEFAULT_ESTIMATORS = ("linear17", "refine", "e_socp", "known_rotation_translation",
-                      "five_plus_one", "eigensolver", "six_point")
+                      "five_plus_one", "eigensolver", "six_point", "upright_four_point")
 #: the recordings evaluated by default (keys of real_data.SET_KEYS)
 DEFAULT_SETS = ("kitti_raw", "dgp_scene_01", "dgp_scene_02", "euroc")
 #: relative scale error tolerated beyond 3 rel_std: the ground truth's own
@@ -59,16 +62,27 @@ def inlier_rays(seq: Sequence, corr: Any, mode: str, threshold: float = THRESHOL
     return seq.rig.ray_pairs(inl.p1, inl.p2, inl.c1, inl.c2), m
 
 
+def needs_vertical(name: str) -> bool:
+    """Whether the registered estimator ``name`` takes the vertical
+    (``gravity1``/``gravity2``: upright_four_point)."""
+    from mcgeom import registry
+    return "gravity1" in registry.get(name).options
+
+
 def evaluate(rays: Any, name: str, R_gt: np.ndarray, t_gt: np.ndarray,
-             calibration_std: Any = None) -> dict:
+             calibration_std: Any = None,
+             vertical: Optional[tuple[np.ndarray, np.ndarray]] = None) -> dict:
     """Run estimator ``name`` on ``rays`` and compare with the ground truth
     ``(R_gt, t_gt)`` (rig2_from_rig1, metres). ``calibration_std``: the rig's
     extrinsic calibration error (:attr:`mcgeom.rig.Rig.extrinsic_std`, what a
     user with the rig file passes to :func:`mcgeom.estimate`; None: noise
-    only). A failure is reported in the row (``ok`` False, ``error``), not
-    raised."""
+    only). ``vertical``: (gravity1, gravity2) in the rig frames at the two
+    times, for an estimator that takes them. A failure is reported in the row
+    (``ok`` False, ``error``), not raised."""
     import mcgeom
-    opts = {"rotation": R_gt} if name == "known_rotation_translation" else {}
+    opts: dict = {"rotation": R_gt} if name == "known_rotation_translation" else {}
+    if vertical is not None:
+        opts.update(gravity1=vertical[0], gravity2=vertical[1])
     t0 = time.perf_counter()
     try:
         m = mcgeom.estimate(rays, name, calibration_std=calibration_std, **opts)
@@ -136,7 +150,14 @@ def run(seqs: Seq[Sequence], estimators: Seq[str] = DEFAULT_ESTIMATORS,
                         f"{type(exc).__name__}: {exc}")
                     continue
                 for name in estimators:
-                    r = evaluate(rays, name, R_gt, t_gt, seq.rig.extrinsic_std)
+                    vertical = None
+                    if needs_vertical(name):
+                        if seq.vertical is None:
+                            out(f"{seq.key:13s} {'%d-%d' % (k1, k2):5s} {mode:11s} "
+                                f"{name:26s} skipped: the recording gives no vertical")
+                            continue
+                        vertical = (seq.vertical(k1), seq.vertical(k2))
+                    r = evaluate(rays, name, R_gt, t_gt, seq.rig.extrinsic_std, vertical)
                     r.update(set=seq.key, pair=(k1, k2), mode=mode, estimator=name,
                              n=len(rays))
                     rows.append(r)

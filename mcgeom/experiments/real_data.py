@@ -227,6 +227,10 @@ class Sequence:
     note: str = ""
     alt_gt: Optional[Callable] = None   # (i, j) -> 4x4 second GT (relative_pose convention)
     alt_gt_name: str = ""
+    #: k -> the vertical (gravity, pointing down) in the rig frame of frame k,
+    #: from the recording's own inertial sensor; None: the recording gives none
+    vertical: Optional[Callable[[int], np.ndarray]] = None
+    vertical_name: str = ""
 
     def gt_motion(self, i: int, j: int, alt: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Ground truth rig2_from_rig1 (R, t): inv(relative_pose(d, i, j))."""
@@ -265,6 +269,18 @@ def load_sequences(keys=SET_KEYS, root: Optional[Path] = None, max_pairs: Option
     return seqs
 
 
+def oxts_gravity(oxts: np.ndarray) -> np.ndarray:
+    """Gravity (unit, pointing down) in the OXTS frame (x forward, y left, z
+    up: KITTI raw's rig frame) from an OXTS packet's roll and pitch (fields 3
+    and 4, radians; the devkit's world_from_imu = Rz(yaw) Ry(pitch) Rx(roll),
+    world z up): Rx(roll)^T Ry(pitch)^T (0, 0, -1), the yaw drops out. What
+    an inertial unit gives a car; the vertical prior of the upright sampler."""
+    roll, pitch = float(oxts[3]), float(oxts[4])
+    cr, sr, cp, sp = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch)
+    # Ry(pitch)^T (0, 0, -1) = (sp, 0, -cp); then Rx(roll)^T
+    return np.array([sp, -sr * cp, -cr * cp])
+
+
 def _consecutive(frames: list) -> list[tuple[int, int]]:
     have = [k for k, f in enumerate(frames) if f.get("T_world_rig") is not None]
     return [(a, b) for a, b in zip(have, have[1:]) if b == a + 1]
@@ -286,6 +302,8 @@ def _load_one(key: str, root: Path) -> Sequence:
                      nfeatures=3000)
         s.alt_gt = lambda i, j, m=mod, dd=d: m.relative_pose_ins(dd, i, j)
         s.alt_gt_name = "OXTS velocity integral"
+        s.vertical = lambda k, dd=d: oxts_gravity(dd["frames"][k]["oxts_raw"])
+        s.vertical_name = "OXTS roll and pitch"
         s.note = ("GT = OXTS poses, ~5 cm per-step position jitter (~5 % of |t|); the scale "
                   "error against the integrated INS velocity is given too")
     elif key == "euroc":
@@ -517,7 +535,7 @@ def evaluate_pair(seq: Sequence, corr: Corr, k1: int, k2: int, mode: str,
         rel_std=float(m.scale.rel_std),
         rel_std_calibration=float(m.info.get("scale_rel_std_calibration", float("nan"))),
         crit=float(np.degrees(m.scale.critical_angle)),
-        gt_rot=rot_angle_deg(R_gt),
+        gt_rot=rot_angle_deg(R_gt), sampler=str(m.info.get("sampler", "-")),
     )
     if seq.alt_gt is not None:
         _, t_alt = seq.gt_motion(k1, k2, alt=True)
@@ -538,9 +556,11 @@ def evaluate_pair(seq: Sequence, corr: Corr, k1: int, k2: int, mode: str,
     return res
 
 
-HEADER = ("%-6s %-11s %6s %6s %6s %6s %8s %8s %8s %7s %7s %5s %-5s %8s %7s  %s" % (
+HEADER = ("%-6s %-11s %6s %6s %6s %6s %8s %8s %8s %7s %7s %5s %-5s %8s %7s %-7s  %s" % (
     "pair", "mode", "#intra", "#cross", "#inl", "#inlX", "rot(deg)", "tdir(deg)", "scale_err",
-    "|t_gt|", "|t_est|", "front", "verd", "crit(deg)", "time(s)", "reason"))
+    "|t_gt|", "|t_est|", "front", "verd", "crit(deg)", "time(s)", "sampler", "reason"))
+#: the sampler column's short names (info["sampler"] of the C search)
+SAMPLER_SHORT = {"five_plus_one": "5+1", "six_point": "6-pt", "upright_four_point": "upright"}
 
 
 def format_row(r: dict) -> str:
@@ -556,10 +576,11 @@ def format_row(r: dict) -> str:
     else:
         scale = "%8s" % "n/a*"
     front = "%4.0f%%" % (100 * r["front"]) if np.isfinite(r["front"]) else "%5s" % "n/a"
-    return "%-6s %-11s %6d %6d %6d %6d %8.3f %8s %8s %7.4f %7.4f %5s %-5s %8.3f %7.2f  %s" % (
+    return "%-6s %-11s %6d %6d %6d %6d %8.3f %8s %8s %7.4f %7.4f %5s %-5s %8.3f %7.2f %-7s  %s" % (
         pair, r["mode"], r["n_intra"], r["n_cross"], r["inliers"], r["inliers_cross"],
         r["rot_err"], tdir, scale, r["t_gt"], r["t_est"], front,
-        "OBS" if r["observable"] else "unobs", r["crit"], r["time"], r["reason"]) + (
+        "OBS" if r["observable"] else "unobs", r["crit"], r["time"],
+        SAMPLER_SHORT.get(r.get("sampler", "-"), r.get("sampler", "-")), r["reason"]) + (
         "  [info['t_metric'] points opposite to t]" if r["info_t_opposite"] else "")
 
 
@@ -620,9 +641,13 @@ def summarize(seq: Sequence, results: list, out=print) -> list[dict]:
 
 def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
         detector: str = "auto", nfeatures: Optional[int] = None,
-        progress: Progress = no_progress, **options: Any) -> dict:
+        progress: Progress = no_progress, vertical: bool = False, **options: Any) -> dict:
     """Evaluate every pair of every sequence in both modes; print rows and summaries
-    with ``out``; ``progress`` wraps the loop over the pairs of each sequence."""
+    with ``out``; ``progress`` wraps the loop over the pairs of each sequence.
+    ``vertical``: give the façade the recording's vertical (``gravity1``,
+    ``gravity2`` from :attr:`Sequence.vertical`) where it has one, so that it
+    runs the upright sampler; the others run as without it (said in their
+    header)."""
     all_results: dict = {}
     summary = []
     for seq in seqs:
@@ -634,6 +659,9 @@ def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
         cams = ", ".join("%d=%s" % (i, n) for i, n in enumerate(seq.rig.names))
         out("%s  [%s]  cameras: %s" % (seq.name, seq.key, cams))
         out("  %s" % seq.note)
+        if vertical:
+            out("  vertical: " + (f"{seq.vertical_name} (upright sampler)" if seq.vertical
+                                  else "none recorded: the default sampler"))
         if seq.cross_pairs:
             out("  cross-camera pairs (overlap from calibration): " + ", ".join(
                 "%s-%s %.0f%%" % (seq.rig.names[i], seq.rig.names[j], 100 * f)
@@ -654,8 +682,11 @@ def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
             out("%-6s GT |t| %.3f m, rot %.3f deg; GT check: %s" % (
                 "%d-%d" % (k1, k2), np.linalg.norm(t_gt), rot_angle_deg(R_gt),
                 format_gt_check(g, seq.static)))
+            pair_opts = dict(options)
+            if vertical and seq.vertical is not None:
+                pair_opts.update(gravity1=seq.vertical(k1), gravity2=seq.vertical(k2))
             for mode in MODES:
-                r = evaluate_pair(seq, corr, k1, k2, mode, threshold, **options)
+                r = evaluate_pair(seq, corr, k1, k2, mode, threshold, **pair_opts)
                 r["gt_check"] = g
                 results.append(r)
                 out(format_row(r))
@@ -708,6 +739,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="feature detector (auto: SIFT if OpenCV has it, else ORB)")
     ap.add_argument("--nfeatures", type=positive_int, default=None,
                     help="features per image (default: per data set, 2000-4000)")
+    ap.add_argument("--vertical", action="store_true",
+                    help="give the façade each recording's own vertical where it has one "
+                         "(KITTI raw: the OXTS roll and pitch): the upright sampler "
+                         "(default: off, the 5+1 / 6-point choice)")
     add_data_argument(ap)
 
 
@@ -726,7 +761,7 @@ def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     t0 = time.perf_counter()
     seqs = load_sequences(args.sets, root, args.max_pairs)
     res = run(seqs, args.threshold, out=out, detector=args.detector,
-              nfeatures=args.nfeatures, progress=progress)
+              nfeatures=args.nfeatures, progress=progress, vertical=args.vertical)
     print_summary_table(res["_summary"], out)
     out("total %.1f s" % (time.perf_counter() - t0))
     return 0
