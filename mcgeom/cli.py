@@ -39,7 +39,7 @@ BENCHES = {
 BENCH_SIZES = {"linear17": (17, 100, 1000, 10000), "cone": (3, 6, 20, 100, 1000),
                "robust": (1000, 10000, 100000, 1000000)}
 #: the default ``--problems`` per benchmark
-BENCH_PROBLEMS = {"bnb": 10, "robust": 100, "essential5": 10000}
+BENCH_PROBLEMS = {"bnb": 10, "robust": 300, "essential5": 10000}
 
 
 #: the samplers the façade chooses from (``mcgeom methods``), in its order of preference
@@ -567,7 +567,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="benchmark: " + ", ".join(BENCHES))
     b.add_argument("--problems", type=positive_int, default=None,
                    help="problems per row (bnb: default 10; essential5: default 10000; "
-                        "robust: per case, default 100)")
+                        "robust: per case, default 300)")
     b.add_argument("--sizes", type=positive_int_list, default=None,
                    help="comma-separated N (linear17, cone, robust; default: linear17 "
                         "17,100,1000,10000, cone 3,6,20,100,1000, robust "

@@ -24,10 +24,13 @@ per problem, how often mcgeom's rotation and scale errors are below each
 PoseLib setting's. Below the table, per case, the 95 % bootstrap intervals of
 mcgeom's median over PoseLib's (``min_iterations=100``): cold time, rotation
 and scale error (:func:`_ratio_interval`): a median over 100 problems moves by
-several % with the problems drawn, as much as the targets' margins. The
-machine's state moves the time ratio between runs by more than that interval
-(four runs in a row, session 15: ring4 0.23 / 0.27 / 0.25 / 0.29, each
-interval about +-0.01).
+several % with the problems drawn, as much as the targets' margins (ring4's
+scale error ratio at 100 problems, session 16: 1.06 [0.87, 1.40]; at 300,
+session 17: 0.80 [0.72, 0.96]), hence 300 problems per case by default
+(~40 s with the scaling part). The machine's state moves the time ratio
+between runs by more than that interval (four runs in a row at 100
+problems, session 15: ring4 0.23 / 0.27 / 0.25 / 0.29, each interval about
++-0.01).
 
 Two timings per method. *Cold*: the methods alternate on every problem (the
 errors come from this pass), so each call starts after the other library's:
@@ -151,7 +154,7 @@ def _run(opt: dict | None, p, rig: Rig, setup, seed: int):
     return Re, te, None
 
 
-def bench_speed(problems: int = 100, seed: int = 0,
+def bench_speed(problems: int = 300, seed: int = 0,
                 progress: Progress = no_progress) -> list[SpeedRow]:
     """Median errors and times (cold and warm, see the module docstring) of
     mcgeom's façade and PoseLib (two settings) per case."""
