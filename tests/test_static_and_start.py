@@ -218,3 +218,21 @@ def test_honesty_gives_the_vertical_to_the_estimator_that_takes_it():
     r = honesty.evaluate(p.rays, "upright_four_point", R, t, vertical=(g1, R @ g1))
     assert r["ok"] and r["rot_err"] < 0.05, r
     assert not honesty.evaluate(p.rays, "upright_four_point", R, t)["ok"]   # needs it
+
+
+def test_metric_t_of_a_static_answer_is_zero():
+    """real_data.metric_t: the returned t when observable, zero for "no
+    translation detected" (not the free refinement's slide), else the
+    metric guess t_metric."""
+    from types import SimpleNamespace
+    from mcgeom.experiments.real_data import metric_t
+    slid = np.array([300.0, 1.0, 0.0])
+    static = SimpleNamespace(scale=SimpleNamespace(observable=False), t=np.zeros(3),
+                             info={"translation_detected": False, "t_metric": slid})
+    np.testing.assert_array_equal(metric_t(static), np.zeros(3))
+    unobs = SimpleNamespace(scale=SimpleNamespace(observable=False), t=np.array([1.0, 0, 0]),
+                            info={"translation_detected": True, "t_metric": slid})
+    np.testing.assert_array_equal(metric_t(unobs), slid)
+    obs = SimpleNamespace(scale=SimpleNamespace(observable=True), t=np.array([0.9, 0, 0]),
+                          info={"t_metric": slid})
+    np.testing.assert_array_equal(metric_t(obs), [0.9, 0, 0])

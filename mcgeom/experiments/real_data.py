@@ -501,8 +501,13 @@ MODES = ("intra", "intra+cross")
 
 
 def metric_t(m) -> np.ndarray:
-    """The metric translation of an estimate, whatever the verdict."""
-    if m.scale.observable:
+    """The metric translation of an estimate, whatever the verdict: ``t`` when
+    the scale is observable, zero when no translation was detected (the
+    answer is the static rig: the free refinement's ``t_metric`` there is a
+    slide along a flat cost, printed as hundreds of metres for the parked DDAD
+    scene), else ``info["t_metric"]``, what |t| the data gave (the scale error
+    of an unobservable answer)."""
+    if m.scale.observable or m.info.get("translation_detected") is False:
         return np.asarray(m.t, float).ravel()
     return np.asarray(m.info.get("t_free", m.info.get("t_metric", m.t)), float).ravel()
 
@@ -700,8 +705,8 @@ def run(seqs: list[Sequence], threshold: float = THRESHOLD_PX, out=print,
     out("(*) n/a: the GT motion is ~0 (static rig), so the translation direction and the "
         "relative scale error are meaningless; judge the verdict and |t_est| instead.")
     out("scale_err = | |t_est| / |t_gt| - 1 |, with t_est the metric estimate (info['t_free'] / "
-        "info['t_metric'] when the verdict is unobservable); in brackets for KITTI raw: against "
-        "the OXTS velocity integral.")
+        "info['t_metric'] when the verdict is unobservable, 0 when no translation was "
+        "detected); in brackets for KITTI raw: against the OXTS velocity integral.")
     all_results["_summary"] = summary
     return all_results
 
