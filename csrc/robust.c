@@ -434,7 +434,8 @@ typedef struct {
     int nsub;
     double best_sub;
     /* the upright sampler's challenges (RIVAL_SUB): the subset's pairs and
-     * the best's count within RIVAL_WIDE thresholds on it (nrival 0: off) */
+     * the best's count within RIVAL_WIDE thresholds on it (nrival 0: off;
+     * rival_best -1: not counted since the best changed, see rival) */
     int rival_idx[RIVAL_SUB], nrival, rival_best;
     /* the refinements also stop once their cost is at most this (-inf: no) */
     double refine_target;
@@ -442,7 +443,6 @@ typedef struct {
 } ctx;
 
 static double msac_sub(ctx *c, const double R[9], const double t[3], double bound);
-static int rival_count(const ctx *c, const double R[9], const double t[3]);
 
 /* ------------------------------------------------------------ scoring */
 
@@ -531,8 +531,7 @@ static void take_best(ctx *c, const double R[9], const double t[3], double score
     c->rcur = tmp;
     if (c->nsub > 0) /* (rcur is scratch now) */
         c->best_sub = msac_sub(c, R, t, INFINITY);
-    if (c->nrival > 0)
-        c->rival_best = rival_count(c, R, t);
+    c->rival_best = -1;
     if (c->records)
         records_of_best(c);
 }
@@ -968,6 +967,10 @@ static int rival(ctx *c, const double R[9], const double t0[3], const double u[3
         return 0;
     for (i = 0; i < 3; i++)
         t[i] = u ? t0[i] + lam * u[i] : t0[i];
+    /* (the best's count on demand: most new bests, LO's rounds among
+     * them, are never challenged) */
+    if (c->rival_best < 0)
+        c->rival_best = rival_count(c, c->R, c->t);
     if (!(rival_count(c, R, t) > c->rival_best))
         return 0;
     memcpy(Rb, c->R, sizeof Rb);

@@ -513,13 +513,13 @@ def equal_success(methods: dict, row: str = "mcgeom façade (auto)") -> str:
     fail = float(np.mean(~np.isfinite(e[:, 0])))
     ms = 1e3 * float(np.median(secs))
     head = f"  {row} against 17-point RANSAC at equal success (failed {fail:.2f}, {ms:.1f} ms):"
-    rows = _rows17(methods)
-    for name in rows:
-        f17 = float(np.mean(~np.isfinite(methods[name][0][:, 0])))
-        ms17 = 1e3 * float(np.median(methods[name][1]))
+    runs = [(name, float(np.mean(~np.isfinite(methods[name][0][:, 0]))),
+             1e3 * float(np.median(methods[name][1]))) for name in _rows17(methods)]
+    for name, f17, ms17 in runs:
         if f17 <= fail:
             return f"{head} {name} failed {f17:.2f} in {ms17:.1f} ms: {ms17 / ms:.2f}x faster"
-    return (f"{head} no cap got there (the largest, {rows[-1]}, failed {f17:.2f} in "
+    name, f17, ms17 = runs[-1]
+    return (f"{head} no cap got there (the largest, {name}, failed {f17:.2f} in "
             f"{ms17:.1f} ms): >= {ms17 / ms:.2f}x faster")
 
 

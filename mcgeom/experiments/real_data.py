@@ -581,11 +581,12 @@ def format_row(r: dict) -> str:
     else:
         scale = "%8s" % "n/a*"
     front = "%4.0f%%" % (100 * r["front"]) if np.isfinite(r["front"]) else "%5s" % "n/a"
+    sampler = r.get("sampler", "-")
     return "%-6s %-11s %6d %6d %6d %6d %8.3f %8s %8s %7.4f %7.4f %5s %-5s %8.3f %7.2f %-7s  %s" % (
         pair, r["mode"], r["n_intra"], r["n_cross"], r["inliers"], r["inliers_cross"],
         r["rot_err"], tdir, scale, r["t_gt"], r["t_est"], front,
         "OBS" if r["observable"] else "unobs", r["crit"], r["time"],
-        SAMPLER_SHORT.get(r.get("sampler", "-"), r.get("sampler", "-")), r["reason"]) + (
+        SAMPLER_SHORT.get(sampler, sampler), r["reason"]) + (
         "  [info['t_metric'] points opposite to t]" if r["info_t_opposite"] else "")
 
 
