@@ -10,6 +10,7 @@ sees a pointer.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import math
 import os
@@ -1279,6 +1280,61 @@ ROBUST_STOP_NAMES = {
 }
 
 
+_ROBUST_OPTIONS_SIZE = ffi.sizeof("mcg_robust_options")
+
+
+@functools.lru_cache(maxsize=64, typed=True)
+def _robust_options(threshold: Any, prob: Any, min_iterations: Any, max_iterations: Any,
+                    max_seconds: Any, lo_rounds: Any, refine: bool, loss: Any,
+                    max_scale_rel_std: Any, sampler: Any, verdict_still_factor: Any) -> bytes:
+    """The checked ``mcg_robust_options`` of :func:`robust_rig_motion`'s
+    arguments but the seed and the vertical, as bytes; made once per distinct
+    set (typed: ``True`` is no ``1``; an estimator in a loop passes the same
+    ones every time, and their checks cost ~35 us of a call that follows
+    other work: issue 19). Raises ValueError naming a bad argument."""
+    if not isinstance(loss, str) or loss not in LOSS_NAMES:
+        raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
+    opt = ffi.new("mcg_robust_options *")
+    lib.mcg_robust_default_options(opt)
+    if not (isinstance(verdict_still_factor, (int, float)) and
+            0.0 <= verdict_still_factor <= 1e6):
+        raise ValueError(f"verdict_still_factor must be a number in [0, 1e6], got "
+                         f"{verdict_still_factor!r}")
+    opt.verdict_still_factor = verdict_still_factor
+    try:
+        opt.threshold = float(threshold)
+        opt.prob = float(prob)
+        opt.max_seconds = float(max_seconds)
+        opt.max_scale_rel_std = float(max_scale_rel_std)
+    except (TypeError, ValueError):
+        raise ValueError(f"threshold, prob and max_seconds must be numbers, got {threshold!r}, "
+                         f"{prob!r}, {max_seconds!r}") from None
+    for name, v, lo, hi in (("min_iterations", min_iterations, 0, 10 ** 7),
+                            ("max_iterations", max_iterations, 1, 10 ** 7),
+                            ("lo_rounds", lo_rounds, 0, 100)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi:
+            raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
+        setattr(opt, name, int(v))
+    if not (math.isfinite(opt.threshold) and opt.threshold > 0):
+        raise ValueError(f"threshold must be a finite number > 0, got {threshold!r}")
+    if not 0.0 < opt.prob < 1.0:
+        raise ValueError(f"prob must be in (0, 1), got {prob!r}")
+    if not (math.isfinite(opt.max_seconds) and 0.0 <= opt.max_seconds <= 1e9):
+        raise ValueError(f"max_seconds must be in [0, 1e9] (0: no limit), got {max_seconds!r}")
+    if not (math.isfinite(opt.max_scale_rel_std) and 0.0 <= opt.max_scale_rel_std <= 10.0):
+        raise ValueError(f"max_scale_rel_std must be in [0, 10], got {max_scale_rel_std!r}")
+    if opt.min_iterations > opt.max_iterations:
+        raise ValueError(f"min_iterations {min_iterations} exceeds max_iterations "
+                         f"{max_iterations}")
+    opt.refine = 1 if refine else 0
+    opt.loss = LOSS_NAMES[loss]
+    if not isinstance(sampler, str) or (sampler not in SAMPLER_NAMES and sampler != "auto"):
+        raise ValueError(f"sampler must be 'auto' or one of {sorted(SAMPLER_NAMES)}, got "
+                         f"{sampler!r}")
+    opt.sampler = lib.MCG_SAMPLER_AUTO if sampler == "auto" else SAMPLER_NAMES[sampler]
+    return bytes(ffi.buffer(opt))
+
+
 def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: Any,
                       cam2: Any, n_cameras: int, *, focal: Any = None, cam_axes: Any = None,
                       cam_focal: Any = None, threshold: float = 1e-3, prob: float = 0.999,
@@ -1371,48 +1427,18 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
             (_f64("cam_axes", cam_axes, (int(n_cameras), 3)),
              _f64("cam_focal", cam_focal, (int(n_cameras),)))
         ax_ptr, cf_ptr = _p(ax), _p(cf)
-    if not isinstance(loss, str) or loss not in LOSS_NAMES:
-        raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
     opt = ffi.new("mcg_robust_options *")
-    lib.mcg_robust_default_options(opt)
-    if not (isinstance(verdict_still_factor, (int, float)) and
-            0.0 <= verdict_still_factor <= 1e6):
-        raise ValueError(f"verdict_still_factor must be a number in [0, 1e6], got "
-                         f"{verdict_still_factor!r}")
-    opt.verdict_still_factor = verdict_still_factor
     try:
-        opt.threshold = float(threshold)
-        opt.prob = float(prob)
-        opt.max_seconds = float(max_seconds)
-        opt.max_scale_rel_std = float(max_scale_rel_std)
-    except (TypeError, ValueError):
-        raise ValueError(f"threshold, prob and max_seconds must be numbers, got {threshold!r}, "
-                         f"{prob!r}, {max_seconds!r}") from None
-    for name, v, lo, hi in (("min_iterations", min_iterations, 0, 10 ** 7),
-                            ("max_iterations", max_iterations, 1, 10 ** 7),
-                            ("lo_rounds", lo_rounds, 0, 100)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi:
-            raise ValueError(f"{name} must be an integer in {lo}..{hi}, got {v!r}")
-        setattr(opt, name, int(v))
-    if not (math.isfinite(opt.threshold) and opt.threshold > 0):
-        raise ValueError(f"threshold must be a finite number > 0, got {threshold!r}")
-    if not 0.0 < opt.prob < 1.0:
-        raise ValueError(f"prob must be in (0, 1), got {prob!r}")
-    if not (math.isfinite(opt.max_seconds) and 0.0 <= opt.max_seconds <= 1e9):
-        raise ValueError(f"max_seconds must be in [0, 1e9] (0: no limit), got {max_seconds!r}")
-    if not (math.isfinite(opt.max_scale_rel_std) and 0.0 <= opt.max_scale_rel_std <= 10.0):
-        raise ValueError(f"max_scale_rel_std must be in [0, 10], got {max_scale_rel_std!r}")
-    if opt.min_iterations > opt.max_iterations:
-        raise ValueError(f"min_iterations {min_iterations} exceeds max_iterations "
-                         f"{max_iterations}")
+        ffi.memmove(opt, _robust_options(threshold, prob, min_iterations, max_iterations,
+                                         max_seconds, lo_rounds, bool(refine), loss,
+                                         max_scale_rel_std, sampler, verdict_still_factor),
+                    _ROBUST_OPTIONS_SIZE)
+    except TypeError:   # an unhashable argument: checked (and named) afresh
+        ffi.memmove(opt, _robust_options.__wrapped__(
+            threshold, prob, min_iterations, max_iterations, max_seconds, lo_rounds,
+            bool(refine), loss, max_scale_rel_std, sampler, verdict_still_factor),
+            _ROBUST_OPTIONS_SIZE)
     opt.seed = int(seed) % (1 << 64) if seed is not None else 0
-    opt.lo_rounds = int(lo_rounds)
-    opt.refine = 1 if refine else 0
-    opt.loss = LOSS_NAMES[loss]
-    if not isinstance(sampler, str) or (sampler not in SAMPLER_NAMES and sampler != "auto"):
-        raise ValueError(f"sampler must be 'auto' or one of {sorted(SAMPLER_NAMES)}, got "
-                         f"{sampler!r}")
-    opt.sampler = lib.MCG_SAMPLER_AUTO if sampler == "auto" else SAMPLER_NAMES[sampler]
     if sampler == "upright_four_point":
         for name, g, field in (("gravity1", gravity1, opt.g1), ("gravity2", gravity2, opt.g2)):
             if g is None:
@@ -1448,23 +1474,54 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
             if cf is not None and not (np.isfinite(cf).all() and (cf > 0).all()):
                 raise ValueError("cam_focal must be finite and > 0 (pixels)")
         _ray_error(st, "robust_rig_motion", rays)
-    # R[9], t[3], t_hypothesis[3] lead the struct: one copy, three views
-    rt = np.frombuffer(ffi.buffer(res, 15 * 8), dtype=np.float64).copy()
-    R, t = rt[:9].reshape(3, 3), rt[9:12]
+    return _robust_result(res, mask, weights)
+
+
+#: float64 offsets of the arrays of an mcg_robust_result (one copy of the
+#: struct gives them all as views)
+_RES_SIZE = ffi.sizeof("mcg_robust_result")
+_RES_AT = {k: ffi.offsetof("mcg_robust_result", *f) // 8 for k, f in (
+    ("covariance", ("covariance",)), ("information", ("refinement", "info")),
+    ("R_fit", ("verdict", "R_fit")), ("t_direction", ("verdict", "t_direction")))}
+
+
+def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
+    """The dict of :func:`robust_rig_motion` from its ``mcg_robust_result``:
+    its arrays are views of one copy of the struct (issue 19: on a 2 GHz
+    core each numpy call costs 1-2.5 us, a cffi field read 0.1 us; a copy
+    per array cost ~15 us of every estimate)."""
+    f = np.frombuffer(ffi.buffer(res, _RES_SIZE), dtype=np.float64).copy()
+    R, t = f[:9].reshape(3, 3), f[9:12]
+    refinement = verdict = None
+    if res.refined:
+        rr = res.refinement
+        i = _RES_AT["information"]
+        refinement = {
+            "R": R, "t": t, "initial_cost": rr.initial_cost, "final_cost": rr.final_cost,
+            "rms": rr.rms, "iterations": rr.iterations, "converged": bool(rr.converged),
+            "reason": REFINE_STOP_NAMES.get(rr.reason, "unknown"), "n_used": rr.n_used,
+            "information": f[i:i + 36].reshape(6, 6), "sigma2": rr.sigma2,
+            "scale_rel_std": rr.scale_rel_std, "info_cond": rr.info_cond}
+    if res.have_verdict:
+        v = res.verdict
+        i, j = _RES_AT["R_fit"], _RES_AT["t_direction"]
+        verdict = {
+            "n_inliers": v.n_inliers, "n_intra": v.n_intra, "n_cross": v.n_cross,
+            "n_cameras_intra": v.n_cameras_intra, "fit_ok": bool(v.fit_ok),
+            "R_fit": f[i:i + 9].reshape(3, 3), "n_still": v.n_still,
+            "critical_angle": v.critical_angle, "n_in_front": v.n_in_front,
+            "t_direction": f[j:j + 3]}
+    i = _RES_AT["covariance"]
     return {
-        "R": R, "t": t,
-        "t_hypothesis": rt[12:],
+        "R": R, "t": t, "t_hypothesis": f[12:15],
         "inliers": (mask & 1).view(bool), "used": (mask >> 1).view(bool), "mask": mask,
         "weights": weights, "loss_scale": res.loss_scale, "score": res.score,
         "n_inliers": res.n_inliers, "iterations": res.iterations,
         "hypotheses": res.hypotheses, "local_optimizations": res.local_optimizations,
         "stop": ROBUST_STOP_NAMES.get(res.stop, "unknown"), "seconds": res.seconds,
         "scale_profile": res.scale_profile, "zero_profile": res.zero_profile,
-        "inlier_rms": res.inlier_rms,
-        "refinement": _refine_dict(res.refinement, R, t) if res.refined else None,
-        "covariance": np.frombuffer(ffi.buffer(res.covariance),
-                                    dtype=np.float64).reshape(6, 6).copy(),
-        "verdict": _verdict_dict(res.verdict) if res.have_verdict else None,
+        "inlier_rms": res.inlier_rms, "refinement": refinement,
+        "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
         "sampler": _SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
     }
 
