@@ -28,6 +28,7 @@ from .. import _core
 from ..observability import critical_angle
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
+from ._common import travel_direction
 from ._start import best_start, metric_translation
 from ._static import check_static
 
@@ -199,10 +200,14 @@ def refine(rays: RayPairs, *, initial: InitialLike = None, loss: str = "cauchy",
                       critical_angle=critical_angle(rays, r["R"], r["t"]))
     t_metric = r["t"].copy()
     t = r["t"]
-    if not verdict.observable:
-        nt = np.linalg.norm(t)
-        if nt > 0:
-            t = t / nt
+    if not verdict.observable and np.linalg.norm(t) > 0:
+        # a unit direction whose sign cheirality picks (travel_direction, as
+        # _finish's): where |t| is unobservable the epipolar constraint may
+        # not tell t from -t (no rotation, intra-camera rays: F = [t]x), and
+        # the start's metric t can lie in the mirrored minimum (5+1's
+        # t_metric on a critical motion of tests/test_refine.py: 1.7 cm
+        # backwards, refined there with |t| held: the unit t pointed back)
+        t = travel_direction(rays, np.ones(n, bool), r["R"], t)
     info = {
         "iterations": r["iterations"] + (first["iterations"] if first is not r else 0),
         "converged": r["converged"],
