@@ -1473,6 +1473,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                 raise ValueError("cam_axes contains NaN or inf")
             if cf is not None and not (np.isfinite(cf).all() and (cf > 0).all()):
                 raise ValueError("cam_focal must be finite and > 0 (pixels)")
+            if sampler != "six_point":
+                _one_centre_error(rays, ids)
         _ray_error(st, "robust_rig_motion", rays)
     return _robust_result(res, mask, weights)
 
@@ -1524,6 +1526,24 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
         "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
         "sampler": _SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
     }
+
+
+def _one_centre_error(rays: tuple, ids: tuple) -> None:
+    """After MCG_EINVAL of a search that may take central samples: ValueError
+    naming a camera id whose rays come from several origins (the kernel's
+    rule: equal within 1e-9 (1 + the largest |coordinate|) at both times).
+    Non-finite origins are left to :func:`_ray_error` to name."""
+    o = np.concatenate([rays[0], rays[2]])
+    if not np.isfinite(o).all():
+        return
+    cam = np.concatenate(ids)
+    tol = 1e-9 * (1.0 + float(np.abs(o).max(initial=0.0)))
+    for g in np.unique(cam):
+        mine = o[cam == g]
+        if np.abs(mine - mine[0]).max() > tol:
+            raise ValueError(f"rays: camera id {g} has several different origins; origins "
+                             "must be the camera centres (rig frame) for the central samples "
+                             "of five_plus_one (and of the upright sampler)")
 
 
 def _camera_id_arrays(cam1: Any, cam2: Any, n: int, n_cameras: Any

@@ -1183,7 +1183,9 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * intra-camera correspondences, a static rig, degenerate scenes),
  * MCG_EINVAL (NULL, sizes, camera ids out of range, NaN/inf, zero
  * directions, focal <= 0, bad options: an unknown sampler, a zero-length or
- * non-finite g1/g2 with MCG_SAMPLER_UPRIGHT4), MCG_ENOMEM (lwork below
+ * non-finite g1/g2 with MCG_SAMPLER_UPRIGHT4; with central samples -- 5+1,
+ * the upright 3+1 -- a camera whose rays do not share one origin at both
+ * times, within 1e-9 (1 + the largest |coordinate|)), MCG_ENOMEM (lwork below
  * mcg_robust_work_size). Budgets: opt->max_iterations samples and
  * opt->max_seconds for the search; each refinement is capped by
  * mcg_refine_motion's defaults (a local optimisation by 8 steps, on at

@@ -550,6 +550,23 @@ static void status_case(void)
     st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "upright sampler, NaN in the vertical");
+    {
+        /* a camera whose rays come from two origins: 5+1's central samples
+         * refuse it; the 6-point sampler takes no central sample */
+        const double keep = o2[3 * 9 + 1];
+        mcg_robust_default_options(&opt);
+        o2[3 * 9 + 1] += 1e-3;
+        st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL,
+                                   &opt, &res, mask, NULL, work, lwork);
+        check_status(st, MCG_EINVAL, "5+1, a camera with two origins");
+        opt.sampler = MCG_SAMPLER_6PT;
+        opt.max_iterations = 1;
+        st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL,
+                                   &opt, &res, mask, NULL, work, lwork);
+        check(st != MCG_EINVAL, "6-point sampler, a camera with two origins accepted", 0.0,
+              0.0);
+        o2[3 * 9 + 1] = keep;
+    }
     check(mcg_robust_work_size(5, 1) == 0 && mcg_robust_work_size(10, 0) == 0,
           "work size 0 for n < 6 or no camera", 0.0, 0.0);
 }

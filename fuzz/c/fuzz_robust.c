@@ -10,10 +10,12 @@
  * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
  * huge --, 6-point, AUTO, or 1 in 16 an unknown one), the verdict's
  * evidence asked for or not, and a workspace 1 double short 1 in 16 times.
+ * Mode 1 gives every camera one origin half of the time.
  * Invariants: the status is known; bad sizes give MCG_EINVAL and a work
  * size of 0, a short workspace MCG_ENOMEM, bad options, ids or focal
  * lengths, an unknown sampler or an upright one without a finite non-zero
- * vertical MCG_EINVAL, NaN/inf inputs never MCG_OK; on MCG_OK R is a
+ * vertical MCG_EINVAL, NaN/inf inputs never MCG_OK, 5+1 on a camera whose
+ * rays have several origins MCG_EINVAL; on MCG_OK R is a
  * rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
@@ -36,6 +38,54 @@
 
 #define MAXN 64
 #define MAXCAM 8
+
+/* Every ray of a camera (at either time) takes the origin of that camera's
+ * first ray: mode 1's arbitrary rays past the central samples' check. */
+static void one_origin_per_camera(int n, const int *cam1, const int *cam2, double *o1,
+                                  double *o2)
+{
+    int first[MAXCAM], i, k, t;
+    for (i = 0; i < MAXCAM; ++i)
+        first[i] = -1;
+    for (i = 0; i < n; ++i)
+        for (t = 0; t < 2; ++t) {
+            const int g = t ? cam2[i] : cam1[i];
+            double *o = (t ? o2 : o1) + 3 * i;
+            if (first[g] < 0) {
+                first[g] = 2 * i + t;
+                continue;
+            }
+            for (k = 0; k < 3; ++k)
+                o[k] = ((first[g] & 1) ? o2 : o1)[3 * (first[g] >> 1) + k];
+        }
+}
+
+/* Do the origins of each camera agree (the rule of mcg_robust_rig_motion:
+ * within 1e-9 (1 + the largest |coordinate|) of its first ray's)? */
+static int centres_agree(int n, const int *cam1, const int *cam2, const double *o1,
+                         const double *o2)
+{
+    int first[MAXCAM], i, k, t;
+    double big = 0.0, tol;
+    for (i = 0; i < 3 * n; ++i)
+        big = fmax(big, fmax(fabs(o1[i]), fabs(o2[i])));
+    tol = 1e-9 * (1.0 + big);
+    for (i = 0; i < MAXCAM; ++i)
+        first[i] = -1;
+    for (i = 0; i < n; ++i)
+        for (t = 0; t < 2; ++t) {
+            const int g = t ? cam2[i] : cam1[i];
+            const double *o = (t ? o2 : o1) + 3 * i;
+            if (first[g] < 0) {
+                first[g] = 2 * i + t;
+                continue;
+            }
+            for (k = 0; k < 3; ++k)
+                if (!(fabs(o[k] - ((first[g] & 1) ? o2 : o1)[3 * (first[g] >> 1) + k]) <= tol))
+                    return 0;
+        }
+    return 1;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -80,6 +130,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             cam1[i] = fz_int(&in, 0, ncams - 1);
             cam2[i] = fz_u8(&in) % 4 == 0 ? fz_int(&in, 0, ncams - 1) : cam1[i];
         }
+        if (fz_u8(&in) & 1) /* one origin per camera: past the central samples' check */
+            one_origin_per_camera(n, cam1, cam2, o1, o2);
     }
     if (fz_u8(&in) % 16 == 0) {
         i = fz_int(&in, 0, n - 1);
@@ -168,6 +220,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if (short_work && st != MCG_EINVAL) {
         FZ_CHECK(st == MCG_ENOMEM, "short workspace gave status %d", st);
+        return 0;
+    }
+    if (opt.sampler == MCG_SAMPLER_5P1 && !centres_agree(n, cam1, cam2, o1, o2)) {
+        FZ_CHECK(st == MCG_EINVAL, "5+1 with a camera of several origins gave status %d", st);
         return 0;
     }
     if (st != MCG_OK)
