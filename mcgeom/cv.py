@@ -24,7 +24,6 @@ name may be passed as a string instead. Estimators that can drive RANSAC
 
 from __future__ import annotations
 
-import functools
 import warnings
 from typing import Any, Optional
 
@@ -167,29 +166,6 @@ def _resolve(method: str, robust_flag: Optional[bool]) -> tuple[str, bool]:
 _RANSAC_DEFAULTS = {"prob": 0.999, "threshold": 1.0, "maxIters": 1000, "seed": 0}
 
 
-@functools.lru_cache(maxsize=64, typed=True)
-def _cached_ransac_options(threshold: Any, prob: Any, max_iters: Any
-                           ) -> "_robust.RansacOptions":
-    return _robust.RansacOptions(threshold=threshold, prob=prob, max_iters=max_iters)
-
-
-def _ransac_options(threshold: Any, prob: Any, max_iters: Any, seed: Any
-                    ) -> "_robust.RansacOptions":
-    """The (frozen) RansacOptions of :func:`estimate`'s four RANSAC arguments
-    (threshold None: 1 px): the first three made once per distinct set
-    (typed: ``True`` is no ``1``), the seed -- often a new one per estimate --
-    set on a copy (:meth:`RansacOptions.with_seed`): the constructor's checks
-    cost ~15 us of a ~0.5 ms call (issue 19). Unhashable arguments are
-    checked afresh (and named) every time."""
-    threshold = 1.0 if threshold is None else threshold
-    try:
-        base = _cached_ransac_options(threshold, prob, max_iters)
-    except TypeError:           # unhashable: no cache
-        return _robust.RansacOptions(threshold=threshold, prob=prob, max_iters=max_iters,
-                                     seed=seed)
-    return base if type(seed) is int and seed == base.seed else base.with_seed(seed)
-
-
 def _no_ransac_options(name: str, **given: Any) -> None:
     """ValueError naming a RANSAC-only option given a non-default value for a method
     that does not run RANSAC (it would be ignored silently)."""
@@ -284,10 +260,11 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
         prior = {k: options.pop(k) for k in ("gravity1", "gravity2") if k in options}
         # (as robust.ransac: an ``options=`` RansacOptions replaces the
         # others; threshold None is 1 px)
+        thr = 1.0 if threshold is None else threshold
         opts = options.pop("options", None) or (
-            _ransac_options(threshold, prob, maxIters, seed) if not options else
-            _robust.RansacOptions(threshold=1.0 if threshold is None else threshold, prob=prob,
-                                  max_iters=maxIters, seed=seed, **options))
+            _robust.ransac_options(thr, prob, maxIters, seed) if not options else
+            _robust.RansacOptions(threshold=thr, prob=prob, max_iters=maxIters, seed=seed,
+                                  **options))
         # the rays, pixel-noise tables and calibration come from the rig and
         # the checks above: the search need not check them again (issue 19)
         # (pixels per radian are per pair: those of the kept pairs are theirs)
@@ -337,7 +314,7 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     if out is None:
         return None
     rays, ppr = out
-    opts = _ransac_options(threshold, prob, maxIters, seed)
+    opts = _robust.ransac_options(1.0 if threshold is None else threshold, prob, maxIters, seed)
     # (the sampler of choose_sampler, picked by the C search: "auto"; with a
     # vertical prior the upright 4-point one, as _gravity_method picks)
     method, prior = ("auto", None) if gravity1 is None else \
