@@ -310,6 +310,18 @@ def test_critical_motion_reported_unobservable(kind):
     assert m2.info["covariance"] is None
 
 
+@pytest.mark.parametrize("kind", ["locally-central", "locally-central-and-axial"])
+def test_critical_motion_direction_from_a_mirrored_start(kind):
+    """A start in the mirrored minimum (t backwards: on a critical motion the
+    epipolar constraint cannot tell t from -t) still gives the travel
+    direction, its sign picked by cheirality, not the start's."""
+    t = np.array([0.3, -0.2, 0.35])
+    p = make(kind, 13, n=60, R=np.eye(3), t=t)
+    m = mcgeom.estimate(p.rays, "refine", initial=(np.eye(3), -0.05 * t), fix_scale=True)
+    assert not m.scale.observable
+    assert np.dot(m.t, t / np.linalg.norm(t)) > 1 - 1e-9
+
+
 def test_fix_scale_keeps_the_norm_of_t():
     p = make("most-general", 17, n=60)
     R0, t0 = _perturbed(p.R, p.t, np.random.default_rng(2))
