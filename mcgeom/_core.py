@@ -727,8 +727,12 @@ def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
     return _refine_dict(res, R, t)
 
 
-def _refine_dict(res: Any, R: np.ndarray, t: np.ndarray) -> dict:
-    """The dict of :func:`refine_motion` from an ``mcg_refine_result``."""
+def _refine_dict(res: Any, R: np.ndarray, t: np.ndarray,
+                 information: Optional[np.ndarray] = None) -> dict:
+    """The dict of :func:`refine_motion` from an ``mcg_refine_result``
+    (``information``: its ``info`` already read, else copied here)."""
+    if information is None:
+        information = np.frombuffer(ffi.buffer(res.info), dtype=np.float64).reshape(6, 6).copy()
     return {
         "R": R,
         "t": t,
@@ -739,7 +743,7 @@ def _refine_dict(res: Any, R: np.ndarray, t: np.ndarray) -> dict:
         "converged": bool(res.converged),
         "reason": REFINE_STOP_NAMES.get(res.reason, "unknown"),
         "n_used": res.n_used,
-        "information": np.frombuffer(ffi.buffer(res.info), dtype=np.float64).reshape(6, 6).copy(),
+        "information": information,
         "sigma2": res.sigma2,
         "scale_rel_std": res.scale_rel_std,
         "info_cond": res.info_cond,
@@ -1496,23 +1500,11 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
     R, t = f[:9].reshape(3, 3), f[9:12]
     refinement = verdict = None
     if res.refined:
-        rr = res.refinement
         i = _RES_AT["information"]
-        refinement = {
-            "R": R, "t": t, "initial_cost": rr.initial_cost, "final_cost": rr.final_cost,
-            "rms": rr.rms, "iterations": rr.iterations, "converged": bool(rr.converged),
-            "reason": REFINE_STOP_NAMES.get(rr.reason, "unknown"), "n_used": rr.n_used,
-            "information": f[i:i + 36].reshape(6, 6), "sigma2": rr.sigma2,
-            "scale_rel_std": rr.scale_rel_std, "info_cond": rr.info_cond}
+        refinement = _refine_dict(res.refinement, R, t, f[i:i + 36].reshape(6, 6))
     if res.have_verdict:
-        v = res.verdict
         i, j = _RES_AT["R_fit"], _RES_AT["t_direction"]
-        verdict = {
-            "n_inliers": v.n_inliers, "n_intra": v.n_intra, "n_cross": v.n_cross,
-            "n_cameras_intra": v.n_cameras_intra, "fit_ok": bool(v.fit_ok),
-            "R_fit": f[i:i + 9].reshape(3, 3), "n_still": v.n_still,
-            "critical_angle": v.critical_angle, "n_in_front": v.n_in_front,
-            "t_direction": f[j:j + 3]}
+        verdict = _verdict_dict(res.verdict, f[i:i + 9].reshape(3, 3), f[j:j + 3])
     i = _RES_AT["covariance"]
     return {
         "R": R, "t": t, "t_hypothesis": f[12:15],
@@ -1635,15 +1627,18 @@ def verdict_stats(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1: An
     return _verdict_dict(out)
 
 
-def _verdict_dict(out: Any) -> dict:
-    """The dict of :func:`verdict_stats` from an ``mcg_verdict_stats_result``."""
+def _verdict_dict(out: Any, R_fit: Optional[np.ndarray] = None,
+                  t_direction: Optional[np.ndarray] = None) -> dict:
+    """The dict of :func:`verdict_stats` from an ``mcg_verdict_stats_result``
+    (``R_fit``, ``t_direction``: its arrays already read, else copied here)."""
+    if R_fit is None:
+        R_fit = np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy()
+        t_direction = np.frombuffer(ffi.buffer(out.t_direction), dtype=np.float64).copy()
     return {
         "n_inliers": out.n_inliers, "n_intra": out.n_intra, "n_cross": out.n_cross,
-        "n_cameras_intra": out.n_cameras_intra, "fit_ok": bool(out.fit_ok),
-        "R_fit": np.frombuffer(ffi.buffer(out.R_fit), dtype=np.float64).reshape(3, 3).copy(),
+        "n_cameras_intra": out.n_cameras_intra, "fit_ok": bool(out.fit_ok), "R_fit": R_fit,
         "n_still": out.n_still, "critical_angle": out.critical_angle,
-        "n_in_front": out.n_in_front,
-        "t_direction": np.frombuffer(ffi.buffer(out.t_direction), dtype=np.float64).copy(),
+        "n_in_front": out.n_in_front, "t_direction": t_direction,
     }
 
 
