@@ -322,6 +322,17 @@ def test_critical_motion_direction_from_a_mirrored_start(kind):
     assert np.dot(m.t, t / np.linalg.norm(t)) > 1 - 1e-9
 
 
+def test_five_plus_one_metric_guess_along_the_travel_on_a_critical_motion():
+    """5+1's metric guess (info["t_metric"]) on a critical motion points along
+    the travel direction it reports, not into the mirrored minimum."""
+    t = np.array([0.3, -0.2, 0.35])
+    p = make("locally-central-and-axial", 13, n=60, R=np.eye(3), t=t)
+    m = mcgeom.estimate(p.rays, "five_plus_one")
+    assert not m.scale.observable
+    assert np.dot(m.t, t / np.linalg.norm(t)) > 1 - 1e-9
+    assert np.dot(m.info["t_metric"], m.t) > 0
+
+
 def test_fix_scale_keeps_the_norm_of_t():
     p = make("most-general", 17, n=60)
     R0, t0 = _perturbed(p.R, p.t, np.random.default_rng(2))

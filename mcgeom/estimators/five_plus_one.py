@@ -345,6 +345,16 @@ def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
     info["scale_determined"] = scale_determined(rel, fixed, zero)
     if not verdict.observable:
         info["t_direction"] = travel_direction(rays, np.ones(len(rays), bool), R, t)
+        nt = float(np.linalg.norm(t))
+        if float(np.dot(info["t_direction"], t)) < -0.9 * nt:
+            # mcgeom.robust._conclude's rule: a refined t within ~25 deg of
+            # the opposite of the travel direction that cheirality picks lies
+            # in the mirrored minimum (on a critical motion the constraint
+            # cannot tell t from -t: tests/test_refine.py's problem gave a
+            # t_metric 1.7 cm backwards): no metric estimate, and its length
+            # goes along the travel
+            info["t_metric"] = nt * info["t_direction"]
+            info["scale_determined"] = False
         if not info["scale_determined"]:
             t = info["t_direction"]
     r = np.abs(_core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t))
