@@ -37,7 +37,7 @@ from .errors import DegenerateError
 # travel_direction: the direction an estimator reports when |t| is not
 # observable; the robust layer finishes any estimator's motion and must report
 # the same (see mcgeom.estimators._common: no estimator imports this module)
-from .estimators._common import camera_ids, travel_direction
+from .estimators._common import camera_ids, in_mirrored_minimum, travel_direction
 from .estimators.five_plus_one import minimal_answer
 # the vertical's checks (the messages name gravity1/gravity2) of the upright solver
 from .estimators.upright_four_point import check_gravity
@@ -753,14 +753,11 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         if direction is None:
             direction = travel_direction(rays, inl, R, t)
         info["t_direction"] = direction
-        # A refined t in the mirrored minimum, within ~25 deg of the opposite
-        # of the travel direction that cheirality picks, is no metric
-        # estimate either: near the critical motion the refinement can cross
-        # |t| = 0 (car rig driving forward, 20 % outliers: t = +0.06 m for a
-        # true -0.54 m). It is treated as slid: the direction, the
+        # A refined t in the mirrored minimum (in_mirrored_minimum) is no
+        # metric estimate either: it is treated as slid: the direction, the
         # hypothesis' length. (A t dominated by the rotation-induced shift
         # may point elsewhere, up to ~130 deg off on KITTI, and is left alone.)
-        slid = slid or float(np.dot(direction, t)) < -0.9 * nt
+        slid = slid or in_mirrored_minimum(direction, t)
         if slid:
             nt = n0
         info["t_slid"] = slid

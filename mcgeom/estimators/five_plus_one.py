@@ -37,7 +37,7 @@ from ..observability import (ZERO_FACTOR, scale_determined, scale_profile, scale
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
 from ..validation import integral_camera_ids
-from ._common import camera_ids, intra_counts, travel_direction
+from ._common import camera_ids, in_mirrored_minimum, intra_counts, travel_direction
 from ._static import with_static_check
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
 from .five_plus_one_minimal import (PRIMARY_RULE, critical_angles, exact_candidates,
@@ -345,15 +345,10 @@ def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
     info["scale_determined"] = scale_determined(rel, fixed, zero)
     if not verdict.observable:
         info["t_direction"] = travel_direction(rays, np.ones(len(rays), bool), R, t)
-        nt = float(np.linalg.norm(t))
-        if float(np.dot(info["t_direction"], t)) < -0.9 * nt:
-            # mcgeom.robust._conclude's rule: a refined t within ~25 deg of
-            # the opposite of the travel direction that cheirality picks lies
-            # in the mirrored minimum (on a critical motion the constraint
-            # cannot tell t from -t: tests/test_refine.py's problem gave a
-            # t_metric 1.7 cm backwards): no metric estimate, and its length
+        if in_mirrored_minimum(info["t_direction"], t):
+            # no metric estimate (as mcgeom.robust._conclude): its length
             # goes along the travel
-            info["t_metric"] = nt * info["t_direction"]
+            info["t_metric"] = float(np.linalg.norm(t)) * info["t_direction"]
             info["scale_determined"] = False
         if not info["scale_determined"]:
             t = info["t_direction"]
