@@ -1431,17 +1431,14 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
             (_f64("cam_axes", cam_axes, (int(n_cameras), 3)),
              _f64("cam_focal", cam_focal, (int(n_cameras),)))
         ax_ptr, cf_ptr = _p(ax), _p(cf)
-    opt = ffi.new("mcg_robust_options *")
+    args = (threshold, prob, min_iterations, max_iterations, max_seconds, lo_rounds,
+            bool(refine), loss, max_scale_rel_std, sampler, verdict_still_factor)
     try:
-        ffi.memmove(opt, _robust_options(threshold, prob, min_iterations, max_iterations,
-                                         max_seconds, lo_rounds, bool(refine), loss,
-                                         max_scale_rel_std, sampler, verdict_still_factor),
-                    _ROBUST_OPTIONS_SIZE)
+        raw = _robust_options(*args)
     except TypeError:   # an unhashable argument: checked (and named) afresh
-        ffi.memmove(opt, _robust_options.__wrapped__(
-            threshold, prob, min_iterations, max_iterations, max_seconds, lo_rounds,
-            bool(refine), loss, max_scale_rel_std, sampler, verdict_still_factor),
-            _ROBUST_OPTIONS_SIZE)
+        raw = _robust_options.__wrapped__(*args)
+    opt = ffi.new("mcg_robust_options *")
+    ffi.memmove(opt, raw, _ROBUST_OPTIONS_SIZE)
     opt.seed = int(seed) % (1 << 64) if seed is not None else 0
     if sampler == "upright_four_point":
         for name, g, field in (("gravity1", gravity1, opt.g1), ("gravity2", gravity2, opt.g2)):
