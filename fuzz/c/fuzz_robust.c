@@ -39,51 +39,59 @@
 #define MAXN 64
 #define MAXCAM 8
 
+/* first[g]: 2 i + t of camera g's first ray (pair i, time t = 0 or 1), -1
+ * for a camera without rays. */
+static void first_rays(int n, const int *cam1, const int *cam2, int first[MAXCAM])
+{
+    int i, t;
+    for (i = 0; i < MAXCAM; ++i)
+        first[i] = -1;
+    for (i = 0; i < n; ++i)
+        for (t = 0; t < 2; ++t) {
+            const int g = t ? cam2[i] : cam1[i];
+            if (first[g] < 0)
+                first[g] = 2 * i + t;
+        }
+}
+
+/* the origin of ray j = 2 i + t */
+static double *origin(double *o1, double *o2, int j)
+{
+    return ((j & 1) ? o2 : o1) + 3 * (j >> 1);
+}
+
 /* Every ray of a camera (at either time) takes the origin of that camera's
  * first ray: mode 1's arbitrary rays past the central samples' check. */
 static void one_origin_per_camera(int n, const int *cam1, const int *cam2, double *o1,
                                   double *o2)
 {
-    int first[MAXCAM], i, k, t;
-    for (i = 0; i < MAXCAM; ++i)
-        first[i] = -1;
-    for (i = 0; i < n; ++i)
-        for (t = 0; t < 2; ++t) {
-            const int g = t ? cam2[i] : cam1[i];
-            double *o = (t ? o2 : o1) + 3 * i;
-            if (first[g] < 0) {
-                first[g] = 2 * i + t;
-                continue;
-            }
-            for (k = 0; k < 3; ++k)
-                o[k] = ((first[g] & 1) ? o2 : o1)[3 * (first[g] >> 1) + k];
-        }
+    int first[MAXCAM], j, k;
+    first_rays(n, cam1, cam2, first);
+    for (j = 0; j < 2 * n; ++j) {
+        const double *ref = origin(o1, o2, first[(j & 1) ? cam2[j >> 1] : cam1[j >> 1]]);
+        double *o = origin(o1, o2, j);
+        for (k = 0; k < 3; ++k)
+            o[k] = ref[k];
+    }
 }
 
 /* Do the origins of each camera agree (the rule of mcg_robust_rig_motion:
  * within 1e-9 (1 + the largest |coordinate|) of its first ray's)? */
-static int centres_agree(int n, const int *cam1, const int *cam2, const double *o1,
-                         const double *o2)
+static int centres_agree(int n, const int *cam1, const int *cam2, double *o1, double *o2)
 {
-    int first[MAXCAM], i, k, t;
+    int first[MAXCAM], j, k;
     double big = 0.0, tol;
-    for (i = 0; i < 3 * n; ++i)
-        big = fmax(big, fmax(fabs(o1[i]), fabs(o2[i])));
+    for (j = 0; j < 3 * n; ++j)
+        big = fmax(big, fmax(fabs(o1[j]), fabs(o2[j])));
     tol = 1e-9 * (1.0 + big);
-    for (i = 0; i < MAXCAM; ++i)
-        first[i] = -1;
-    for (i = 0; i < n; ++i)
-        for (t = 0; t < 2; ++t) {
-            const int g = t ? cam2[i] : cam1[i];
-            const double *o = (t ? o2 : o1) + 3 * i;
-            if (first[g] < 0) {
-                first[g] = 2 * i + t;
-                continue;
-            }
-            for (k = 0; k < 3; ++k)
-                if (!(fabs(o[k] - ((first[g] & 1) ? o2 : o1)[3 * (first[g] >> 1) + k]) <= tol))
-                    return 0;
-        }
+    first_rays(n, cam1, cam2, first);
+    for (j = 0; j < 2 * n; ++j) {
+        const double *ref = origin(o1, o2, first[(j & 1) ? cam2[j >> 1] : cam1[j >> 1]]);
+        const double *o = origin(o1, o2, j);
+        for (k = 0; k < 3; ++k)
+            if (!(fabs(o[k] - ref[k]) <= tol))
+                return 0;
+    }
     return 1;
 }
 
