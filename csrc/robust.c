@@ -48,9 +48,11 @@
  * (3 pairs of a camera -> mcg_upright3_central: its rotation and direction
  * of travel; the scale as for 5+1; w^3), else 4 pairs of any cameras solved
  * with the known vertical (mcg_upright4); MCG_SAMPLER_6PT draws 6 and
- * solves them with the generic minimal solver (mcg_sixpt); each real
+ * solves them with the generic minimal solver (mcg_sixpt);
+ * MCG_SAMPLER_EIGEN draws 17 and solves them with Kneip and Li's
+ * eigensolver from linear17's rotation (sample_eigen); each real
  * solution with its own metric t is scored, locally optimised and finished
- * as above, the adaptive stop uses w^4 or w^6. Solutions that satisfy a
+ * as above, the adaptive stop uses w^4, w^6 or w^17. Solutions that satisfy a
  * sample pair trivially (its camera only rotated about its centre, e.g.
  * the static rig) are dropped.
  *
@@ -251,10 +253,20 @@
  * instead of counted, ring4 took 3.32 M against 3.05 M. */
 #define REC_PAIRS 64
 #define REC_PROPOSALS 16
-/* doubles of the solutions of one upright or 6-point sample (R and t) */
+/* doubles of the solutions of one upright or 6-point sample (R and t); an
+ * eigensolver sample's mcg_eigensolver workspace (17 pairs: 17 x 16 + its
+ * SVD's, ~400) lies there too */
 #define MINIMAL_SOLUTIONS_SIZE (12 * MCG_SIXPT_MAX_SOLUTIONS)
 /* draws of a 6-point sample before one with two cameras is given up */
 #define SAMPLE_TRIES 16
+/* The eigensolver sampler (MCG_SAMPLER_EIGEN, issue 21): EIGEN_M pairs, the
+ * fewest that mcg_linear17 (its start rotation) solves; at most
+ * EIGEN_ITERATIONS LM steps from it, and the no-motion trap below
+ * EIGEN_TRAP of the start's travel -- the values of
+ * mcgeom.estimators.eigensolver's own RANSAC sample (minimal_solutions). */
+#define EIGEN_M 17
+#define EIGEN_ITERATIONS 100
+#define EIGEN_TRAP 1e-2
 
 static double now_seconds(void)
 {
@@ -1450,7 +1462,7 @@ static int offer_motion(ctx *c, const double R[9], const double t[3], const doub
 static int check_sampler(const mcg_robust_options *o)
 {
     if (o->sampler == MCG_SAMPLER_5P1 || o->sampler == MCG_SAMPLER_6PT ||
-        o->sampler == MCG_SAMPLER_AUTO)
+        o->sampler == MCG_SAMPLER_AUTO || o->sampler == MCG_SAMPLER_EIGEN)
         return 1;
     if (o->sampler != MCG_SAMPLER_UPRIGHT4)
         return 0;
@@ -1458,15 +1470,15 @@ static int check_sampler(const mcg_robust_options *o)
            dot3(o->g2, o->g2) >= 1e-100;
 }
 
-/* m distinct pairs drawn uniformly into idx (m <= 6 < n). `central`: 1 when
- * all of them are intra-camera pairs of one camera (rays from one centre:
- * no metric scale, the minimal solvers are degenerate there). */
-static void draw_distinct(ctx *c, int m, int idx[6], int *central)
+/* m distinct pairs drawn uniformly into idx (m <= EIGEN_M, m <= n).
+ * `central`: 1 when all of them are intra-camera pairs of one camera (rays
+ * from one centre: no metric scale, the solvers are degenerate there). */
+static void draw_distinct(ctx *c, int m, int *idx, int *central)
 {
     int j, i;
     for (j = 0; j < m; j++) {
         int k, dup;
-        do { /* rejection of repeats: m <= 6 of n >= 6 */
+        do { /* rejection of repeats: m <= 17 of n >= m */
             k = rng_below(&c->rng, c->n);
             dup = 0;
             for (i = 0; i < j; i++)
@@ -1612,11 +1624,72 @@ static int sample_minimal(ctx *c, const double *w)
     return offer_solutions(c, c->msol, c->msol + 9 * max_sol, ns, idx, a1, b1, a2, b2, m, w);
 }
 
+/* |t + R g - g|: how far the motion (R, t) carries g (metres) */
+static double travel(const double R[9], const double t[3], const double g[3])
+{
+    double v[3];
+    int i;
+    mat_vec(R, g, v);
+    for (i = 0; i < 3; i++)
+        v[i] += t[i] - g[i];
+    return sqrt(dot3(v, v));
+}
+
+/* One eigensolver sample (MCG_SAMPLER_EIGEN): EIGEN_M distinct pairs drawn
+ * uniformly (a central sample redrawn as in sample_minimal) -> the rotation
+ * of mcg_linear17 without its refinement -> mcg_eigensolver from it (Kneip
+ * and Li, "Efficient computation of relative pose for multi-camera
+ * systems", CVPR 2014: the rotation minimising the smallest eigenvalue of
+ * the generalized-epipolar matrix, t its eigenvector). Near pure forward
+ * motion with intra-camera rays that eigenvalue also vanishes at R = I,
+ * t = 0 (every such ray fits the resting rig), and the minimiser can slide
+ * there: a result whose centroid of origins travels less than EIGEN_TRAP
+ * of the start's is that trap, and the start (0 steps) is offered instead.
+ * A motion without a metric t (no rotation with intra-camera rays only) is
+ * no hypothesis. As mcgeom.estimators.eigensolver.minimal_solutions, which
+ * drives mcgeom.robust's Python search. The workspace of mcg_eigensolver
+ * is c->msol. */
+static int sample_eigen(ctx *c, const double *w)
+{
+    int idx[EIGEN_M], central = 1, tries, has_scale, has0, its, k, i;
+    double a1[3 * EIGEN_M], b1[3 * EIGEN_M], a2[3 * EIGEN_M], b2[3 * EIGEN_M];
+    double R[9], t[3], R0[9], t0[3], g[3] = {0.0, 0.0, 0.0}, lmin;
+    mcg_linear17_options lo;
+    mcg_linear17_result lr;
+    if (c->n < EIGEN_M)
+        return -1;
+    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
+        draw_distinct(c, EIGEN_M, idx, &central);
+    if (central)
+        return 0;
+    copy_pairs(c, idx, EIGEN_M, a1, b1, a2, b2);
+    mcg_linear17_default_options(&lo);
+    lo.refine = 0;
+    if (mcg_linear17(EIGEN_M, a1, b1, a2, b2, &lo, &lr) != MCG_OK ||
+        mcg_eigensolver(EIGEN_M, a1, b1, a2, b2, lr.R, EIGEN_ITERATIONS, R, t, &lmin,
+                        &has_scale, &its, c->msol, MINIMAL_SOLUTIONS_SIZE) != MCG_OK ||
+        !has_scale)
+        return 0;
+    for (k = 0; k < EIGEN_M; k++)
+        for (i = 0; i < 3; i++)
+            g[i] += (a1[3 * k + i] + a2[3 * k + i]) / (2.0 * EIGEN_M);
+    if (mcg_eigensolver(EIGEN_M, a1, b1, a2, b2, lr.R, 0, R0, t0, &lmin, &has0, &its, c->msol,
+                        MINIMAL_SOLUTIONS_SIZE) == MCG_OK &&
+        has0 && travel(R, t, g) < EIGEN_TRAP * travel(R0, t0, g)) {
+        memcpy(R, R0, sizeof R);
+        memcpy(t, t0, sizeof t);
+    }
+    return offer_solutions(c, R, t, 1, idx, a1, b1, a2, b2, EIGEN_M, w);
+}
+
 /* One sample of the options' sampler: the hypotheses offered, or -1 when
- * the data can never give one (5+1: no camera with 5 intra-camera pairs). */
+ * the data can never give one (5+1: no camera with 5 intra-camera pairs;
+ * the eigensolver: fewer than 17 pairs). */
 static int draw(ctx *c, const double *w)
 {
-    return c->central_m > 0 ? sample(c, w) : sample_minimal(c, w);
+    if (c->central_m > 0)
+        return sample(c, w);
+    return c->opt.sampler == MCG_SAMPLER_EIGEN ? sample_eigen(c, w) : sample_minimal(c, w);
 }
 
 /* ------------------------------------------------------------ phases */
@@ -2230,7 +2303,10 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         return MCG_EINVAL;
     /* (the two-stage search counts central samples: REC_PAIRS) */
     c.records = c.central_m > 0;
-    c.sample_size = c.records ? c.central_m : c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4 : 6;
+    c.sample_size = c.records                                ? c.central_m
+                    : c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4
+                    : c.opt.sampler == MCG_SAMPLER_EIGEN    ? EIGEN_M
+                                                            : 6;
     res->sample_size = c.sample_size;
     if (c.records)
         setup_records(&c);
@@ -2248,7 +2324,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         iters++;
         got = draw(&c, wlo);
         if (got < 0)
-            break; /* no camera with 5 intra-camera correspondences */
+            break; /* no camera with 5 intra-camera pairs (5+1), n < 17 (eigen) */
         if (c.have && c.n_wide != before) {
             /* the fraction of true inliers: those within WIDE thresholds
              * (at 1 threshold the tail of the noise, ~16 % of the inliers at

@@ -43,15 +43,49 @@ def test_no_motion_trap_is_avoided():
     assert np.linalg.norm(m.info["t_metric"]) > 0.1
 
 
-def test_drives_ransac():
-    rng = np.random.default_rng(2)
+def _ransac_problem(seed: int):
+    rng = np.random.default_rng(seed)
     rig = synth.generic_rig(4, rng)
     R = synth.rotation_about([0.2, 1.0, 0.1], 0.3)
     t = np.array([0.4, 0.05, 0.3])
     p = synth.make_problem(rig, R, t, 150, rng, cross_fraction=0.5, angular_noise=1e-4,
                            outlier_fraction=0.2, require_visible=False)
+    return p, R, t
+
+
+def test_drives_ransac():
+    p, R, _ = _ransac_problem(2)
     m = robust.ransac(p.rays, "eigensolver", threshold=1e-3)
     assert np.degrees(rot_err(m.R, R)) < 0.05
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_drives_the_c_search_as_its_python_one(seed):
+    """robust.ransac runs the eigensolver's samples in the C entry point
+    (MCG_SAMPLER_EIGEN: 17 pairs -> linear17's rotation -> the eigensolver);
+    the Python driver of the same samples (strategy="minimal",
+    minimal_solutions) is the reference. On seed 2 both find the motion and
+    agree; on seed 3 the C search still finds it (the Python driver's
+    search fails there: 1000 samples, no consensus)."""
+    p, R, t = _ransac_problem(seed)
+    m = robust.ransac(p.rays, "eigensolver", threshold=1e-3, seed=0)
+    assert m.info["sampler"] == "eigensolver" and m.info["sample_size"] == 17
+    assert m.info["c_seconds"] > 0.0
+    assert np.degrees(rot_err(m.R, R)) < 0.02
+    assert np.linalg.norm(m.info["t_metric"] - t) < 0.02 * np.linalg.norm(t)
+    truth = p.inlier
+    assert np.mean(m.inliers[truth]) > 0.9 and np.mean(m.inliers[~truth]) < 0.1
+    if seed == 2:
+        ref = robust.ransac(p.rays, "eigensolver", threshold=1e-3, seed=0, strategy="minimal")
+        assert "c_seconds" not in ref.info
+        assert np.degrees(rot_err(m.R, ref.R)) < 0.01
+        assert np.mean(m.inliers == ref.inliers) > 0.97
+
+
+def test_c_search_needs_17_correspondences():
+    p, _, _ = _ransac_problem(2)
+    with pytest.raises(ValueError, match="eigensolver needs at least 17"):
+        robust.ransac(p.rays.take(np.arange(16)), "eigensolver", threshold=1e-3)
 
 
 def test_bad_input():

@@ -1063,9 +1063,13 @@ enum {
                                  any cameras (mcg_upright4) */
     MCG_SAMPLER_6PT = 2,      /* 6 pairs not all of one camera, the generic
                                  minimal solver (mcg_sixpt) */
-    MCG_SAMPLER_AUTO = 3      /* MCG_SAMPLER_5P1 when some camera has 5
+    MCG_SAMPLER_AUTO = 3,     /* MCG_SAMPLER_5P1 when some camera has 5
                                  intra-camera pairs, else MCG_SAMPLER_6PT
                                  (res->sampler says which) */
+    MCG_SAMPLER_EIGEN = 4     /* 17 pairs not all of one camera -> the start
+                                 rotation of mcg_linear17 (no refinement) ->
+                                 mcg_eigensolver (Kneip and Li 2014), its
+                                 motion when it has a metric t; needs n >= 17 */
 };
 
 /* mcg_robust_result.stop: why the search ended */
@@ -1142,7 +1146,12 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * pairs of one camera solved with the vertical (the central upright
  * 3-point solver: rotation and the camera's direction of travel, adaptive
  * stop with sample size 3), else 4 distinct pairs uniformly (any cameras)
- * -> mcg_upright4 with opt->g1, opt->g2; MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
+ * -> mcg_upright4 with opt->g1, opt->g2; MCG_SAMPLER_EIGEN draws 17 distinct
+ * pairs uniformly (redrawn as below) -> mcg_linear17's rotation ->
+ * mcg_eigensolver from it (at most 100 steps; a result whose centroid of
+ * origins hardly travels, from a start that clearly did, is the no-motion
+ * trap of intra-camera rays: the start is kept), scored as the 6-point
+ * solutions below (sample size 17); MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
  * redrawn when all six are intra-camera pairs of one camera (a central
  * camera: no metric scale) -> mcg_sixpt; every real solution that puts
  * its sample in front of the cameras and satisfies no pair trivially (e.g.
@@ -1180,7 +1189,8 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * final refinement; weights (may be NULL): the final refinement's weights
  * (0 for unused pairs). Returns MCG_OK, MCG_EDEGENERATE when no motion
  * explains 6 correspondences (res has the counts; e.g. no camera with 5
- * intra-camera correspondences, a static rig, degenerate scenes),
+ * intra-camera correspondences, fewer than 17 pairs with MCG_SAMPLER_EIGEN,
+ * a static rig, degenerate scenes),
  * MCG_EINVAL (NULL, sizes, camera ids out of range, NaN/inf, zero
  * directions, focal <= 0, bad options: an unknown sampler, a zero-length or
  * non-finite g1/g2 with MCG_SAMPLER_UPRIGHT4; with central samples -- 5+1,

@@ -21,7 +21,8 @@
  * checks, and fewer samples than 5+1: its 3+1 samples), and with a vertical
  * 0.2 deg off (the free final refinement absorbs it); the 6-point one on the
  * outlier scene and on a rig where no camera has 5 intra-camera pairs (5+1
- * fails there); their option checks. Exit status 0 iff every check passes.
+ * fails there); the eigensolver one on the outlier scene (and fewer than
+ * 17 pairs); their option checks. Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
@@ -495,6 +496,35 @@ static void six_point_case(void)
     check(caught == 2 && agree, "few pairs, 6-point: both outliers flagged", caught, 2);
 }
 
+/* The eigensolver sampler (17 pairs -> linear17's rotation -> Kneip and
+ * Li's eigensolver) on the outlier scene: the same checks as the minimal
+ * samplers; its sample size; fewer than 17 pairs cannot be sampled. */
+static void eigen_case(void)
+{
+    const int n = 300, n_out = 90;
+    double R[9], t[3], rerr, terr;
+    mcg_robust_options opt;
+    mcg_robust_result res;
+    int st, agree, caught;
+    scene(n, n_out, 1e-3, R, t);
+    mcg_robust_default_options(&opt);
+    opt.threshold = 3e-3;
+    opt.seed = 7;
+    opt.sampler = MCG_SAMPLER_EIGEN;
+    /* an all-inlier sample of 17 at 30 % outliers: 0.7^17 = 0.23 %; 3000
+     * samples hold one with probability 0.999 */
+    opt.max_iterations = 3000;
+    st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
+    check_outlier_run("eigensolver", st, &res, rerr, terr, agree, caught);
+    check(res.sampler == MCG_SAMPLER_EIGEN && res.sample_size == 17,
+          "eigensolver: the sampler and its sample size (17)", res.sample_size, 17);
+    st = mcg_robust_rig_motion(16, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    check_status(st, MCG_EDEGENERATE, "eigensolver, 16 pairs: no sample of 17");
+    check(res.iterations <= 1, "eigensolver, 16 pairs: the search ends at once",
+          res.iterations, 1);
+}
+
 static void status_case(void)
 {
     double R[9], t[3];
@@ -537,7 +567,7 @@ static void status_case(void)
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "focal <= 0");
     mcg_robust_default_options(&opt);
-    opt.sampler = MCG_SAMPLER_AUTO + 1;
+    opt.sampler = MCG_SAMPLER_EIGEN + 1;
     st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "unknown sampler");
@@ -711,6 +741,7 @@ int main(void)
     minimal_case();
     upright_case();
     six_point_case();
+    eigen_case();
     status_case();
     large_case();
     mid_upright_case();

@@ -8,14 +8,15 @@
  * camera table, options valid or not (threshold, prob, iteration budgets,
  * LO rounds, loss), the sampler (a byte: 5+1, upright 4-point with the
  * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
- * huge --, 6-point, AUTO, or 1 in 16 an unknown one), the verdict's
+ * huge --, 6-point, AUTO, the eigensolver, or 1 in 16 an unknown one), the verdict's
  * evidence asked for or not, and a workspace 1 double short 1 in 16 times.
  * Mode 1 gives every camera one origin half of the time.
  * Invariants: the status is known; bad sizes give MCG_EINVAL and a work
  * size of 0, a short workspace MCG_ENOMEM, bad options, ids or focal
  * lengths, an unknown sampler or an upright one without a finite non-zero
  * vertical MCG_EINVAL, NaN/inf inputs never MCG_OK, 5+1 on a camera whose
- * rays have several origins MCG_EINVAL; on MCG_OK R is a
+ * rays have several origins MCG_EINVAL, the eigensolver sampler on fewer
+ * than 17 pairs MCG_EDEGENERATE; on MCG_OK R is a
  * rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
@@ -170,7 +171,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     opt_ok = 1;
     {
         const int sb = fz_u8(&in);
-        opt.sampler = sb % 16 == 15 ? 4 + sb % 5 : sb % 4;
+        opt.sampler = sb % 16 == 15 ? 5 + sb % 5 : sb % 5;
         if (opt.sampler == MCG_SAMPLER_UPRIGHT4) {
             if (mode == 0) { /* the true vertical: g2 = R g1 */
                 double g[3];
@@ -189,7 +190,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                      opt.g2[0] * opt.g2[0] + opt.g2[1] * opt.g2[1] + opt.g2[2] * opt.g2[2] >=
                          1e-100;
         }
-        opt_ok &= opt.sampler <= MCG_SAMPLER_AUTO;
+        opt_ok &= opt.sampler <= MCG_SAMPLER_EIGEN;
         /* (AUTO picks the 6-point sampler where no camera has 5 intra pairs) */
         if (opt.sampler == MCG_SAMPLER_6PT || opt.sampler == MCG_SAMPLER_AUTO) {
             /* mcg_sixpt: ~1 s a sample here */
@@ -234,6 +235,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(st == MCG_EINVAL, "5+1 with a camera of several origins gave status %d", st);
         return 0;
     }
+    if (opt.sampler == MCG_SAMPLER_EIGEN && n < 17) {
+        FZ_CHECK(st == MCG_EDEGENERATE, "eigensolver sampler on %d < 17 pairs gave status %d",
+                 n, st);
+        return 0;
+    }
     if (st != MCG_OK)
         return 0;
     FZ_CHECK(fz_is_rotation(res.R, 1e-9), "R not a rotation (orthogonality error %g)",
@@ -260,9 +266,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              res.n_used, cnt1);
     FZ_CHECK(isnan(res.scale_profile) || res.scale_profile >= 0.0,
              "scale profile %g is negative", res.scale_profile);
-    FZ_CHECK(res.sampler >= MCG_SAMPLER_5P1 && res.sampler <= MCG_SAMPLER_6PT &&
-                 (opt.sampler == MCG_SAMPLER_AUTO ? res.sampler != MCG_SAMPLER_UPRIGHT4
-                                                  : res.sampler == opt.sampler),
+    FZ_CHECK(res.sampler >= MCG_SAMPLER_5P1 && res.sampler <= MCG_SAMPLER_EIGEN &&
+                 res.sampler != MCG_SAMPLER_AUTO &&
+                 (opt.sampler == MCG_SAMPLER_AUTO
+                      ? res.sampler == MCG_SAMPLER_5P1 || res.sampler == MCG_SAMPLER_6PT
+                      : res.sampler == opt.sampler),
              "sampler used %d for the option %d", res.sampler, opt.sampler);
     /* the verdict's evidence (asked for, n <= 2^20 here): over the inliers */
     FZ_CHECK((opt.verdict_still_factor > 0.0) == (res.have_verdict != 0),

@@ -8,6 +8,12 @@ correspondences: more accurate than the linear 17-point solution it starts
 from (it enforces ``R`` in SO(3) and ``E = [t]x R`` exactly), cheaper than the
 Sampson refinement, which ``refine=True`` runs after it.
 
+In RANSAC (``mcgeom.robust.ransac(rays, "eigensolver")``) its samples of 17
+correspondences run in the C entry point (``mcg_robust_rig_motion`` with
+``MCG_SAMPLER_EIGEN``: linear17's rotation, then the eigensolver from it, as
+:func:`minimal_solutions` here, which the Python driver
+``strategy="minimal"`` still calls).
+
 Frames and units (docs/architecture.md §3): rays in the rig frame (metres),
 ``X2 = R X1 + t`` with ``t`` in metres.
 """
