@@ -194,10 +194,17 @@ def adaptive_iterations(inlier_ratio: float, sample_size: int, prob: float,
 def sample_across_cameras(rays: RayPairs, size: int, rng: np.random.Generator) -> np.ndarray:
     """``size`` distinct correspondences spread over the camera pairs.
 
-    Camera pairs (cam1, cam2) are visited in a random order, one correspondence
-    each, round after round, so that no camera dominates the sample (drawing
-    uniformly from all correspondences would give samples from the one camera
-    that has most of them).
+    A uniform draw with at most ``ceil(size / G)`` correspondences of each of
+    the G camera pairs (cam1, cam2) (raised round by round only when the
+    others cannot fill the sample): no camera dominates the sample (drawing
+    uniformly from all correspondences would give samples from the one
+    camera that has most of them), and no camera pair is forced into it.
+    Visiting every pair once per round did force them: with a sample as
+    large as the pairs (17 correspondences over 16 camera pairs), every
+    sample held each one-correspondence pair, and where that one was an
+    outlier no sample was clean (a generic 4-camera rig, 150 pairs, 20 %
+    outliers: the eigensolver's RANSAC found no consensus in 1000 samples).
+    Indices into ``rays``, in the order drawn.
     """
     n = len(rays)
     if size > n:
@@ -205,18 +212,19 @@ def sample_across_cameras(rays: RayPairs, size: int, rng: np.random.Generator) -
     if rays.cam1 is None or rays.cam2 is None:
         return rng.choice(n, size, replace=False)
     key = rays.cam1 * (int(rays.cam2.max(initial=0)) + 1) + rays.cam2
-    groups = [rng.permutation(np.flatnonzero(key == k)) for k in np.unique(key)]
-    order = rng.permutation(len(groups))
-    out: list[int] = []
-    depth = 0
-    while len(out) < size:
-        for g in order:
-            if depth < len(groups[g]):
-                out.append(int(groups[g][depth]))
-                if len(out) == size:
-                    break
-        depth += 1
-    return np.asarray(out, dtype=np.int64)
+    _, group = np.unique(key, return_inverse=True)
+    group = group.ravel()
+    perm = rng.permutation(n)
+    g = group[perm]
+    # rank of each drawn correspondence among those of its camera pair drawn
+    # before it: round r of the draw holds ranks [r cap, (r + 1) cap)
+    counts = np.bincount(g)
+    by_group = np.argsort(g, kind="stable")
+    rank = np.empty(n, dtype=np.int64)
+    rank[by_group] = np.arange(n) - np.repeat(np.cumsum(counts) - counts, counts)
+    cap = -(-size // len(counts))
+    take = np.argsort((rank // cap) * n + np.arange(n), kind="stable")[:size]
+    return perm[take].astype(np.int64)
 
 
 def _msac(r: np.ndarray, thr: float) -> float:

@@ -23,7 +23,7 @@ def test_minimal_part_small():
 def test_ransac_part_small():
     """One problem of ring4: every row present but the 6-point one (run only
     where the façade chooses it); the façade reports its sampler and the 5+1
-    row reuses its run."""
+    row reuses its run; the eigensolver row runs the C search."""
     pytest.importorskip("poselib")
     res = peer_solvers.run_ransac(1, 0, {"ring4 4x50 0.5px":
                                          peer_solvers.RANSAC_CASES["ring4 4x50 0.5px"]})
@@ -38,6 +38,9 @@ def test_ransac_part_small():
     assert ring4["mcgeom upright (0.2 deg)"][4][0] >= 1 and np.isnan(ring4["poselib defaults"][4][0])
     # ring4's cameras have 50 intra-camera correspondences each: 3+1 samples
     assert ring4["mcgeom upright (0.2 deg)"][2] == ["upright 3+1"]
+    # the eigensolver's 17-pair samples run in the C search as well
+    assert ring4["mcgeom eigensolver"][2] == ["eigensolver"]
+    assert ring4["mcgeom eigensolver"][0][0, 0] < 0.1 and ring4["mcgeom eigensolver"][3][0] > 0
     assert "vs 17-pt" in table and "C vs 5+1" in table and "upright 3+1" in table
     assert "samples" in table
 

@@ -44,6 +44,32 @@ def test_samples_are_spread_across_cameras():
         assert len(set(p.rays.cam1[idx].tolist())) == 6   # one per camera of the head
 
 
+def test_samples_do_not_force_a_small_camera_pair_in():
+    """17 of 150 correspondences over 16 camera pairs, two of them with a
+    single correspondence: a sample holds such a pair about as often as a
+    uniform draw would (17 / 150), not always, and no pair more than
+    ceil(17 / 16) = 2 times."""
+    rng = np.random.default_rng(3)
+    rig = synth.generic_rig(4, rng)
+    p = synth.make_problem(rig, synth.rotation_about([0.2, 1.0, 0.1], 0.3),
+                           np.array([0.4, 0.05, 0.3]), 150, rng, cross_fraction=0.5,
+                           angular_noise=1e-4, outlier_fraction=0.2, require_visible=False)
+    key = p.rays.cam1 * 4 + p.rays.cam2
+    keys, counts = np.unique(key, return_counts=True)
+    assert len(keys) == 16
+    single = keys[counts == 1]
+    assert len(single) >= 2
+    draw = np.random.default_rng(0)
+    held, most = 0, 0
+    for _ in range(400):
+        idx = robust.sample_across_cameras(p.rays, 17, draw)
+        assert len(set(idx.tolist())) == 17
+        held += np.isin(key[idx], single[:1]).any()
+        most = max(most, np.unique(key[idx], return_counts=True)[1].max())
+    assert held / 400 < 0.3
+    assert most <= 2
+
+
 @pytest.mark.parametrize("strategy", ["proposer", "minimal"])
 def test_ransac_finds_the_motion_among_outliers(strategy):
     p = _vehicle_problem(1)

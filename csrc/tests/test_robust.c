@@ -456,24 +456,34 @@ static void upright_case(void)
           caught, 86);
 }
 
+/* The 300-pair outlier scene estimated with `sampler` (threshold 3e-3,
+ * `seed`, at most max_samples samples) and checked by check_outlier_run;
+ * *opt holds the options, *res the result. */
+static void sampler_outlier_run(const char *what, int sampler, int seed, int max_samples,
+                                mcg_robust_options *opt, mcg_robust_result *res)
+{
+    double R[9], t[3], rerr, terr;
+    int st, agree, caught;
+    scene(300, 90, 1e-3, R, t);
+    mcg_robust_default_options(opt);
+    opt->threshold = 3e-3;
+    opt->seed = seed;
+    opt->sampler = sampler;
+    opt->max_iterations = max_samples;
+    st = run_checked(300, opt, R, t, res, &rerr, &terr, &agree, &caught);
+    check_outlier_run(what, st, res, rerr, terr, agree, caught);
+}
+
 static void six_point_case(void)
 {
-    const int n = 300, n_out = 90;
     double R[9], t[3], rerr, terr;
     mcg_robust_options opt;
     mcg_robust_result res;
     int st, agree, caught, k, c4[NCAM] = {0};
-    scene(n, n_out, 1e-3, R, t);
-    mcg_robust_default_options(&opt);
-    opt.threshold = 3e-3;
-    opt.seed = 5;
-    opt.sampler = MCG_SAMPLER_6PT;
     /* mcg_sixpt takes ~0.1 s per sample (a homotopy of 64 paths): 40
      * samples (an all-inlier one among them with probability 0.993 at 30 %
      * outliers; the seed is fixed) keep this under valgrind bearable */
-    opt.max_iterations = 40;
-    st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
-    check_outlier_run("6-point", st, &res, rerr, terr, agree, caught);
+    sampler_outlier_run("6-point", MCG_SAMPLER_6PT, 5, 40, &opt, &res);
     /* 20 pairs, 4 intra-camera ones per camera and 4 cross-camera, 2
      * outliers: no 5-point camera, the 6-point sampler still finds it */
     scene(20, 2, 1e-4, R, t);
@@ -501,21 +511,12 @@ static void six_point_case(void)
  * samplers; its sample size; fewer than 17 pairs cannot be sampled. */
 static void eigen_case(void)
 {
-    const int n = 300, n_out = 90;
-    double R[9], t[3], rerr, terr;
     mcg_robust_options opt;
     mcg_robust_result res;
-    int st, agree, caught;
-    scene(n, n_out, 1e-3, R, t);
-    mcg_robust_default_options(&opt);
-    opt.threshold = 3e-3;
-    opt.seed = 7;
-    opt.sampler = MCG_SAMPLER_EIGEN;
+    int st;
     /* an all-inlier sample of 17 at 30 % outliers: 0.7^17 = 0.23 %; 3000
      * samples hold one with probability 0.999 */
-    opt.max_iterations = 3000;
-    st = run_checked(n, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
-    check_outlier_run("eigensolver", st, &res, rerr, terr, agree, caught);
+    sampler_outlier_run("eigensolver", MCG_SAMPLER_EIGEN, 7, 3000, &opt, &res);
     check(res.sampler == MCG_SAMPLER_EIGEN && res.sample_size == 17,
           "eigensolver: the sampler and its sample size (17)", res.sample_size, 17);
     st = mcg_robust_rig_motion(16, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,

@@ -36,8 +36,11 @@ has 5 intra-camera correspondences, else 6-point; the sampler column counts
 its choices), the C search forced to 5+1, to the generic 6-point, and to the
 upright sampler (3+1 where a camera has 3 intra-camera correspondences, else
 4-point) with the vertical known to 0.2 deg (each gravity vector turned by
-0.2 deg about a random axis), 17-point RANSAC (``ransac:linear17``, capped at
-the façade's 1000 samples, and at each cap of ``--caps17``), and PoseLib's
+0.2 deg about a random axis), the C search with Kneip and Li's eigensolver
+(``ransac:eigensolver``: 17-pair samples, linear17's rotation refined by
+the eigensolver; capped at the façade's 1000 samples), 17-point RANSAC
+(``ransac:linear17``, capped at the façade's 1000 samples, and at each cap
+of ``--caps17``), and PoseLib's
 ``estimate_generalized_relative_pose`` (its 5+1 sampler,
 :mod:`.poselib_peer`) with ``min_iterations=100`` and with its defaults; on
 the cases of ``robust_vs_poselib`` (ring4, ladybug6 with 30 % outliers, car8
@@ -374,7 +377,8 @@ def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: flo
     runs = {"mcgeom façade (auto)": facade,
             "mcgeom 5+1": lambda: facade(method="ransac:five_plus_one"),
             "mcgeom 6-pt": lambda: facade(method="ransac:six_point"),
-            f"mcgeom upright ({deg:g} deg)": lambda: facade(gravity1=g1, gravity2=g2)}
+            f"mcgeom upright ({deg:g} deg)": lambda: facade(gravity1=g1, gravity2=g2),
+            "mcgeom eigensolver": lambda: facade(method="ransac:eigensolver")}
     for cap in caps17:
         runs[row17(cap)] = lambda cap=cap: facade(method=RIG_LINEAR17_RANSAC, maxIters=cap)
     runs.update({name: peer(opt) for name, opt in POSELIB_SETTINGS.items()})
