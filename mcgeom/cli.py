@@ -94,8 +94,9 @@ def _cmd_methods(args: argparse.Namespace) -> int:
     for name, text in _SAMPLERS:
         print(_wrapped(text, " " * 24, f"    {name:<20}"))
     print(_wrapped("Any registered name, 'ransac:NAME' or 'direct:NAME' may be passed as "
-                   "method instead ('ransac:five_plus_one' forces 5+1; 'ransac:linear17' is "
-                   "17-point RANSAC).", ""))
+                   "method instead ('ransac:five_plus_one' forces 5+1; 'ransac:eigensolver' "
+                   "runs the eigensolver's 17-correspondence samples in the same C entry "
+                   "point; 'ransac:linear17' is 17-point RANSAC).", ""))
     # the LP backends of bnb_lp: the available ones, and why GLPK is not (with
     # the command that brings it) when it is not
     print(f"\nLP backends (bnb_lp, default {registry.default_lp_backend()}):")
