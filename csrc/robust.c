@@ -253,9 +253,7 @@
  * instead of counted, ring4 took 3.32 M against 3.05 M. */
 #define REC_PAIRS 64
 #define REC_PROPOSALS 16
-/* doubles of the solutions of one upright or 6-point sample (R and t); an
- * eigensolver sample's mcg_eigensolver workspace (17 pairs: 17 x 16 + its
- * SVD's, ~400) lies there too */
+/* doubles of the solutions of one upright or 6-point sample (R and t) */
 #define MINIMAL_SOLUTIONS_SIZE (12 * MCG_SIXPT_MAX_SOLUTIONS)
 /* draws of a 6-point sample before one with two cameras is given up */
 #define SAMPLE_TRIES 16
@@ -267,6 +265,15 @@
 #define EIGEN_M 17
 #define EIGEN_ITERATIONS 100
 #define EIGEN_TRAP 1e-2
+
+/* doubles of the region c->msol: the solutions of one upright or 6-point
+ * sample, or an eigensolver sample's mcg_eigensolver workspace (405 for 17
+ * pairs: the solutions' 768 hold it, so the workspace did not grow) */
+static size_t sample_work_size(void)
+{
+    const size_t e = mcg_eigensolver_work_size(EIGEN_M);
+    return e > MINIMAL_SOLUTIONS_SIZE ? e : MINIMAL_SOLUTIONS_SIZE;
+}
 
 static double now_seconds(void)
 {
@@ -398,7 +405,7 @@ size_t mcg_robust_work_size(int n, int n_cameras)
     nn = (size_t)scale_cap(n);
     s = add_sz(s, 2 * ints_as_doubles(nn) + scale_work_own(n), &ok);
     /* the solutions of one minimal sample (the 6-point solver's are the most) */
-    s = add_sz(s, MINIMAL_SOLUTIONS_SIZE, &ok);
+    s = add_sz(s, sample_work_size(), &ok);
     /* the verdict's evidence (opt.verdict_still_factor) */
     s = add_sz(s, mcg_verdict_stats_work_size(n_cameras), &ok);
     /* the two-stage 5+1: each camera's record score, its subset's offsets
@@ -1648,7 +1655,7 @@ static double travel(const double R[9], const double t[3], const double g[3])
  * A motion without a metric t (no rotation with intra-camera rays only) is
  * no hypothesis. As mcgeom.estimators.eigensolver.minimal_solutions, which
  * drives mcgeom.robust's Python search. The workspace of mcg_eigensolver
- * is c->msol. */
+ * is c->msol (sample_work_size). */
 static int sample_eigen(ctx *c, const double *w)
 {
     int idx[EIGEN_M], central = 1, tries, has_scale, has0, its, k, i;
@@ -1667,14 +1674,14 @@ static int sample_eigen(ctx *c, const double *w)
     lo.refine = 0;
     if (mcg_linear17(EIGEN_M, a1, b1, a2, b2, &lo, &lr) != MCG_OK ||
         mcg_eigensolver(EIGEN_M, a1, b1, a2, b2, lr.R, EIGEN_ITERATIONS, R, t, &lmin,
-                        &has_scale, &its, c->msol, MINIMAL_SOLUTIONS_SIZE) != MCG_OK ||
+                        &has_scale, &its, c->msol, sample_work_size()) != MCG_OK ||
         !has_scale)
         return 0;
     for (k = 0; k < EIGEN_M; k++)
         for (i = 0; i < 3; i++)
             g[i] += (a1[3 * k + i] + a2[3 * k + i]) / (2.0 * EIGEN_M);
     if (mcg_eigensolver(EIGEN_M, a1, b1, a2, b2, lr.R, 0, R0, t0, &lmin, &has0, &its, c->msol,
-                        MINIMAL_SOLUTIONS_SIZE) == MCG_OK &&
+                        sample_work_size()) == MCG_OK &&
         has0 && travel(R, t, g) < EIGEN_TRAP * travel(R0, t0, g)) {
         memcpy(R, R0, sizeof R);
         memcpy(t, t0, sizeof t);
@@ -1747,7 +1754,7 @@ static void carve(ctx *c, double *work)
         x += 2 * ints_as_doubles(m);
         c->xwork = scale_work_aliased(c->n) ? c->sub : x;
         c->msol = x + scale_work_own(c->n);
-        c->vwork = c->msol + MINIMAL_SOLUTIONS_SIZE;
+        c->vwork = c->msol + sample_work_size();
         c->rec = c->vwork + mcg_verdict_stats_work_size(c->ncam);
         c->rec_off = (int *)(c->rec + c->ncam);
         c->rec_idx = (int *)(c->rec + c->ncam + ints_as_doubles((size_t)c->ncam + 1));
