@@ -63,6 +63,19 @@ def rigid(rng: np.random.Generator):
 rot_err = metrics.rotation_error  # angle (rad) between two rotations, accurate near zero
 
 
+def generic_outlier_problem(seed: int):
+    """A generic 4-camera rig (random cameras), 150 correspondences, half of
+    them cross-camera, 1e-4 rad noise, 20 % outliers, one fixed motion
+    (|t| 0.50 m): the RANSAC problem of the eigensolver's tests. Seed 3 has
+    16 camera pairs, two of them a single outlier each."""
+    rng = np.random.default_rng(seed)
+    rig = synth.generic_rig(4, rng)
+    R = synth.rotation_about([0.2, 1.0, 0.1], 0.3)
+    t = np.array([0.4, 0.05, 0.3])
+    return synth.make_problem(rig, R, t, 150, rng, cross_fraction=0.5, angular_noise=1e-4,
+                              outlier_fraction=0.2, require_visible=False)
+
+
 def turning_motion(rng: np.random.Generator, max_angle: float = 0.3,
                    min_angle: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
     """A motion that is far from the critical one: a random rotation of at

@@ -8,7 +8,7 @@ import pytest
 
 import mcgeom
 from mcgeom import robust, synth
-from problems import make, rot_err
+from problems import generic_outlier_problem, make, rot_err
 
 
 def test_at_least_as_accurate_as_its_linear17_start():
@@ -43,20 +43,10 @@ def test_no_motion_trap_is_avoided():
     assert np.linalg.norm(m.info["t_metric"]) > 0.1
 
 
-def _ransac_problem(seed: int):
-    rng = np.random.default_rng(seed)
-    rig = synth.generic_rig(4, rng)
-    R = synth.rotation_about([0.2, 1.0, 0.1], 0.3)
-    t = np.array([0.4, 0.05, 0.3])
-    p = synth.make_problem(rig, R, t, 150, rng, cross_fraction=0.5, angular_noise=1e-4,
-                           outlier_fraction=0.2, require_visible=False)
-    return p, R, t
-
-
 def test_drives_ransac():
-    p, R, _ = _ransac_problem(2)
+    p = generic_outlier_problem(2)
     m = robust.ransac(p.rays, "eigensolver", threshold=1e-3)
-    assert np.degrees(rot_err(m.R, R)) < 0.05
+    assert np.degrees(rot_err(m.R, p.R)) < 0.05
 
 
 @pytest.mark.parametrize("seed", [2, 3])
@@ -68,7 +58,8 @@ def test_drives_the_c_search_as_its_python_one(seed):
     Seed 3 has two camera pairs with one correspondence each, both outliers
     (the Python driver's samples held them in every sample before
     sample_across_cameras capped its rounds)."""
-    p, R, t = _ransac_problem(seed)
+    p = generic_outlier_problem(seed)
+    R, t = p.R, p.t
     m = robust.ransac(p.rays, "eigensolver", threshold=1e-3, seed=0)
     assert m.info["sampler"] == "eigensolver" and m.info["sample_size"] == 17
     assert m.info["c_seconds"] > 0.0
@@ -83,7 +74,7 @@ def test_drives_the_c_search_as_its_python_one(seed):
 
 
 def test_c_search_needs_17_correspondences():
-    p, _, _ = _ransac_problem(2)
+    p = generic_outlier_problem(2)
     with pytest.raises(ValueError, match="eigensolver needs at least 17"):
         robust.ransac(p.rays.take(np.arange(16)), "eigensolver", threshold=1e-3)
 

@@ -8,7 +8,7 @@ import pytest
 import mcgeom
 from mcgeom import robust, synth
 from mcgeom.cv import estimate as cv_estimate
-from problems import rot_err, turning_motion
+from problems import generic_outlier_problem, rot_err, turning_motion
 
 
 def _ladybug_problem(seed, n=300, outliers=0.3, noise=0.5):
@@ -49,11 +49,7 @@ def test_samples_do_not_force_a_small_camera_pair_in():
     single correspondence: a sample holds such a pair about as often as a
     uniform draw would (17 / 150), not always, and no pair more than
     ceil(17 / 16) = 2 times."""
-    rng = np.random.default_rng(3)
-    rig = synth.generic_rig(4, rng)
-    p = synth.make_problem(rig, synth.rotation_about([0.2, 1.0, 0.1], 0.3),
-                           np.array([0.4, 0.05, 0.3]), 150, rng, cross_fraction=0.5,
-                           angular_noise=1e-4, outlier_fraction=0.2, require_visible=False)
+    p = generic_outlier_problem(3)
     key = p.rays.cam1 * 4 + p.rays.cam2
     keys, counts = np.unique(key, return_counts=True)
     assert len(keys) == 16
