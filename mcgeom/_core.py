@@ -1274,6 +1274,7 @@ SAMPLER_NAMES = {
     "upright_four_point": lib.MCG_SAMPLER_UPRIGHT4,
     "six_point": lib.MCG_SAMPLER_6PT,
     "eigensolver": lib.MCG_SAMPLER_EIGEN,
+    "linear17": lib.MCG_SAMPLER_LINEAR17,
 }
 _SAMPLER_OF = {v: k for k, v in SAMPLER_NAMES.items()}
 
@@ -1370,8 +1371,9 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     3-vectors in rig frames 1 and 2, any non-zero length, required for it
     and refused otherwise; 3 intra-camera pairs of one camera and a fourth,
     as 5+1, when a camera has 3, else 4 pairs of any cameras), ``six_point`` (6 pairs,
-    the generic minimal solver) or ``eigensolver`` (17 pairs: Kneip and Li's
-    eigensolver from linear17's rotation; at least 17 pairs, else None).
+    the generic minimal solver), ``eigensolver`` (17 pairs: Kneip and Li's
+    eigensolver from linear17's rotation; at least 17 pairs, else None) or
+    ``linear17`` (17 pairs: linear17's motion; at least 17 pairs, else None).
 
     Returns None when no motion explains 6 correspondences (degenerate data),
     else a dict: ``R`` (3, 3), ``t`` (3,) (metres, metric only if the verdict
@@ -1396,7 +1398,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     the same call (None otherwise, or beyond 2^20 pairs), ``sample_size``
     (pairs per sample of the adaptive stop: 5 for 5+1, 3 and 4 for the
     upright sampler's 3+1 and 4-point samples, 6 for the 6-point, 17 for the
-    eigensolver).
+    eigensolver and linear17).
     Raises ValueError naming the bad argument. ``prechecked``: the caller
     made the arrays itself (:func:`mcgeom.robust.ransac_prechecked`): the
     rays (N, 3) and ``focal`` (N,) float64 C-contiguous, ``cam1``/``cam2``
@@ -1477,7 +1479,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                 raise ValueError("cam_axes contains NaN or inf")
             if cf is not None and not (np.isfinite(cf).all() and (cf > 0).all()):
                 raise ValueError("cam_focal must be finite and > 0 (pixels)")
-            if sampler not in ("six_point", "eigensolver"):   # (central samples only)
+            if sampler not in ("six_point", "eigensolver", "linear17"):   # (central samples only)
                 _one_centre_error(rays, ids)
         _ray_error(st, "robust_rig_motion", rays)
     return _robust_result(res, mask, weights)

@@ -54,8 +54,10 @@ __all__ = ["RansacOptions", "ransac_options", "ransac", "residuals", "adaptive_i
 #: (``mcg_robust_options.sampler``), with their sample sizes: 5 intra-camera
 #: correspondences of one camera and a sixth; 4 of any cameras with the
 #: vertical known; 6 not all of one camera; 17 not all of one camera for the
-#: eigensolver (Kneip and Li's, from linear17's rotation)
-C_SAMPLERS = {"five_plus_one": 6, "upright_four_point": 4, "six_point": 6, "eigensolver": 17}
+#: eigensolver (Kneip and Li's, from linear17's rotation) and for linear17
+#: (its motion, thesis ch. 8)
+C_SAMPLERS = {"five_plus_one": 6, "upright_four_point": 4, "six_point": 6, "eigensolver": 17,
+              "linear17": 17}
 
 
 
@@ -75,7 +77,7 @@ class RansacOptions:
     max_scale_rel_std: float = 0.1
     # "auto": the C entry point (csrc/robust.c) for the estimators whose
     # minimal solver it samples (C_SAMPLERS: five_plus_one,
-    # upright_four_point, six_point, eigensolver), else the estimator's proposer, else its
+    # upright_four_point, six_point, eigensolver, linear17), else the estimator's proposer, else its
     # minimal solver; "proposer" and "minimal" force the Python drivers below
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
     max_seconds: float = 0.0        # wall-time budget of the C search (0: none)
@@ -359,13 +361,13 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
 
     The methods of :data:`C_SAMPLERS` (``five_plus_one``,
     ``upright_four_point`` with ``solver_options={"gravity1": g1, "gravity2":
-    g2}``, ``six_point``, ``eigensolver``) with ``strategy="auto"`` run as one call of the C
+    g2}``, ``six_point``, ``eigensolver``, ``linear17``) with ``strategy="auto"`` run as one call of the C
     entry point ``mcg_robust_rig_motion`` (csrc/robust.c: the method's
     minimal samples, MSAC, local optimisation, adaptive stop, final
     refinement of all six degrees of freedom); the verdict stays here;
     ``info["sampler"]`` names the minimal solver and ``info["sample_size"]``
     the pairs of its samples (5 for 5+1, 6 for the 6-point, 17 for the
-    eigensolver; the upright
+    eigensolver and linear17; the upright
     sampler's 3 for its 3+1 samples, 4 for its 4-point ones: see
     :mod:`mcgeom.estimators.upright_four_point`). ``pixel_cameras = (focal,
     axes)``, the (M,) focal lengths (pixels) and (M, 3) optical axes (rig

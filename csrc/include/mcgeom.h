@@ -1066,10 +1066,14 @@ enum {
     MCG_SAMPLER_AUTO = 3,     /* MCG_SAMPLER_5P1 when some camera has 5
                                  intra-camera pairs, else MCG_SAMPLER_6PT
                                  (res->sampler says which) */
-    MCG_SAMPLER_EIGEN = 4     /* 17 pairs not all of one camera -> the start
+    MCG_SAMPLER_EIGEN = 4,    /* 17 pairs not all of one camera -> the start
                                  rotation of mcg_linear17 (no refinement) ->
                                  mcg_eigensolver (Kneip and Li 2014), its
                                  motion when it has a metric t; needs n >= 17 */
+    MCG_SAMPLER_LINEAR17 = 5  /* 17 pairs not all of one camera -> the motion
+                                 of mcg_linear17 without its refinement (the
+                                 linear step of thesis ch. 8), when it has a
+                                 metric t; needs n >= 17 */
 };
 
 /* mcg_robust_result.stop: why the search ended */
@@ -1151,7 +1155,11 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * mcg_eigensolver from it (at most 100 steps; a result whose centroid of
  * origins hardly travels, from a start that clearly did, is the no-motion
  * trap of intra-camera rays: the start is kept), scored as the 6-point
- * solutions below (sample size 17); MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
+ * solutions below (sample size 17); MCG_SAMPLER_LINEAR17 draws as
+ * MCG_SAMPLER_EIGEN and scores the motion of mcg_linear17 itself (its
+ * metric least-squares t, eq. 8.15, also where the sample alone does not
+ * trust it: the search's consensus judges it; none when it is not
+ * determined); MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
  * redrawn when all six are intra-camera pairs of one camera (a central
  * camera: no metric scale) -> mcg_sixpt; every real solution that puts
  * its sample in front of the cameras and satisfies no pair trivially (e.g.
@@ -1189,7 +1197,8 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * final refinement; weights (may be NULL): the final refinement's weights
  * (0 for unused pairs). Returns MCG_OK, MCG_EDEGENERATE when no motion
  * explains 6 correspondences (res has the counts; e.g. no camera with 5
- * intra-camera correspondences, fewer than 17 pairs with MCG_SAMPLER_EIGEN,
+ * intra-camera correspondences, fewer than 17 pairs with MCG_SAMPLER_EIGEN
+ * or MCG_SAMPLER_LINEAR17,
  * a static rig, degenerate scenes),
  * MCG_EINVAL (NULL, sizes, camera ids out of range, NaN/inf, zero
  * directions, focal <= 0, bad options: an unknown sampler, a zero-length or

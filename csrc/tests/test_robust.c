@@ -21,8 +21,9 @@
  * checks, and fewer samples than 5+1: its 3+1 samples), and with a vertical
  * 0.2 deg off (the free final refinement absorbs it); the 6-point one on the
  * outlier scene and on a rig where no camera has 5 intra-camera pairs (5+1
- * fails there); the eigensolver one on the outlier scene (and fewer than
- * 17 pairs); their option checks. Exit status 0 iff every check passes.
+ * fails there); the eigensolver one and linear17's on the outlier scene
+ * (and fewer than 17 pairs), linear17's also on the few-pairs rig; their
+ * option checks. Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
@@ -506,24 +507,49 @@ static void six_point_case(void)
     check(caught == 2 && agree, "few pairs, 6-point: both outliers flagged", caught, 2);
 }
 
-/* The eigensolver sampler (17 pairs -> linear17's rotation -> Kneip and
- * Li's eigensolver) on the outlier scene: the same checks as the minimal
- * samplers; its sample size; fewer than 17 pairs cannot be sampled. */
-static void eigen_case(void)
+/* The 17-pair samplers on the outlier scene: the eigensolver's (17 pairs
+ * -> linear17's rotation -> Kneip and Li's eigensolver) and linear17's (its
+ * linear step's motion): the same checks as the minimal samplers; the
+ * sample size; fewer than 17 pairs cannot be sampled. */
+static void seventeen_case(const char *what, int sampler, int seed)
 {
     mcg_robust_options opt;
     mcg_robust_result res;
+    char label[96];
     int st;
     /* an all-inlier sample of 17 at 30 % outliers: 0.7^17 = 0.23 %; 3000
      * samples hold one with probability 0.999 */
-    sampler_outlier_run("eigensolver", MCG_SAMPLER_EIGEN, 7, 3000, &opt, &res);
-    check(res.sampler == MCG_SAMPLER_EIGEN && res.sample_size == 17,
-          "eigensolver: the sampler and its sample size (17)", res.sample_size, 17);
+    sampler_outlier_run(what, sampler, seed, 3000, &opt, &res);
+    snprintf(label, sizeof label, "%s: the sampler and its sample size (17)", what);
+    check(res.sampler == sampler && res.sample_size == 17, label, res.sample_size, 17);
     st = mcg_robust_rig_motion(16, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
-    check_status(st, MCG_EDEGENERATE, "eigensolver, 16 pairs: no sample of 17");
-    check(res.iterations <= 1, "eigensolver, 16 pairs: the search ends at once",
-          res.iterations, 1);
+    snprintf(label, sizeof label, "%s, 16 pairs: no sample of 17", what);
+    check_status(st, MCG_EDEGENERATE, label);
+    snprintf(label, sizeof label, "%s, 16 pairs: the search ends at once", what);
+    check(res.iterations <= 1, label, res.iterations, 1);
+}
+
+static void eigen_case(void) { seventeen_case("eigensolver", MCG_SAMPLER_EIGEN, 7); }
+
+/* linear17's sampler also on the few-pairs scene of six_point_case (no
+ * camera with 5 intra-camera pairs, where 5+1 cannot sample) */
+static void linear17_case(void)
+{
+    double R[9], t[3], rerr, terr;
+    mcg_robust_options opt;
+    mcg_robust_result res;
+    int st, agree, caught;
+    seventeen_case("linear17", MCG_SAMPLER_LINEAR17, 11);
+    scene(20, 2, 1e-4, R, t);
+    mcg_robust_default_options(&opt);
+    opt.threshold = 1e-3;
+    opt.sampler = MCG_SAMPLER_LINEAR17;
+    st = run_checked(20, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
+    check_status(st, MCG_OK, "few pairs: linear17 status");
+    check(rerr < 0.2, "few pairs, linear17: rotation error (deg)", rerr, 0.2);
+    check(terr < 0.05, "few pairs, linear17: relative t error", terr, 0.05);
+    check(caught == 2 && agree, "few pairs, linear17: both outliers flagged", caught, 2);
 }
 
 static void status_case(void)
@@ -568,7 +594,7 @@ static void status_case(void)
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "focal <= 0");
     mcg_robust_default_options(&opt);
-    opt.sampler = MCG_SAMPLER_EIGEN + 1;
+    opt.sampler = MCG_SAMPLER_LINEAR17 + 1;
     st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "unknown sampler");
@@ -743,6 +769,7 @@ int main(void)
     upright_case();
     six_point_case();
     eigen_case();
+    linear17_case();
     status_case();
     large_case();
     mid_upright_case();

@@ -8,15 +8,15 @@
  * camera table, options valid or not (threshold, prob, iteration budgets,
  * LO rounds, loss), the sampler (a byte: 5+1, upright 4-point with the
  * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
- * huge --, 6-point, AUTO, the eigensolver, or 1 in 16 an unknown one), the verdict's
+ * huge --, 6-point, AUTO, the eigensolver, linear17, or 1 in 16 an unknown one), the verdict's
  * evidence asked for or not, and a workspace 1 double short 1 in 16 times.
  * Mode 1 gives every camera one origin half of the time.
  * Invariants: the status is known; bad sizes give MCG_EINVAL and a work
  * size of 0, a short workspace MCG_ENOMEM, bad options, ids or focal
- * lengths, an unknown sampler or an upright one without a finite non-zero
+ * lengths, a zero direction, an unknown sampler or an upright one without a finite non-zero
  * vertical MCG_EINVAL, NaN/inf inputs never MCG_OK, 5+1 on a camera whose
- * rays have several origins MCG_EINVAL, the eigensolver sampler on fewer
- * than 17 pairs MCG_EDEGENERATE; on MCG_OK R is a
+ * rays have several origins MCG_EINVAL, the eigensolver and linear17
+ * samplers on fewer than 17 pairs MCG_EDEGENERATE; on MCG_OK R is a
  * rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
@@ -74,6 +74,20 @@ static void one_origin_per_camera(int n, const int *cam1, const int *cam2, doubl
         for (k = 0; k < 3; ++k)
             o[k] = ref[k];
     }
+}
+
+/* 1 when every direction has a squared length of at least 1e-100 (the
+ * kernel's test of a zero direction, MCG_EINVAL) */
+static int directions_nonzero(int n, const double *d1, const double *d2)
+{
+    int k;
+    for (k = 0; k < n; ++k) {
+        const double *a = d1 + 3 * k, *b = d2 + 3 * k;
+        if (!(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] >= 1e-100) ||
+            !(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] >= 1e-100))
+            return 0;
+    }
+    return 1;
 }
 
 /* Do the origins of each camera agree (the rule of mcg_robust_rig_motion:
@@ -171,7 +185,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     opt_ok = 1;
     {
         const int sb = fz_u8(&in);
-        opt.sampler = sb % 16 == 15 ? 5 + sb % 5 : sb % 5;
+        opt.sampler = sb % 16 == 15 ? 6 + sb % 5 : sb % 6;
         if (opt.sampler == MCG_SAMPLER_UPRIGHT4) {
             if (mode == 0) { /* the true vertical: g2 = R g1 */
                 double g[3];
@@ -190,7 +204,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                      opt.g2[0] * opt.g2[0] + opt.g2[1] * opt.g2[1] + opt.g2[2] * opt.g2[2] >=
                          1e-100;
         }
-        opt_ok &= opt.sampler <= MCG_SAMPLER_EIGEN;
+        opt_ok &= opt.sampler <= MCG_SAMPLER_LINEAR17;
         /* (AUTO picks the 6-point sampler where no camera has 5 intra pairs) */
         if (opt.sampler == MCG_SAMPLER_6PT || opt.sampler == MCG_SAMPLER_AUTO) {
             /* mcg_sixpt: ~1 s a sample here */
@@ -227,6 +241,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(st == MCG_EINVAL, "NaN/inf input gave status %d", st);
         return 0;
     }
+    if (!directions_nonzero(n, d1, d2)) {
+        FZ_CHECK(st == MCG_EINVAL, "a zero direction gave status %d", st);
+        return 0;
+    }
     if (short_work && st != MCG_EINVAL) {
         FZ_CHECK(st == MCG_ENOMEM, "short workspace gave status %d", st);
         return 0;
@@ -235,9 +253,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(st == MCG_EINVAL, "5+1 with a camera of several origins gave status %d", st);
         return 0;
     }
-    if (opt.sampler == MCG_SAMPLER_EIGEN && n < 17) {
-        FZ_CHECK(st == MCG_EDEGENERATE, "eigensolver sampler on %d < 17 pairs gave status %d",
-                 n, st);
+    if ((opt.sampler == MCG_SAMPLER_EIGEN || opt.sampler == MCG_SAMPLER_LINEAR17) && n < 17) {
+        FZ_CHECK(st == MCG_EDEGENERATE, "17-pair sampler %d on %d < 17 pairs gave status %d",
+                 opt.sampler, n, st);
         return 0;
     }
     if (st != MCG_OK)
@@ -266,7 +284,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              res.n_used, cnt1);
     FZ_CHECK(isnan(res.scale_profile) || res.scale_profile >= 0.0,
              "scale profile %g is negative", res.scale_profile);
-    FZ_CHECK(res.sampler >= MCG_SAMPLER_5P1 && res.sampler <= MCG_SAMPLER_EIGEN &&
+    FZ_CHECK(res.sampler >= MCG_SAMPLER_5P1 && res.sampler <= MCG_SAMPLER_LINEAR17 &&
                  res.sampler != MCG_SAMPLER_AUTO &&
                  (opt.sampler == MCG_SAMPLER_AUTO
                       ? res.sampler == MCG_SAMPLER_5P1 || res.sampler == MCG_SAMPLER_6PT
