@@ -1515,6 +1515,25 @@ static void copy_pairs(const ctx *c, const int *idx, int m, double *a1, double *
         }
 }
 
+/* A sample of m distinct pairs drawn uniformly into idx and copied into the
+ * m x 3 arrays a1, b1, a2, b2: 1; 0 when every one of SAMPLE_TRIES draws
+ * was central (all pairs intra-camera pairs of one camera: its rotation may
+ * be determined but not |t|, the solvers find it degenerate); -1 when there
+ * are fewer than m pairs. */
+static int draw_sample(ctx *c, int m, int *idx, double *a1, double *b1, double *a2,
+                       double *b2)
+{
+    int tries, central = 1;
+    if (c->n < m)
+        return -1;
+    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
+        draw_distinct(c, m, idx, &central);
+    if (central)
+        return 0;
+    copy_pairs(c, idx, m, a1, b1, a2, b2);
+    return 1;
+}
+
 /* 1 when (R, t) satisfies the constraint of one of the m sample pairs
  * (origins a1 -> a2) trivially: the constraint reads d2 . (g x R d1) = 0
  * with g = R a1 + t - a2 (thesis eq. 8.16 with m = o x d), which holds for
@@ -1613,19 +1632,15 @@ static int offer_solutions(ctx *c, const double *Rs, const double *ts, int ns, c
  * 2005), drawn uniformly: with outliers spread evenly an all-inlier sample
  * is as likely as anywhere, and a rig with few pairs per camera (where 5+1
  * has no 5-point camera) is covered as evenly as its pairs are. A central
- * sample (pairs of one camera) is redrawn up to SAMPLE_TRIES times: its
- * rotation may be determined but not |t|, the solvers find it degenerate. */
+ * sample is redrawn (draw_sample). */
 static int sample_minimal(ctx *c, const double *w)
 {
     const int upright = c->opt.sampler == MCG_SAMPLER_UPRIGHT4, m = upright ? 4 : 6;
     const int max_sol = upright ? MCG_UPRIGHT4_MAX_SOLUTIONS : MCG_SIXPT_MAX_SOLUTIONS;
-    int idx[6], central = 1, tries, ns = 0, st;
+    int idx[6], ns = 0, st;
     double a1[18], b1[18], a2[18], b2[18];
-    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
-        draw_distinct(c, m, idx, &central);
-    if (central)
+    if (draw_sample(c, m, idx, a1, b1, a2, b2) <= 0)
         return 0;
-    copy_pairs(c, idx, m, a1, b1, a2, b2);
     st = upright ? mcg_upright4(a1, b1, a2, b2, c->opt.g1, c->opt.g2, c->msol,
                                 c->msol + 9 * max_sol, &ns)
                  : mcg_sixpt(a1, b1, a2, b2, c->msol, c->msol + 9 * max_sol, &ns);
@@ -1661,18 +1676,13 @@ static double travel(const double R[9], const double t[3], const double g[3])
  * is c->msol (sample_work_size). */
 static int sample_eigen(ctx *c, const double *w)
 {
-    int idx[EIGEN_M], central = 1, tries, has_scale, has0, its, k, i;
+    int idx[EIGEN_M], has_scale, has0, its, k, i, got;
     double a1[3 * EIGEN_M], b1[3 * EIGEN_M], a2[3 * EIGEN_M], b2[3 * EIGEN_M];
     double R[9], t[3], R0[9], t0[3], g[3] = {0.0, 0.0, 0.0}, lmin;
     mcg_linear17_options lo;
     mcg_linear17_result lr;
-    if (c->n < EIGEN_M)
-        return -1;
-    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
-        draw_distinct(c, EIGEN_M, idx, &central);
-    if (central)
-        return 0;
-    copy_pairs(c, idx, EIGEN_M, a1, b1, a2, b2);
+    if ((got = draw_sample(c, EIGEN_M, idx, a1, b1, a2, b2)) <= 0)
+        return got;
     mcg_linear17_default_options(&lo);
     lo.refine = 0;
     if (mcg_linear17(EIGEN_M, a1, b1, a2, b2, &lo, &lr) != MCG_OK ||
@@ -1709,18 +1719,13 @@ static int sample_eigen(ctx *c, const double *w)
  * (t_metric 0) gives no hypothesis. */
 static int sample_linear17(ctx *c, const double *w)
 {
-    int idx[EIGEN_M], central = 1, tries;
+    int idx[EIGEN_M], got;
     double a1[3 * EIGEN_M], b1[3 * EIGEN_M], a2[3 * EIGEN_M], b2[3 * EIGEN_M];
     const double *t;
     mcg_linear17_options lo;
     mcg_linear17_result lr;
-    if (c->n < EIGEN_M)
-        return -1;
-    for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
-        draw_distinct(c, EIGEN_M, idx, &central);
-    if (central)
-        return 0;
-    copy_pairs(c, idx, EIGEN_M, a1, b1, a2, b2);
+    if ((got = draw_sample(c, EIGEN_M, idx, a1, b1, a2, b2)) <= 0)
+        return got;
     mcg_linear17_default_options(&lo);
     if (mcg_linear17(EIGEN_M, a1, b1, a2, b2, &lo, &lr) != MCG_OK)
         return 0;
