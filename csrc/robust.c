@@ -51,8 +51,8 @@
  * solves them with the generic minimal solver (mcg_sixpt);
  * MCG_SAMPLER_EIGEN draws 17 and solves them with Kneip and Li's
  * eigensolver from linear17's rotation (sample_eigen); MCG_SAMPLER_LINEAR17
- * draws 17 and takes the motion of linear17 (sample_linear17: ~50-65 us a
- * sample where the 6-point solver takes ~30 ms); each real
+ * draws 17 and takes the motion of linear17 (sample_linear17: ~55 us a
+ * sample where the 6-point solver takes ~27 ms); each real
  * solution with its own metric t is scored, locally optimised and finished
  * as above, the adaptive stop uses w^4, w^6 or w^17. Solutions that satisfy a
  * sample pair trivially (its camera only rotated about its centre, e.g.

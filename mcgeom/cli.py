@@ -97,8 +97,8 @@ def _cmd_methods(args: argparse.Namespace) -> int:
                    "method instead ('ransac:five_plus_one' forces 5+1; 'ransac:eigensolver' "
                    "runs the eigensolver's 17-correspondence samples in the same C entry "
                    "point; 'ransac:linear17' is 17-point RANSAC there too: linear17's motion "
-                   "from 17 correspondences, ~50-65 us a sample against the 6-point "
-                   "solver's ~30 ms, so below ~45 % outliers it beats the 6-point search "
+                   "from 17 correspondences, ~55 us a sample against the 6-point "
+                   "solver's ~27 ms, so below ~43 % outliers it beats the 6-point search "
                    "on rigs without a 5-point camera, see mcgeom experiment peer_solvers).",
                    ""))
     # the LP backends of bnb_lp: the available ones, and why GLPK is not (with

@@ -8,16 +8,17 @@
  * camera table, options valid or not (threshold, prob, iteration budgets,
  * LO rounds, loss), the sampler (a byte: 5+1, upright 4-point with the
  * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
- * huge --, 6-point, AUTO, the eigensolver, linear17, or 1 in 16 an unknown one), the verdict's
- * evidence asked for or not, and a workspace 1 double short 1 in 16 times.
+ * huge --, 6-point, AUTO, the eigensolver, linear17, or 1 in 16 an
+ * unknown one), the verdict's evidence asked for or not, and a workspace 1
+ * double short 1 in 16 times.
  * Mode 1 gives every camera one origin half of the time.
  * Invariants: the status is known; bad sizes give MCG_EINVAL and a work
  * size of 0, a short workspace MCG_ENOMEM, bad options, ids or focal
- * lengths, a zero direction, an unknown sampler or an upright one without a finite non-zero
- * vertical MCG_EINVAL, NaN/inf inputs never MCG_OK, 5+1 on a camera whose
- * rays have several origins MCG_EINVAL, the eigensolver and linear17
- * samplers on fewer than 17 pairs MCG_EDEGENERATE; on MCG_OK R is a
- * rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
+ * lengths, a zero direction, an unknown sampler or an upright one without
+ * a finite non-zero vertical MCG_EINVAL, NaN/inf inputs never MCG_OK, 5+1
+ * on a camera whose rays have several origins MCG_EINVAL, the eigensolver
+ * and linear17 samplers on fewer than 17 pairs MCG_EDEGENERATE; on MCG_OK R
+ * is a rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
  * of the threshold excepted), n_inliers counts it, n_used counts bit 1 and

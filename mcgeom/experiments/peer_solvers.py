@@ -39,7 +39,7 @@ upright sampler (3+1 where a camera has 3 intra-camera correspondences, else
 0.2 deg about a random axis), the C search with Kneip and Li's eigensolver
 (``ransac:eigensolver``: 17-pair samples, linear17's rotation refined by
 the eigensolver; capped at the façade's 1000 samples), 17-point RANSAC
-(``ransac:linear17``: the C search's linear17 samples, ~50-65 us each;
+(``ransac:linear17``: the C search's linear17 samples, ~55 us each;
 capped at the façade's 1000 samples, and at each cap of ``--caps17``), and
 PoseLib's
 ``estimate_generalized_relative_pose`` (its 5+1 sampler,
