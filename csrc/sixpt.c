@@ -54,7 +54,13 @@
  * Cost: 64 paths of about 65 steps (a sixth rejected), each about five
  * evaluations and complex 6 x 6 solves: some 14 ms per call on a 2-core
  * machine (50 ms before the step control of track() and the vectorised
- * eval_h), still far slower than an elimination template;
+ * eval_h), 27-30 ms on a 2.0 GHz EPYC core, still far slower than an
+ * elimination template (PoseLib's gen_relpose_6pt: 1.6-4.2 ms there). A
+ * multistep predictor (the Hermite extrapolation through the last 2 or 3
+ * points of a path and their velocities, one new velocity per step)
+ * instead of Runge-Kutta was tried in session 20: 3 points took 17.7 k
+ * evaluations a call against ~20.8 k, within the timing noise, 2 points
+ * more than Runge-Kutta; not kept;
  * no allocation (all work is on the stack). Every solution returned is
  * checked (step 4); a miss (a path that failed or jumped) is possible in
  * ill-conditioned problems and its rate is measured by `mcgeom experiment

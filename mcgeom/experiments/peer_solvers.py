@@ -51,7 +51,7 @@ cannot sample a case (5+1 and PoseLib without a 5-point camera pair) counts
 as failed there. Where the façade chose a sampler, the row forcing it reuses
 the façade's run (the same C call with the same seed); the 6-point row runs
 only where the façade chose it: ``mcg_sixpt`` (a homotopy continuation of 64
-paths) takes about 14 ms per sample on this machine, seconds per RANSAC
+paths) takes 14-30 ms per sample (by machine), seconds per RANSAC
 problem, which on the cases with a 5-point camera would only measure that.
 ``--outliers F ...`` runs each chosen case at these outlier fractions
 instead of its own: the upright sampler's smaller samples (w^3 against
@@ -70,7 +70,7 @@ and its time is that of a failure.
 [--cases CASE ...] [--outliers F ...] [--caps17 N ...]`` (needs poselib).
 The 6-point table runs the families in rounds of ``--chunk6`` configurations
 each and prints the table so far to stderr after every round (10,000
-configurations of each of the 7 families take mcgeom's homotopy about 20
+configurations of each of the 7 families take mcgeom's homotopy 20-40
 minutes on a 2-core machine).
 """
 
@@ -242,8 +242,8 @@ def run_minimal6(configs: int = 10000, seed: int = 0, families=SIX_FAMILIES,
     The families are run in turn, ``chunk`` configurations of each at a time
     (default: all at once), and ``on_chunk(done, table)`` receives the table of
     the first ``done`` configurations per family after each round: mcgeom's
-    homotopy takes ~14 ms a call, so 10,000 configurations of 7 families run
-    for about 20 minutes, and a run stopped early still has figures
+    homotopy takes 14-30 ms a call, so 10,000 configurations of 7 families run
+    for 20-40 minutes, and a run stopped early still has figures
     for every family. Each family draws from its own generator seeded with
     ``seed``, so the configurations do not depend on ``chunk``."""
     poselib = import_peer("poselib", "peer_solvers")
@@ -541,7 +541,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="noise-free configurations per family (minimal part)")
     ap.add_argument("--configs6", type=positive_int, default=None,
                     help="configurations per family of the 6-point comparison (minimal "
-                         "part; default --configs; mcgeom's homotopy takes ~14 ms a call)")
+                         "part; default --configs; mcgeom's homotopy takes 14-30 ms a call)")
     ap.add_argument("--chunk6", type=positive_int, default=500,
                     help="6-point configurations per family and round; the table so far "
                          "goes to stderr after each round")
