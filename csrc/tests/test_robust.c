@@ -769,11 +769,13 @@ int main(void)
     upright_case();
     six_point_case();
     eigen_case();
-    linear17_case();
     status_case();
     large_case();
     mid_upright_case();
     two_stage_case();
+    /* (last: its draws from the shared generator leave the scenes of the
+     * cases above as they were) */
+    linear17_case();
     free(work);
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed != 0;
