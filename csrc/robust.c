@@ -259,12 +259,13 @@
 #define MINIMAL_SOLUTIONS_SIZE (12 * MCG_SIXPT_MAX_SOLUTIONS)
 /* draws of a 6-point sample before one with two cameras is given up */
 #define SAMPLE_TRIES 16
-/* The eigensolver sampler (MCG_SAMPLER_EIGEN, issue 21): EIGEN_M pairs, the
- * fewest that mcg_linear17 (its start rotation) solves; at most
- * EIGEN_ITERATIONS LM steps from it, and the no-motion trap below
- * EIGEN_TRAP of the start's travel -- the values of
- * mcgeom.estimators.eigensolver's own RANSAC sample (minimal_solutions). */
-#define EIGEN_M 17
+/* Pairs of a linear17 or eigensolver sample (MCG_SAMPLER_LINEAR17,
+ * MCG_SAMPLER_EIGEN): the fewest that mcg_linear17 solves. The eigensolver
+ * sampler (issue 21) takes at most EIGEN_ITERATIONS LM steps from
+ * linear17's rotation, with the no-motion trap below EIGEN_TRAP of the
+ * start's travel -- the values of mcgeom.estimators.eigensolver's own
+ * RANSAC sample (minimal_solutions). */
+#define PAIRS17 17
 #define EIGEN_ITERATIONS 100
 #define EIGEN_TRAP 1e-2
 
@@ -273,7 +274,7 @@
  * pairs: the solutions' 768 hold it, so the workspace did not grow) */
 static size_t sample_work_size(void)
 {
-    const size_t e = mcg_eigensolver_work_size(EIGEN_M);
+    const size_t e = mcg_eigensolver_work_size(PAIRS17);
     return e > MINIMAL_SOLUTIONS_SIZE ? e : MINIMAL_SOLUTIONS_SIZE;
 }
 
@@ -1480,7 +1481,7 @@ static int check_sampler(const mcg_robust_options *o)
            dot3(o->g2, o->g2) >= 1e-100;
 }
 
-/* m distinct pairs drawn uniformly into idx (m <= EIGEN_M, m <= n).
+/* m distinct pairs drawn uniformly into idx (m <= PAIRS17, m <= n).
  * `central`: 1 when all of them are intra-camera pairs of one camera (rays
  * from one centre: no metric scale, the solvers are degenerate there). */
 static void draw_distinct(ctx *c, int m, int *idx, int *central)
@@ -1660,7 +1661,7 @@ static double travel(const double R[9], const double t[3], const double g[3])
     return sqrt(dot3(v, v));
 }
 
-/* One eigensolver sample (MCG_SAMPLER_EIGEN): EIGEN_M distinct pairs drawn
+/* One eigensolver sample (MCG_SAMPLER_EIGEN): PAIRS17 distinct pairs drawn
  * uniformly (a central sample redrawn as in sample_minimal) -> the rotation
  * of mcg_linear17 without its refinement -> mcg_eigensolver from it (Kneip
  * and Li, "Efficient computation of relative pose for multi-camera
@@ -1676,33 +1677,33 @@ static double travel(const double R[9], const double t[3], const double g[3])
  * is c->msol (sample_work_size). */
 static int sample_eigen(ctx *c, const double *w)
 {
-    int idx[EIGEN_M], has_scale, has0, its, k, i, got;
-    double a1[3 * EIGEN_M], b1[3 * EIGEN_M], a2[3 * EIGEN_M], b2[3 * EIGEN_M];
+    int idx[PAIRS17], has_scale, has0, its, k, i, got;
+    double a1[3 * PAIRS17], b1[3 * PAIRS17], a2[3 * PAIRS17], b2[3 * PAIRS17];
     double R[9], t[3], R0[9], t0[3], g[3] = {0.0, 0.0, 0.0}, lmin;
     mcg_linear17_options lo;
     mcg_linear17_result lr;
-    if ((got = draw_sample(c, EIGEN_M, idx, a1, b1, a2, b2)) <= 0)
+    if ((got = draw_sample(c, PAIRS17, idx, a1, b1, a2, b2)) <= 0)
         return got;
     mcg_linear17_default_options(&lo);
     lo.refine = 0;
-    if (mcg_linear17(EIGEN_M, a1, b1, a2, b2, &lo, &lr) != MCG_OK ||
-        mcg_eigensolver(EIGEN_M, a1, b1, a2, b2, lr.R, EIGEN_ITERATIONS, R, t, &lmin,
+    if (mcg_linear17(PAIRS17, a1, b1, a2, b2, &lo, &lr) != MCG_OK ||
+        mcg_eigensolver(PAIRS17, a1, b1, a2, b2, lr.R, EIGEN_ITERATIONS, R, t, &lmin,
                         &has_scale, &its, c->msol, sample_work_size()) != MCG_OK ||
         !has_scale)
         return 0;
-    for (k = 0; k < EIGEN_M; k++)
+    for (k = 0; k < PAIRS17; k++)
         for (i = 0; i < 3; i++)
-            g[i] += (a1[3 * k + i] + a2[3 * k + i]) / (2.0 * EIGEN_M);
-    if (mcg_eigensolver(EIGEN_M, a1, b1, a2, b2, lr.R, 0, R0, t0, &lmin, &has0, &its, c->msol,
+            g[i] += (a1[3 * k + i] + a2[3 * k + i]) / (2.0 * PAIRS17);
+    if (mcg_eigensolver(PAIRS17, a1, b1, a2, b2, lr.R, 0, R0, t0, &lmin, &has0, &its, c->msol,
                         sample_work_size()) == MCG_OK &&
         has0 && travel(R, t, g) < EIGEN_TRAP * travel(R0, t0, g)) {
         memcpy(R, R0, sizeof R);
         memcpy(t, t0, sizeof t);
     }
-    return offer_solutions(c, R, t, 1, idx, a1, b1, a2, b2, EIGEN_M, w);
+    return offer_solutions(c, R, t, 1, idx, a1, b1, a2, b2, PAIRS17, w);
 }
 
-/* One linear 17-point sample (MCG_SAMPLER_LINEAR17): EIGEN_M distinct pairs
+/* One linear 17-point sample (MCG_SAMPLER_LINEAR17): PAIRS17 distinct pairs
  * drawn as sample_eigen's -> the motion of mcg_linear17 with its default
  * refinement (thesis ch. 8: the generalized essential matrix from the 17 x
  * 18 linear system, R by its constrained decomposition, t by the least
@@ -1719,20 +1720,20 @@ static int sample_eigen(ctx *c, const double *w)
  * (t_metric 0) gives no hypothesis. */
 static int sample_linear17(ctx *c, const double *w)
 {
-    int idx[EIGEN_M], got;
-    double a1[3 * EIGEN_M], b1[3 * EIGEN_M], a2[3 * EIGEN_M], b2[3 * EIGEN_M];
+    int idx[PAIRS17], got;
+    double a1[3 * PAIRS17], b1[3 * PAIRS17], a2[3 * PAIRS17], b2[3 * PAIRS17];
     const double *t;
     mcg_linear17_options lo;
     mcg_linear17_result lr;
-    if ((got = draw_sample(c, EIGEN_M, idx, a1, b1, a2, b2)) <= 0)
+    if ((got = draw_sample(c, PAIRS17, idx, a1, b1, a2, b2)) <= 0)
         return got;
     mcg_linear17_default_options(&lo);
-    if (mcg_linear17(EIGEN_M, a1, b1, a2, b2, &lo, &lr) != MCG_OK)
+    if (mcg_linear17(PAIRS17, a1, b1, a2, b2, &lo, &lr) != MCG_OK)
         return 0;
     t = lr.scale_observable ? lr.t : lr.t_metric;
     if (!(dot3(t, t) > 0.0))
         return 0;
-    return offer_solutions(c, lr.R, t, 1, idx, a1, b1, a2, b2, EIGEN_M, w);
+    return offer_solutions(c, lr.R, t, 1, idx, a1, b1, a2, b2, PAIRS17, w);
 }
 
 /* One sample of the options' sampler: the hypotheses offered, or -1 when
@@ -2363,11 +2364,11 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         return MCG_EINVAL;
     /* (the two-stage search counts central samples: REC_PAIRS) */
     c.records = c.central_m > 0;
-    c.sample_size = c.records                                ? c.central_m
-                    : c.opt.sampler == MCG_SAMPLER_UPRIGHT4 ? 4
+    c.sample_size = c.records                                   ? c.central_m
+                    : c.opt.sampler == MCG_SAMPLER_UPRIGHT4    ? 4
                     : c.opt.sampler == MCG_SAMPLER_EIGEN ||
-                            c.opt.sampler == MCG_SAMPLER_LINEAR17 ? EIGEN_M
-                                                            : 6;
+                      c.opt.sampler == MCG_SAMPLER_LINEAR17 ? PAIRS17
+                                                               : 6;
     res->sample_size = c.sample_size;
     if (c.records)
         setup_records(&c);

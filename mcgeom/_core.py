@@ -1277,6 +1277,10 @@ SAMPLER_NAMES = {
     "linear17": lib.MCG_SAMPLER_LINEAR17,
 }
 _SAMPLER_OF = {v: k for k, v in SAMPLER_NAMES.items()}
+#: the samplers that take central samples (5+1, the upright 3+1; "auto" may
+#: be 5+1), whose cameras must each have one centre: the others draw pairs
+#: of any cameras
+_CENTRAL_SAMPLERS = ("five_plus_one", "upright_four_point", "auto")
 
 #: why the search of :func:`robust_rig_motion` ended
 ROBUST_STOP_NAMES = {
@@ -1479,7 +1483,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                 raise ValueError("cam_axes contains NaN or inf")
             if cf is not None and not (np.isfinite(cf).all() and (cf > 0).all()):
                 raise ValueError("cam_focal must be finite and > 0 (pixels)")
-            if sampler not in ("six_point", "eigensolver", "linear17"):   # (central samples only)
+            if sampler in _CENTRAL_SAMPLERS:
                 _one_centre_error(rays, ids)
         _ray_error(st, "robust_rig_motion", rays)
     return _robust_result(res, mask, weights)

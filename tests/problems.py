@@ -66,7 +66,7 @@ rot_err = metrics.rotation_error  # angle (rad) between two rotations, accurate 
 def generic_outlier_problem(seed: int):
     """A generic 4-camera rig (random cameras), 150 correspondences, half of
     them cross-camera, 1e-4 rad noise, 20 % outliers, one fixed motion
-    (|t| 0.50 m): the RANSAC problem of the eigensolver's tests. Seed 3 has
+    (|t| 0.50 m): the RANSAC problem of the 17-pair C searches' tests. Seed 3 has
     16 camera pairs, two of them a single outlier each."""
     rng = np.random.default_rng(seed)
     rig = synth.generic_rig(4, rng)

@@ -49,36 +49,6 @@ def test_drives_ransac():
     assert np.degrees(rot_err(m.R, p.R)) < 0.05
 
 
-@pytest.mark.parametrize("seed", [2, 3])
-def test_drives_the_c_search_as_its_python_one(seed):
-    """robust.ransac runs the eigensolver's samples in the C entry point
-    (MCG_SAMPLER_EIGEN: 17 pairs -> linear17's rotation -> the eigensolver);
-    the Python driver of the same samples (strategy="minimal",
-    minimal_solutions) is the reference: both find the motion and agree.
-    Seed 3 has two camera pairs with one correspondence each, both outliers
-    (the Python driver's samples held them in every sample before
-    sample_across_cameras capped its rounds)."""
-    p = generic_outlier_problem(seed)
-    R, t = p.R, p.t
-    m = robust.ransac(p.rays, "eigensolver", threshold=1e-3, seed=0)
-    assert m.info["sampler"] == "eigensolver" and m.info["sample_size"] == 17
-    assert m.info["c_seconds"] > 0.0
-    assert np.degrees(rot_err(m.R, R)) < 0.02
-    assert np.linalg.norm(m.info["t_metric"] - t) < 0.02 * np.linalg.norm(t)
-    truth = p.inlier
-    assert np.mean(m.inliers[truth]) > 0.9 and np.mean(m.inliers[~truth]) < 0.1
-    ref = robust.ransac(p.rays, "eigensolver", threshold=1e-3, seed=0, strategy="minimal")
-    assert "c_seconds" not in ref.info
-    assert np.degrees(rot_err(m.R, ref.R)) < 0.01
-    assert np.mean(m.inliers == ref.inliers) > 0.97
-
-
-def test_c_search_needs_17_correspondences():
-    p = generic_outlier_problem(2)
-    with pytest.raises(ValueError, match="eigensolver needs at least 17"):
-        robust.ransac(p.rays.take(np.arange(16)), "eigensolver", threshold=1e-3)
-
-
 def test_bad_input():
     p = make("most-general", 0, n=30)
     with pytest.raises(ValueError, match="rotation_start"):

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import mcgeom
-from mcgeom import _core, robust
+from mcgeom import _core
 from mcgeom.experiments.bench.linear17_numpy import linear17_numpy
-from problems import KIND_SETUPS, generic_outlier_problem, make, rot_err
+from problems import KIND_SETUPS, make, rot_err
 
 EXPECTED_RANK = {"most-general": 17, "locally-central": 16, "axial": 16,
                  "locally-central-and-axial": 14}
@@ -199,28 +199,3 @@ def test_hot_path_constructors_make_the_dataclass_objects():
     assert type(got) is RigMotion and type(got.scale) is ScaleVerdict
     assert dataclasses.replace(got.scale) == got.scale
 
-
-@pytest.mark.parametrize("seed", [2, 3])
-def test_drives_the_c_search_as_its_python_one(seed):
-    """robust.ransac runs linear17's samples in the C entry point
-    (MCG_SAMPLER_LINEAR17: 17 pairs -> linear17's motion); the Python driver
-    of the same samples (strategy="minimal", the estimator's minimal solver)
-    is the reference: both find the motion and agree."""
-    p = generic_outlier_problem(seed)
-    m = robust.ransac(p.rays, "linear17", threshold=1e-3, seed=0)
-    assert m.info["sampler"] == "linear17" and m.info["sample_size"] == 17
-    assert m.info["c_seconds"] > 0.0
-    assert rot_err(m.R, p.R) < np.radians(0.02)
-    assert np.linalg.norm(m.info["t_metric"] - p.t) < 0.02 * np.linalg.norm(p.t)
-    truth = p.inlier
-    assert np.mean(m.inliers[truth]) > 0.9 and np.mean(m.inliers[~truth]) < 0.1
-    ref = robust.ransac(p.rays, "linear17", threshold=1e-3, seed=0, strategy="minimal")
-    assert "c_seconds" not in ref.info
-    assert rot_err(m.R, ref.R) < np.radians(0.01)
-    assert np.mean(m.inliers == ref.inliers) > 0.97
-
-
-def test_c_search_needs_17_correspondences():
-    p = generic_outlier_problem(2)
-    with pytest.raises(ValueError, match="linear17 needs at least 17"):
-        robust.ransac(p.rays.take(np.arange(16)), "linear17", threshold=1e-3)

@@ -9,7 +9,7 @@ import pytest
 from mcgeom import _core, robust, synth
 from mcgeom.observability import scale_profile
 from mcgeom.pixel_noise import camera_table, pixels_per_radian
-from problems import rot_err, turning_motion
+from problems import generic_outlier_problem, rot_err, turning_motion
 
 
 def _problem(seed, n=300, outliers=0.3, cross=0.2):
@@ -188,3 +188,35 @@ def test_c_path_names_a_camera_with_two_origins():
                        p.rays.cam2)
     with pytest.raises(ValueError, match="several different origins"):
         robust.ransac(bad, threshold=1.0, focal=pixels_per_radian(rig, p.rays))
+
+
+@pytest.mark.parametrize("method", ["eigensolver", "linear17"])
+@pytest.mark.parametrize("seed", [2, 3])
+def test_17_pair_c_search_as_its_python_one(method, seed):
+    """robust.ransac runs the 17-pair samples in the C entry point
+    (MCG_SAMPLER_EIGEN: 17 pairs -> linear17's rotation -> the eigensolver;
+    MCG_SAMPLER_LINEAR17: 17 pairs -> linear17's motion); the Python driver
+    of the same samples (strategy="minimal", the estimator's minimal solver)
+    is the reference: both find the motion and agree. Seed 3 has two camera
+    pairs with one correspondence each, both outliers (the Python driver's
+    samples held them in every sample before sample_across_cameras capped
+    its rounds)."""
+    p = generic_outlier_problem(seed)
+    m = robust.ransac(p.rays, method, threshold=1e-3, seed=0)
+    assert m.info["sampler"] == method and m.info["sample_size"] == 17
+    assert m.info["c_seconds"] > 0.0
+    assert np.degrees(rot_err(m.R, p.R)) < 0.02
+    assert np.linalg.norm(m.info["t_metric"] - p.t) < 0.02 * np.linalg.norm(p.t)
+    truth = p.inlier
+    assert np.mean(m.inliers[truth]) > 0.9 and np.mean(m.inliers[~truth]) < 0.1
+    ref = robust.ransac(p.rays, method, threshold=1e-3, seed=0, strategy="minimal")
+    assert "c_seconds" not in ref.info
+    assert np.degrees(rot_err(m.R, ref.R)) < 0.01
+    assert np.mean(m.inliers == ref.inliers) > 0.97
+
+
+@pytest.mark.parametrize("method", ["eigensolver", "linear17"])
+def test_17_pair_c_search_needs_17_correspondences(method):
+    p = generic_outlier_problem(2)
+    with pytest.raises(ValueError, match=f"{method} needs at least 17"):
+        robust.ransac(p.rays.take(np.arange(16)), method, threshold=1e-3)
