@@ -91,8 +91,11 @@ def _arr(name: str, a: Any, shape: tuple, check_finite: bool = True) -> np.ndarr
     return arr
 
 
-def _p(a: np.ndarray):
-    return ffi.from_buffer("double[]", a)
+#: ``_p(a)``: a ``double[]`` pointer to the float64 C-contiguous array ``a``
+#: (a partial, not a def: a C call without a Python frame; issue 19: the
+#: façade's call makes ~20 of them, a frame each cost ~0.5 us warm and more
+#: after other work)
+_p = functools.partial(ffi.from_buffer, "double[]")
 
 
 def _work(size: int) -> np.ndarray:

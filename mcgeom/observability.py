@@ -119,9 +119,10 @@ def scale_determined(rel_std: float, direction_only: bool = False,
     to trust it: observable only within ``max_rel_std``); when False, ``t``
     is a unit direction.
     """
-    if np.isfinite(zero_profile) and zero_profile < 9.0:
+    # (math on the scalars: numpy's scalar ufuncs cost more, on every estimate)
+    if math.isfinite(zero_profile) and zero_profile < 9.0:
         return False
-    return bool(not direction_only and np.isfinite(rel_std) and rel_std <= UNDETERMINED_REL_STD)
+    return bool(not direction_only and math.isfinite(rel_std) and rel_std <= UNDETERMINED_REL_STD)
 
 
 def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sigma2: float,

@@ -754,7 +754,7 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         # vector whose direction the data do not determine
         t = np.zeros(3)
     elif not verdict.observable:
-        nt = np.linalg.norm(t)
+        nt = math.hypot(*np.asarray(t, dtype=np.float64).tolist())
         # Slid out along the flat valley (|t| grew more than 10x: the cost
         # keeps falling towards |t| = infinity, the central-camera limit):
         # keep the robust hypothesis' length. A large drop is no such slide:
@@ -934,7 +934,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     # median (a partition of all N) is taken only then
     if focal is None:
         _check_threshold_angle(options.threshold, options.threshold, focal)
-    elif options.threshold > MAX_THRESHOLD_RAD * float(focal.min()):
+    elif options.threshold > MAX_THRESHOLD_RAD * float(np.minimum.reduce(focal)):
         _check_threshold_angle(options.threshold, options.threshold / float(np.median(focal)),
                                focal)
     seed = _c_seed(options)
@@ -989,7 +989,7 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
     """
     n = len(rays)
     if n <= 6 or options.strategy != "auto" or \
-            options.threshold > MAX_THRESHOLD_RAD * float(focal.min()):
+            options.threshold > MAX_THRESHOLD_RAD * float(np.minimum.reduce(focal)):
         return None
     gravity = _solver_gravity(method, solver_options or {})
     registry.check_distinct(rays, 6 if method == "auto" else C_SAMPLERS[method],
@@ -1048,9 +1048,11 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)
         used = out["used"]
         w = out["weights"][used]
-        # (w.max() == w.min(): np.ptp's Python layers cost more than its two passes)
+        # (the ufuncs' reduce: np.ptp's, ndarray.max's Python layers cost more
+        # than their passes)
         fit = (out["refinement"], used, out["loss_scale"],
-               None if focal is None or w.size == 0 or w.max() == w.min() else w)
+               None if focal is None or w.size == 0 or
+               np.maximum.reduce(w) == np.minimum.reduce(w) else w)
     # the RMS residual of the inliers and the verdict's evidence come from C
     # (no Python pass over the rays: issue 19)
     return _conclude(rays, R, t, None, inl, fit, out["loss_scale"],
