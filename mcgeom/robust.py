@@ -77,8 +77,9 @@ class RansacOptions:
     max_scale_rel_std: float = 0.1
     # "auto": the C entry point (csrc/robust.c) for the estimators whose
     # minimal solver it samples (C_SAMPLERS: five_plus_one,
-    # upright_four_point, six_point, eigensolver, linear17), else the estimator's proposer, else its
-    # minimal solver; "proposer" and "minimal" force the Python drivers below
+    # upright_four_point, six_point, eigensolver, linear17), else the
+    # estimator's proposer, else its minimal solver; "proposer" and "minimal"
+    # force the Python drivers below
     strategy: str = "auto"          # "auto" | "proposer" | "minimal"
     max_seconds: float = 0.0        # wall-time budget of the C search (0: none)
 
@@ -361,10 +362,11 @@ def ransac(rays: RayPairs, method: str = "five_plus_one", *,
 
     The methods of :data:`C_SAMPLERS` (``five_plus_one``,
     ``upright_four_point`` with ``solver_options={"gravity1": g1, "gravity2":
-    g2}``, ``six_point``, ``eigensolver``, ``linear17``) with ``strategy="auto"`` run as one call of the C
-    entry point ``mcg_robust_rig_motion`` (csrc/robust.c: the method's
-    minimal samples, MSAC, local optimisation, adaptive stop, final
-    refinement of all six degrees of freedom); the verdict stays here;
+    g2}``, ``six_point``, ``eigensolver``, ``linear17``) with
+    ``strategy="auto"`` run as one call of the C entry point
+    ``mcg_robust_rig_motion`` (csrc/robust.c: the method's minimal samples,
+    MSAC, local optimisation, adaptive stop, final refinement of all six
+    degrees of freedom); the verdict stays here;
     ``info["sampler"]`` names the minimal solver and ``info["sample_size"]``
     the pairs of its samples (5 for 5+1, 6 for the 6-point, 17 for the
     eigensolver and linear17; the upright

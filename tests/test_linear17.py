@@ -198,4 +198,3 @@ def test_hot_path_constructors_make_the_dataclass_objects():
     got = mcgeom.estimate(make("most-general", 0, n=40).rays, "linear17")
     assert type(got) is RigMotion and type(got.scale) is ScaleVerdict
     assert dataclasses.replace(got.scale) == got.scale
-

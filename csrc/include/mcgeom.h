@@ -1071,9 +1071,9 @@ enum {
                                  mcg_eigensolver (Kneip and Li 2014), its
                                  motion when it has a metric t; needs n >= 17 */
     MCG_SAMPLER_LINEAR17 = 5  /* 17 pairs not all of one camera -> the motion
-                                 of mcg_linear17 without its refinement (the
-                                 linear step of thesis ch. 8), when it has a
-                                 metric t; needs n >= 17 */
+                                 of mcg_linear17 with its default refinement
+                                 (thesis ch. 8), when it has a metric t;
+                                 needs n >= 17 */
 };
 
 /* mcg_robust_result.stop: why the search ended */
@@ -1156,10 +1156,10 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * origins hardly travels, from a start that clearly did, is the no-motion
  * trap of intra-camera rays: the start is kept), scored as the 6-point
  * solutions below (sample size 17); MCG_SAMPLER_LINEAR17 draws as
- * MCG_SAMPLER_EIGEN and scores the motion of mcg_linear17 itself (its
- * metric least-squares t, eq. 8.15, also where the sample alone does not
- * trust it: the search's consensus judges it; none when it is not
- * determined); MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
+ * MCG_SAMPLER_EIGEN and scores the motion of mcg_linear17 itself, refined
+ * to the sample's Sampson optimum (its metric t, eq. 8.15, also where the
+ * sample alone does not trust it: the search's consensus judges it; none
+ * when it is not determined); MCG_SAMPLER_6PT draws 6 distinct pairs uniformly,
  * redrawn when all six are intra-camera pairs of one camera (a central
  * camera: no metric scale) -> mcg_sixpt; every real solution that puts
  * its sample in front of the cameras and satisfies no pair trivially (e.g.

@@ -119,8 +119,8 @@ def in_mirrored_minimum(direction: np.ndarray, t: np.ndarray) -> bool:
     -0.54 m; a 5+1 t_metric 1.7 cm backwards on tests/test_refine.py's
     critical motion)."""
     # (on Python floats: numpy's calls on 3-vectors cost more, on every estimate)
-    (d0, d1, d2) = np.asarray(direction, float).reshape(3).tolist()
-    (t0, t1, t2) = np.asarray(t, float).reshape(3).tolist()
+    d0, d1, d2 = np.asarray(direction, float).reshape(3).tolist()
+    t0, t1, t2 = np.asarray(t, float).reshape(3).tolist()
     return d0 * t0 + d1 * t1 + d2 * t2 < -0.9 * math.hypot(t0, t1, t2)
 
 
