@@ -29,4 +29,21 @@ static inline double poly_eval(const double *p, int n, double x)
     return v;
 }
 
+/* p(x) and q(x) for p of degree n >= 1 and q of degree n - 1 (p and its
+ * derivative in a Newton step): the two Horner chains of poly_eval in one
+ * loop, so that their latencies overlap; each value is rounded exactly as
+ * poly_eval rounds it */
+static inline void poly_eval2(const double *p, const double *q, int n, double x, double *pv,
+                              double *qv)
+{
+    double v = p[n], w = q[n - 1];
+    int i;
+    for (i = n - 1; i >= 1; --i) {
+        v = v * x + p[i];
+        w = w * x + q[i - 1];
+    }
+    *pv = v * x + p[0];
+    *qv = w;
+}
+
 #endif /* MCGEOM_POLY_H */
