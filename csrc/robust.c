@@ -359,18 +359,20 @@ static size_t ints_as_doubles(size_t n) { return (n * sizeof(int) + sizeof(doubl
  * gathered subset (sub, wsub: 13 n doubles), which is dead while
  * mcg_scale_ransac runs (LO and the final stage gather it afresh; the
  * preemptive subset that lives in its tail exists only from PREEMPT_MIN),
- * and the search takes at most 13 n / 14 pairs so that its 14 doubles per
- * pair fit there; its pairs are indices into the input, not a copy
- * (issue 19: the peak memory of a call on 1e3 pairs was 3.1x, then 2.26x
- * its input, mostly these buffers). */
+ * and the search takes at most as many pairs as fit there (all of them
+ * since its workspace is 5 doubles per pair, 13 n / 14 when it was 14);
+ * its pairs are indices into the input, not a copy (issue 19: the peak
+ * memory of a call on 1e3 pairs was 3.1x, then 2.26x its input, mostly
+ * these buffers). */
 static int scale_work_aliased(int n) { return n < PREEMPT_MIN; }
 
 /* pairs of the scale search at most */
 static int scale_cap(int n)
 {
     int cap = n < SCALE_PAIRS ? n : SCALE_PAIRS;
-    if (scale_work_aliased(n) && cap > 13 * n / 14)
-        cap = 13 * n / 14;
+    const int fit = (int)(13 * (size_t)n / mcg_scale_ransac_work_size(1));
+    if (scale_work_aliased(n) && cap > fit)
+        cap = fit;
     return cap;
 }
 

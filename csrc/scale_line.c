@@ -11,9 +11,21 @@
  *             = A_k + 2 B_k lam + C_k lam^2      (P(v) = I - v v^T),
  *
  * both being affine in lam inside the norms, and the Sampson angular residual
- * is r_k(lam) = e / sqrt(D) (D summed from the two tangent vectors, not from
- * the expanded quadratic, which cancels where D is near 0; with the floors of mcg_gec_residuals: at most
- * pi/2 in size, 0 where e = D = 0).
+ * is r_k(lam) = e / sqrt(D) (with the floors of mcg_gec_residuals: at most
+ * pi/2 in size, 0 where e = D = 0). With g0, g1 the 6-vectors of the
+ * tangent parts [P(d2) (s x a); P(a) (d2 x s)] at lam = 0 and per unit lam,
+ * D = |g0 + lam g1|^2, and for lam >= 0 (every scale searched is positive)
+ *
+ *     D(lam)  = (|g0| - lam |g1|)^2 + 2 lam q,
+ *     q       = |g0| |g1| + g0 . g1 = |g0| |g1| |g0 / |g0| + g1 / |g1||^2 / 2,
+ *
+ * a sum of two terms >= 0: where D is near 0 (e.g. where the pair's camera
+ * centre stops moving) only q loses digits, in the sum of the unit vectors,
+ * as the direct sum |g0 + lam g1|^2 loses them in g0 + lam g1, whereas the
+ * expanded quadratic A + 2 B lam + C lam^2 cancels as a whole there. Three
+ * numbers per pair instead of g0 and g1's twelve (issue 19: the scoring's
+ * loads and arithmetic were most of the scale search, ~15 % of the C time
+ * of a robust estimate on the Ladybug case).
  * Each correspondence proposes lam = -a_k / b_k (eq. 7.4); proposals are
  * scored by MSAC over all correspondences in batches of 16 with the adaptive
  * stop of a 1-point sample, and the best is re-estimated by weighted least
@@ -33,9 +45,8 @@
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction */
 #define DEN_MIN 1e-300  /* floor of D(lam) in the least-squares weights */
 #define INV_HALF_PI2 0.40528473456935109 /* (2 / pi)^2 */
-/* terms per pair: a, b and the tangent gradients P(d2) g0, P(d2) g1,
- * P(a) k0, P(a) k1 (3 each) whose combinations at lam give D(lam) */
-#define NT 14
+/* terms per pair, each an array of n: a, b, |g0|, |g1| and q (see above) */
+#define NT 5
 
 size_t mcg_scale_ransac_work_size(int n)
 {
@@ -44,18 +55,11 @@ size_t mcg_scale_ransac_work_size(int n)
     return NT * (size_t)n;
 }
 
-/* D(lam) of pair k: |P(d2) (g0 + lam g1)|^2 + |P(a) (k0 + lam k1)|^2, summed
- * from the vectors (the expanded quadratic A + 2 B lam + C lam^2 cancels
- * where D is near 0, e.g. where the pair's camera centre stops moving) */
+/* D(lam) of pair k, lam >= 0 (terms in structure-of-arrays order) */
 static double den_at(const double *t, size_t n, size_t k, double lam)
 {
-    double d = 0.0;
-    int i;
-    for (i = 0; i < 6; i++) {
-        double v = t[(2 + i) * n + k] + lam * t[(8 + i) * n + k];
-        d += v * v;
-    }
-    return d;
+    double u = t[2 * n + k] - lam * t[3 * n + k];
+    return u * u + 2.0 * lam * t[4 * n + k];
 }
 
 /* squared residual of pair k at lam (terms in structure-of-arrays order):
@@ -112,8 +116,8 @@ static double msac_bounded(const double *t, size_t n, double lam, double thr2, d
     return s;
 }
 
-/* the terms a, b, A, B, C of every pair (see the file comment); 0 on a NaN,
- * inf, zero direction or overflow */
+/* the terms a, b, |g0|, |g1|, q of every pair (see the file comment); 0 on a
+ * NaN, inf, zero direction or overflow */
 MCG_AVX2_CLONE
 static int terms(size_t n, const int *idx, const double *o1, const double *d1,
                  const double *o2, const double *d2, const double R[9], const double t0[3],
@@ -126,7 +130,8 @@ static int terms(size_t n, const int *idx, const double *o1, const double *d1,
         const double *p1 = o1 + q, *u1 = d1 + q, *p2 = o2 + q, *u2 = d2 + q;
         double n1 = dot3(u1, u1);
         double n2 = dot3(u2, u2);
-        double a[3], b[3], s[3], g0[3], g1[3], k0[3], k1[3], x;
+        double a[3], b[3], s[3], g0[3], g1[3], k0[3], k1[3], x, v0[6], v1[6];
+        double s0 = 0.0, s1 = 0.0, c = 0.0, p01;
         if (!(n1 >= DIR2_MIN && n2 >= DIR2_MIN) || !isfinite(n1) || !isfinite(n2))
             return 0;
         n1 = 1.0 / sqrt(n1);
@@ -149,19 +154,35 @@ static int terms(size_t n, const int *idx, const double *o1, const double *d1,
             double q1 = dot3(a, k1);
             t[k] = e0;
             t[n + k] = e1;
-            x = e0 + e1;
+            /* the tangent parts P(d2) g and P(a) k: lam-free (v0) and lam
+             * (v1) 6-vectors */
             for (i = 0; i < 3; i++) {
-                /* tangent parts P(d2) g and P(a) k, lam-free and lam parts */
-                t[(2 + i) * n + k] = g0[i] - e0 * b[i];
-                t[(5 + i) * n + k] = k0[i] - q0 * a[i];
-                t[(8 + i) * n + k] = g1[i] - e1 * b[i];
-                t[(11 + i) * n + k] = k1[i] - q1 * a[i];
-                x += t[(2 + i) * n + k] + t[(5 + i) * n + k] + t[(8 + i) * n + k] +
-                     t[(11 + i) * n + k];
+                v0[i] = g0[i] - e0 * b[i];
+                v0[3 + i] = k0[i] - q0 * a[i];
+                v1[i] = g1[i] - e1 * b[i];
+                v1[3 + i] = k1[i] - q1 * a[i];
             }
-            if (!isfinite(x))
-                return 0;
         }
+        for (i = 0; i < 6; i++) {
+            s0 += v0[i] * v0[i];
+            s1 += v1[i] * v1[i];
+        }
+        s0 = sqrt(s0);
+        s1 = sqrt(s1);
+        /* q = |v0| |v1| |v0 / |v0| + v1 / |v1||^2 / 2
+         *   = ||v1| v0 + |v0| v1|^2 / (2 |v0| |v1|), 0 when either is 0 */
+        for (i = 0; i < 6; i++) {
+            double h = s1 * v0[i] + s0 * v1[i];
+            c += h * h;
+        }
+        p01 = s0 * s1;
+        c = p01 > 0.0 ? 0.5 * c / p01 : 0.0;
+        t[2 * n + k] = s0;
+        t[3 * n + k] = s1;
+        t[4 * n + k] = c;
+        x = t[k] + t[n + k] + s0 + s1 + c;
+        if (!isfinite(x))
+            return 0;
     }
     return 1;
 }

@@ -844,7 +844,7 @@ int mcg_skyline_eig(int n, const int *first, const int *ptr, const double *a,
 
 /* ------------------------------------------------------------ scale_line.c */
 
-/* Doubles of workspace for mcg_scale_ransac: 14 n (0 for n outside [1, 2^26]). */
+/* Doubles of workspace for mcg_scale_ransac: 5 n (0 for n outside [1, 2^26]). */
 size_t mcg_scale_ransac_work_size(int n);
 
 /* The metric scale of the 5+1 method (thesis ch. 7.4) by 1-point RANSAC.

@@ -79,7 +79,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         prob = fz_range(&in, 0.5, 0.9999);
     }
     lwork = mcg_scale_ransac_work_size(n);
-    FZ_CHECK(lwork == 14 * (size_t)n, "work size %zu for n = %d", lwork, n);
+    FZ_CHECK(lwork == 5 * (size_t)n, "work size %zu for n = %d", lwork, n);
     if (fz_u8(&in) % 16 == 0)
         lwork -= 1;
     work = fz_alloc(lwork);
@@ -101,7 +101,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(st == MCG_EINVAL, "scale_ransac of non-finite input: %d", st);
         return 0;
     }
-    if (lwork < 14 * (size_t)n) {
+    if (lwork < mcg_scale_ransac_work_size(n)) {
         FZ_CHECK(st == MCG_ENOMEM || st == MCG_EINVAL, "short workspace: %d", st);
         return 0;
     }
