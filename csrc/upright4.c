@@ -63,7 +63,7 @@
 #define DIR2_MIN 1e-100 /* smallest squared length of a direction or gravity */
 
 /* ---------------------------------------------------------- polynomials
- * (poly_mul, poly_eval: poly.h) */
+ * (poly_mul, poly_eval, poly_eval2: poly.h) */
 
 /* Real roots by Sturm's theorem. The Sturm chain s_0 = a, s_1 = a',
  * s_{k+1} = -rem(s_{k-1}, s_k) (each divided by a positive factor, which
@@ -171,7 +171,8 @@ static double bracket_root(const double *a, const double *da, int n, double lo, 
     if (!(x > lo && x < hi))
         x = 0.5 * (lo + hi);
     for (it = 0; it < 100; ++it) {
-        double f = poly_eval(a, n, x), df = poly_eval(da, n - 1, x), xn;
+        double f, df, xn;
+        poly_eval2(a, da, n, x, &f, &df);
         if (f == 0.0)
             return x;
         if ((f < 0.0) == (flo < 0.0))
