@@ -255,6 +255,29 @@
  * instead of counted, ring4 took 3.32 M against 3.05 M. */
 #define REC_PAIRS 64
 #define REC_PROPOSALS 16
+/* Pairs of a record's scale search at most (a random subset beyond; the
+ * cap of the others is scale_cap): a record is a candidate whose sixth pair
+ * failed, and the scale found for it only has to make it win the MSAC over
+ * all pairs, after which its local optimisation and the final refinement
+ * on all inliers set the motion; a search of a new best keeps scale_cap.
+ * Records make most of the searches (43 of 46 on 10 problems of the scaling
+ * bench at 1e3 pairs), each on every pair of the other cameras up to
+ * SCALE_PAIRS: 250 on the Ladybug head, 280 on the car rig. Issue 19,
+ * measured with 128: C instructions per estimate (callgrind, 40 problems of
+ * each `mcgeom bench robust` case) ring4 2.51 -> 2.42 M, Ladybug 5.46 ->
+ * 4.95 M, car8 3.83 -> 3.64 M (64: 2.35 / 4.75 / 3.44 M); `mcgeom bench
+ * robust` (300 problems a case): cold median ms 1.03 / 1.72 / 1.27 ->
+ * 0.97 / 1.61 / 1.18, median rotation error 0.0164 / 0.0179 / 0.0094 ->
+ * 0.0164 / 0.0176 / 0.0094 deg, scale error 0.0270 / 0.160 / 0.180 ->
+ * 0.0273 / 0.157 / 0.179; 60 problems of the scaling bench's ring at 1e3
+ * pairs: 9.13 -> 7.82 M (median rotation error 0.0118 -> 0.0117 deg, scale
+ * error 0.0228 -> 0.0199); `mcgeom experiment ch7 --trials 1200 --seed 10
+ * --cross 0 0.1 0.3`: no estimate more than 30 % off called observable
+ * (0 / 0 / 0, as before); observable 0 / 1198 / 1198 -> 0 / 1198 / 1200,
+ * more than 30 % off 728 / 2 / 2 -> 736 / 2 / 0, median scale error of the
+ * observable 0.00468 / 0.00285 -> 0.00467 / 0.00284 (the searches now
+ * shuffle the identity, not the last order: the same distribution). */
+#define REC_SCALE_PAIRS 128
 /* doubles of the solutions of one upright or 6-point sample (R and t) */
 #define MINIMAL_SOLUTIONS_SIZE (12 * MCG_SIXPT_MAX_SOLUTIONS)
 /* draws of a 6-point sample before one with two cameras is given up */
@@ -820,29 +843,32 @@ static void local_optimise_held(ctx *c, const double *w, int hold)
 
 static void local_optimise(ctx *c, const double *w) { local_optimise_held(c, w, 1); }
 
-static int gather_others(ctx *c, int a);
+static int gather_others(ctx *c, int a, int cap);
 static int unit3(const double *v, double u[3]);
 static int depths(const double a[3], const double b[3], const double p[3], double *s1,
                   double *s2);
 
-/* The 1-point scale search (thesis ch. 7.4, mcg_scale_ransac on the pairs
- * gathered in xidx) for the motion (R, t0 + lam u) on the line t0 + lam' u:
+/* The 1-point scale search (thesis ch. 7.4, mcg_scale_ransac on the first m
+ * pairs gathered in xidx) for the motion (R, t0 + lam u) on the line t0 + lam' u:
  * 1 and *lam2 when it found a scale other than lam and not the trivial
  * root lam' = 0 of pairs whose cameras sit at the line's fixed point (a
  * central rig: every F vanishes there, a zero-residual false consensus),
  * found up to rounding. */
-static int line_scale(ctx *c, const double R[9], const double t0[3], const double u[3],
-                      double lam, int proposals, double prob, double *lam2)
+static int line_scale(ctx *c, int m, const double R[9], const double t0[3],
+                      const double u[3], double lam, int proposals, double prob,
+                      double *lam2)
 {
     double sc2;
     int j;
-    for (j = 0; j < c->nx; j++) { /* a fresh random order of the proposals */
-        int r = j + rng_below(&c->rng, c->nx - j), tmp = c->xorder[j];
+    for (j = 0; j < m; j++)
+        c->xorder[j] = j;
+    for (j = 0; j < m; j++) { /* a fresh random order of the proposals */
+        int r = j + rng_below(&c->rng, m - j), tmp = c->xorder[j];
         c->xorder[j] = c->xorder[r];
         c->xorder[r] = tmp;
     }
-    return mcg_scale_ransac_indexed(c->nx, c->xidx, c->o1, c->d1, c->o2, c->d2, R, t0, u,
-                                    c->nx, c->xorder, proposals, c->loss_scale,
+    return mcg_scale_ransac_indexed(m, c->xidx, c->o1, c->d1, c->o2, c->d2, R, t0, u, m,
+                                    c->xorder, proposals, c->loss_scale,
                                     prob, lam2, &sc2, NULL, c->xwork) == MCG_OK &&
            *lam2 != lam && *lam2 > 1e-9 * (c->size + sqrt(dot3(t0, t0)));
 }
@@ -901,16 +927,16 @@ static int pair_in_front(const double R[9], const double t[3], const double *o1,
     return s1 > 0.0 && s2 > 0.0;
 }
 
-/* Are most of the scale search's pairs that (R, t) explains (residual
+/* Are most of the scale search's m pairs that (R, t) explains (residual
  * within the threshold) in front of both their rays? The sixth pair of a
  * 5+1 sample is checked so (candidate); a scale searched for a motion the
  * sixth did not make the best (record) must pass the same test on the
  * pairs that gave it (a wrong 5-point root has a scale that puts them
  * behind: on 6 noise-free pairs it fits them exactly). */
-static int scale_in_front(const ctx *c, const double R[9], const double t[3])
+static int scale_in_front(const ctx *c, int m, const double R[9], const double t[3])
 {
     int j, front = 0, behind = 0;
-    for (j = 0; j < c->nx; j++) {
+    for (j = 0; j < m; j++) {
         const size_t k = (size_t)c->xidx[j];
         int f;
         if (!(pair_residual(c, R, t, k) < c->opt.threshold))
@@ -923,22 +949,28 @@ static int scale_in_front(const ctx *c, const double R[9], const double t[3])
 }
 
 /* The scale search of a new best (R, t0 + lam u) on camera a's line (see
- * offer), or of a record (from_record: REC_PROPOSALS, its scale's pairs in
- * front, scored on the preemptive subset first): the motion it finds
- * becomes the best if it scores better; 1 when it did. */
+ * offer), or of a record (from_record: REC_PROPOSALS on at most
+ * REC_SCALE_PAIRS pairs, its scale's pairs in front, scored on the
+ * preemptive subset first): the motion it finds becomes the best if it
+ * scores better; 1 when it did. */
 static int scale_search(ctx *c, const double R[9], const double t0[3], const double u[3],
                         double lam, int a, int from_record)
 {
     double sc, t[3], lam2, bound = c->have ? c->score : INFINITY;
-    int n_inl = 0, n_wide = 0, i, took = 0;
-    if (c->nx > 0 || (a >= 0 && gather_others(c, a) > 0)) {
-        if (line_scale(c, R, t0, u, lam, from_record ? REC_PROPOSALS : SCALE_PROPOSALS,
+    int n_inl = 0, n_wide = 0, i, took = 0, m, cap = scale_cap(c->n);
+    if (from_record && cap > REC_SCALE_PAIRS)
+        cap = REC_SCALE_PAIRS;
+    if (c->nx > 0 || (a >= 0 && gather_others(c, a, cap) > 0)) {
+        /* (the cross-camera pairs are a random subset of all of them in a
+         * random order: any prefix is one too) */
+        m = c->nx < cap ? c->nx : cap;
+        if (line_scale(c, m, R, t0, u, lam, from_record ? REC_PROPOSALS : SCALE_PROPOSALS,
                        c->opt.prob, &lam2)) {
             for (i = 0; i < 3; i++)
                 t[i] = t0[i] + lam2 * u[i];
             /* (a record's motion is first scored on the preemptive subset,
              * as offer's are: at 1e6 pairs a full score costs ~6 ms) */
-            if (!from_record || (scale_in_front(c, R, t) && !preempted(c, R, t))) {
+            if (!from_record || (scale_in_front(c, m, R, t) && !preempted(c, R, t))) {
                 c->n_hyp++;
                 sc = msac2(c, R, t, bound, &n_inl, &n_wide);
                 if (sc < bound) {
@@ -1099,7 +1131,7 @@ static int final_scale_search(ctx *c, const double cen[3], const double *w)
          * called observable 7 -> 1, more than 30 % off 833 -> 784. (Only
          * for this sampler: 5+1's scale comes from its scale search on
          * the other cameras' pairs at every new best.) */
-        if (c->opt.sampler != MCG_SAMPLER_UPRIGHT4 || gather_others(c, -1) <= 0)
+        if (c->opt.sampler != MCG_SAMPLER_UPRIGHT4 || gather_others(c, -1, scale_cap(c->n)) <= 0)
             return 0;
         others = 1;
     }
@@ -1110,7 +1142,8 @@ static int final_scale_search(ctx *c, const double cen[3], const double *w)
     }
     lam = sqrt(dot3(u, u));
     memcpy(R0, c->R, sizeof R0);
-    i = lam > 0.0 && unit3(u, u) && line_scale(c, R0, t0, u, lam, SCALE_PROPOSALS, 1.0, &lam2);
+    i = lam > 0.0 && unit3(u, u) &&
+        line_scale(c, c->nx, R0, t0, u, lam, SCALE_PROPOSALS, 1.0, &lam2);
     if (others)
         c->nx = c->nx_others = 0; /* (that set was for this search only) */
     if (!i || !(fabs(lam2 - lam) > FINAL_SCALE_JUMP * lam))
@@ -1160,13 +1193,12 @@ static void gather_cross(ctx *c)
 }
 
 /* The pairs of the scale search when there are few cross-camera pairs: up
- * to scale_cap of those not of camera a (each kept with probability
- * cap / their count), gathered for one search. */
-static int gather_others(ctx *c, int a)
+ * to cap (at most scale_cap) of those not of camera a (each kept with
+ * probability cap / their count), gathered for one search. */
+static int gather_others(ctx *c, int a, int cap)
 {
     int start = a >= 0 ? c->off[a] : 0, cnt = a >= 0 ? c->off[a + 1] - start : 0;
     int nother = c->n - cnt, j, m = 0;
-    int cap = scale_cap(c->n);
     uint64_t cut = nother > cap ? (uint64_t)((double)cap / nother * 18446744073709551615.0)
                                 : UINT64_MAX;
     if (nother < 1)
