@@ -73,7 +73,9 @@ static int unit(const double *v, double u[3])
 
 /* Inliers in front at each of the nt translations T (nt x 3), in one pass
  * (R d1 and d2 as they are): the translation enters the mid-point depths
- * only through a.w and b.w, w = o2 - R o1 - T, affine in T. */
+ * only through a.w and b.w, w = o2 - R o1 - T, affine in T. The depths are
+ * s1 = (aw bb - bw ab) / den and s2 = (aw ab - bw aa) / den with den > 0:
+ * their signs are those of the numerators (no division; issue 19). */
 static void count_front(int n, const double *o1, const double *d1, const double *o2,
                         const double *d2, const unsigned char *inlier, const double R[9],
                         const double *T, int nt, int *count)
@@ -100,8 +102,7 @@ static void count_front(int n, const double *o1, const double *d1, const double 
         bw0 = dot3(b, w);
         for (j = 0; j < nt; ++j) {
             const double aw = aw0 - dot3(a, T + 3 * j), bw = bw0 - dot3(b, T + 3 * j);
-            const double s1 = (aw * bb - bw * ab) / den, s2 = (aw * ab - bw * aa) / den;
-            count[j] += s1 > 0.0 && s2 > 0.0;
+            count[j] += aw * bb - bw * ab > 0.0 && aw * ab - bw * aa > 0.0;
         }
     }
 }
