@@ -457,7 +457,7 @@ typedef struct {
     int central_m;   /* pairs of a central sample: 5 (5+1), 3 (upright 3+1), 0 */
     int *xidx;       /* the scale search's pairs (indices of the input) */
     double *xwork;   /* its mcg_scale_ransac workspace */
-    int *xorder;     /* its proposal order */
+    int *xorder;     /* its proposal order (line_scale draws it afresh) */
     double *msol;    /* the solutions of an upright / 6-point sample */
     double *vwork;   /* mcg_verdict_stats's workspace */
     /* the two-stage 5+1 (REC_PAIRS): on when records is 1 */
@@ -1187,7 +1187,6 @@ static void gather_cross(ctx *c)
         c->perm[g0 + j] = c->perm[g0 + r];
         c->perm[g0 + r] = tmp;
         c->xidx[j] = c->perm[g0 + j];
-        c->xorder[j] = j;
     }
     c->nx = take;
 }
@@ -1208,9 +1207,7 @@ static int gather_others(ctx *c, int a, int cap)
             continue;
         if (cut != UINT64_MAX && rng_next(&c->rng) > cut)
             continue;
-        c->xidx[m] = c->perm[j];
-        c->xorder[m] = m;
-        m++;
+        c->xidx[m++] = c->perm[j];
     }
     if (m == 0)
         return 0;
