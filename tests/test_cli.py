@@ -205,7 +205,7 @@ def test_methods_fits_the_terminal_and_keeps_commands_whole(capsys):
     assert cli.main(["methods"]) == 0
     out = capsys.readouterr().out
     assert all(len(line) <= 100 for line in out.splitlines())
-    assert "mcgeom experiment peer_solvers --part ransac --outliers 0.3 0.5 0.6" in out
+    assert "mcgeom experiment peer_solvers --part ransac --outliers 0 0.3 0.5 0.6" in out
     assert "upright_four_point  when a vertical prior is passed" in out
     assert "\0" not in out
 
