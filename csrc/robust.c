@@ -1181,10 +1181,11 @@ static int final_scale_search(ctx *c, const double cen[3], const double *w)
          * right scale by itself (car rig turning, vertical 0.2 deg off:
          * the search's |t| 0.1-33 m, the truth ~1 m, after the free
          * optimisation 0.8-1.5 m in 34 of 34 jumps; the jump's own
-         * optimisation ended within a few % of it, its MSAC score within
-         * 0.5 %). So the line is searched again at the free optimum, and
-         * the jump is optimised only if its scale still lies elsewhere:
-         * one line search instead of a local optimisation in most jumps
+         * optimisation ended within 10 % of it in 33, its MSAC score
+         * within 0.5 % in all). So the line is searched again at the free
+         * optimum, and the jump is optimised only if its scale still lies
+         * elsewhere: one line search instead of a local optimisation in
+         * most jumps
          * (there: 68 -> 37 local optimisations in 73 searches, 4 jumps
          * left). C instructions per estimate, 40 problems of each upright
          * case of `mcgeom experiment peer_solvers`: car rig turning 4.75
