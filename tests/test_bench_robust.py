@@ -45,6 +45,15 @@ def test_bench_robust_command_prints_both_ratios(capsys):
 
 
 
+def test_bench_robust_prints_the_cost_fit_over_sizes(capsys):
+    pytest.importorskip("poselib")
+    assert cli.main(["bench", "robust", "--problems", "2", "--sizes", "1000,3000"]) == 0
+    out = capsys.readouterr().out
+    assert "largest / smallest median" in out
+    fit = next(line for line in out.splitlines() if line.startswith("fit of the medians"))
+    assert "us x N, within" in fit and "of the time at N = 1000" in fit
+
+
 def test_scaling_rows_are_medians_over_several_problems():
     from mcgeom.experiments.bench.robust import _scaling_problems, bench_scaling
     assert _scaling_problems(1000) == 15 and _scaling_problems(10 ** 6) == 3
@@ -55,6 +64,23 @@ def test_scaling_rows_are_medians_over_several_problems():
         assert 0 < r.us_per_corr_min <= r.us_per_corr <= r.us_per_corr_max
         assert r.seconds == pytest.approx(r.us_per_corr * n / 1e6)
         assert 0 < r.c_seconds < r.seconds and r.peak_mb > 0 and r.rot_deg < 0.5
+
+
+def test_fixed_and_marginal_cost_fit():
+    """The model seconds = fixed + marginal N is recovered from exact rows
+    (across three decades, where an unweighted fit would ignore the
+    smallest), and refused on one size."""
+    from mcgeom.experiments.bench.robust import ScaleRow, fixed_and_marginal
+    rows = [ScaleRow(n, 1.8e-3 + 0.6e-6 * n, 0.0, 0.0, 1.0, 0.0, 0.8)
+            for n in (1000, 10000, 100000, 1000000)]
+    fixed, marginal = fixed_and_marginal(rows)
+    assert fixed == pytest.approx(1.8e-3, rel=1e-9) and marginal == pytest.approx(0.6e-6, rel=1e-9)
+    # a noisy smallest size moves the fixed part, not the marginal cost, much
+    rows[0] = ScaleRow(1000, 1.1 * rows[0].seconds, 0.0, 0.0, 1.0, 0.0, 0.8)
+    fixed, marginal = fixed_and_marginal(rows)
+    assert 1.8e-3 < fixed < 2.2e-3 and marginal == pytest.approx(0.6e-6, rel=0.05)
+    with pytest.raises(ValueError, match="two sizes"):
+        fixed_and_marginal(rows[:1])
 
 
 def test_ratio_interval_brackets_the_ratio_of_medians():

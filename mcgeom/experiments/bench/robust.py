@@ -61,7 +61,7 @@ from __future__ import annotations
 import time
 import tracemalloc
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -251,6 +251,23 @@ def _big_problem(n: int, rng: np.random.Generator, outliers: float = 0.2):
     o = np.ascontiguousarray(centres[cam])
     rays = RayPairs(o, np.ascontiguousarray(d1), o.copy(), np.ascontiguousarray(d2), cam, cam)
     return rays, R, t
+
+
+def fixed_and_marginal(rows: Sequence[ScaleRow]) -> tuple[float, float]:
+    """The cost model ``seconds = fixed + marginal * N`` fitted to the median
+    times of the scaling rows (least squares of the relative errors, so that
+    1e3 counts as much as 1e6): ``(fixed seconds, marginal seconds per
+    correspondence)``. A cost per correspondence that falls with N is the
+    fixed part (the samples, local optimisations and final refinement, whose
+    number does not grow with N) spread over more correspondences: at N the
+    cost per correspondence is ``marginal + fixed / N``. Needs two sizes."""
+    if len({r.n for r in rows}) < 2:
+        raise ValueError("the fit needs rows of at least two sizes")
+    T = np.array([r.seconds for r in rows])
+    N = np.array([float(r.n) for r in rows])
+    (fixed, marginal), *_ = np.linalg.lstsq(np.stack([1.0 / T, N / T], axis=1),
+                                            np.ones(len(rows)), rcond=None)
+    return float(fixed), float(marginal)
 
 
 def _scaling_problems(n: int) -> int:
