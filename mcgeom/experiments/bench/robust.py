@@ -53,7 +53,9 @@ ring with 20 % outliers (rays in, :func:`mcgeom.robust.ransac`): seconds,
 microseconds per correspondence, and the peak memory allocated during the
 call (``tracemalloc``: numpy's buffers and the C workspace, which _core
 allocates with numpy) against the size of the input arrays, and the share of
-the time inside the C entry point (``info["c_seconds"]``).
+the time inside the C entry point (``info["c_seconds"]``); then the fit of
+the medians to a fixed cost per estimate plus a cost per correspondence
+(:func:`fixed_and_marginal`).
 """
 
 from __future__ import annotations
