@@ -1357,7 +1357,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                       max_scale_rel_std: float = 0.0, sampler: str = "five_plus_one",
                       gravity1: Any = None, gravity2: Any = None,
                       verdict_still_factor: float = 0.0,
-                      prechecked: bool = False) -> Optional[dict]:
+                      prechecked: bool = False,
+                      search_info: Optional[dict] = None) -> Optional[dict]:
     """The whole robust estimate in C (``mcg_robust_rig_motion``).
 
     Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins the
@@ -1382,8 +1383,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     eigensolver from linear17's rotation; at least 17 pairs, else None) or
     ``linear17`` (17 pairs: linear17's motion; at least 17 pairs, else None).
 
-    Returns None when no motion explains 6 correspondences (degenerate data),
-    else a dict: ``R`` (3, 3), ``t`` (3,) (metres, metric only if the verdict
+    Returns None when no motion explains 6 correspondences (degenerate data,
+    or a search that ended before it drew a sample of inliers; a dict passed
+    as ``search_info`` then receives ``iterations``, ``hypotheses``, ``stop``
+    and ``sample_size`` of that search), else a dict: ``R`` (3, 3), ``t`` (3,) (metres, metric only if the verdict
     says so), ``t_hypothesis`` (the best 5+1 hypothesis' t before the final
     refinement), ``inliers`` and ``used`` (N,) bool (``|r| < threshold`` at
     (R, t); the pairs of the final refinement), ``weights`` (N,) of the final
@@ -1476,6 +1479,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
         int(n_cameras), f_ptr, ax_ptr, cf_ptr, opt, res, ffi.from_buffer("unsigned char[]", mask),
         _p(weights), _p(work), work.size)
     if st == lib.MCG_EDEGENERATE:
+        if search_info is not None:
+            search_info.update(iterations=res.iterations, hypotheses=res.hypotheses,
+                               stop=ROBUST_STOP_NAMES.get(res.stop, "unknown"),
+                               sample_size=res.sample_size)
         return None
     if st != lib.MCG_OK:
         if st == lib.MCG_EINVAL:

@@ -479,8 +479,11 @@ def _ransac(rays: RayPairs, method: str, options: RansacOptions, focal: Any,
     if not use_proposer:
         iterations += _run_minimal(info_est, rays, scorer, options, rng, solver_options or {})
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
+        ended = {"iterations": iterations, "hypotheses": scorer.n_hyp,
+                 "stop": "max_iterations" if iterations >= options.max_iters else "confidence",
+                 "sample_size": info_est.min_sample}
         return _nothing_found(rays, scorer, options, method, t_start, max(6, info_est.min_sample),
-                              f" ({scorer.n_hyp} hypotheses from {iterations} samples)")
+                              f" ({scorer.n_hyp} hypotheses from {iterations} samples)", ended)
     return _finish(rays, scorer, options, method, iterations, t_start, calibration_std)
 
 
@@ -537,17 +540,41 @@ def _threshold_too_small(rays: RayPairs, scorer: "_Scorer", options: RansacOptio
 
 
 def _nothing_found(rays: RayPairs, scorer: "_Scorer", options: RansacOptions, method: str,
-                   t_start: float, need: int, counts: str) -> RigMotion:
+                   t_start: float, need: int, counts: str,
+                   ended: Optional[dict] = None) -> RigMotion:
     """No motion explains ``need`` correspondences: a static rig or pure
-    rotation (:func:`_no_translation`), else DegenerateError."""
+    rotation (:func:`_no_translation`), else DegenerateError; ``ended`` (how
+    the search ended: ``iterations``, ``hypotheses``, ``stop``,
+    ``sample_size``) names its cap when the cap ended it."""
     still = _no_translation(rays, scorer, options, method, t_start)
     if still is not None:
         return still
     _threshold_too_small(rays, scorer, options, method, need)
+    if ended and ended.get("stop") in ("max_iterations", "max_seconds"):
+        raise DegenerateError(_capped_message(rays, method, need, ended))
     raise DegenerateError(f"{method}: no motion found that explains at least {need} "
                           f"correspondences{counts}: degenerate data (e.g. points collinear or "
                           f"coplanar in every camera, or too few correspondences per camera: "
                           f"{_per_camera(rays)})")
+
+
+def _capped_message(rays: RayPairs, method: str, need: int, ended: dict) -> str:
+    """The error of a search that its cap ended with no consensus: the data
+    may be degenerate, or no sample drawn was all inliers (issue 21: 17-pair
+    samples at 40 % outliers are, once in ~6,000 draws; the message blamed
+    the data alone)."""
+    k, m, h = int(ended["iterations"]), int(ended["sample_size"]), int(ended["hypotheses"])
+    cap = ("its time limit (max_seconds)" if ended["stop"] == "max_seconds" else
+           "its sample cap (maxIters of mcgeom.cv.estimate, max_iters of mcgeom.robust.ransac)")
+    return (f"{method}: no motion found that explains at least {need} correspondences after "
+            f"{k} sample{'' if k == 1 else 's'} ({h} hypothes{'is' if h == 1 else 'es'}): the "
+            f"search reached {cap}. Either no sample was all inliers -- at an inlier fraction "
+            f"w a sample of this sampler is with probability w^{m}: once in "
+            f"{1 / 0.7 ** m:,.0f} draws at 30 % outliers, once in {1 / 0.5 ** m:,.0f} at "
+            f"50 % -- then raise the cap, or use a sampler with smaller samples where the "
+            f"data allow one (the default method picks 5+1, the upright or the 6-point "
+            f"sampler); or the data are degenerate (e.g. points collinear or coplanar in "
+            f"every camera; {_per_camera(rays)})")
 
 
 def _per_camera(rays: RayPairs) -> str:
@@ -944,14 +971,16 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     prechecked = ids32 and (focal is None or focal.flags.c_contiguous) and \
         (pixel_cameras is None or from_rig)
 
-    def search(threshold: float, refine: bool) -> Optional[dict]:
+    def search(threshold: float, refine: bool, ended: Optional[dict] = None) -> Optional[dict]:
         return _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
-                         threshold, refine, method, seed, prechecked, gravity)
+                         threshold, refine, method, seed, prechecked, gravity, ended)
 
-    out = search(options.threshold, options.refine)
+    ended: dict = {}
+    out = search(options.threshold, options.refine, ended)
     if out is not None and len(rays) > 6 and np.count_nonzero(out["inliers"]) <= 6:
         # only the sample itself within the threshold (a threshold below the
         # noise: every exact minimal sample fits itself): no consensus
+        ended = {k: out[k] for k in ("iterations", "hypotheses", "stop", "sample_size")}
         out = None
     if out is None:
         # nothing explains 6 correspondences within the threshold: a probe at
@@ -963,7 +992,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
         if probe is not None:
             scorer.best = (probe["R"], probe["t"])
             scorer.n_hyp = int(probe["hypotheses"])
-        return _nothing_found(rays, scorer, options, method, t_start, 6, "")
+        return _nothing_found(rays, scorer, options, method, t_start, 6, "", ended)
     return _c_conclude(rays, out, focal, options, method, t_start, calibration_std, cam1, cam2,
                        n_cameras)
 
@@ -1019,9 +1048,10 @@ def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int
               focal: Optional[np.ndarray], cam_axes: Optional[np.ndarray],
               cam_focal: Optional[np.ndarray], options: RansacOptions, threshold: float,
               refine: bool, method: str, seed: int, prechecked: bool,
-              gravity: dict) -> Optional[dict]:
+              gravity: dict, search_info: Optional[dict] = None) -> Optional[dict]:
     """One C search (``_core.robust_rig_motion``) with ``options`` at
-    ``threshold``, the verdict's evidence gathered in the same call."""
+    ``threshold``, the verdict's evidence gathered in the same call; None
+    when it found no motion (``search_info`` then says how the search ended)."""
     return _core.robust_rig_motion(
         rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
         focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=threshold,
@@ -1030,7 +1060,7 @@ def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int
         lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
         refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
         sampler=method, prechecked=prechecked, verdict_still_factor=NO_PARALLAX_FACTOR,
-        **gravity)
+        search_info=search_info, **gravity)
 
 
 def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options: RansacOptions,

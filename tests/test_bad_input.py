@@ -872,6 +872,29 @@ def test_threshold_too_small():
         assert "collinear" not in str(e.value)
 
 
+@row("sample-cap-reached", "`maxIters` too small for the outliers: 17-point RANSAC "
+     "(`RIG_LINEAR17_RANSAC`) capped at 3 samples, or `ransac:six_point` at 1, on a 4-camera "
+     "ring with half the correspondences outliers",
+     "`DegenerateError`: linear17: no motion found ... after 3 samples (k hypotheses): the "
+     "search reached its sample cap (maxIters of mcgeom.cv.estimate, ...). Either no sample "
+     "was all inliers -- ... w^17: once in 430 draws at 30 % outliers ... -- then raise the "
+     "cap ...; or the data are degenerate (not the data alone blamed)")
+def test_sample_cap_reached():
+    rng = np.random.default_rng(3)
+    p = synth.make_problem(ring(), *MOTION, 120, rng, pixel_noise=0.3, outlier_fraction=0.5)
+    for method, cap, m in ((cv.RIG_LINEAR17_RANSAC, 3, 17), ("ransac:six_point", 1, 6)):
+        with pytest.raises(mcgeom.DegenerateError) as e:
+            cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig, method=method,
+                        maxIters=cap)
+        msg = str(e.value)
+        assert f"after {cap} sample" in msg and "reached its sample cap (maxIters" in msg, msg
+        assert f"w^{m}: once in {1 / 0.7 ** m:,.0f} draws at 30 % outliers" in msg, msg
+        assert "raise the cap" in msg and "or the data are degenerate" in msg, msg
+    # the data are not degenerate: the default method finds the motion
+    m = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, p.rig)
+    assert rot_err(m.R, MOTION[0]) < R_TOL
+
+
 @row("five-camera-not-integer", "`five_camera` 1.5, NaN, '1', True or [1] (`five_plus_one`)",
      "`ValueError`: five_camera must be an integer camera id, got 1.5 (1.0 is camera 1, as "
      "for camera ids)")
