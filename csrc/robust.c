@@ -2336,6 +2336,25 @@ static void fill_covariance(mcg_robust_result *res)
             res->covariance[i] = HUGE_VAL;
 }
 
+/* How likely a search of k samples of m pairs drew one of inliers of the
+ * final motion's consensus, w its fraction of the pairs within WIDE
+ * thresholds (as the adaptive stop counts them): 1 - (1 - w^m)^k. The
+ * adaptive stop ends the search once the search's best reaches opt.prob;
+ * a search that its cap ended below it may return a partial fit: 17-point
+ * RANSAC at its 1000-sample cap on the Ladybug head with 30 % outliers
+ * returned motions 1-2.4 deg off with 10-16 % of the pairs as inliers in 3
+ * of 30 problems (the truth has ~70 %), at a confidence below 1e-7, where
+ * the right ones had 0.90-0.92. */
+static double search_confidence(int k, int m, double w)
+{
+    const double p = pow(w, (double)m);
+    if (k <= 0 || !(p > 0.0))
+        return 0.0;
+    if (!(p < 1.0))
+        return 1.0;
+    return -expm1((double)k * log1p(-p));
+}
+
 int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const double *o2,
                           const double *d2, const int *cam1, const int *cam2, int n_cameras,
                           const double *focal, const double *cam_axes,
@@ -2532,16 +2551,19 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     res->n_inliers = 0;
     res->inlier_rms = NAN;
     {
-        double ss = 0.0;
+        double ss = 0.0, wide = WIDE * c.opt.threshold;
+        int n_wide = 0;
         for (k = 0; k < n; k++) {
             int in = c.rbest[k] < c.opt.threshold;
             mask[k] = (unsigned char)((mask[k] & 2) | in);
             res->n_inliers += in;
+            n_wide += c.rbest[k] < wide;
             if (in)
                 ss += c.rbest[k] * c.rbest[k];
         }
         if (res->n_inliers > 0)
             res->inlier_rms = sqrt(ss / res->n_inliers);
+        res->confidence = search_confidence(res->iterations, c.sample_size, (double)n_wide / n);
     }
     fill_covariance(res);
     if (c.opt.verdict_still_factor > 0.0) {

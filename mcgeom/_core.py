@@ -1408,7 +1408,10 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     the same call (None otherwise, or beyond 2^20 pairs), ``sample_size``
     (pairs per sample of the adaptive stop: 5 for 5+1, 3 and 4 for the
     upright sampler's 3+1 and 4-point samples, 6 for the 6-point, 17 for the
-    eigensolver and linear17).
+    eigensolver and linear17), ``confidence`` (1 - (1 - w^sample_size)^iterations,
+    w the best's fraction of pairs within the adaptive stop's wide threshold:
+    how likely the search drew a sample of inliers of its consensus; at least
+    ``prob`` when ``stop`` is "confidence").
     Raises ValueError naming the bad argument. ``prechecked``: the caller
     made the arrays itself (:func:`mcgeom.robust.ransac_prechecked`): the
     rays (N, 3) and ``focal`` (N,) float64 C-contiguous, ``cam1``/``cam2``
@@ -1533,6 +1536,7 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
         "inlier_rms": res.inlier_rms, "refinement": refinement,
         "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
         "sampler": _SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
+        "confidence": res.confidence,
     }
 
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 import functools
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Optional, Union
 
 import numpy as np
@@ -721,7 +721,8 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
               options: RansacOptions, method: str, info: dict, t_start: float,
               profile: Optional[float] = None, calibration_std: Any = None,
               rms: Optional[float] = None, c_ids: Optional[tuple] = None,
-              zero_profile: float = float("nan")) -> RigMotion:
+              zero_profile: float = float("nan"),
+              unconfirmed: Optional[str] = None) -> RigMotion:
     """Scale verdict and the returned ``RigMotion`` of a robust estimate.
 
     ``r`` are the residuals at the final (R, t) (pixels when thresholds are),
@@ -737,7 +738,10 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
     it gathered, or None) switches the verdict's evidence and the travel
     direction to one C pass over all the rays (:func:`scale_verdict_stats`);
     ``zero_profile`` the statistic of :func:`scale_profile` at
-    ``ZERO_FACTOR`` when already computed (by C).
+    ``ZERO_FACTOR`` when already computed (by C). ``unconfirmed``: why the
+    search's consensus is not confirmed (a cap ended it at a confidence below
+    :data:`CONFIRMED`), or None: then no scale is reported (the verdict says
+    why, ``t`` is the unit direction of travel).
     """
     rel_std = float("inf")
     given, profile = profile, float("nan")
@@ -771,6 +775,9 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
         v_rays, v_inl = _verdict_sample(rays, inl, options.seed)
         verdict = scale_verdict(v_rays, v_inl, R, t, rel_std, options.max_scale_rel_std,
                                 noise_level=noise_level, profile=profile)
+    if unconfirmed is not None and not verdict.reason.startswith("no translation"):
+        # (a static rig keeps its verdict: t = 0 whatever the consensus)
+        verdict = replace(verdict, observable=False, reason=unconfirmed)
     info["translation_detected"] = not verdict.reason.startswith("no translation")
     # the metric estimate whatever the verdict (when the scale is unobservable
     # the refinement may have slid |t| far along its flat valley: a guess)
@@ -808,7 +815,7 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
             if not math.isfinite(zero):
                 zero = scale_profile(rays.take(used), R, t, out["final_cost"], out["sigma2"],
                                      (ZERO_FACTOR,), options.loss, scale_used, w_used)
-        if slid or not scale_determined(rel_std, zero_profile=zero):
+        if slid or unconfirmed is not None or not scale_determined(rel_std, zero_profile=zero):
             # the data define no scale: a unit direction (issue 18: never a
             # silent unit vector where a metric estimate exists, and never a
             # metric-looking one where none does)
@@ -822,6 +829,17 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
     if rms is None:
         rms = float(np.sqrt(np.mean(r[inl] ** 2))) if inl.any() else float("nan")
     return RigMotion(np.asarray(R), np.asarray(t), verdict, f"ransac[{method}]", rms, inl, info)
+
+
+#: the confidence (``info["confidence"]``: how likely the search drew a sample
+#: of inliers of its consensus, csrc/robust.c search_confidence) below which
+#: a search that its cap ended reports no scale: it is less likely than not
+#: that the search drew a sample of inliers of the consensus it returns
+#: (17-point RANSAC and the eigensolver sampler at their 1000-sample cap on
+#: the Ladybug head, 30 % outliers, 30 problems each: right motions at
+#: 0.90-0.92, partial fits 0.8-2.4 deg off with 9-24 % of the pairs at
+#: 2e-4 or less, of which 3 had been called metric)
+CONFIRMED = 0.5
 
 
 #: intra-camera inliers the verdict's statistics (no-parallax fraction,
@@ -1075,6 +1093,14 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
     info["c_seconds"] = out["seconds"]
     info["sampler"] = method
     info["sample_size"] = out["sample_size"]
+    info["confidence"] = out["confidence"]
+    unconfirmed = None
+    if out["stop"] != "confidence" and out["confidence"] < CONFIRMED:
+        unconfirmed = (f"consensus not confirmed: the search reached its "
+                       f"{'time limit' if out['stop'] == 'max_seconds' else 'sample cap'} after "
+                       f"{out['iterations']} samples of {out['sample_size']} with a chance of "
+                       f"{out['confidence']:.2g} to have drawn one of inliers of this "
+                       f"consensus; the motion may be a partial fit: raise maxIters")
     fit = None
     if out["refinement"] is not None:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)
@@ -1092,4 +1118,4 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
                      info, t_start,
                      out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
                      c_ids=(cam1, cam2, n_cameras, out["mask"], out["verdict"]),
-                     zero_profile=float(out["zero_profile"]))
+                     zero_profile=float(out["zero_profile"]), unconfirmed=unconfirmed)

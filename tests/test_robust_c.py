@@ -220,3 +220,39 @@ def test_17_pair_c_search_needs_17_correspondences(method):
     p = generic_outlier_problem(2)
     with pytest.raises(ValueError, match=f"{method} needs at least 17"):
         robust.ransac(p.rays.take(np.arange(16)), method, threshold=1e-3)
+
+
+def test_confidence_of_the_search_and_an_unconfirmed_consensus():
+    """``confidence`` = 1 - (1 - w^m)^k of the final consensus (w its pairs
+    within 2 thresholds, m the sample size, k the samples): at least prob
+    when the adaptive stop ended the search. A search that its cap ended
+    below CONFIRMED reports no scale, whatever its consensus: the verdict
+    says why and t is the unit direction (info['t_metric'] keeps the fit)."""
+    rig, p, R, t = _problem(0, cross=0.3)
+    focal = pixels_per_radian(rig, p.rays)
+    table = camera_table(rig)
+
+    def run(**kw):
+        return robust.ransac(p.rays, "five_plus_one", threshold=1.0, focal=focal,
+                             pixel_cameras=table, **kw)
+
+    full = run(seed=1)
+    assert full.info["stop"] == "confidence" and full.info["confidence"] >= 0.999
+    assert full.scale.observable, full.scale.reason
+    # capped at 4 samples: with seed 1 the consensus of the full search
+    # (confidence above CONFIRMED: the scale stays metric) ...
+    kept = run(seed=1, max_iters=4)
+    assert kept.info["stop"] == "max_iterations" and kept.info["iterations"] == 4
+    assert robust.CONFIRMED < kept.info["confidence"] < 0.999
+    assert kept.scale.observable and rot_err(kept.R, R) < np.radians(0.1)
+    w = np.count_nonzero(full.inliers) / len(p.rays)   # (a lower bound of the wide w)
+    assert kept.info["confidence"] >= 1.0 - (1.0 - w ** 5) ** 4 - 1e-12
+    # ... with seed 2 a partial fit, at a chance of ~1e-5 of a sample of its
+    # inliers: no scale
+    partial = run(seed=2, max_iters=4)
+    assert partial.info["confidence"] < 1e-3 and not partial.scale.observable
+    assert np.count_nonzero(partial.inliers) < 0.5 * np.count_nonzero(full.inliers)
+    assert partial.scale.reason.startswith("consensus not confirmed: the search reached its "
+                                          "sample cap after 4 samples of 5")
+    assert np.linalg.norm(partial.t) == pytest.approx(1.0)
+    assert np.linalg.norm(partial.info["t_metric"]) > 0.0

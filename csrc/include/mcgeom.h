@@ -1134,6 +1134,14 @@ typedef struct {
     int sample_size;        /* issue 21: pairs per sample of the adaptive
                                stop -- 5 (5+1), 3 (the upright sampler's 3+1),
                                4 (its 4-point samples), 6 (6-point) */
+    double confidence;      /* issue 21: 1 - (1 - w^sample_size)^iterations,
+                               w the best's fraction of pairs within the
+                               adaptive stop's wide threshold: how likely the
+                               search drew a sample of inliers of that
+                               consensus. At least prob when stop is
+                               MCG_ROBUST_STOP_CONFIDENCE; after a cap a small
+                               value says the consensus is not confirmed
+                               (0 when nothing was found) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
