@@ -21,7 +21,7 @@
  * is a rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
- * of the threshold excepted), n_inliers counts it, n_used counts bit 1 and
+ * of the threshold excepted), the confidence lies in [0, 1], n_inliers counts it, n_used counts bit 1 and
  * the scale profile is NaN (not asked) or >= 0, the sampler used is the
  * one asked for (AUTO: 5+1 or 6-point), the verdict's evidence is there
  * exactly when asked for and counts the mask's inliers, and the covariance
@@ -266,6 +266,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(fz_all_finite(res.t, 3), "t not finite");
     FZ_CHECK(res.iterations >= 1 && res.iterations <= opt.max_iterations,
              "iterations %d outside [1, %d]", res.iterations, opt.max_iterations);
+    FZ_CHECK(res.confidence >= 0.0 && res.confidence <= 1.0,
+             "confidence %g outside [0, 1]", res.confidence);
     st = mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
     FZ_CHECK(st == MCG_OK, "residuals at the result: status %d", st);
     cnt0 = cnt1 = 0;
