@@ -1185,9 +1185,8 @@ static int final_scale_search(ctx *c, const double cen[3], const double *w)
          * within 0.5 % in all). So the line is searched again at the free
          * optimum, and the jump is optimised only if its scale still lies
          * elsewhere: one line search instead of a local optimisation in
-         * most jumps
-         * (there: 68 -> 37 local optimisations in 73 searches, 4 jumps
-         * left). C instructions per estimate, 40 problems of each upright
+         * most jumps (there: 68 -> 37 local optimisations in 73 searches,
+         * 4 jumps left). C instructions per estimate, 40 problems of each upright
          * case of `mcgeom experiment peer_solvers`: car rig turning 4.75
          * -> 4.40 M, ring4 3.20 -> 2.98 M, car rig forward 5.19 -> 5.01 M,
          * Ladybug 4.40 -> 4.28 M; median errors of 200 problems each

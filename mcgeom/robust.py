@@ -560,9 +560,9 @@ def _nothing_found(rays: RayPairs, scorer: "_Scorer", options: RansacOptions, me
 
 def _capped_message(rays: RayPairs, method: str, need: int, ended: dict) -> str:
     """The error of a search that its cap ended with no consensus: the data
-    may be degenerate, or no sample drawn was all inliers (issue 21: 17-pair
-    samples at 40 % outliers are, once in ~6,000 draws; the message blamed
-    the data alone)."""
+    may be degenerate, or no sample drawn was all inliers (issue 21: a
+    17-pair sample is all inliers once in ~6,000 draws at 40 % outliers; the
+    message blamed the data alone)."""
     k, m, h = int(ended["iterations"]), int(ended["sample_size"]), int(ended["hypotheses"])
     cap = ("its time limit (max_seconds)" if ended["stop"] == "max_seconds" else
            "its sample cap (maxIters of mcgeom.cv.estimate, max_iters of mcgeom.robust.ransac)")
@@ -738,10 +738,10 @@ def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarr
     it gathered, or None) switches the verdict's evidence and the travel
     direction to one C pass over all the rays (:func:`scale_verdict_stats`);
     ``zero_profile`` the statistic of :func:`scale_profile` at
-    ``ZERO_FACTOR`` when already computed (by C). ``unconfirmed``: why the
-    search's consensus is not confirmed (a cap ended it at a confidence below
-    :data:`CONFIRMED`), or None: then no scale is reported (the verdict says
-    why, ``t`` is the unit direction of travel).
+    ``ZERO_FACTOR`` when already computed (by C). ``unconfirmed``: None, or
+    why the search's consensus is not confirmed (a cap ended it at a
+    confidence below :data:`CONFIRMED`): then no scale is reported (the
+    verdict says why, ``t`` is the unit direction of travel).
     """
     rel_std = float("inf")
     given, profile = profile, float("nan")
@@ -1100,7 +1100,8 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
                        f"{'time limit' if out['stop'] == 'max_seconds' else 'sample cap'} after "
                        f"{out['iterations']} samples of {out['sample_size']} with a chance of "
                        f"{out['confidence']:.2g} to have drawn one of inliers of this "
-                       f"consensus; the motion may be a partial fit: raise maxIters")
+                       f"consensus; the motion may be a partial fit: raise the cap (maxIters, "
+                       f"max_iters) or the time limit")
     fit = None
     if out["refinement"] is not None:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)
