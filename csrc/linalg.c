@@ -200,6 +200,7 @@ static void house_qr(size_t len, size_t ncol, double *at, double *tau,
         double *x = at + k * len + k;
         size_t nk = len - k;
         double alpha, xn2, beta, sc, f, xmax;
+        int s2;
         if (perm != NULL) {
             size_t best = k;
             for (j = k + 1; j < ncol; ++j)
@@ -219,19 +220,25 @@ static void house_qr(size_t len, size_t ncol, double *at, double *tau,
          * tiny next to the others (a graded matrix): below 1e-150 its
          * squares would underflow into the denormals and the reflector lose
          * its orthogonality (found by fuzz_linalg), so such a column is
-         * computed scaled by the power of two f (exact; the reflector is
-         * scale-invariant, beta scales back). f = 1 otherwise. */
-        f = 1.0;
+         * computed scaled by 2^s (exact; the reflector is scale-invariant,
+         * beta scales back), s = 0 otherwise. s is applied as an exponent
+         * (mul_pow2): for a subnormal column s exceeds 1023 and the factor
+         * 2^s itself would be inf, making the reflector NaN (found by
+         * fuzz_linalg: a 9 x 4 matrix with entries from 5e-324 to 3e304). */
+        s2 = 0;
         xmax = max_abs(x, nk);
         if (xmax > 0.0 && xmax < 1e-150)
-            f = ldexp(1.0, -scale_exponent(xmax));
-        alpha = x[0] * f;
-        if (f == 1.0) {
+            s2 = -scale_exponent(xmax);
+        f = pow2_or_zero(s2);
+        alpha = mul_pow2(x[0], s2, f);
+        if (s2 == 0) {
             xn2 = dot(x + 1, x + 1, nk - 1);
         } else {
             xn2 = 0.0;
-            for (i = 1; i < nk; ++i)
-                xn2 += (x[i] * f) * (x[i] * f);
+            for (i = 1; i < nk; ++i) {
+                const double xi = mul_pow2(x[i], s2, f);
+                xn2 += xi * xi;
+            }
         }
         if (xn2 == 0.0) {
             tau[k] = 0.0; /* already triangular in this column */
@@ -240,10 +247,10 @@ static void house_qr(size_t len, size_t ncol, double *at, double *tau,
              * cancels */
             beta = -copysign(sqrt(alpha * alpha + xn2), alpha);
             tau[k] = (beta - alpha) / beta;
-            sc = f / (alpha - beta);
+            sc = 1.0 / (alpha - beta);
             for (i = 1; i < nk; ++i)
-                x[i] *= sc;
-            x[0] = beta / f;
+                x[i] = mul_pow2(x[i], s2, f) * sc;
+            x[0] = s2 == 0 ? beta : ldexp(beta, -s2);
             for (j = k + 1; j < ncol; ++j) {
                 double *y = at + j * len + k;
                 double d = (y[0] + dot(x + 1, y + 1, nk - 1)) * tau[k];

@@ -49,6 +49,33 @@ static void test_qr_graded_columns(void)
     check(e <= 1e-14, "qr of a graded matrix: |Q^T Q - I|", e, 1e-14);
 }
 
+/* fuzz_linalg (session 24): a 9 x 4 matrix whose entries span 5e-324 to
+ * 3e304 (the smallest subnormal in most places). Scaled to max |a| < 1, the
+ * last column's remaining part was subnormal, and the factor 2^s of the
+ * tiny-column scaling (s > 1023) overflowed to inf: Q held NaN with MCG_OK. */
+static void test_qr_subnormal_column(void)
+{
+    double a[36], q[36], r[16], w[128], e = 0.0;
+    int i, j, k;
+    for (i = 0; i < 36; ++i)
+        a[i] = 4.9406564584124654e-324;
+    a[0] = 1e150;
+    a[31] = -0.000244140625;
+    a[32] = -7.269300888741212e+182;
+    a[35] = -3.0173682326313768e+304;
+    check_status(mcg_qr(9, 4, a, q, r, w, 128), MCG_OK, "qr with a subnormal column");
+    for (i = 0; i < 4; ++i)
+        for (j = 0; j < 4; ++j) {
+            double s = 0.0;
+            for (k = 0; k < 9; ++k)
+                s += q[4 * k + i] * q[4 * k + j];
+            s = fabs(s - (i == j ? 1.0 : 0.0));
+            if (!(s <= e))
+                e = s; /* (NaN propagates into e) */
+        }
+    check(e <= 1e-14, "qr with a subnormal column: |Q^T Q - I|", e, 1e-14);
+}
+
 /* fuzz_linear17: 15 rays of one central camera (centre (-1, -1, -1) at both
  * times) of which one has a component of 1e150 in both directions: the
  * Sampson terms of the refinement overflowed, cost_final was NaN with MCG_OK
@@ -698,6 +725,7 @@ int main(void)
     test_linear17_overflowing_direction();
     test_angle_axis_overflow();
     test_qr_graded_columns();
+    test_qr_subnormal_column();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed != 0;
 }
