@@ -272,7 +272,7 @@ def _problems(args: argparse.Namespace) -> int:
 
 def _bench_robust(args: argparse.Namespace) -> int:
     from .experiments.bench.robust import (TUNED_PEER, WARM_BLOCK, bench_scaling, bench_speed,
-                                           fixed_and_marginal)
+                                           fit_worst_error, fixed_and_marginal)
 
     rows = bench_speed(_problems(args), progress=progress_bar)
     print(f"robust: mcgeom.cv.estimate (pixels in, 5+1 in one C call, verdict in Python) vs "
@@ -321,7 +321,7 @@ def _bench_robust(args: argparse.Namespace) -> int:
               f"(issue 19's target: within 2x)")
         fixed, marginal = fixed_and_marginal(scaling)
         small = min(scaling, key=lambda r: r.n)
-        off = max(abs(fixed + marginal * r.n - r.seconds) / r.seconds for r in scaling)
+        off = fit_worst_error(scaling, fixed, marginal)
         print(f"fit of the medians, seconds = fixed + marginal x N: {1e3 * fixed:.2f} ms + "
               f"{1e6 * marginal:.3f} us x N, within {100 * off:.0f} % of every median; the "
               f"fixed part is {100 * fixed / small.seconds:.0f} % of the time at N = {small.n}")

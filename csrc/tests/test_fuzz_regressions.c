@@ -24,28 +24,37 @@ static void test_angle_axis_overflow(void)
           "rot_from_angle_axis: |w| = 1.4e300 finite", 0.0, 0.0);
 }
 
+/* max |Q^T Q - I| of the m x n row-major q (NaN if any entry is NaN) */
+static double orthonormality_error(const double *q, int m, int n)
+{
+    double e = 0.0;
+    int i, j, k;
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            double s = 0.0;
+            for (k = 0; k < m; ++k)
+                s += q[n * k + i] * q[n * k + j];
+            s = fabs(s - (i == j ? 1.0 : 0.0));
+            if (!(s <= e))
+                e = s; /* (NaN propagates into e) */
+        }
+    return e;
+}
+
 /* fuzz_linalg: a 9 x 3 matrix with a column of size 1e-8 next to one of
  * 1e150 (a graded matrix): the reflector of the small column was computed
  * from squares in the denormal range, Q lost its orthonormality (2.7e-9). */
 static void test_qr_graded_columns(void)
 {
-    double a[27], q[27], r[9], w[64], e = 0.0;
-    int i, j, k;
+    double a[27], q[27], r[9], w[64], e;
+    int i;
     for (i = 0; i < 9; ++i) {
         a[3 * i] = (i % 2) ? 1e-8 * (i + 1) : 0.0;
         a[3 * i + 1] = 2.5 * (i + 1) - 0.3 * i * i;
         a[3 * i + 2] = (i % 2) ? 1e150 * (i + 1) : -1.27e126 * (i + 1);
     }
     check_status(mcg_qr(9, 3, a, q, r, w, 64), MCG_OK, "qr of a graded 9 x 3 matrix");
-    for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j) {
-            double s = 0.0;
-            for (k = 0; k < 9; ++k)
-                s += q[3 * k + i] * q[3 * k + j];
-            s = fabs(s - (i == j ? 1.0 : 0.0));
-            if (s > e)
-                e = s;
-        }
+    e = orthonormality_error(q, 9, 3);
     check(e <= 1e-14, "qr of a graded matrix: |Q^T Q - I|", e, 1e-14);
 }
 
@@ -55,8 +64,8 @@ static void test_qr_graded_columns(void)
  * tiny-column scaling (s > 1023) overflowed to inf: Q held NaN with MCG_OK. */
 static void test_qr_subnormal_column(void)
 {
-    double a[36], q[36], r[16], w[128], e = 0.0;
-    int i, j, k;
+    double a[36], q[36], r[16], w[128], e;
+    int i;
     for (i = 0; i < 36; ++i)
         a[i] = 4.9406564584124654e-324;
     a[0] = 1e150;
@@ -64,15 +73,7 @@ static void test_qr_subnormal_column(void)
     a[32] = -7.269300888741212e+182;
     a[35] = -3.0173682326313768e+304;
     check_status(mcg_qr(9, 4, a, q, r, w, 128), MCG_OK, "qr with a subnormal column");
-    for (i = 0; i < 4; ++i)
-        for (j = 0; j < 4; ++j) {
-            double s = 0.0;
-            for (k = 0; k < 9; ++k)
-                s += q[4 * k + i] * q[4 * k + j];
-            s = fabs(s - (i == j ? 1.0 : 0.0));
-            if (!(s <= e))
-                e = s; /* (NaN propagates into e) */
-        }
+    e = orthonormality_error(q, 9, 4);
     check(e <= 1e-14, "qr with a subnormal column: |Q^T Q - I|", e, 1e-14);
 }
 

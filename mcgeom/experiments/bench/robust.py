@@ -272,6 +272,12 @@ def fixed_and_marginal(rows: Sequence[ScaleRow]) -> tuple[float, float]:
     return float(fixed), float(marginal)
 
 
+def fit_worst_error(rows: Sequence[ScaleRow], fixed: float, marginal: float) -> float:
+    """The largest relative error of ``fixed + marginal * N`` (seconds,
+    seconds per correspondence) against the rows' median seconds."""
+    return max(abs(fixed + marginal * r.n - r.seconds) / r.seconds for r in rows)
+
+
 def _scaling_problems(n: int) -> int:
     """Problems timed at size ``n``: the time of one estimate moves by up to 3x
     between problems (the samples drawn before the adaptive stop), so a single
