@@ -326,6 +326,9 @@ class _Scorer:
 
 #: fewest correspondences the final refinement (``refine_centred``) can fit
 _MIN_REFIT = 6
+#: the final refinement fits the correspondences within this many thresholds
+#: (csrc/robust.c WIDE; the confidence counts them as the consensus)
+WIDE = 2.0
 
 
 def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
@@ -476,15 +479,18 @@ def _ransac(rays: RayPairs, method: str, options: RansacOptions, focal: Any,
         # nothing proposed (e.g. no camera with enough correspondences for the
         # proposer's own search): fall back to minimal samples where possible
         use_proposer = scorer.best is not None or info_est.minimal_solver is None
+    samples = 0   # minimal samples drawn (the proposer's motions are no samples)
     if not use_proposer:
-        iterations += _run_minimal(info_est, rays, scorer, options, rng, solver_options or {})
+        samples = _run_minimal(info_est, rays, scorer, options, rng, solver_options or {})
+        iterations += samples
+    ended = {"iterations": iterations, "hypotheses": scorer.n_hyp,
+             "stop": "max_iterations" if iterations >= options.max_iters else "confidence",
+             "sample_size": info_est.min_sample}
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
-        ended = {"iterations": iterations, "hypotheses": scorer.n_hyp,
-                 "stop": "max_iterations" if iterations >= options.max_iters else "confidence",
-                 "sample_size": info_est.min_sample}
         return _nothing_found(rays, scorer, options, method, t_start, max(6, info_est.min_sample),
                               f" ({scorer.n_hyp} hypotheses from {iterations} samples)", ended)
-    return _finish(rays, scorer, options, method, iterations, t_start, calibration_std)
+    return _finish(rays, scorer, options, method, iterations, t_start, calibration_std,
+                   dict(ended, iterations=samples) if samples else None)
 
 
 #: largest inlier threshold as an angle (radians): above it every correspondence is an
@@ -667,8 +673,14 @@ def _no_translation(rays: RayPairs, scorer: _Scorer, options: RansacOptions, met
 
 
 def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str,
-            iterations: int, t_start: float, calibration_std: Any = None) -> RigMotion:
-    """Final robust refinement on the inliers, verdict and diagnostics."""
+            iterations: int, t_start: float, calibration_std: Any = None,
+            sampled: Optional[dict] = None) -> RigMotion:
+    """Final robust refinement on the inliers, verdict and diagnostics.
+    ``sampled``: how the minimal samples' search ended (``iterations`` =
+    samples drawn, ``stop``, ``sample_size``), None when no sample was drawn
+    (the proposer's own robust search found the motion); it gives the
+    search's confidence and, after a cap below :data:`CONFIRMED`, the
+    unconfirmed verdict, as the C search's (:func:`_c_conclude`)."""
     R, t = scorer.best
     inl = scorer.best_inliers
     info: dict = {"iterations": iterations, "hypotheses": scorer.n_hyp,
@@ -693,7 +705,7 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
         # motion (``scaling_at``). Gating with the latter too measured no gain
         # (Ladybug scale median 0.186 -> 0.192, 0.179 -> 0.180, 0.174 -> 0.179
         # over three seeds; 0.187, 0.176, 0.180 as done here).
-        wide = 2.0 * options.threshold
+        wide = WIDE * options.threshold
         sel = scorer.best_residuals < wide     # the residuals of (R, t), kept by the scorer
         for _ in range(2):   # refit once more if the set moved
             used = sel
@@ -711,9 +723,45 @@ def _finish(rays: RayPairs, scorer: _Scorer, options: RansacOptions, method: str
     if r is None:
         r = scorer.best_residuals
     info["score"] = scorer.best_score
+    unconfirmed = None
+    if sampled is not None:
+        # w as the C search's: the final consensus within WIDE thresholds
+        w = np.count_nonzero(r < WIDE * options.threshold) / len(rays)
+        info.update(stop=sampled["stop"], sample_size=sampled["sample_size"],
+                    confidence=search_confidence(sampled["iterations"],
+                                                 sampled["sample_size"], w))
+        unconfirmed = _unconfirmed(sampled["stop"], sampled["iterations"],
+                                   sampled["sample_size"], info["confidence"])
     fit = (out, used, scale_used, w_used) if options.refine else None
     return _conclude(rays, R, t, r, inl, fit, scorer.loss_scale, np.linalg.norm(scorer.best[1]),
-                     options, method, info, t_start, calibration_std=calibration_std)
+                     options, method, info, t_start, calibration_std=calibration_std,
+                     unconfirmed=unconfirmed)
+
+
+def search_confidence(samples: int, sample_size: int, inlier_fraction: float) -> float:
+    """How likely a search of ``samples`` uniform samples of ``sample_size``
+    correspondences drew one of inliers only, at an ``inlier_fraction`` of
+    them: 1 - (1 - w^m)^k (the adaptive stop's rule read backwards; the C
+    search's ``confidence``, csrc/robust.c search_confidence)."""
+    p = float(inlier_fraction) ** int(sample_size)
+    if samples <= 0 or not p > 0.0:
+        return 0.0
+    if not p < 1.0:
+        return 1.0
+    return float(-math.expm1(samples * math.log1p(-p)))
+
+
+def _unconfirmed(stop: str, samples: int, sample_size: int, confidence: float
+                 ) -> Optional[str]:
+    """The verdict's reason when a cap (``stop`` not "confidence") ended the
+    search at a ``confidence`` below :data:`CONFIRMED`, else None."""
+    if stop == "confidence" or confidence >= CONFIRMED:
+        return None
+    return (f"consensus not confirmed: the search reached its "
+            f"{'time limit' if stop == 'max_seconds' else 'sample cap'} after {samples} "
+            f"samples of {sample_size} with a chance of {confidence:.2g} to have drawn one of "
+            f"inliers of this consensus; the motion may be a partial fit: raise the cap "
+            f"(maxIters, max_iters) or the time limit")
 
 
 def _conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarray],
@@ -1094,14 +1142,8 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
     info["sampler"] = method
     info["sample_size"] = out["sample_size"]
     info["confidence"] = out["confidence"]
-    unconfirmed = None
-    if out["stop"] != "confidence" and out["confidence"] < CONFIRMED:
-        unconfirmed = (f"consensus not confirmed: the search reached its "
-                       f"{'time limit' if out['stop'] == 'max_seconds' else 'sample cap'} after "
-                       f"{out['iterations']} samples of {out['sample_size']} with a chance of "
-                       f"{out['confidence']:.2g} to have drawn one of inliers of this "
-                       f"consensus; the motion may be a partial fit: raise the cap (maxIters, "
-                       f"max_iters) or the time limit")
+    unconfirmed = _unconfirmed(out["stop"], out["iterations"], out["sample_size"],
+                               out["confidence"])
     fit = None
     if out["refinement"] is not None:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)

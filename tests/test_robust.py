@@ -8,6 +8,7 @@ import pytest
 import mcgeom
 from mcgeom import robust, synth
 from mcgeom.cv import estimate as cv_estimate
+from mcgeom.pixel_noise import pixels_per_radian
 from problems import generic_outlier_problem, rot_err, turning_motion
 
 
@@ -79,6 +80,52 @@ def test_ransac_finds_the_motion_among_outliers(strategy):
     agree = np.mean(m.inliers == p.inlier)
     assert agree > 0.95
     assert m.info["iterations"] >= 1
+
+
+def test_search_confidence_reads_the_adaptive_stop_backwards():
+    """1 - (1 - w^m)^k: the stop's own count gives at least prob; no sample
+    or no inlier gives 0, all inliers 1."""
+    k = robust.adaptive_iterations(0.6, 6, 0.99, 10**6)
+    assert robust.search_confidence(k, 6, 0.6) >= 0.99
+    assert robust.search_confidence(k - 1, 6, 0.6) < 0.99
+    assert robust.search_confidence(3, 5, 0.5) == pytest.approx(1.0 - (1.0 - 0.5**5) ** 3)
+    assert robust.search_confidence(0, 6, 0.9) == 0.0
+    assert robust.search_confidence(10, 6, 0.0) == 0.0
+    assert robust.search_confidence(1, 6, 1.0) == 1.0
+
+
+def test_python_driver_does_not_present_an_unconfirmed_consensus_as_metric():
+    """The Python LO-RANSAC (strategy="minimal", and any plugin's minimal
+    solver) reports the confidence of its search as the C search does; a
+    search that its cap ended below CONFIRMED reports no scale: a partial
+    fit is never metric (Ladybug head, 30 % outliers)."""
+    rng = np.random.default_rng(0)
+    rig = synth.ladybug2()
+    R, t = turning_motion(rng)
+    p = synth.make_problem(rig, R, t, 300, rng, pixel_noise=0.5, outlier_fraction=0.3,
+                           cross_fraction=0.3)
+    focal = pixels_per_radian(rig, p.rays)
+
+    def run(**kw):
+        return robust.ransac(p.rays, "five_plus_one", threshold=1.0, focal=focal,
+                             strategy="minimal", **kw)
+
+    full = run(seed=1)
+    assert full.info["stop"] == "confidence" and full.info["confidence"] >= 0.999
+    assert full.scale.observable and rot_err(full.R, R) < np.radians(0.1)
+    # 8 samples with seed 1 find the full search's consensus (0.64: metric)
+    kept = run(seed=1, max_iters=8)
+    assert kept.info["stop"] == "max_iterations" and kept.info["sample_size"] == 6
+    assert robust.CONFIRMED < kept.info["confidence"] < 0.999
+    assert kept.scale.observable and rot_err(kept.R, R) < np.radians(0.1)
+    # with seed 4 a partial fit (~0.7 deg off, 35 of ~200 inliers): no scale
+    partial = run(seed=4, max_iters=8)
+    assert partial.info["confidence"] < 1e-2 and not partial.scale.observable
+    assert np.count_nonzero(partial.inliers) < 0.5 * np.count_nonzero(full.inliers)
+    assert partial.scale.reason.startswith("consensus not confirmed: the search reached its "
+                                          "sample cap after 8 samples of 6")
+    assert np.linalg.norm(partial.t) == pytest.approx(1.0)
+    assert np.linalg.norm(partial.info["t_metric"]) > 0.0
 
 
 def test_ransac_is_deterministic_with_a_seed():
