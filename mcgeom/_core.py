@@ -37,6 +37,7 @@ __all__ = [
     "upright4", "eigensolver",
     "static_noise", "static_check", "static_options", "static_check_rays",
     "sixpt",
+    "sixpt_local",
 ]
 
 GC_CASE_NAMES = {
@@ -1959,4 +1960,35 @@ def sixpt(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any) -> tuple[np.ndar
     st = lib.mcg_sixpt(_p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]), _p(R), _p(t), n)
     if st != lib.MCG_OK:
         _ray_error(st, "sixpt", rays)
+    return R[:n[0]].copy(), t[:n[0]].copy()
+
+
+def sixpt_local(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any,
+                R_start: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    """The motions of 6 generalized correspondences that a local search finds
+    (``mcg_sixpt_local``): Gauss-Newton on the smallest eigenvalue of the
+    generalized-epipolar matrix from fixed start rotations and ``R_start``
+    (3 x 3 rotation, optional).
+
+    Rays and result as :func:`sixpt` (``Rs`` (k, 3, 3), ``ts`` (k, 3),
+    rig2_from_rig1, metres; each motion satisfies the 6 constraints to 1e-10
+    on the normalised rays), but a motion whose basin holds no start is
+    missed: the sample solver of RANSAC, not a complete minimal solver.
+    ValueError names a bad argument.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+    if rays[0].shape[0] != 6:
+        raise ValueError(f"sixpt_local: exactly 6 correspondences needed, got "
+                         f"{rays[0].shape[0]}")
+    R0 = None if R_start is None else _f64("R_start", R_start, (3, 3))
+    R = np.empty((lib.MCG_SIXPT_LOCAL_MAX_SOLUTIONS, 3, 3))
+    t = np.empty((lib.MCG_SIXPT_LOCAL_MAX_SOLUTIONS, 3))
+    n = ffi.new("int *")
+    st = lib.mcg_sixpt_local(_p(rays[0]), _p(rays[1]), _p(rays[2]), _p(rays[3]),
+                             ffi.NULL if R0 is None else _p(R0), _p(R), _p(t), n)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL and R0 is not None and np.isfinite(R0).all() and \
+                _not_rotation(R0):
+            raise ValueError("sixpt_local: R_start is not a rotation")
+        _ray_error(st, "sixpt_local", rays, () if R0 is None else (("R_start", R0),))
     return R[:n[0]].copy(), t[:n[0]].copy()

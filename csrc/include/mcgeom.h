@@ -1427,6 +1427,26 @@ enum { MCG_SIXPT_MAX_SOLUTIONS = 64 };
 int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], const double d2[18],
               double R[576], double t[192], int *n_solutions);
 
+/* ---------------------------------------------------------- sixpt_local.c */
+
+/* Start rotations of mcg_sixpt_local and the bound on its solutions (one
+ * per start, and the caller's). */
+enum { MCG_SIXPT_LOCAL_STARTS = 43, MCG_SIXPT_LOCAL_MAX_SOLUTIONS = 44 };
+
+/* The motions of 6 generalized correspondences that a local search finds:
+ * Gauss-Newton on the smallest eigenvalue of the generalized-epipolar
+ * matrix (Kneip and Li 2014) from MCG_SIXPT_LOCAL_STARTS fixed rotations
+ * and, when R_start is not NULL, from R_start (a rotation, e.g. the best
+ * motion of a robust search so far). Inputs and outputs as mcg_sixpt's; R:
+ * MCG_SIXPT_LOCAL_MAX_SOLUTIONS x 9, t: x 3. Every motion returned satisfies
+ * the 6 constraints as mcg_sixpt's do (to 1e-10 on the normalised rays), but
+ * not every motion is found: a solution whose basin holds no start is
+ * missed (for RANSAC samples; mcg_sixpt finds them all). MCG_EINVAL: NULL,
+ * NaN/inf, zero directions, R_start not a rotation. No malloc. */
+int mcg_sixpt_local(const double o1[18], const double d1[18], const double o2[18],
+                    const double d2[18], const double *R_start, double *R, double *t,
+                    int *n_solutions);
+
 /* MCG_CDEF_END */
 
 #if defined(__GNUC__) && __GNUC__ >= 4

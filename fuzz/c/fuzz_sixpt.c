@@ -1,6 +1,7 @@
 /*
  * fuzz_sixpt.c -- libFuzzer harness of mcg_sixpt, the generic minimal
- * 6-point generalized relative pose.
+ * 6-point generalized relative pose, and of mcg_sixpt_local, its local
+ * search (same input, same invariants, the same status).
  *
  * Inputs: mode 0 a synthetic rig scene of 6 pairs (1-6 cameras, intra- or
  * cross-camera, fz_scene's noise and replaced entries); mode 1 arbitrary
@@ -20,44 +21,18 @@
  * seeds for each) */
 #define FUZZ_MODES 2
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+/* the invariants of n solutions (Rs, ts) of the solver `who` (at most max) */
+static void check_solutions(const char *who, const double *Rs, const double *ts, int n, int max,
+                            int exact, const double *o1, const double *d1, const double *o2,
+                            const double *d2)
 {
-    fz_in in = fz_make(data, size);
-    int mode = fz_u8(&in) % FUZZ_MODES, st, n = -1, s, i, k, exact = 0;
-    double o1[18], d1[18], o2[18], d2[18], Rm[9], t[3];
-    static double Rs[9 * MCG_SIXPT_MAX_SOLUTIONS], ts[3 * MCG_SIXPT_MAX_SOLUTIONS];
-    if (mode == 0) {
-        fz_rotation(&in, Rm);
-        for (i = 0; i < 3; ++i)
-            t[i] = fz_range(&in, -2.0, 2.0);
-        {   /* decoded in this order (not as arguments of one call) */
-            const int ncams = fz_int(&in, 1, 6), cross = fz_u8(&in) & 1;
-            exact = fz_scene(&in, 6, ncams, cross, Rm, t, o1, d1, o2, d2, NULL);
-        }
-    } else {
-        fz_rays(&in, 6, o1, d1, o2, d2);
-    }
-    st = mcg_sixpt(o1, d1, o2, d2, Rs, ts, &n);
-    FZ_CHECK(fz_status_known(st), "sixpt status %d", st);
-    if (!fz_all_finite(o1, 18) || !fz_all_finite(d1, 18) || !fz_all_finite(o2, 18) ||
-        !fz_all_finite(d2, 18)) {
-        FZ_CHECK(st == MCG_EINVAL, "sixpt of non-finite input: %d", st);
-        return 0;
-    }
-    for (k = 0; k < 6; ++k)
-        if (!(fz_dot3(d1 + 3 * k, d1 + 3 * k) >= 1e-100 &&
-              fz_dot3(d2 + 3 * k, d2 + 3 * k) >= 1e-100)) {
-            FZ_CHECK(st == MCG_EINVAL, "sixpt with a zero direction: %d", st);
-            return 0;
-        }
-    if (st != MCG_OK)
-        return 0;
-    FZ_CHECK(n >= 0 && n <= MCG_SIXPT_MAX_SOLUTIONS, "sixpt: %d solutions", n);
+    int s, i, k;
+    FZ_CHECK(n >= 0 && n <= max, "%s: %d solutions", who, n);
     for (s = 0; s < n; ++s) {
         const double *R = Rs + 9 * s, *tt = ts + 3 * s;
-        FZ_CHECK(fz_all_finite(R, 9) && fz_all_finite(tt, 3), "sixpt: solution %d not finite",
+        FZ_CHECK(fz_all_finite(R, 9) && fz_all_finite(tt, 3), "%s: solution %d not finite", who,
                  s);
-        FZ_CHECK(fz_is_rotation(R, 1e-9), "sixpt: solution %d not a rotation (%g)", s,
+        FZ_CHECK(fz_is_rotation(R, 1e-9), "%s: solution %d not a rotation (%g)", who, s,
                  fz_orth_err3(R));
         if (exact) {
             double size = 1.0, worst = 0.0;
@@ -79,8 +54,51 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                         sqrt(fz_dot3(a, a) * fz_dot3(b, b)));
             }
             worst /= size + sqrt(fz_dot3(tt, tt));
-            FZ_CHECK(worst <= 1e-8, "sixpt: solution %d GEC residual %g", s, worst);
+            FZ_CHECK(worst <= 1e-8, "%s: solution %d GEC residual %g", who, s, worst);
         }
     }
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_in in = fz_make(data, size);
+    int mode = fz_u8(&in) % FUZZ_MODES, st, stl, n = -1, nl = -1, i, k, exact = 0;
+    double o1[18], d1[18], o2[18], d2[18], Rm[9], t[3];
+    static double Rs[9 * MCG_SIXPT_MAX_SOLUTIONS], ts[3 * MCG_SIXPT_MAX_SOLUTIONS];
+    static double Rl[9 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS], tl[3 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS];
+    if (mode == 0) {
+        fz_rotation(&in, Rm);
+        for (i = 0; i < 3; ++i)
+            t[i] = fz_range(&in, -2.0, 2.0);
+        {   /* decoded in this order (not as arguments of one call) */
+            const int ncams = fz_int(&in, 1, 6), cross = fz_u8(&in) & 1;
+            exact = fz_scene(&in, 6, ncams, cross, Rm, t, o1, d1, o2, d2, NULL);
+        }
+    } else {
+        fz_rays(&in, 6, o1, d1, o2, d2);
+        fz_rotation(&in, Rm);
+    }
+    st = mcg_sixpt(o1, d1, o2, d2, Rs, ts, &n);
+    /* the local search, from the scene's rotation as its extra start (mode
+     * 0) or from a decoded one */
+    stl = mcg_sixpt_local(o1, d1, o2, d2, Rm, Rl, tl, &nl);
+    FZ_CHECK(fz_status_known(st), "sixpt status %d", st);
+    FZ_CHECK(stl == st, "sixpt_local status %d where sixpt's is %d", stl, st);
+    if (!fz_all_finite(o1, 18) || !fz_all_finite(d1, 18) || !fz_all_finite(o2, 18) ||
+        !fz_all_finite(d2, 18)) {
+        FZ_CHECK(st == MCG_EINVAL, "sixpt of non-finite input: %d", st);
+        return 0;
+    }
+    for (k = 0; k < 6; ++k)
+        if (!(fz_dot3(d1 + 3 * k, d1 + 3 * k) >= 1e-100 &&
+              fz_dot3(d2 + 3 * k, d2 + 3 * k) >= 1e-100)) {
+            FZ_CHECK(st == MCG_EINVAL, "sixpt with a zero direction: %d", st);
+            return 0;
+        }
+    if (st != MCG_OK)
+        return 0;
+    check_solutions("sixpt", Rs, ts, n, MCG_SIXPT_MAX_SOLUTIONS, exact, o1, d1, o2, d2);
+    check_solutions("sixpt_local", Rl, tl, nl, MCG_SIXPT_LOCAL_MAX_SOLUTIONS, exact, o1, d1, o2,
+                    d2);
     return 0;
 }
