@@ -49,6 +49,10 @@
  * of travel; the scale as for 5+1; w^3), else 4 pairs of any cameras solved
  * with the known vertical (mcg_upright4); MCG_SAMPLER_6PT draws 6 and
  * solves them with the generic minimal solver (mcg_sixpt);
+ * MCG_SAMPLER_6PT_LOCAL (AUTO's choice without a 5-point camera) draws 6
+ * and solves them by local search (mcg_sixpt_local, every HOMOTOPY_EVERY-th
+ * by mcg_sixpt), measures how often that finds its consensus' motion
+ * (found_rate) and uses found_rate w^6 in the stop;
  * MCG_SAMPLER_EIGEN draws 17 and solves them with Kneip and Li's
  * eigensolver from linear17's rotation (sample_eigen); MCG_SAMPLER_LINEAR17
  * draws 17 and takes the motion of linear17 (sample_linear17: ~55 us a
@@ -288,6 +292,12 @@
  * linear17's rotation, with the no-motion trap below EIGEN_TRAP of the
  * start's travel -- the values of mcgeom.estimators.eigensolver's own
  * RANSAC sample (minimal_solutions). */
+/* The local 6-point sampler's check of its solver (found_rate) */
+#define HOMOTOPY_EVERY 256  /* of its samples, this one solved by mcg_sixpt */
+#define FOUND_CHECKS 16     /* samples of the consensus solved */
+#define FOUND_PAIRS 64      /* pairs of the consensus they are drawn from */
+#define FOUND_AGREE 0.5     /* a hit: a motion with this fraction of the others */
+#define FOUND_MIN_OTHERS 10 /* pool pairs besides a sample, at least */
 #define PAIRS17 17
 #define EIGEN_ITERATIONS 100
 #define EIGEN_TRAP 1e-2
@@ -466,6 +476,10 @@ typedef struct {
     int *rec_off;    /* camera a's subset: rec_idx[rec_off[a] .. rec_off[a + 1]) */
     int *rec_idx;
     int sample_size; /* pairs per sample (adaptive stop) */
+    double found;    /* chance that a sample of inliers yields the motion
+                      * (MCG_SAMPLER_6PT_LOCAL: found_rate; else 1) */
+    int found_at;    /* n_wide when found was measured (-1: never) */
+    int local_samples; /* MCG_SAMPLER_6PT_LOCAL: its samples so far */
     int nx;          /* its pairs (0: no scale search) */
     int nx_others;   /* 1: they are another camera's (gather_others) */
     /* derived */
@@ -1543,7 +1557,7 @@ static int check_sampler(const mcg_robust_options *o)
 {
     if (o->sampler == MCG_SAMPLER_5P1 || o->sampler == MCG_SAMPLER_6PT ||
         o->sampler == MCG_SAMPLER_AUTO || o->sampler == MCG_SAMPLER_EIGEN ||
-        o->sampler == MCG_SAMPLER_LINEAR17)
+        o->sampler == MCG_SAMPLER_LINEAR17 || o->sampler == MCG_SAMPLER_6PT_LOCAL)
         return 1;
     if (o->sampler != MCG_SAMPLER_UPRIGHT4)
         return 0;
@@ -1806,6 +1820,120 @@ static int sample_linear17(ctx *c, const double *w)
     return offer_solutions(c, lr.R, t, 1, idx, a1, b1, a2, b2, PAIRS17, w);
 }
 
+/* One local 6-point sample (MCG_SAMPLER_6PT_LOCAL): 6 pairs drawn as
+ * sample_minimal's -> mcg_sixpt_local from its fixed starts and, once the
+ * search has a best motion, from it too (an all-inlier sample's motion then
+ * lies next to it) -> its motions offered as sample_minimal's. Every
+ * HOMOTOPY_EVERY-th sample is solved by the complete mcg_sixpt instead: a
+ * motion no start reaches is still found (a planar ring turned by 180 deg
+ * with cross-camera pairs only: the local search found it in none of 10
+ * samples, from 1e-3 rad away only from the truth itself), at ~0.1 ms a
+ * sample on average (1 in 64 cost the 12-camera case of `mcgeom experiment
+ * peer_solvers` about a third of its time). */
+static int sample_local(ctx *c, const double *w)
+{
+    int idx[6], ns = 0, got;
+    double a1[18], b1[18], a2[18], b2[18];
+    if (++c->local_samples % HOMOTOPY_EVERY == 0)
+        return sample_minimal(c, w); /* (c->opt.sampler read there: the homotopy) */
+    if ((got = draw_sample(c, 6, idx, a1, b1, a2, b2)) <= 0)
+        return got;
+    if (mcg_sixpt_local(a1, b1, a2, b2, c->have ? c->R : NULL, c->msol,
+                        c->msol + 9 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS, &ns) != MCG_OK)
+        return 0;
+    return offer_solutions(c, c->msol, c->msol + 9 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS, ns, idx,
+                           a1, b1, a2, b2, 6, w);
+}
+
+/* How often mcg_sixpt_local finds the motion of a sample of inliers, measured
+ * on this data (MCG_SAMPLER_6PT_LOCAL; the adaptive stop and the confidence
+ * count an all-inlier sample as found with this chance, so an incomplete
+ * solver draws more samples instead of stopping early): FOUND_CHECKS
+ * samples of 6 distinct pairs (not all of one camera) drawn from FOUND_PAIRS
+ * pairs of the best's consensus (a uniform reservoir sample of the pairs
+ * within the threshold), each solved from the fixed starts only -- as a
+ * sample drawn before any consensus was -- and a hit when one of its
+ * motions puts FOUND_AGREE of the other pool pairs within WIDE thresholds.
+ * Returns (hits + 1/2) / (checks + 1) (a Jeffreys-like estimate, never 0 or
+ * 1), or 1/2 when the consensus is too small to draw checks from. */
+static double found_rate(ctx *c)
+{
+    int pool[FOUND_PAIRS], np = 0, seen = 0, k, s, hits = 0, checks = 0;
+    for (k = 0; k < c->n; k++)
+        if (c->rbest[k] < c->opt.threshold) {
+            seen++;
+            if (np < FOUND_PAIRS)
+                pool[np++] = k;
+            else {
+                int j = rng_below(&c->rng, seen);
+                if (j < FOUND_PAIRS)
+                    pool[j] = k;
+            }
+        }
+    if (np < 6 + FOUND_MIN_OTHERS)
+        return 0.5;
+    for (s = 0; s < FOUND_CHECKS; s++) {
+        int pick[6], idx[6], central = 1, tries, ns = 0, j, i;
+        double a1[18], b1[18], a2[18], b2[18];
+        for (tries = 0; tries < SAMPLE_TRIES && central; tries++) {
+            for (j = 0; j < 6; j++) {
+                int dup;
+                do {
+                    pick[j] = rng_below(&c->rng, np);
+                    dup = 0;
+                    for (i = 0; i < j; i++)
+                        dup |= pick[i] == pick[j];
+                } while (dup);
+                idx[j] = pool[pick[j]];
+            }
+            central = 1;
+            for (j = 0; j < 6; j++)
+                central &= c->cam1[idx[j]] == c->cam2[idx[j]] &&
+                           c->cam1[idx[j]] == c->cam1[idx[0]];
+        }
+        if (central)
+            continue; /* a consensus of one camera's pairs: no 6-point sample */
+        checks++;
+        copy_pairs(c, idx, 6, a1, b1, a2, b2);
+        if (mcg_sixpt_local(a1, b1, a2, b2, NULL, c->msol,
+                            c->msol + 9 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS, &ns) != MCG_OK)
+            continue;
+        for (j = 0; j < ns; j++) {
+            const double *R = c->msol + 9 * j, *t = c->msol + 9 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS +
+                                                     3 * j;
+            int agree = 0;
+            for (i = 0; i < np; i++) {
+                int in_sample = 0, q;
+                for (q = 0; q < 6; q++)
+                    in_sample |= pick[q] == i;
+                agree += !in_sample &&
+                         pair_residual(c, R, t, (size_t)pool[i]) < WIDE * c->opt.threshold;
+            }
+            if (agree >= FOUND_AGREE * (np - 6)) {
+                hits++;
+                break;
+            }
+        }
+    }
+    return checks > 0 ? (hits + 0.5) / (checks + 1.0) : 0.5;
+}
+
+/* The adaptive stop's sample count: log(1 - prob) / log(1 - found w^m), w the
+ * best's fraction within WIDE thresholds (at 1 threshold the tail of the
+ * noise, ~16 % of the inliers at 0.5 px noise and 1 px, would count as
+ * outliers and more than double the samples drawn for an all-inlier
+ * sample), m the sample size, capped at max_iterations */
+static int adaptive_count(const ctx *c)
+{
+    double nw = c->found * pow((double)c->n_wide / c->n, (double)c->sample_size), kk;
+    if (nw >= 1.0)
+        return 1;
+    if (!(nw > 0.0))
+        return c->opt.max_iterations;
+    kk = log1p(-c->opt.prob) / log1p(-nw);
+    return kk < c->opt.max_iterations ? (int)ceil(kk) : c->opt.max_iterations;
+}
+
 /* One sample of the options' sampler: the hypotheses offered, or -1 when
  * the data can never give one (5+1: no camera with 5 intra-camera pairs;
  * the eigensolver and linear17: fewer than 17 pairs). */
@@ -1818,6 +1946,8 @@ static int draw(ctx *c, const double *w)
         return sample_eigen(c, w);
     case MCG_SAMPLER_LINEAR17:
         return sample_linear17(c, w);
+    case MCG_SAMPLER_6PT_LOCAL:
+        return sample_local(c, w);
     default:
         return sample_minimal(c, w);
     }
@@ -2344,9 +2474,9 @@ static void fill_covariance(mcg_robust_result *res)
  * returned motions 1-2.4 deg off with 10-16 % of the pairs as inliers in 3
  * of 30 problems (the truth has ~70 %), at a confidence below 1e-7, where
  * the right ones had 0.90-0.92. */
-static double search_confidence(int k, int m, double w)
+static double search_confidence(int k, int m, double w, double found)
 {
-    const double p = pow(w, (double)m);
+    const double p = found * pow(w, (double)m);
     if (k <= 0 || !(p > 0.0))
         return 0.0;
     if (!(p < 1.0))
@@ -2362,7 +2492,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                           double *work, size_t lwork)
 {
     ctx c;
-    double t_start, deadline, nw;
+    double t_start, deadline;
     int st, k, iters = 0, k_needed;
     double cen[3];
     const double *wlo;
@@ -2409,7 +2539,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         int has5 = 0;
         for (k = 0; k < n_cameras; k++)
             has5 |= c.off[k + 1] - c.off[k] >= 5;
-        c.opt.sampler = has5 ? MCG_SAMPLER_5P1 : MCG_SAMPLER_6PT;
+        c.opt.sampler = has5 ? MCG_SAMPLER_5P1 : MCG_SAMPLER_6PT_LOCAL;
     }
     res->sampler = c.opt.sampler;
     /* central samples: 5+1; the upright sampler's 3+1 when a camera has 3
@@ -2469,33 +2599,49 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
 
     /* search */
     k_needed = c.opt.max_iterations;
-    while (iters < c.opt.max_iterations &&
-           (iters < k_needed || iters < c.opt.min_iterations)) {
-        int before = c.have ? c.n_wide : -1, got;
-        iters++;
-        got = draw(&c, wlo);
-        if (got < 0)
-            break; /* no camera with 5 intra-camera pairs (5+1), n < 17 (eigen) */
-        if (c.have && c.n_wide != before) {
-            /* the fraction of true inliers: those within WIDE thresholds
-             * (at 1 threshold the tail of the noise, ~16 % of the inliers at
-             * 0.5 px noise and 1 px, would count as outliers and more than
-             * double the samples drawn for an all-inlier sample) */
-            nw = pow((double)c.n_wide / n, (double)c.sample_size);
-            if (nw >= 1.0)
-                k_needed = 1;
-            else if (nw > 0.0) {
-                double kk = log1p(-c.opt.prob) / log1p(-nw);
-                k_needed = kk < c.opt.max_iterations ? (int)ceil(kk) : c.opt.max_iterations;
+    c.found = 1.0;
+    c.found_at = -1;
+    c.local_samples = 0;
+    for (;;) {
+        int exhausted = 0;
+        while (iters < c.opt.max_iterations &&
+               (iters < k_needed || iters < c.opt.min_iterations)) {
+            int before = c.have ? c.n_wide : -1, got;
+            iters++;
+            got = draw(&c, wlo);
+            if (got < 0) {
+                exhausted = 1; /* no camera with 5 intra-camera pairs (5+1), n < 17 */
+                break;
+            }
+            if (c.have && c.n_wide != before)
+                k_needed = adaptive_count(&c);
+            /* (a 6-point sample takes ~0.03 s: the clock after each one) */
+            if ((iters % CLOCK_EVERY == 0 || c.opt.sampler == MCG_SAMPLER_6PT) &&
+                now_seconds() > deadline) {
+                res->stop = MCG_ROBUST_STOP_TIME;
+                break;
             }
         }
-        /* (a 6-point sample takes ~0.1 s: the clock after each one) */
-        if ((iters % CLOCK_EVERY == 0 || c.opt.sampler == MCG_SAMPLER_6PT) &&
-            now_seconds() > deadline) {
-            res->stop = MCG_ROBUST_STOP_TIME;
+        /* the local 6-point solver may have missed all-inlier samples: once
+         * the stop is reached, measure how often it finds this consensus'
+         * motion and draw on while the stop, so corrected, asks for more
+         * (again when the consensus has grown since) */
+        if (exhausted || res->stop == MCG_ROBUST_STOP_TIME ||
+            c.opt.sampler != MCG_SAMPLER_6PT_LOCAL || !c.have || c.found_at == c.n_wide ||
+            iters >= c.opt.max_iterations)
             break;
-        }
+        c.found = found_rate(&c);
+        c.found_at = c.n_wide;
+        k_needed = adaptive_count(&c);
+        if (iters >= k_needed && iters >= c.opt.min_iterations)
+            break;
     }
+    /* (a search its cap or clock ended: the rate for its confidence) */
+    if (c.opt.sampler == MCG_SAMPLER_6PT_LOCAL && c.have && c.found_at != c.n_wide) {
+        c.found = found_rate(&c);
+        c.found_at = c.n_wide;
+    }
+    res->found_rate = c.found;
     if (res->stop != MCG_ROBUST_STOP_TIME)
         res->stop = iters >= c.opt.max_iterations ? MCG_ROBUST_STOP_MAX_ITERATIONS
                                                    : MCG_ROBUST_STOP_CONFIDENCE;
@@ -2562,7 +2708,8 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         }
         if (res->n_inliers > 0)
             res->inlier_rms = sqrt(ss / res->n_inliers);
-        res->confidence = search_confidence(res->iterations, c.sample_size, (double)n_wide / n);
+        res->confidence = search_confidence(res->iterations, c.sample_size, (double)n_wide / n,
+                                            c.found);
     }
     fill_covariance(res);
     if (c.opt.verdict_still_factor > 0.0) {

@@ -51,9 +51,11 @@
  *
  * 4. Starts: the identity, and rotations of 0.25 and 0.6 rad about the six
  *    signed axes, 0.4 and 0.9 rad about the eight cube diagonals, 1.5 rad
- *    about the axes and 2.2 rad about the diagonals (43), plus an optional
- *    caller's start (e.g. the best motion of the search so far, near which
- *    the next all-inlier sample's solution lies).
+ *    about the axes and 2.2 rad about the diagonals, and the 13 half turns
+ *    about the axes, the cube and the face diagonals (56: without the half
+ *    turns a rotation of 180 deg was never found), plus an optional caller's
+ *    start (e.g. the best motion of the search so far, near which the next
+ *    all-inlier sample's solution lies).
  */
 #include "mcgeom.h"
 #include "internal.h"
@@ -62,6 +64,7 @@
 #include <string.h>
 
 #define DIR2_MIN 1e-100  /* smallest squared length of a direction */
+#define PI 3.14159265358979323846
 #define MAX_STEPS 4      /* Levenberg-Marquardt steps per start */
 #define ACCEPT 1e-10     /* normalised constraint left, relative to 1 + |t_u| */
 #define NEAR 1e-3        /* ... below which Newton in (R, t_u) takes over */
@@ -89,6 +92,21 @@ static void start_axes(double w[MCG_SIXPT_LOCAL_STARTS][3])
                     w[k++][2] = c * f;
                 }
     }
+    /* half turns (pi about an axis and about its opposite are one rotation):
+     * the 3 axes, the 4 cube diagonals and the 6 face diagonals */
+    for (i = 0; i < 3; i++)
+        w[k++][i] = PI;
+    for (b = -1; b <= 1; b += 2)
+        for (c = -1; c <= 1; c += 2) {
+            w[k][0] = PI / sqrt(3.0);
+            w[k][1] = b * PI / sqrt(3.0);
+            w[k++][2] = c * PI / sqrt(3.0);
+        }
+    for (i = 0; i < 3; i++)
+        for (s = -1; s <= 1; s += 2) {
+            w[k][i] = PI / sqrt(2.0);
+            w[k++][(i + 1) % 3] = s * PI / sqrt(2.0);
+        }
 }
 
 /* M(R) of (L1), the per-pair a = R d1, b = R m1 kept for (L2) */
@@ -255,8 +273,19 @@ static int descend(double R[9], const double *p, const double *q, double t_u[3])
                 t_u[i] = u[i] / u[3];
             for (k = 0; k < 6; k++)
                 worst = fmax(worst, fabs(dot3(v[k], t_u) + v[k][3]));
-            if (worst <= NEAR * (1.0 + sqrt(dot3(t_u, t_u))))
-                return polish(R, p, t_u) && !trivial_pair(R, t_u, q);
+            if (worst <= NEAR * (1.0 + sqrt(dot3(t_u, t_u))) && it < MAX_STEPS) {
+                /* Newton from a copy: where it fails (an ill-conditioned
+                 * sample, e.g. a planar ring turned by ~180 deg) the
+                 * descent goes on and Newton is tried again at its end */
+                double Rp[9], tp[3];
+                memcpy(Rp, R, sizeof Rp);
+                memcpy(tp, t_u, sizeof tp);
+                if (polish(Rp, p, tp)) {
+                    memcpy(R, Rp, sizeof Rp);
+                    memcpy(t_u, tp, sizeof tp);
+                    return !trivial_pair(R, t_u, q);
+                }
+            }
         }
         if (it == MAX_STEPS)   /* (t_u of the last eigenvector with u4 != 0) */
             return fabs(u[3]) > 1e-12 && polish(R, p, t_u) && !trivial_pair(R, t_u, q);

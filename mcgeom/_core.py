@@ -1276,7 +1276,11 @@ __all__ += ["robust_rig_motion", "ROBUST_STOP_NAMES", "SAMPLER_NAMES"]
 SAMPLER_NAMES = {
     "five_plus_one": lib.MCG_SAMPLER_5P1,
     "upright_four_point": lib.MCG_SAMPLER_UPRIGHT4,
-    "six_point": lib.MCG_SAMPLER_6PT,
+    # 6-point samples solved by the local search (mcg_sixpt_local, ~1 ms a
+    # sample, its rate of success measured by the search) or by the complete
+    # homotopy (mcg_sixpt, ~30 ms)
+    "six_point": lib.MCG_SAMPLER_6PT_LOCAL,
+    "six_point_homotopy": lib.MCG_SAMPLER_6PT,
     "eigensolver": lib.MCG_SAMPLER_EIGEN,
     "linear17": lib.MCG_SAMPLER_LINEAR17,
 }
@@ -1379,8 +1383,12 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     ``upright_four_point`` (the vertical ``gravity1``/``gravity2`` known:
     3-vectors in rig frames 1 and 2, any non-zero length, required for it
     and refused otherwise; 3 intra-camera pairs of one camera and a fourth,
-    as 5+1, when a camera has 3, else 4 pairs of any cameras), ``six_point`` (6 pairs,
-    the generic minimal solver), ``eigensolver`` (17 pairs: Kneip and Li's
+    as 5+1, when a camera has 3, else 4 pairs of any cameras), ``six_point`` (6 pairs
+    solved by the local search :func:`sixpt_local`, which may miss an
+    all-inlier sample's motion: the search measures how often it finds its
+    consensus' motion, ``found_rate``, and draws that many more samples),
+    ``six_point_homotopy`` (6 pairs, the complete minimal solver
+    :func:`sixpt`, ~30x the time a sample), ``eigensolver`` (17 pairs: Kneip and Li's
     eigensolver from linear17's rotation; at least 17 pairs, else None) or
     ``linear17`` (17 pairs: linear17's motion; at least 17 pairs, else None).
 
@@ -1409,10 +1417,12 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     the same call (None otherwise, or beyond 2^20 pairs), ``sample_size``
     (pairs per sample of the adaptive stop: 5 for 5+1, 3 and 4 for the
     upright sampler's 3+1 and 4-point samples, 6 for the 6-point, 17 for the
-    eigensolver and linear17), ``confidence`` (1 - (1 - w^sample_size)^iterations,
-    w the best's fraction of pairs within the adaptive stop's wide threshold:
-    how likely the search drew a sample of inliers of its consensus; at least
-    ``prob`` when ``stop`` is "confidence").
+    eigensolver and linear17), ``confidence`` (1 - (1 - found_rate
+    w^sample_size)^iterations, w the best's fraction of pairs within the
+    adaptive stop's wide threshold: how likely the search drew a sample of
+    inliers of its consensus and solved it; at least ``prob`` when ``stop`` is
+    "confidence"), ``found_rate`` (``six_point``: the measured chance that
+    its solver finds the motion of a sample of inliers; 1 for the others).
     Raises ValueError naming the bad argument. ``prechecked``: the caller
     made the arrays itself (:func:`mcgeom.robust.ransac_prechecked`): the
     rays (N, 3) and ``focal`` (N,) float64 C-contiguous, ``cam1``/``cam2``
@@ -1537,7 +1547,7 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
         "inlier_rms": res.inlier_rms, "refinement": refinement,
         "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
         "sampler": _SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
-        "confidence": res.confidence,
+        "confidence": res.confidence, "found_rate": res.found_rate,
     }
 
 

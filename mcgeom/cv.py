@@ -55,8 +55,9 @@ RIG_5P1_DIRECT = "direct:five_plus_one"
 #: upright 4-point with a known vertical inside LO-RANSAC (chosen by itself when
 #: ``gravity1``/``gravity2`` are passed with the default method)
 RIG_UPRIGHT_RANSAC = "upright_four_point"
-#: generic minimal 6-point inside LO-RANSAC (the C search with mcg_sixpt; chosen by
-#: itself when no camera has the 5 intra-camera correspondences of a 5+1 sample)
+#: generic minimal 6-point inside LO-RANSAC (the C search, its samples solved by
+#: mcg_sixpt_local and every 256th by mcg_sixpt; chosen by itself when no camera
+#: has the 5 intra-camera correspondences of a 5+1 sample)
 RIG_6PT_RANSAC = "ransac:six_point"
 
 

@@ -975,12 +975,22 @@ _MAX_CAMERAS = 4096
 
 def _solver_gravity(method: str, solver_options: dict) -> dict:
     """The C search's keywords from ``solver_options``: the vertical of
-    ``upright_four_point`` (checked, named), nothing for the others; an
-    option the sampler does not take is a ValueError naming it."""
+    ``upright_four_point`` (checked, named); for ``six_point`` its
+    ``solver``, "local" (the default: the local search, ~1 ms a sample, its
+    rate of success measured by the search) or "homotopy" (the complete
+    minimal solver, ~30 ms a sample), as the sampler name of
+    :data:`mcgeom._core.SAMPLER_NAMES`; nothing for the others. An option
+    the sampler does not take is a ValueError naming it."""
     opts = dict(solver_options)
     out = {}
     if method == "upright_four_point":
         out = {k: check_gravity(k, opts.pop(k, None)) for k in ("gravity1", "gravity2")}
+    if method == "six_point" and "solver" in opts:
+        solver = opts.pop("solver")
+        if solver not in ("local", "homotopy"):
+            raise ValueError(f"six_point's solver must be 'local' or 'homotopy', got "
+                             f"{solver!r}")
+        out = {"sampler": "six_point" if solver == "local" else "six_point_homotopy"}
     if opts:
         raise ValueError(f"solver_options {sorted(opts)} are not options of {method}'s "
                          f"minimal solver")
@@ -1118,6 +1128,7 @@ def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int
     """One C search (``_core.robust_rig_motion``) with ``options`` at
     ``threshold``, the verdict's evidence gathered in the same call; None
     when it found no motion (``search_info`` then says how the search ended)."""
+    kw = dict(gravity)
     return _core.robust_rig_motion(
         rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
         focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=threshold,
@@ -1125,8 +1136,8 @@ def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int
         max_iterations=int(options.max_iters), max_seconds=options.max_seconds, seed=seed,
         lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
         refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
-        sampler=method, prechecked=prechecked, verdict_still_factor=NO_PARALLAX_FACTOR,
-        search_info=search_info, **gravity)
+        sampler=kw.pop("sampler", method), prechecked=prechecked,
+        verdict_still_factor=NO_PARALLAX_FACTOR, search_info=search_info, **kw)
 
 
 def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options: RansacOptions,
@@ -1142,6 +1153,10 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
     info["sampler"] = method
     info["sample_size"] = out["sample_size"]
     info["confidence"] = out["confidence"]
+    if out["sampler"].startswith("six_point"):
+        info["six_point_solver"] = "homotopy" if out["sampler"] == "six_point_homotopy" \
+            else "local"
+        info["found_rate"] = out["found_rate"]
     unconfirmed = _unconfirmed(out["stop"], out["iterations"], out["sample_size"],
                                out["confidence"])
     fit = None

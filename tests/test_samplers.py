@@ -1,6 +1,7 @@
 """The minimal solvers of the C robust search (issue 21): the façade's choice
 (upright with a vertical prior, 5+1 when a camera has 5 intra-camera
-correspondences, else the generic 6-point), ``info["sampler"]``,
+correspondences, else the generic 6-point, its samples solved by the local
+search or the homotopy), ``info["sampler"]``,
 ``robust.ransac`` running all three in C, and their argument checks."""
 
 from __future__ import annotations
@@ -118,6 +119,32 @@ def test_ransac_runs_six_point_in_c():
     m = robust.ransac(p.rays, "six_point", threshold=2e-3)
     assert m.info["sampler"] == "six_point" and "c_seconds" in m.info
     assert _rot_deg(m.R, R) < 0.2
+
+
+def test_six_point_local_search_measures_its_rate_of_success():
+    """The 6-point samples are solved by the local search by default
+    (mcg_sixpt_local): it may miss an all-inlier sample's motion, so the
+    search measures how often it finds its consensus' motion (found_rate, in
+    (0, 1)) and its stop and confidence count with it; solver="homotopy"
+    solves them completely (found_rate 1) and both reach the same motion."""
+    rig, R, t, p = _ring12(6)
+    local = robust.ransac(p.rays, "six_point", threshold=2e-3, seed=1)
+    assert local.info["six_point_solver"] == "local"
+    assert 0.0 < local.info["found_rate"] < 1.0
+    assert local.info["stop"] == "confidence" and local.info["confidence"] >= 0.999
+    # without the rate the stop would have come after k0 samples at the
+    # consensus' fraction w; with it, after more
+    w = np.count_nonzero(local.inliers) / len(p.rays)
+    k0 = robust.adaptive_iterations(w, 6, 0.999, 10 ** 6)
+    # (seed 1: found_rate 0.44, 27 samples where the rate-blind stop takes 10)
+    assert local.info["found_rate"] < 0.5 and local.info["iterations"] >= 2 * k0
+    complete = robust.ransac(p.rays, "six_point", threshold=2e-3, seed=1,
+                             solver_options={"solver": "homotopy"}, max_iters=20)
+    assert complete.info["six_point_solver"] == "homotopy" and complete.info["found_rate"] == 1.0
+    assert _rot_deg(local.R, R) < 0.2 and _rot_deg(complete.R, R) < 0.2
+    assert _rot_deg(local.R, complete.R) < 0.05
+    with pytest.raises(ValueError, match="six_point's solver must be 'local' or 'homotopy'"):
+        robust.ransac(p.rays, "six_point", solver_options={"solver": "grobner"})
 
 
 def test_ransac_upright_in_c_matches_the_python_loop():

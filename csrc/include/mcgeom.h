@@ -1064,16 +1064,25 @@ enum {
     MCG_SAMPLER_6PT = 2,      /* 6 pairs not all of one camera, the generic
                                  minimal solver (mcg_sixpt) */
     MCG_SAMPLER_AUTO = 3,     /* MCG_SAMPLER_5P1 when some camera has 5
-                                 intra-camera pairs, else MCG_SAMPLER_6PT
-                                 (res->sampler says which) */
+                                 intra-camera pairs, else
+                                 MCG_SAMPLER_6PT_LOCAL (res->sampler says
+                                 which) */
     MCG_SAMPLER_EIGEN = 4,    /* 17 pairs not all of one camera -> the start
                                  rotation of mcg_linear17 (no refinement) ->
                                  mcg_eigensolver (Kneip and Li 2014), its
                                  motion when it has a metric t; needs n >= 17 */
-    MCG_SAMPLER_LINEAR17 = 5  /* 17 pairs not all of one camera -> the motion
+    MCG_SAMPLER_LINEAR17 = 5, /* 17 pairs not all of one camera -> the motion
                                  of mcg_linear17 with its default refinement
                                  (thesis ch. 8), when it has a metric t;
                                  needs n >= 17 */
+    MCG_SAMPLER_6PT_LOCAL = 6 /* 6 pairs as MCG_SAMPLER_6PT, solved by
+                                 mcg_sixpt_local (from its fixed starts and
+                                 the best motion so far): ~1 ms a sample
+                                 where mcg_sixpt takes ~30, but it may miss
+                                 the motion of an all-inlier sample; the
+                                 search measures how often it finds the
+                                 consensus' motion (res->found_rate) and
+                                 draws that many more samples */
 };
 
 /* mcg_robust_result.stop: why the search ended */
@@ -1134,7 +1143,7 @@ typedef struct {
     int sample_size;        /* issue 21: pairs per sample of the adaptive
                                stop -- 5 (5+1), 3 (the upright sampler's 3+1),
                                4 (its 4-point samples), 6 (6-point) */
-    double confidence;      /* issue 21: 1 - (1 - w^sample_size)^iterations,
+    double confidence;      /* issue 21: 1 - (1 - found_rate w^sample_size)^iterations,
                                w the best's fraction of pairs within the
                                adaptive stop's wide threshold: how likely the
                                search drew a sample of inliers of that
@@ -1142,6 +1151,11 @@ typedef struct {
                                MCG_ROBUST_STOP_CONFIDENCE; after a cap a small
                                value says the consensus is not confirmed
                                (0 when nothing was found) */
+    double found_rate;      /* issue 21: MCG_SAMPLER_6PT_LOCAL: the measured
+                               chance that a sample of inliers yields the
+                               consensus' motion (in (0, 1); the adaptive
+                               stop and confidence use found_rate w^6); 1
+                               for the complete solvers */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
@@ -1431,7 +1445,7 @@ int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], con
 
 /* Start rotations of mcg_sixpt_local and the bound on its solutions (one
  * per start, and the caller's). */
-enum { MCG_SIXPT_LOCAL_STARTS = 43, MCG_SIXPT_LOCAL_MAX_SOLUTIONS = 44 };
+enum { MCG_SIXPT_LOCAL_STARTS = 56, MCG_SIXPT_LOCAL_MAX_SOLUTIONS = 57 };
 
 /* The motions of 6 generalized correspondences that a local search finds:
  * Gauss-Newton on the smallest eigenvalue of the generalized-epipolar

@@ -485,6 +485,12 @@ static void six_point_case(void)
      * samples (an all-inlier one among them with probability 0.993 at 30 %
      * outliers; the seed is fixed) keep this under valgrind bearable */
     sampler_outlier_run("6-point", MCG_SAMPLER_6PT, 5, 40, &opt, &res);
+    /* the local solver: its measured rate of success enters the stop */
+    sampler_outlier_run("6-point local", MCG_SAMPLER_6PT_LOCAL, 5, 5000, &opt, &res);
+    check(res.found_rate > 0.0 && res.found_rate < 1.0,
+          "6-point local: its measured rate of success in (0, 1)", res.found_rate, 0.0);
+    check(res.stop != MCG_ROBUST_STOP_CONFIDENCE || res.confidence >= opt.prob,
+          "6-point local: the stop's confidence with that rate", res.confidence, opt.prob);
     /* 20 pairs, 4 intra-camera ones per camera and 4 cross-camera, 2
      * outliers: no 5-point camera, the 6-point sampler still finds it */
     scene(20, 2, 1e-4, R, t);
@@ -500,8 +506,9 @@ static void six_point_case(void)
     opt.sampler = MCG_SAMPLER_AUTO; /* no 5-point camera: AUTO is the 6-point sampler */
     st = run_checked(20, &opt, R, t, &res, &rerr, &terr, &agree, &caught);
     check_status(st, MCG_OK, "few pairs: 6-point status");
-    check(res.sampler == MCG_SAMPLER_6PT, "few pairs: AUTO picked the 6-point sampler",
-          res.sampler, MCG_SAMPLER_6PT);
+    check(res.sampler == MCG_SAMPLER_6PT_LOCAL,
+          "few pairs: AUTO picked the (local) 6-point sampler", res.sampler,
+          MCG_SAMPLER_6PT_LOCAL);
     check(rerr < 0.2, "few pairs, 6-point: rotation error (deg)", rerr, 0.2);
     check(terr < 0.05, "few pairs, 6-point: relative t error", terr, 0.05);
     check(caught == 2 && agree, "few pairs, 6-point: both outliers flagged", caught, 2);
@@ -594,7 +601,7 @@ static void status_case(void)
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "focal <= 0");
     mcg_robust_default_options(&opt);
-    opt.sampler = MCG_SAMPLER_LINEAR17 + 1;
+    opt.sampler = MCG_SAMPLER_6PT_LOCAL + 1;
     st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     check_status(st, MCG_EINVAL, "unknown sampler");

@@ -8,7 +8,7 @@
  * camera table, options valid or not (threshold, prob, iteration budgets,
  * LO rounds, loss), the sampler (a byte: 5+1, upright 4-point with the
  * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
- * huge --, 6-point, AUTO, the eigensolver, linear17, or 1 in 16 an
+ * huge --, 6-point, AUTO, the eigensolver, linear17, the local 6-point, or 1 in 16 an
  * unknown one), the verdict's evidence asked for or not, and a workspace 1
  * double short 1 in 16 times.
  * Mode 1 gives every camera one origin half of the time.
@@ -23,11 +23,13 @@
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
  * of the threshold excepted), the confidence lies in [0, 1], n_inliers counts it, n_used counts bit 1 and
  * the scale profile is NaN (not asked) or >= 0, the sampler used is the
- * one asked for (AUTO: 5+1 or 6-point), the verdict's evidence is there
+ * one asked for (AUTO: 5+1 or the local 6-point), its found_rate in (0, 1]
+ * (1 but for the local 6-point), the verdict's evidence is there
  * exactly when asked for and counts the mask's inliers, and the covariance
  * is finite (or HUGE_VAL everywhere).
  * Bounded time: max_iterations <= 200 (<= 3 with the 6-point sampler,
- * whose solver takes about a second per sample under the sanitizers) and
+ * whose solver takes about a second per sample under the sanitizers, <= 20
+ * with the local one) and
  * max_seconds = 0.5 here, and
  * libFuzzer's timeout catches any loop that ignores them.
  */
@@ -186,7 +188,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     opt_ok = 1;
     {
         const int sb = fz_u8(&in);
-        opt.sampler = sb % 16 == 15 ? 6 + sb % 5 : sb % 6;
+        opt.sampler = sb % 16 == 15 ? 7 + sb % 5 : sb % 7;
         if (opt.sampler == MCG_SAMPLER_UPRIGHT4) {
             if (mode == 0) { /* the true vertical: g2 = R g1 */
                 double g[3];
@@ -205,11 +207,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                      opt.g2[0] * opt.g2[0] + opt.g2[1] * opt.g2[1] + opt.g2[2] * opt.g2[2] >=
                          1e-100;
         }
-        opt_ok &= opt.sampler <= MCG_SAMPLER_LINEAR17;
+        opt_ok &= opt.sampler <= MCG_SAMPLER_6PT_LOCAL;
         /* (AUTO picks the 6-point sampler where no camera has 5 intra pairs) */
-        if (opt.sampler == MCG_SAMPLER_6PT || opt.sampler == MCG_SAMPLER_AUTO) {
+        if (opt.sampler == MCG_SAMPLER_6PT) {
             /* mcg_sixpt: ~1 s a sample here */
             opt.max_iterations = 1 + opt.max_iterations % 3;
+            opt.min_iterations = opt.min_iterations % (opt.max_iterations + 1);
+        } else if (opt.sampler == MCG_SAMPLER_6PT_LOCAL || opt.sampler == MCG_SAMPLER_AUTO) {
+            /* mcg_sixpt_local: ~1 ms a sample, 20-50x that here, and 16
+             * more samples to measure its rate of success */
+            opt.max_iterations = 1 + opt.max_iterations % 20;
             opt.min_iterations = opt.min_iterations % (opt.max_iterations + 1);
         }
     }
@@ -287,12 +294,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              res.n_used, cnt1);
     FZ_CHECK(isnan(res.scale_profile) || res.scale_profile >= 0.0,
              "scale profile %g is negative", res.scale_profile);
-    FZ_CHECK(res.sampler >= MCG_SAMPLER_5P1 && res.sampler <= MCG_SAMPLER_LINEAR17 &&
+    FZ_CHECK(res.sampler >= MCG_SAMPLER_5P1 && res.sampler <= MCG_SAMPLER_6PT_LOCAL &&
                  res.sampler != MCG_SAMPLER_AUTO &&
                  (opt.sampler == MCG_SAMPLER_AUTO
-                      ? res.sampler == MCG_SAMPLER_5P1 || res.sampler == MCG_SAMPLER_6PT
+                      ? res.sampler == MCG_SAMPLER_5P1 || res.sampler == MCG_SAMPLER_6PT_LOCAL
                       : res.sampler == opt.sampler),
              "sampler used %d for the option %d", res.sampler, opt.sampler);
+    /* the local 6-point solver's measured rate of success: in (0, 1), 1 for
+     * the complete solvers */
+    FZ_CHECK(res.sampler == MCG_SAMPLER_6PT_LOCAL
+                 ? res.found_rate > 0.0 && res.found_rate <= 1.0
+                 : res.found_rate == 1.0,
+             "found_rate %g with sampler %d", res.found_rate, res.sampler);
     /* the verdict's evidence (asked for, n <= 2^20 here): over the inliers */
     FZ_CHECK((opt.verdict_still_factor > 0.0) == (res.have_verdict != 0),
              "verdict evidence %d with factor %g", res.have_verdict, opt.verdict_still_factor);

@@ -50,9 +50,10 @@ cross-camera, 40 % outliers) and the 8-camera car rig turning. A method that
 cannot sample a case (5+1 and PoseLib without a 5-point camera pair) counts
 as failed there. Where the façade chose a sampler, the row forcing it reuses
 the façade's run (the same C call with the same seed); the 6-point row runs
-only where the façade chose it: ``mcg_sixpt`` (a homotopy continuation of 64
-paths) takes 14-30 ms per sample (by machine), seconds per RANSAC
-problem, which on the cases with a 5-point camera would only measure that.
+only where the façade chose it: its samples are solved by ``mcg_sixpt_local``
+(~1 ms, its rate of success measured by the search) and every 256th by
+``mcg_sixpt`` (a homotopy continuation of 64 paths, 14-30 ms per sample by
+machine), which on the cases with a 5-point camera would only measure that.
 ``--outliers F ...`` runs each chosen case at these outlier fractions
 instead of its own: the upright sampler's smaller samples (w^3 against
 5+1's w^5) pay off once outliers are many, while with few outliers both
@@ -234,12 +235,19 @@ def _sixpt_list(o1, d1, o2, d2) -> list:
     return list(zip(Rs, ts))
 
 
+def _sixpt_local_list(o1, d1, o2, d2) -> list:
+    Rs, ts = _core.sixpt_local(o1, d1, o2, d2)
+    return list(zip(Rs, ts))
+
+
 def run_minimal6(configs: int = 10000, seed: int = 0, families=SIX_FAMILIES,
                  progress: Progress = no_progress, chunk: Optional[int] = None,
                  on_chunk: Optional[Callable[[int, dict], None]] = None) -> dict:
     """The 6-point solvers: {family: {solver: (success fraction, mean real
-    solutions, seconds per call)}}: mcgeom's ``_core.sixpt`` (csrc/sixpt.c)
-    and ``poselib.gen_relpose_6pt`` on the same noise-free configurations.
+    solutions, seconds per call)}}: mcgeom's ``_core.sixpt`` (csrc/sixpt.c),
+    its local search ``_core.sixpt_local`` (csrc/sixpt_local.c, the robust
+    search's) and ``poselib.gen_relpose_6pt`` on the same noise-free
+    configurations.
 
     The families are run in turn, ``chunk`` configurations of each at a time
     (default: all at once), and ``on_chunk(done, table)`` receives the table of
@@ -249,7 +257,11 @@ def run_minimal6(configs: int = 10000, seed: int = 0, families=SIX_FAMILIES,
     for every family. Each family draws from its own generator seeded with
     ``seed``, so the configurations do not depend on ``chunk``."""
     poselib = import_peer("poselib", "peer_solvers")
+    # (sixpt_local: the robust search's solver of 6-point samples, incomplete
+    # by design -- its success fraction here is what the search measures
+    # and allows for)
     solvers = (("mcgeom sixpt", _safe(_sixpt_list), False),
+               ("mcgeom sixpt_local", _safe(_sixpt_local_list), False),
                ("poselib gen_relpose_6pt", _safe(poselib.gen_relpose_6pt), True))
     rngs = {fam: np.random.default_rng(seed) for fam in families}
     acc = {fam: {name: [0, 0, 0.0] for name, _, _ in solvers} for fam in families}
