@@ -86,3 +86,18 @@ def turning_motion(rng: np.random.Generator, max_angle: float = 0.3,
     t = rng.normal(size=3)
     return R, t / np.linalg.norm(t)
 
+
+
+def assert_unconfirmed_partial_fit(partial, full, samples: int, sample_size: int) -> None:
+    """``partial``, a robust search that its cap of ``samples`` samples of
+    ``sample_size`` ended on a partial fit, reports no scale: its verdict says
+    the consensus is not confirmed, ``t`` is a unit direction and
+    ``info['t_metric']`` keeps the fit; it explains less than half of what
+    ``full`` (the uncapped search) does."""
+    assert np.count_nonzero(partial.inliers) < 0.5 * np.count_nonzero(full.inliers)
+    assert not partial.scale.observable
+    assert partial.scale.reason.startswith(
+        f"consensus not confirmed: the search reached its sample cap after {samples} samples "
+        f"of {sample_size}")
+    assert abs(np.linalg.norm(partial.t) - 1.0) < 1e-9
+    assert np.linalg.norm(partial.info["t_metric"]) > 0.0

@@ -9,7 +9,8 @@ import pytest
 from mcgeom import _core, robust, synth
 from mcgeom.observability import scale_profile
 from mcgeom.pixel_noise import camera_table, pixels_per_radian
-from problems import generic_outlier_problem, rot_err, turning_motion
+from problems import (assert_unconfirmed_partial_fit, generic_outlier_problem, rot_err,
+                      turning_motion)
 
 
 def _problem(seed, n=300, outliers=0.3, cross=0.2):
@@ -250,9 +251,5 @@ def test_confidence_of_the_search_and_an_unconfirmed_consensus():
     # ... with seed 2 a partial fit, at a chance of ~1e-5 of a sample of its
     # inliers: no scale
     partial = run(seed=2, max_iters=4)
-    assert partial.info["confidence"] < 1e-3 and not partial.scale.observable
-    assert np.count_nonzero(partial.inliers) < 0.5 * np.count_nonzero(full.inliers)
-    assert partial.scale.reason.startswith("consensus not confirmed: the search reached its "
-                                          "sample cap after 4 samples of 5")
-    assert np.linalg.norm(partial.t) == pytest.approx(1.0)
-    assert np.linalg.norm(partial.info["t_metric"]) > 0.0
+    assert partial.info["confidence"] < 1e-3
+    assert_unconfirmed_partial_fit(partial, full, 4, 5)
