@@ -292,7 +292,8 @@
  * linear17's rotation, with the no-motion trap below EIGEN_TRAP of the
  * start's travel -- the values of mcgeom.estimators.eigensolver's own
  * RANSAC sample (minimal_solutions). */
-/* The local 6-point sampler's check of its solver (found_rate) */
+/* The local 6-point sampler (sample_local) and the check of its solver
+ * (found_rate) */
 #define HOMOTOPY_EVERY 256  /* of its samples, this one solved by mcg_sixpt */
 #define FOUND_CHECKS 16     /* samples of the consensus solved */
 #define FOUND_PAIRS 64      /* pairs of the consensus they are drawn from */
@@ -1565,16 +1566,18 @@ static int check_sampler(const mcg_robust_options *o)
            dot3(o->g2, o->g2) >= 1e-100;
 }
 
-/* m distinct pairs drawn uniformly into idx (m <= PAIRS17, m <= n).
+/* m distinct pairs drawn uniformly into idx (m <= PAIRS17) from the np
+ * distinct pairs of pool (NULL: all n, np = n; np >= m).
  * `central`: 1 when all of them are intra-camera pairs of one camera (rays
  * from one centre: no metric scale, the solvers are degenerate there). */
-static void draw_distinct(ctx *c, int m, int *idx, int *central)
+static void draw_distinct(ctx *c, int m, const int *pool, int np, int *idx, int *central)
 {
     int j, i;
     for (j = 0; j < m; j++) {
         int k, dup;
-        do { /* rejection of repeats: m <= 17 of n >= m */
-            k = rng_below(&c->rng, c->n);
+        do { /* rejection of repeats: m <= 17 of np >= m */
+            k = rng_below(&c->rng, np);
+            k = pool ? pool[k] : k;
             dup = 0;
             for (i = 0; i < j; i++)
                 dup |= idx[i] == k;
@@ -1600,23 +1603,30 @@ static void copy_pairs(const ctx *c, const int *idx, int m, double *a1, double *
         }
 }
 
-/* A sample of m distinct pairs drawn uniformly into idx and copied into the
- * m x 3 arrays a1, b1, a2, b2: 1; 0 when every one of SAMPLE_TRIES draws
- * was central (all pairs intra-camera pairs of one camera: its rotation may
- * be determined but not |t|, the solvers find it degenerate); -1 when there
- * are fewer than m pairs. */
-static int draw_sample(ctx *c, int m, int *idx, double *a1, double *b1, double *a2,
-                       double *b2)
+/* A sample of m distinct pairs of pool (as draw_distinct's) drawn
+ * uniformly into idx and copied into the m x 3 arrays a1, b1, a2, b2: 1; 0
+ * when every one of SAMPLE_TRIES draws was central (all pairs intra-camera
+ * pairs of one camera: its rotation may be determined but not |t|, the
+ * solvers find it degenerate); -1 when there are fewer than m pairs. */
+static int draw_sample_of(ctx *c, int m, const int *pool, int np, int *idx, double *a1,
+                          double *b1, double *a2, double *b2)
 {
     int tries, central = 1;
-    if (c->n < m)
+    if (np < m)
         return -1;
     for (tries = 0; tries < SAMPLE_TRIES && central; tries++)
-        draw_distinct(c, m, idx, &central);
+        draw_distinct(c, m, pool, np, idx, &central);
     if (central)
         return 0;
     copy_pairs(c, idx, m, a1, b1, a2, b2);
     return 1;
+}
+
+/* draw_sample_of all pairs */
+static int draw_sample(ctx *c, int m, int *idx, double *a1, double *b1, double *a2,
+                       double *b2)
+{
+    return draw_sample_of(c, m, NULL, c->n, idx, a1, b1, a2, b2);
 }
 
 /* 1 when (R, t) satisfies the constraint of one of the m sample pairs
@@ -1873,28 +1883,11 @@ static double found_rate(ctx *c)
     if (np < 6 + FOUND_MIN_OTHERS)
         return 0.5;
     for (s = 0; s < FOUND_CHECKS; s++) {
-        int pick[6], idx[6], central = 1, tries, ns = 0, j, i;
+        int idx[6], ns = 0, j, i;
         double a1[18], b1[18], a2[18], b2[18];
-        for (tries = 0; tries < SAMPLE_TRIES && central; tries++) {
-            for (j = 0; j < 6; j++) {
-                int dup;
-                do {
-                    pick[j] = rng_below(&c->rng, np);
-                    dup = 0;
-                    for (i = 0; i < j; i++)
-                        dup |= pick[i] == pick[j];
-                } while (dup);
-                idx[j] = pool[pick[j]];
-            }
-            central = 1;
-            for (j = 0; j < 6; j++)
-                central &= c->cam1[idx[j]] == c->cam2[idx[j]] &&
-                           c->cam1[idx[j]] == c->cam1[idx[0]];
-        }
-        if (central)
+        if (draw_sample_of(c, 6, pool, np, idx, a1, b1, a2, b2) <= 0)
             continue; /* a consensus of one camera's pairs: no 6-point sample */
         checks++;
-        copy_pairs(c, idx, 6, a1, b1, a2, b2);
         if (mcg_sixpt_local(a1, b1, a2, b2, NULL, c->msol,
                             c->msol + 9 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS, &ns) != MCG_OK)
             continue;
@@ -1905,7 +1898,7 @@ static double found_rate(ctx *c)
             for (i = 0; i < np; i++) {
                 int in_sample = 0, q;
                 for (q = 0; q < 6; q++)
-                    in_sample |= pick[q] == i;
+                    in_sample |= idx[q] == pool[i];
                 agree += !in_sample &&
                          pair_residual(c, R, t, (size_t)pool[i]) < WIDE * c->opt.threshold;
             }

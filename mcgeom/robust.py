@@ -973,7 +973,7 @@ def _sampler_ids(rays: RayPairs, method: str, tabled: bool
 _MAX_CAMERAS = 4096
 
 
-def _solver_gravity(method: str, solver_options: dict) -> dict:
+def _solver_keywords(method: str, solver_options: dict) -> dict:
     """The C search's keywords from ``solver_options``: the vertical of
     ``upright_four_point`` (checked, named); for ``six_point`` its
     ``solver``, "local" (the default: the local search, ~1 ms a sample, its
@@ -1005,7 +1005,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
     in one C call (``_core.robust_rig_motion``, csrc/robust.c), the verdict here.
     ``from_rig``: the rays' ids are those of the rig of ``pixel_cameras`` and
     their origins its centres (:func:`ransac_prechecked`): not checked again."""
-    gravity = _solver_gravity(method, solver_options or {})
+    solver_kw = _solver_keywords(method, solver_options or {})
     if from_rig:
         cam1, cam2, n_cameras = rays.cam1, rays.cam2, 0
     elif method == "five_plus_one":
@@ -1049,7 +1049,7 @@ def _ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOption
 
     def search(threshold: float, refine: bool, ended: Optional[dict] = None) -> Optional[dict]:
         return _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
-                         threshold, refine, method, seed, prechecked, gravity, ended)
+                         threshold, refine, method, seed, prechecked, solver_kw, ended)
 
     ended: dict = {}
     out = search(options.threshold, options.refine, ended)
@@ -1098,7 +1098,7 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
     if n <= 6 or options.strategy != "auto" or \
             options.threshold > MAX_THRESHOLD_RAD * float(np.minimum.reduce(focal)):
         return None
-    gravity = _solver_gravity(method, solver_options or {})
+    solver_kw = _solver_keywords(method, solver_options or {})
     registry.check_distinct(rays, 6 if method == "auto" else C_SAMPLERS[method],
                             "five_plus_one" if method == "auto" else method)
     t_start = time.perf_counter()
@@ -1107,7 +1107,7 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
     # (ids of the rig's cameras, checked by its ray kernel: int32 for C)
     cam1, cam2 = rays.cam1.astype(np.int32), rays.cam2.astype(np.int32)
     out = _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
-                    options.threshold, options.refine, method, _c_seed(options), True, gravity)
+                    options.threshold, options.refine, method, _c_seed(options), True, solver_kw)
     if out is None or out["n_inliers"] <= 6:
         return None
     return _c_conclude(rays, out, focal, options, out["sampler"], t_start, calibration_std,
@@ -1124,11 +1124,13 @@ def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int
               focal: Optional[np.ndarray], cam_axes: Optional[np.ndarray],
               cam_focal: Optional[np.ndarray], options: RansacOptions, threshold: float,
               refine: bool, method: str, seed: int, prechecked: bool,
-              gravity: dict, search_info: Optional[dict] = None) -> Optional[dict]:
+              solver_kw: dict, search_info: Optional[dict] = None) -> Optional[dict]:
     """One C search (``_core.robust_rig_motion``) with ``options`` at
-    ``threshold``, the verdict's evidence gathered in the same call; None
-    when it found no motion (``search_info`` then says how the search ended)."""
-    kw = dict(gravity)
+    ``threshold``, the verdict's evidence gathered in the same call
+    (``solver_kw`` from :func:`_solver_keywords`: the vertical, or the
+    6-point sampler's solver); None when it found no motion
+    (``search_info`` then says how the search ended)."""
+    kw = dict(solver_kw)
     return _core.robust_rig_motion(
         rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
         focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=threshold,
