@@ -25,10 +25,11 @@ the epipolar constraint's gradient; the final refinement uses it.
 from __future__ import annotations
 
 import functools
+import inspect
 import math
 import time
 from dataclasses import dataclass, replace
-from typing import Any, Optional, Union
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
@@ -473,6 +474,8 @@ def _ransac(rays: RayPairs, method: str, options: RansacOptions, focal: Any,
         raise ValueError(f"estimator {method!r} has no proposer")
     if not use_proposer and info_est.minimal_solver is None:
         raise ValueError(f"estimator {method!r} has no minimal solver: it cannot drive RANSAC")
+    if solver_options and info_est.minimal_solver is not None:
+        _check_solver_options(info_est.minimal_solver, method, solver_options)
     iterations = 0
     if use_proposer:
         iterations = _run_proposer(info_est, rays, scorer, options, rng)
@@ -590,6 +593,23 @@ def _per_camera(rays: RayPairs) -> str:
     counts = np.bincount(rays.cam1[same], minlength=int(rays.cam1.max(initial=0)) + 1)
     return (", ".join(f"camera {k}: {c}" for k, c in enumerate(counts)) +
             f"; {int((~same).sum())} cross-camera")
+
+
+def _check_solver_options(solver: Callable, method: str, solver_options: dict) -> None:
+    """The Python loop passes ``solver_options`` to the estimator's minimal
+    solver (after the sample): a key it does not take is a ValueError naming
+    it, not a TypeError in the loop."""
+    params = list(inspect.signature(solver).parameters.values())
+    if any(p.kind == p.VAR_KEYWORD for p in params):
+        return
+    taken = {p.name for p in params[1:] if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD)}
+    bad = sorted(k for k in solver_options if k not in taken)
+    if bad:
+        hint = (" ('solver' picks the 6-point solver of the C search, strategy='auto'; the "
+                "Python loop solves with the homotopy)" if method == "six_point" and
+                "solver" in bad else "")
+        raise ValueError(f"solver_options {bad} are not options of {method}'s minimal solver "
+                         f"in the Python loop{hint}")
 
 
 def _run_proposer(info_est, rays: RayPairs, scorer: _Scorer, options: RansacOptions,

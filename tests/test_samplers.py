@@ -145,6 +145,10 @@ def test_six_point_local_search_measures_its_rate_of_success():
     assert _rot_deg(local.R, complete.R) < 0.05
     with pytest.raises(ValueError, match="six_point's solver must be 'local' or 'homotopy'"):
         robust.ransac(p.rays, "six_point", solver_options={"solver": "grobner"})
+    # (the Python loop's solver is the homotopy: the option is named, not a TypeError)
+    with pytest.raises(ValueError, match=r"solver_options \['solver'\] are not options of "
+                                         r"six_point's minimal solver in the Python loop"):
+        robust.ransac(p.rays, "six_point", strategy="minimal", solver_options={"solver": "local"})
 
 
 def test_ransac_upright_in_c_matches_the_python_loop():
