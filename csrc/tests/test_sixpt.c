@@ -140,6 +140,25 @@ static int has_truth(const double *R, const double *t, int n, const double Rt[9]
     return 0;
 }
 
+/* 1 if (Rq, tq) is one of the n solutions (R, t) to 1e-6 (max |R - Rq|,
+ * |t - tq| / (1 + |tq|)): the same solution polished by another solver
+ * (seen 2e-8 apart where |t| = 0.02 m) */
+static int among(const double *R, const double *t, int n, const double Rq[9],
+                 const double tq[3])
+{
+    int s, i;
+    for (s = 0; s < n; s++) {
+        double e = 0.0, et = 0.0;
+        for (i = 0; i < 9; i++)
+            e = fmax(e, fabs(R[9 * s + i] - Rq[i]));
+        for (i = 0; i < 3; i++)
+            et = fmax(et, fabs(t[3 * s + i] - tq[i]));
+        if (e < 1e-6 && et < 1e-6 * (1.0 + sqrt(dot3(tq, tq))))
+            return 1;
+    }
+    return 0;
+}
+
 int main(void)
 {
     double o1[18], d1[18], o2[18], d2[18], R[576], t[192], Rt[9], tt[3], Rq0[9];
@@ -249,14 +268,18 @@ int main(void)
 
     /* (5) mcg_sixpt_local, with mcg_sixpt as its reference: every motion it
      * returns is a valid solution and one of mcg_sixpt's; from the truth as
-     * its extra start it finds the truth; on mild motions its fixed starts
-     * find it in most problems (measured 0.63 of 150 ring-rig samples) */
+     * its extra start it finds the truth; on mild motions (up to 0.3 rad)
+     * its fixed starts find it in at least 30 % of 16 fixed problems (11 of
+     * them; 0.63 of 150 ring-rig samples in the robust search's case) */
     {
         double Rl[9 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS], tl[3 * MCG_SIXPT_LOCAL_MAX_SOLUTIONS];
         int trials = scaled(12), nl, all_among = 1, from_truth = 0, mild = 0, total = 0;
+        /* (the rate on mild motions: a fixed count, the local search alone,
+         * so that a reduced run -- valgrind's -- still measures a rate) */
+        const int mild_trials = 16;
         double worst_res = 0.0, worst_rot = 0.0;
         for (trial = 0; trial < trials; trial++) {
-            random_rotation(Rt, trial < trials / 2 ? 3.0 : 0.6);
+            random_rotation(Rt, trial % 2 ? 3.0 : 0.6);
             randn(tt, 3);
             make_problem(trial & 1, (trial >> 1) & 1, Rt, tt, o1, d1, o2, d2);
             if (mcg_sixpt(o1, d1, o2, d2, R, t, &n) != MCG_OK ||
@@ -267,23 +290,29 @@ int main(void)
             total += nl;
             for (i = 0; i < nl; i++) {
                 double scale = 1.0 + sqrt(dot3(tl + 3 * i, tl + 3 * i));
-                all_among &= has_truth(R, t, n, Rl + 9 * i, tl + 3 * i);
+                all_among &= among(R, t, n, Rl + 9 * i, tl + 3 * i);
                 worst_res = fmax(worst_res,
                                  triple_residual(o1, d1, o2, d2, Rl + 9 * i, tl + 3 * i) / scale);
                 worst_rot = fmax(worst_rot, rot_error(Rl + 9 * i));
             }
-            if (trial >= trials / 2)
-                mild += has_truth(Rl, tl, nl, Rt, tt);
             if (mcg_sixpt_local(o1, d1, o2, d2, Rt, Rl, tl, &nl) == MCG_OK)
                 from_truth += has_truth(Rl, tl, nl, Rt, tt);
+        }
+        rng_state = TEST_SEED ^ 0x5d; /* (the same problems at every scale) */
+        for (trial = 0; trial < mild_trials; trial++) {
+            random_rotation(Rt, 0.6);
+            randn(tt, 3);
+            make_problem(trial & 1, (trial >> 1) & 1, Rt, tt, o1, d1, o2, d2);
+            if (mcg_sixpt_local(o1, d1, o2, d2, NULL, Rl, tl, &nl) == MCG_OK)
+                mild += has_truth(Rl, tl, nl, Rt, tt);
         }
         check(all_among && total > 0, "local: every motion one of mcg_sixpt's", total, 0);
         check(worst_res <= 1e-9, "local: every motion's GEC residual", worst_res, 1e-9);
         check(worst_rot <= 1e-12, "local: every motion a rotation", worst_rot, 1e-12);
         check(from_truth == trials, "local: the truth from the truth as a start", from_truth,
               trials);
-        check(mild >= 0.3 * (trials - trials / 2), "local: mild motions, truth in >= 30 %",
-              mild, 0.3 * (trials - trials / 2));
+        check(mild >= 0.3 * mild_trials, "local: mild motions, truth in >= 30 %", mild,
+              0.3 * mild_trials);
         make_problem(2, 0, Rt, tt, o1, d1, o2, d2);
         st = mcg_sixpt_local(o1, d1, o2, d2, NULL, Rl, tl, &nl);
         check(st == MCG_OK && nl == 0, "local: central camera (one centre): no solution", nl, 0);
