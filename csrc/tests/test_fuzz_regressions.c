@@ -24,23 +24,6 @@ static void test_angle_axis_overflow(void)
           "rot_from_angle_axis: |w| = 1.4e300 finite", 0.0, 0.0);
 }
 
-/* max |Q^T Q - I| of the m x n row-major q (NaN if any entry is NaN) */
-static double orthonormality_error(const double *q, int m, int n)
-{
-    double e = 0.0;
-    int i, j, k;
-    for (i = 0; i < n; ++i)
-        for (j = 0; j < n; ++j) {
-            double s = 0.0;
-            for (k = 0; k < m; ++k)
-                s += q[n * k + i] * q[n * k + j];
-            s = fabs(s - (i == j ? 1.0 : 0.0));
-            if (!(s <= e))
-                e = s; /* (NaN propagates into e) */
-        }
-    return e;
-}
-
 /* fuzz_linalg: a 9 x 3 matrix with a column of size 1e-8 next to one of
  * 1e150 (a graded matrix): the reflector of the small column was computed
  * from squares in the denormal range, Q lost its orthonormality (2.7e-9). */

@@ -55,23 +55,6 @@ static double max_abs_diff(const double *a, const double *b, int n)
     return mx;
 }
 
-/* max |Q^T Q - I| for an m x n matrix with (supposedly) orthonormal columns */
-static double orth_err(int m, int n, const double *q)
-{
-    double mx = 0.0;
-    int i, j, l;
-    for (i = 0; i < n; ++i)
-        for (j = 0; j < n; ++j) {
-            double acc = 0.0;
-            for (l = 0; l < m; ++l)
-                acc += q[l * n + i] * q[l * n + j];
-            acc -= (i == j) ? 1.0 : 0.0;
-            if (fabs(acc) > mx)
-                mx = fabs(acc);
-        }
-    return mx;
-}
-
 /* Random m x m orthogonal matrix as a product of m Householder reflections
  * (independent of the library's QR). */
 static void rand_orth(int m, double *q)
@@ -136,7 +119,7 @@ static void test_qr_case(int m, int n, int rank_def)
     matmul(m, n, n, q, r, qr);
     na = max_abs(a, m * n);
     e1 = max_abs_diff(a, qr, m * n) / na;
-    e2 = orth_err(m, n, q);
+    e2 = orthonormality_error(q, m, n);
     e3 = 0.0;
     for (i = 0; i < n; ++i)
         for (j = 0; j < i; ++j)
@@ -210,10 +193,10 @@ static void svd_checks(int m, int n, const double *a, const char *label,
              m, n);
     check(e < 2e-14 * sqrt((double)(m + n)), what, e,
           2e-14 * sqrt((double)(m + n)));
-    e = orth_err(m, mn, u);
+    e = orthonormality_error(u, m, mn);
     snprintf(what, sizeof what, "svd %s %dx%d  |u^T u - I|", label, m, n);
     check(e < 2e-14 * sqrt((double)m), what, e, 2e-14 * sqrt((double)m));
-    e = orth_err(n, n, v);
+    e = orthonormality_error(v, n, n);
     snprintf(what, sizeof what, "svd %s %dx%d  |v^T v - I| (full n x n)",
              label, m, n);
     check(e < 2e-14 * sqrt((double)n), what, e, 2e-14 * sqrt((double)n));
@@ -458,7 +441,7 @@ static void eig_case(eig_fn eig, int n, const double *a0, const double *w_true,
     snprintf(what, sizeof what, "sym_eig %s n=%d  |A v - v w| / |A|", label,
              n);
     check(e < 1e-14 * n, what, e, 1e-14 * n);
-    e = orth_err(n, n, v);
+    e = orthonormality_error(v, n, n);
     snprintf(what, sizeof what, "sym_eig %s n=%d  |v^T v - I|", label, n);
     check(e < 1e-14 * n, what, e, 1e-14 * n);
     for (k = 0; k + 1 < n; ++k)
@@ -973,8 +956,8 @@ static void test_exact_workspaces(void)
                             acc += u[i * (int)mn + k] * s[k] * v[j * n + k];
                         e = fmax(e, fabs(acc - a[i * n + j]));
                     }
-                e = fmax(e, orth_err(m, (int)mn, u));
-                e = fmax(e, orth_err(n, n, v));
+                e = fmax(e, orthonormality_error(u, m, (int)mn));
+                e = fmax(e, orthonormality_error(v, n, n));
                 if (e > worst)
                     worst = e;
                 if (e > 1e-13)

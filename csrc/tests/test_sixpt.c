@@ -123,28 +123,10 @@ static double rot_error(const double R[9])
     return e;
 }
 
-/* 1 if (Rt, tt) is among the n solutions to 1e-8 (max |R - Rt|, |t - tt| / |tt|) */
-static int has_truth(const double *R, const double *t, int n, const double Rt[9],
-                     const double tt[3])
-{
-    int s, i;
-    for (s = 0; s < n; s++) {
-        double e = 0.0, et = 0.0;
-        for (i = 0; i < 9; i++)
-            e = fmax(e, fabs(R[9 * s + i] - Rt[i]));
-        for (i = 0; i < 3; i++)
-            et += (t[3 * s + i] - tt[i]) * (t[3 * s + i] - tt[i]);
-        if (e < 1e-8 && sqrt(et / dot3(tt, tt)) < 1e-8)
-            return 1;
-    }
-    return 0;
-}
-
-/* 1 if (Rq, tq) is one of the n solutions (R, t) to 1e-6 (max |R - Rq|,
- * |t - tq| / (1 + |tq|)): the same solution polished by another solver
- * (seen 2e-8 apart where |t| = 0.02 m) */
-static int among(const double *R, const double *t, int n, const double Rq[9],
-                 const double tq[3])
+/* 1 if (Rq, tq) is one of the n solutions (R, t): max |R - Rq| < tol and
+ * |t - tq| < tol * t_scale */
+static int near_one(const double *R, const double *t, int n, const double Rq[9],
+                    const double tq[3], double tol, double t_scale)
 {
     int s, i;
     for (s = 0; s < n; s++) {
@@ -152,11 +134,27 @@ static int among(const double *R, const double *t, int n, const double Rq[9],
         for (i = 0; i < 9; i++)
             e = fmax(e, fabs(R[9 * s + i] - Rq[i]));
         for (i = 0; i < 3; i++)
-            et = fmax(et, fabs(t[3 * s + i] - tq[i]));
-        if (e < 1e-6 && et < 1e-6 * (1.0 + sqrt(dot3(tq, tq))))
+            et += (t[3 * s + i] - tq[i]) * (t[3 * s + i] - tq[i]);
+        if (e < tol && sqrt(et) < tol * t_scale)
             return 1;
     }
     return 0;
+}
+
+/* 1 if (Rt, tt) is among the n solutions to 1e-8 (max |R - Rt|, |t - tt| / |tt|) */
+static int has_truth(const double *R, const double *t, int n, const double Rt[9],
+                     const double tt[3])
+{
+    return near_one(R, t, n, Rt, tt, 1e-8, sqrt(dot3(tt, tt)));
+}
+
+/* 1 if (Rq, tq) is one of the n solutions to 1e-6 (|t - tq| relative to
+ * 1 + |tq|): the same solution polished by another solver (seen 2e-8 apart
+ * where |t| = 0.02 m) */
+static int among(const double *R, const double *t, int n, const double Rq[9],
+                 const double tq[3])
+{
+    return near_one(R, t, n, Rq, tq, 1e-6, 1.0 + sqrt(dot3(tq, tq)));
 }
 
 int main(void)

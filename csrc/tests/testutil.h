@@ -71,6 +71,23 @@ static inline void randn(double *a, int n) /* n standard normal values */
         a[i] = nrand();
 }
 
+/* max |Q^T Q - I| of the m x n row-major q (NaN if any entry is NaN) */
+static inline double orthonormality_error(const double *q, int m, int n)
+{
+    double e = 0.0;
+    int i, j, k;
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            double s = 0.0;
+            for (k = 0; k < m; ++k)
+                s += q[n * k + i] * q[n * k + j];
+            s = fabs(s - (i == j ? 1.0 : 0.0));
+            if (!(s <= e))
+                e = s; /* (NaN propagates into e) */
+        }
+    return e;
+}
+
 /* c (m x n) = a (m x k) b (k x n), row-major, the textbook triple loop */
 static inline void matmul(int m, int k, int n, const double *a, const double *b,
                    double *c)
