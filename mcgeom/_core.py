@@ -1976,7 +1976,7 @@ def sixpt(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any) -> tuple[np.ndar
 def sixpt_local(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any,
                 R_start: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """The motions of 6 generalized correspondences that a local search finds
-    (``mcg_sixpt_local``): Gauss-Newton on the smallest eigenvalue of the
+    (``mcg_sixpt_local``): Levenberg-Marquardt on the smallest eigenvalue of the
     generalized-epipolar matrix from fixed start rotations and ``R_start``
     (3 x 3 rotation, optional).
 

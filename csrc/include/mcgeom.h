@@ -1448,8 +1448,9 @@ int mcg_sixpt(const double o1[18], const double d1[18], const double o2[18], con
 enum { MCG_SIXPT_LOCAL_STARTS = 56, MCG_SIXPT_LOCAL_MAX_SOLUTIONS = 57 };
 
 /* The motions of 6 generalized correspondences that a local search finds:
- * Gauss-Newton on the smallest eigenvalue of the generalized-epipolar
- * matrix (Kneip and Li 2014) from MCG_SIXPT_LOCAL_STARTS fixed rotations
+ * Levenberg-Marquardt on the smallest eigenvalue of the generalized-
+ * epipolar matrix (Kneip and Li 2014), then Newton on the constraints,
+ * from MCG_SIXPT_LOCAL_STARTS fixed rotations
  * and, when R_start is not NULL, from R_start (a rotation, e.g. the best
  * motion of a robust search so far). Inputs and outputs as mcg_sixpt's; R:
  * MCG_SIXPT_LOCAL_MAX_SOLUTIONS x 9, t: x 3. Every motion returned satisfies
