@@ -2459,8 +2459,10 @@ static void fill_covariance(mcg_robust_result *res)
 }
 
 /* How likely a search of k samples of m pairs drew one of inliers of the
- * final motion's consensus, w its fraction of the pairs within WIDE
- * thresholds (as the adaptive stop counts them): 1 - (1 - w^m)^k. The
+ * final motion's consensus and solved it, w its fraction of the pairs
+ * within WIDE thresholds (as the adaptive stop counts them), found the
+ * chance that the solver finds a sample's motion (found_rate; 1 for the
+ * complete solvers): 1 - (1 - found w^m)^k. The
  * adaptive stop ends the search once the search's best reaches opt.prob;
  * a search that its cap ended below it may return a partial fit: 17-point
  * RANSAC at its 1000-sample cap on the Ladybug head with 30 % outliers
