@@ -39,10 +39,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* The passes over a camera's rows (the candidates' counting passes of
- * the least median of squares) and over the bearings (the rotation-only
- * statistic) vectorise, and carry MCG_AVX2_CLONE (internal.h: the same
- * bits on every CPU; issue 22). */
+/* The passes over a camera's rows (making them, and the candidates'
+ * counting passes and medians of the least median of squares) and over
+ * the bearings (making them unit, and the rotation-only statistic) are
+ * written without branches so that they vectorise, and carry
+ * MCG_AVX2_CLONE (internal.h: the same bits on every CPU; issue 22). A
+ * function the clones call carries it too: GCC does not inline it into
+ * them, and the default build of it would not vectorise for AVX2. */
 
 #define MAX_SAMPLES 65536
 #define MAD_TO_STD 1.4826 /* 1 / the median of |N(0, 1)| */
@@ -200,6 +203,7 @@ static int smallest_eigvec(const double s[9], double u[3])
  * order of dot3. */
 
 /* median of |ahat . v| over the k rows, scratch prod (k doubles) */
+MCG_AVX2_CLONE
 static double median_abs_dot(const double *ax, const double *ay, const double *az, int k,
                              const double v[3], double *prod)
 {
@@ -216,6 +220,7 @@ static double median_abs_dot(const double *ax, const double *ay, const double *a
  * so does not vectorise (issue 22: this pass is most of the test's time) */
 #define COUNT_BLOCK 64
 #define COUNT_LANES 4
+MCG_AVX2_CLONE
 static int enough_below(const double *ax, const double *ay, const double *az, int k,
                         const double v[3], double x, int need)
 {
@@ -239,52 +244,82 @@ static int enough_below(const double *ax, const double *ay, const double *az, in
     return c >= need;
 }
 
-/* the row a = (R d1) x d2 of unit bearings, added to the scatter s += a a^T;
- * 0 when R maps the bearing to zero or beyond the doubles (not a rotation) */
-static int add_row(const double *p, const double *q, const double R[9], double s[9],
-                   double a[3])
+/* The rows a = (R d1 / |R d1|) x (d2 / |d2|) of a camera's m pairs (its
+ * bearings gathered contiguously in d1, d2): into raw by row (3 m) and
+ * their units into ax, ay, az by coordinate (NaN where a = 0, whose
+ * bearings are parallel). One pass without branches, so that it
+ * vectorises: its square roots and divisions, one row at a time, were half
+ * of camera_direction's time (issue 22); the same operations in the same
+ * order as before, so the same bits. 0 when R maps a bearing to zero or
+ * beyond the doubles (not a rotation). */
+MCG_AVX2_CLONE
+static int unit_rows(const double *restrict d1, const double *restrict d2, const double R[9],
+                     int m, double *restrict raw, double *restrict ax, double *restrict ay,
+                     double *restrict az)
 {
-    double rd[3], b[3], nr, nb;
-    int r, c;
-    mat_vec(R, p, rd);
-    nr = sqrt(dot3(rd, rd));
-    nb = sqrt(dot3(q, q));
-    if (!(nr > 0.0 && isfinite(nr)))
-        return 0;
-    for (r = 0; r < 3; r++) {
-        rd[r] /= nr;
-        b[r] = q[r] / nb;
+    double Rl[9]; /* (a local copy: no store can change it, so R is loaded once) */
+    int i, bad = 0;
+    for (i = 0; i < 9; i++)
+        Rl[i] = R[i];
+    for (i = 0; i < m; i++) {
+        const double *p = d1 + 3 * i, *q = d2 + 3 * i;
+        double rd[3], b0, b1, b2, a0, a1, a2, nr, nb, na;
+        mat_vec(Rl, p, rd);
+        nr = sqrt(dot3(rd, rd));
+        nb = sqrt(dot3(q, q));
+        bad |= (nr > 0.0) & (nr <= DBL_MAX) ? 0 : 1;
+        rd[0] /= nr;
+        rd[1] /= nr;
+        rd[2] /= nr;
+        b0 = q[0] / nb;
+        b1 = q[1] / nb;
+        b2 = q[2] / nb;
+        /* cross3(rd, b) */
+        a0 = rd[1] * b2 - rd[2] * b1;
+        a1 = rd[2] * b0 - rd[0] * b2;
+        a2 = rd[0] * b1 - rd[1] * b0;
+        na = sqrt(a0 * a0 + a1 * a1 + a2 * a2);
+        raw[3 * i] = a0;
+        raw[3 * i + 1] = a1;
+        raw[3 * i + 2] = a2;
+        ax[i] = a0 / na;
+        ay[i] = a1 / na;
+        az[i] = a2 / na;
     }
-    cross3(rd, b, a);
-    for (r = 0; r < 3; r++)
-        for (c = 0; c < 3; c++)
-            s[3 * r + c] += a[r] * a[c];
-    return 1;
+    return !bad;
 }
 
 /* the robust null vector u of the m rows of one camera, its bearings
  * gathered contiguously in d1, d2 (see the file comment); ahat and raw: 3 m
  * doubles (the unit rows and the rows), prod: m doubles */
+MCG_AVX2_CLONE
 static int camera_direction(const double *d1, const double *d2, const double R[9], int m,
                             int samples, double *ahat, double *raw, double *prod, double u[3])
 {
     double s[9] = {0}, best, *ax = ahat, *ay = ahat + m, *az = ahat + 2 * (size_t)m;
     int i, k, n_ok = 0, st, need;
     uint64_t state = (uint64_t)m;
+    if (!unit_rows(d1, d2, R, m, raw, ax, ay, az))
+        return MCG_EINVAL;
+    /* the rows with a direction (a != 0: ahat not NaN), kept in order, and
+     * their scatter s = sum a a^T (the zero rows add nothing to it) */
     for (i = 0; i < m; i++) {
-        double a[3], na;
-        if (!add_row(d1 + 3 * i, d2 + 3 * i, R, s, a))
-            return MCG_EINVAL;
-        na = sqrt(dot3(a, a));
-        if (na > 0.0) {
-            raw[3 * n_ok] = a[0];
-            raw[3 * n_ok + 1] = a[1];
-            raw[3 * n_ok + 2] = a[2];
-            ax[n_ok] = a[0] / na;
-            ay[n_ok] = a[1] / na;
-            az[n_ok] = a[2] / na;
-            n_ok++;
+        const double *a;
+        int r, c;
+        if (!(ax[i] == ax[i]))
+            continue;
+        if (n_ok != i) {
+            for (r = 0; r < 3; r++)
+                raw[3 * n_ok + r] = raw[3 * i + r];
+            ax[n_ok] = ax[i];
+            ay[n_ok] = ay[i];
+            az[n_ok] = az[i];
         }
+        a = raw + 3 * n_ok;
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++)
+                s[3 * r + c] += a[r] * a[c];
+        n_ok++;
     }
     st = smallest_eigvec(s, u);
     if (st != MCG_OK || n_ok < 3)
@@ -333,7 +368,7 @@ static int camera_direction(const double *d1, const double *d2, const double R[9
         int kept = 0;
         for (i = 0; i < n_ok; i++) {
             if (fabs(ax[i] * u[0] + ay[i] * u[1] + az[i] * u[2]) <= lim) {
-                const double *a = raw + 3 * i; /* as add_row made it */
+                const double *a = raw + 3 * i; /* as unit_rows made it */
                 int r, c;
                 for (r = 0; r < 3; r++)
                     for (c = 0; c < 3; c++)
@@ -526,13 +561,23 @@ size_t mcg_static_check_work_size(int n)
     return ok ? w : 0;
 }
 
-/* unit copy of v */
-static inline void unit3(const double *v, double u[3])
+/* the unit bearings u1 = d1 / |d1|, u2 = d2 / |d2| of every pair, in one
+ * pass without branches so that it vectorises (issue 22); a pair outside
+ * the intra-camera ones may have a zero direction, whose NaN here is never
+ * read (the passes below skip group < 0). The products as v * (1 / |v|),
+ * as before. */
+MCG_AVX2_CLONE
+static void unit_bearings(int n, const double *restrict d1, const double *restrict d2,
+                          double *restrict u1, double *restrict u2)
 {
-    double s = 1.0 / sqrt(dot3(v, v));
-    u[0] = v[0] * s;
-    u[1] = v[1] * s;
-    u[2] = v[2] * s;
+    int i, r;
+    for (i = 0; i < 3 * n; i += 3) {
+        double s1 = 1.0 / sqrt(dot3(d1 + i, d1 + i)), s2 = 1.0 / sqrt(dot3(d2 + i, d2 + i));
+        for (r = 0; r < 3; r++) {
+            u1[i + r] = d1[i + r] * s1;
+            u2[i + r] = d2[i + r] * s2;
+        }
+    }
 }
 
 /* the sine and cosine of the angle between the unit bearings b and R a (as
@@ -560,16 +605,43 @@ static void rotation_statistic(int n, const double *u1, const double *u2, const 
 {
     int i, m = 0, inside = 0, fast = lim > 1e-100 && lim < 1.5;
     double tl = fast ? tan(lim) : 0.0, below = tl * (1.0 - 1e-9), above = tl * (1.0 + 1e-9);
-    for (i = 0; i < n; i++) {
-        double s, c;
-        if (group[i] < 0)
-            continue;
-        rotation_angle_terms(u1 + 3 * i, u2 + 3 * i, R, &s, &c);
-        if (fast && c > 0.0 && s < c * below)
-            inside++;
-        else if (!fast || (c > 0.0 && !(s > c * above)))
+    if (!fast) {
+        for (i = 0; i < n; i++) {
+            double s, c;
+            if (group[i] < 0)
+                continue;
+            rotation_angle_terms(u1 + 3 * i, u2 + 3 * i, R, &s, &c);
             inside += atan2(s, c) < lim;
-        m++;
+            m++;
+        }
+    } else {
+        /* counted without branches, so that the pass vectorises (the
+         * counts are integers: any order gives the same sums); the pairs
+         * within the margin, if any, get their atan2 in a second pass */
+        double Rl[9];
+        long long cm = 0, cin = 0, unsure = 0;
+        for (i = 0; i < 9; i++)
+            Rl[i] = R[i];
+        for (i = 0; i < n; i++) {
+            double s, c;
+            long long g = group[i] >= 0, below_ok, above_ok;
+            rotation_angle_terms(u1 + 3 * i, u2 + 3 * i, Rl, &s, &c);
+            below_ok = (c > 0.0) & (s < c * below);
+            above_ok = (c > 0.0) & !(s > c * above);
+            cm += g;
+            cin += g & below_ok;
+            unsure += g & !below_ok & above_ok;
+        }
+        m = (int)cm;
+        inside = (int)cin;
+        for (i = 0; unsure > 0 && i < n; i++) {
+            double s, c;
+            if (group[i] < 0)
+                continue;
+            rotation_angle_terms(u1 + 3 * i, u2 + 3 * i, Rl, &s, &c);
+            if (c > 0.0 && !(s < c * below) && !(s > c * above))
+                inside += atan2(s, c) < lim;
+        }
     }
     *n_intra = m;
     *explained = m ? (double)inside / m : 0.0;
@@ -768,12 +840,11 @@ int mcg_static_check(int n, const double *o1, const double *d1, const double *o2
     u2 = u1 + 3 * (size_t)n;
     /* the best pure rotation: nearest rotation to sum d2 d1^T (identity
      * with fewer than two intra-camera pairs) */
+    unit_bearings(n, d1, d2, u1, u2);
     for (i = 0; i < n; i++) {
-        double *a = u1 + 3 * i, *b = u2 + 3 * i;
+        const double *a = u1 + 3 * i, *b = u2 + 3 * i;
         if (group[i] < 0)
             continue;
-        unit3(d1 + 3 * i, a);
-        unit3(d2 + 3 * i, b);
         for (r = 0; r < 3; r++)
             for (c = 0; c < 3; c++)
                 B[3 * r + c] += b[r] * a[c];
