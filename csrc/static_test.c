@@ -267,7 +267,7 @@ static int unit_rows(const double *restrict d1, const double *restrict d2, const
         mat_vec(Rl, p, rd);
         nr = sqrt(dot3(rd, rd));
         nb = sqrt(dot3(q, q));
-        bad |= (nr > 0.0) & (nr <= DBL_MAX) ? 0 : 1;
+        bad |= !((nr > 0.0) & (nr <= DBL_MAX));
         rd[0] /= nr;
         rd[1] /= nr;
         rd[2] /= nr;
