@@ -110,6 +110,18 @@ static int unit_block(const double *restrict d1, const double *restrict d2, int 
     return slow;
 }
 
+/* y = |R e1 x e2| and c = (R e1) . e2 of one pair of unit bearings: its
+ * rotation-only angle is atan2(y, c) */
+static inline void angle_terms(const double R[9], const double *e1, const double *e2, double *y,
+                               double *c)
+{
+    double a[3], x[3];
+    mat_vec(R, e1, a);
+    cross3(a, e2, x);
+    *y = sqrt(dot3(x, x));
+    *c = dot3(a, e2);
+}
+
 /* The rotation-only angles between d2 and R_fit d1 of the intra-camera
  * inliers of a block (unit bearings e1, e2): the number below the still
  * angle s, decided by the sign of D = c sin(s) - y cos(s) (see
@@ -128,12 +140,9 @@ static int still_block(int nb, const double *restrict e1, const double *restrict
     for (i = 0; i < 9; ++i)
         Rl[i] = R_fit[i];
     for (k = 0; k < nb; ++k) {
-        double a[3], x[3], y, c, D, margin;
+        double y, c, D, margin;
         long long use = (long long)(inlier[k] & 1) & (cam1[k] == cam2[k] ? 1LL : 0LL), above;
-        mat_vec(Rl, e1 + 3 * k, a);
-        cross3(a, e2 + 3 * k, x);
-        y = sqrt(dot3(x, x));
-        c = dot3(a, e2 + 3 * k);
+        angle_terms(Rl, e1 + 3 * k, e2 + 3 * k, &y, &c);
         D = c * sn - y * cs;
         margin = 1e-9 * (fabs(c) + y);
         above = D > margin ? 1LL : 0LL;
@@ -141,13 +150,10 @@ static int still_block(int nb, const double *restrict e1, const double *restrict
         unsure += use & (above ^ 1LL) & (D < -margin ? 0LL : 1LL);
     }
     for (k = 0; unsure > 0 && k < nb; ++k) {
-        double a[3], x[3], y, c, D, margin;
+        double y, c, D, margin;
         if (!(inlier[k] & 1) || cam1[k] != cam2[k])
             continue;
-        mat_vec(Rl, e1 + 3 * k, a);
-        cross3(a, e2 + 3 * k, x);
-        y = sqrt(dot3(x, x));
-        c = dot3(a, e2 + 3 * k);
+        angle_terms(Rl, e1 + 3 * k, e2 + 3 * k, &y, &c);
         D = c * sn - y * cs;
         margin = 1e-9 * (fabs(c) + y);
         if (!(D > margin) && !(D < -margin))
@@ -346,13 +352,12 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
                 continue;
             }
             for (j = 0; j < nb; ++j) {
-                double a[3], x[3];
+                double y, c;
                 k = k0 + j;
                 if (!(inlier[k] & 1) || cam1[k] != cam2[k])
                     continue;
-                mat_vec(out->R_fit, e1 + 3 * j, a);
-                cross3(a, e2 + 3 * j, x);
-                out->n_still += atan2(sqrt(dot3(x, x)), dot3(a, e2 + 3 * j)) < still_angle;
+                angle_terms(out->R_fit, e1 + 3 * j, e2 + 3 * j, &y, &c);
+                out->n_still += atan2(y, c) < still_angle;
             }
         }
     } else {
