@@ -8,8 +8,9 @@
  * centres; cheirality by explicit least-squares triangulation here; the
  * travel direction of a straight drive (the true direction, also with the
  * bearings swapped end for end: the sign); the no-parallax count recounted
- * with atan2 at many thresholds, also exactly at the angles; the status
- * codes of invalid arguments. Exit status 0 iff every check passes.
+ * with atan2 at many thresholds, also exactly at the angles; the same
+ * evidence from directions of any length; the status codes of invalid
+ * arguments. Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
@@ -294,12 +295,63 @@ static void test_invalid(void)
                                    64), MCG_OK, "no pairs at all");
 }
 
+/* Directions of any length give the same evidence: every third d1 scaled
+ * by 1e-150 and every fourth d2 by 1e145 (squared lengths outside the
+ * kernel's fast range of unit(), its other path), against the same scene
+ * unscaled; the counts exactly, the rotation fit, the critical angle and
+ * the direction of travel to rounding. */
+static void test_scaled_directions(void)
+{
+    double R[9], t[3] = {0.3, -0.2, 0.4}, axis[3] = {0.5, 1.0, -0.3}, dev = 0.0;
+    mcg_verdict_stats_result a, b;
+    int k, i, sa, sb;
+    rot_about(axis, 0.15, R);
+    scene(R, t, 1);
+    sa = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 0.05, &a, work, 64);
+    for (k = 0; k < N; ++k)
+        for (i = 0; i < 3; ++i) {
+            if (k % 3 == 0)
+                d1[3 * k + i] *= 1e-150;
+            if (k % 4 == 0)
+                d2[3 * k + i] *= 1e145;
+        }
+    sb = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 0.05, &b, work, 64);
+    for (i = 0; i < 9; ++i)
+        dev = fmax(dev, fabs(a.R_fit[i] - b.R_fit[i]));
+    for (i = 0; i < 3; ++i)
+        dev = fmax(dev, fabs(a.t_direction[i] - b.t_direction[i]));
+    dev = fmax(dev, fabs(a.critical_angle - b.critical_angle));
+    check(sa == MCG_OK && sb == MCG_OK && a.n_inliers == b.n_inliers && a.n_intra == b.n_intra &&
+              a.n_still == b.n_still && a.n_in_front == b.n_in_front &&
+              a.n_cameras_intra == b.n_cameras_intra && a.fit_ok == b.fit_ok && a.n_still > 0 &&
+              a.n_still < a.n_intra,
+          "tiny and huge directions: the same counts", (double)(a.n_still - b.n_still), 0);
+    check(dev < 1e-12, "tiny and huge directions: the same fit and angles", dev, 1e-12);
+    /* lengths whose squares under- and overflow (1e-170, 1e170): the unit
+     * bearings still the same (cheirality, on the raw directions, is not
+     * compared: its products leave the doubles) */
+    for (k = 0; k < N; ++k)
+        for (i = 0; i < 3; ++i) {
+            if (k % 3 == 0)
+                d1[3 * k + i] *= 1e-20;
+            if (k % 4 == 0)
+                d2[3 * k + i] *= 1e25;
+        }
+    sb = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 0.05, &b, work, 64);
+    dev = 0.0;
+    for (i = 0; i < 9; ++i)
+        dev = fmax(dev, fabs(a.R_fit[i] - b.R_fit[i]));
+    check(sb == MCG_OK && a.n_still == b.n_still && a.n_intra == b.n_intra && dev < 1e-12,
+          "squared lengths beyond the doubles: the same bearings", dev, 1e-12);
+}
+
 int main(void)
 {
     test_counts_crit_front();
     test_pure_rotation();
     test_still_count();
     test_straight_drive();
+    test_scaled_directions();
     test_invalid();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed ? 1 : 0;
