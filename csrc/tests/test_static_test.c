@@ -5,8 +5,9 @@
  * translation (R c + t - c, through mcg_gec_residuals), also with planted
  * outliers in one camera; on noisy data the median is no worse than the true
  * directions' and equals the median of the sorted residuals (qsort); cameras
- * below min_rows and pairs of group -1 are left out; the status codes of
- * invalid arguments. Exit status 0 iff every check passes.
+ * below min_rows and pairs of group -1 are left out; the explained fraction
+ * of mcg_static_check against an atan2 recount, also with its bound at each
+ * angle; the status codes of invalid arguments. Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"
 
@@ -315,6 +316,41 @@ static void test_fast_paths(void)
         check(st == MCG_OK && fabs(res.explained - (double)inside / N) < 1e-12,
               "explained = atan2 count below the bound", res.explained - (double)inside / N,
               1e-12);
+    }
+    /* bounds at the angles themselves, where the tan prefilter cannot
+     * decide (its second pass with atan2): the angles as the kernel rounds
+     * them (unit bearings d / |d| as v (1 / |v|), then R u1) */
+    {
+        int bad = 0, k, c;
+        for (j = 0; j < N; j++) {
+            double u[3], w[3], a[3], x[3], s1 = 0.0, s2 = 0.0;
+            for (c = 0; c < 3; c++) {
+                s1 += d1[3 * j + c] * d1[3 * j + c];
+                s2 += d2[3 * j + c] * d2[3 * j + c];
+            }
+            s1 = 1.0 / sqrt(s1);
+            s2 = 1.0 / sqrt(s2);
+            for (c = 0; c < 3; c++) {
+                u[c] = d1[3 * j + c] * s1;
+                w[c] = d2[3 * j + c] * s2;
+            }
+            for (c = 0; c < 3; c++)
+                a[c] = R[3 * c] * u[0] + R[3 * c + 1] * u[1] + R[3 * c + 2] * u[2];
+            x[0] = a[1] * w[2] - a[2] * w[1];
+            x[1] = a[2] * w[0] - a[0] * w[2];
+            x[2] = a[0] * w[1] - a[1] * w[0];
+            ang[j] = atan2(sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]),
+                           a[0] * w[0] + a[1] * w[1] + a[2] * w[2]);
+        }
+        for (j = 0; j < N; j++) {
+            double level = ang[j] / opt.parallax_factor, lim = opt.parallax_factor * level;
+            int inside = 0;
+            for (k = 0; k < N; k++)
+                inside += ang[k] < lim;
+            st = mcg_static_check(N, o1, d1, o2, d2, grp, NULL, R, level, &opt, &res, work, lw);
+            bad += st != MCG_OK || fabs(res.explained - (double)inside / N) > 1e-12;
+        }
+        check(bad == 0, "explained = atan2 count with the bound at each angle", (double)bad, 0);
     }
     free(work);
 }
