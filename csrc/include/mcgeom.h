@@ -281,7 +281,8 @@ typedef struct {
                                scale is not trusted (0 if not determined) */
     double E[9];            /* E = [t]x R of the linear step (unit norm,
                                normalised frame) */
-    int gc_case;            /* MCG_GC_* detected from the data */
+    int gc_case;            /* MCG_GC_* detected from the data (the kind
+                               solved; see mcg_linear17) */
     int rank_ar;            /* numerical rank of A_R (9 columns) */
     int rank_a;             /* rank(A) expected noise-free: 17 - nullity */
     double ar_eig[9];       /* eigenvalues of A_R^T A_R / trace, ascending */
@@ -327,7 +328,11 @@ void mcg_linear17_default_options(mcg_linear17_options *opt);
  * pair has the same origin at both times. Otherwise (a cross-camera rig that
  * hardly moves nearly annihilates (0, I) by accident) the most-general
  * solve is run as well and the motion of lower Sampson error is returned;
- * MCG_EDEGENERATE if the most-general reading is not unique either.
+ * MCG_EDEGENERATE if the most-general reading is not unique either. Where
+ * a motion was found and the kind read with eigenvalues up to 1e-8 of the
+ * largest as structural is a more special one (a rig nearly axial: two
+ * centres 1e-4 apart), that kind is solved too and the motion of lower
+ * Sampson error returned (res->gc_case then names it).
  * The result is in the caller's rig frame (R, t: rig2_from_rig1, t in the
  * unit of the origins). n in [14, 2^26]. MCG_EINVAL: NULL, n, bad options,
  * NaN/inf, a zero-length direction (|d| < 1e-50); MCG_ENUMERIC: an inner
