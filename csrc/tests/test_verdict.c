@@ -295,6 +295,19 @@ static void test_invalid(void)
                                    64), MCG_OK, "no pairs at all");
 }
 
+/* every third d1 times f1, every fourth d2 times f2 */
+static void scale_directions(double f1, double f2)
+{
+    int k, i;
+    for (k = 0; k < N; ++k)
+        for (i = 0; i < 3; ++i) {
+            if (k % 3 == 0)
+                d1[3 * k + i] *= f1;
+            if (k % 4 == 0)
+                d2[3 * k + i] *= f2;
+        }
+}
+
 /* Directions of any length give the same evidence: every third d1 scaled
  * by 1e-150 and every fourth d2 by 1e145 (squared lengths outside the
  * kernel's fast range of unit(), its other path), against the same scene
@@ -304,17 +317,11 @@ static void test_scaled_directions(void)
 {
     double R[9], t[3] = {0.3, -0.2, 0.4}, axis[3] = {0.5, 1.0, -0.3}, dev = 0.0;
     mcg_verdict_stats_result a, b;
-    int k, i, sa, sb;
+    int i, sa, sb;
     rot_about(axis, 0.15, R);
     scene(R, t, 1);
     sa = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 0.05, &a, work, 64);
-    for (k = 0; k < N; ++k)
-        for (i = 0; i < 3; ++i) {
-            if (k % 3 == 0)
-                d1[3 * k + i] *= 1e-150;
-            if (k % 4 == 0)
-                d2[3 * k + i] *= 1e145;
-        }
+    scale_directions(1e-150, 1e145);
     sb = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 0.05, &b, work, 64);
     for (i = 0; i < 9; ++i)
         dev = fmax(dev, fabs(a.R_fit[i] - b.R_fit[i]));
@@ -330,13 +337,7 @@ static void test_scaled_directions(void)
     /* lengths whose squares under- and overflow (1e-170, 1e170): the unit
      * bearings still the same (cheirality, on the raw directions, is not
      * compared: its products leave the doubles) */
-    for (k = 0; k < N; ++k)
-        for (i = 0; i < 3; ++i) {
-            if (k % 3 == 0)
-                d1[3 * k + i] *= 1e-20;
-            if (k % 4 == 0)
-                d2[3 * k + i] *= 1e25;
-        }
+    scale_directions(1e-20, 1e25);
     sb = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 0.05, &b, work, 64);
     dev = 0.0;
     for (i = 0; i < 9; ++i)
