@@ -263,28 +263,23 @@ static int unit_rows(const double *restrict d1, const double *restrict d2, const
         Rl[i] = R[i];
     for (i = 0; i < m; i++) {
         const double *p = d1 + 3 * i, *q = d2 + 3 * i;
-        double rd[3], b0, b1, b2, a0, a1, a2, nr, nb, na;
+        double rd[3], b[3], a[3], nr, nb, na;
+        int r;
         mat_vec(Rl, p, rd);
         nr = sqrt(dot3(rd, rd));
         nb = sqrt(dot3(q, q));
         bad |= !((nr > 0.0) & (nr <= DBL_MAX));
-        rd[0] /= nr;
-        rd[1] /= nr;
-        rd[2] /= nr;
-        b0 = q[0] / nb;
-        b1 = q[1] / nb;
-        b2 = q[2] / nb;
-        /* cross3(rd, b) */
-        a0 = rd[1] * b2 - rd[2] * b1;
-        a1 = rd[2] * b0 - rd[0] * b2;
-        a2 = rd[0] * b1 - rd[1] * b0;
-        na = sqrt(a0 * a0 + a1 * a1 + a2 * a2);
-        raw[3 * i] = a0;
-        raw[3 * i + 1] = a1;
-        raw[3 * i + 2] = a2;
-        ax[i] = a0 / na;
-        ay[i] = a1 / na;
-        az[i] = a2 / na;
+        for (r = 0; r < 3; r++) {
+            rd[r] /= nr;
+            b[r] = q[r] / nb;
+        }
+        cross3(rd, b, a);
+        na = sqrt(dot3(a, a));
+        for (r = 0; r < 3; r++)
+            raw[3 * i + r] = a[r];
+        ax[i] = a[0] / na;
+        ay[i] = a[1] / na;
+        az[i] = a[2] / na;
     }
     return !bad;
 }

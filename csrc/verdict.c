@@ -79,10 +79,9 @@ static int unit(const double *v, double u[3])
  * makes them: its common case (squared length within (1e-280, 1e280)) in
  * one pass without branches, so that it vectorises, then unit() itself for
  * the others (zeros where it fails), so the same bits (issue 19: the
- * verdict's unit bearings were made one at a time, twice). Returns the
- * number of pairs that took unit() itself. */
+ * verdict's unit bearings were made one at a time, twice). */
 MCG_AVX2_CLONE
-static int unit_block(const double *restrict d1, const double *restrict d2, int nb,
+static void unit_block(const double *restrict d1, const double *restrict d2, int nb,
                       double *restrict e1, double *restrict e2)
 {
     int k, i, slow = 0;
@@ -107,7 +106,6 @@ static int unit_block(const double *restrict d1, const double *restrict d2, int 
                 (void)unit(d2 + 3 * k, e2 + 3 * k);
             }
         }
-    return slow;
 }
 
 /* y = |R e1 x e2| and c = (R e1) . e2 of one pair of unit bearings: its
@@ -177,14 +175,14 @@ static void count_front(int n, const double *restrict o1, const double *restrict
                         const double *T, int nt, int *count)
 {
     double Rl[9], Tl[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    long long c0 = 0, c1 = 0, c2 = 0;
-    int k, i;
+    long long cnt[3] = {0, 0, 0};
+    int k, i, j;
     for (i = 0; i < 9; ++i)
         Rl[i] = R[i];
     for (i = 0; i < 3 * nt; ++i)
         Tl[i] = T[i];
     for (k = 0; k < n; ++k) {
-        double a[3], p[3], w[3], aa, bb, ab, aw0, bw0, aw, bw;
+        double a[3], p[3], w[3], aa, bb, ab, aw0, bw0;
         const double *b = d2 + 3 * k;
         long long ok;
         mat_vec(Rl, d1 + 3 * k, a);
@@ -198,21 +196,14 @@ static void count_front(int n, const double *restrict o1, const double *restrict
         ok = (long long)(inlier[k] & 1) & (aa * bb - ab * ab > 1e-14 * aa * bb ? 1LL : 0LL);
         aw0 = dot3(a, w);
         bw0 = dot3(b, w);
-        aw = aw0 - dot3(a, Tl);
-        bw = bw0 - dot3(b, Tl);
-        c0 += ok & (aw * bb - bw * ab > 0.0 ? 1LL : 0LL) & (aw * ab - bw * aa > 0.0 ? 1LL : 0LL);
-        aw = aw0 - dot3(a, Tl + 3);
-        bw = bw0 - dot3(b, Tl + 3);
-        c1 += ok & (aw * bb - bw * ab > 0.0 ? 1LL : 0LL) & (aw * ab - bw * aa > 0.0 ? 1LL : 0LL);
-        aw = aw0 - dot3(a, Tl + 6);
-        bw = bw0 - dot3(b, Tl + 6);
-        c2 += ok & (aw * bb - bw * ab > 0.0 ? 1LL : 0LL) & (aw * ab - bw * aa > 0.0 ? 1LL : 0LL);
+        for (j = 0; j < 3; ++j) {
+            const double aw = aw0 - dot3(a, Tl + 3 * j), bw = bw0 - dot3(b, Tl + 3 * j);
+            cnt[j] += ok & (aw * bb - bw * ab > 0.0 ? 1LL : 0LL) &
+                      (aw * ab - bw * aa > 0.0 ? 1LL : 0LL);
+        }
     }
-    count[0] = (int)c0;
-    if (nt > 1)
-        count[1] = (int)c1;
-    if (nt > 2)
-        count[2] = (int)c2;
+    for (j = 0; j < nt; ++j)
+        count[j] = (int)cnt[j];
 }
 
 /* The largest folded angle between the displacement lines of the centres
@@ -313,7 +304,7 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
      * centroid of the inliers' origins */
     for (k0 = 0; k0 < n; k0 += VBLOCK) {
         const int nb = n - k0 < VBLOCK ? n - k0 : VBLOCK;
-        (void)unit_block(d1 + 3 * (size_t)k0, d2 + 3 * (size_t)k0, nb, e1, e2);
+        unit_block(d1 + 3 * (size_t)k0, d2 + 3 * (size_t)k0, nb, e1, e2);
         for (j = 0; j < nb; ++j) {
             k = k0 + j;
             if (!(inlier[k] & 1))
@@ -345,7 +336,7 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
         out->fit_ok = 1;
         for (k0 = 0; k0 < n; k0 += VBLOCK) {
             const int nb = n - k0 < VBLOCK ? n - k0 : VBLOCK;
-            (void)unit_block(d1 + 3 * (size_t)k0, d2 + 3 * (size_t)k0, nb, e1, e2);
+            unit_block(d1 + 3 * (size_t)k0, d2 + 3 * (size_t)k0, nb, e1, e2);
             if (fast) {
                 out->n_still += still_block(nb, e1, e2, inlier + k0, cam1 + k0, cam2 + k0,
                                             out->R_fit, sn, cs, still_angle);
