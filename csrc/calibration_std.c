@@ -20,11 +20,26 @@
  * of theta, G = d theta / d p (6 x 3 per kind); var |tau| = u^T Cov_tau u,
  * u = tau / |tau|.
  *
- * J and the derivatives of a camera's turn are central differences of the
- * residuals (sampson.h, the residual of mcg_gec_residuals): steps of 1e-6
- * rad and 1e-6 |tau|; the residuals are smooth, so the differences are
- * accurate to ~1e-10 relative. A camera's centre enters only through the
- * translation term, so its derivatives come from J's translation columns. One pass over the pairs: each pair's J
+ * J and the derivatives of a camera's turn are analytic. The residual is a
+ * function r(A, B, c) of A = R d1, B = d2 and c = tau + R o1 - o2 (sampson.h),
+ * so every derivative needed is one of three (left increments: a rotation
+ * by the small vector phi moves a vector v by phi x v):
+ *   dr/dc            the translation row of J;
+ *   A x dr/dA        the bearings' turn at time 1 seen in the rig2 frame, and
+ *                    with R (o1) x dr/dc the rotation row of J;
+ *   B x dr/dB        the bearings' turn at time 2.
+ * dr/dc and A x dr/dA are those of the refinement's rows (refine.c,
+ * block_rows: derived on the same raw form); B x dr/dB follows the same way:
+ * with E = B.Q, Q = c x A, H = B x c and den = |B|^2|Q|^2 + |A|^2|H|^2 - 2E^2,
+ * dr/dB = f1 Q - f2 (|Q|^2 B + |A|^2 c x H), f1 = s (1 + 2 r^2), f2 = r s^2,
+ * s = den^-1/2, so B x dr/dB = f1 B x Q + f2 |A|^2 (B.c) H (B.H = 0). On the
+ * pi/2 cap r is constant and every derivative 0. A camera turned by phi about
+ * its centre turns its bearings d1 by phi in the rig1 frame, which is R phi
+ * in the rig2 frame of A: dr/dphi = R^T (A x dr/dA); at time 2, B x dr/dB.
+ * A camera's centre enters only through the translation term, so its
+ * derivatives come from J's translation columns. (Until session 27 these
+ * were central differences, 13-25 residuals per pair: 4.4 ms of a 20 ms
+ * KITTI estimate.) One pass over the pairs: each pair's J
  * row and its derivatives for its one or two cameras go straight into
  * J^T W J and the per-camera sums J^T W dr / dp (6 x 3 per camera and
  * kind, in the workspace), so nothing of size N is stored. The numpy
@@ -39,22 +54,12 @@
 #include <string.h>
 
 #define MAX_CAL_CAMERAS 4096
-#define H_ANG 1e-6 /* angular step of the central differences (radians) */
-#define H_REL 1e-6 /* translation step, relative to |tau| */
 
 size_t mcg_calibration_std_work_size(int n_cameras)
 {
     if (n_cameras < 1 || n_cameras > MAX_CAL_CAMERAS)
         return 0;
     return 36 * (size_t)n_cameras; /* per camera: J^T W dr/dp, 6 x 3 per kind */
-}
-
-/* Rodrigues' rotation by the angle h about axis k (0, 1, 2) */
-static void axis_turn(int k, double h, double out[9])
-{
-    double w[3] = {0.0, 0.0, 0.0};
-    w[k] = h;
-    mcg_rot_from_angle_axis(w, out);
 }
 
 /* the loss's IRLS weight factor at the residual r (scale s, radians), as
@@ -76,40 +81,64 @@ static double loss_weight(int loss, double r, double s)
     }
 }
 
+/* One pair's residual r (radians; NaN for an invalid pair) and its
+ * derivatives (see the header): j the row of J (dr/dw, dr/dtau), turn1 and
+ * turn2 dr/dphi for a turn of the bearings by phi (rig frame) at time 1 and
+ * at time 2. o1, o2: origins relative to the centroid; d1, d2 unit. */
+static double pair_derivatives(const double R[9], const double tau[3], const double o1[3],
+                               const double d1[3], const double o2[3], const double d2[3],
+                               double j[6], double turn1[3], double turn2[3])
+{
+    sampson_terms p;
+    double on, s, r, f1, f2, f3, ac, bc, ja[3];
+    sampson_pair(R, tau, o1, d1, o2, d2, &p);
+    on = p.dd > p.lo ? 1.0 : 0.0; /* off on the pi/2 cap: r is constant */
+    s = 1.0 / sqrt(p.m);
+    r = p.e * s;
+    f1 = on * s * (1.0 + 2.0 * r * r);
+    f2 = on * r * s * s;
+    ac = p.a0 * p.c0 + p.a1 * p.c1 + p.a2 * p.c2;
+    bc = p.b0 * p.c0 + p.b1 * p.c1 + p.b2 * p.c2;
+    f3 = f2 * p.n2 * ac;
+    /* dr/dc = f1 A x B - f2 (2 |A|^2 |B|^2 c - |B|^2 (A.c) A - |A|^2 (B.c) B) */
+    j[3] = f1 * (p.a1 * p.b2 - p.a2 * p.b1) -
+           f2 * (2.0 * p.n1 * p.n2 * p.c0 - p.n2 * ac * p.a0 - p.n1 * bc * p.b0);
+    j[4] = f1 * (p.a2 * p.b0 - p.a0 * p.b2) -
+           f2 * (2.0 * p.n1 * p.n2 * p.c1 - p.n2 * ac * p.a1 - p.n1 * bc * p.b1);
+    j[5] = f1 * (p.a0 * p.b1 - p.a1 * p.b0) -
+           f2 * (2.0 * p.n1 * p.n2 * p.c2 - p.n2 * ac * p.a2 - p.n1 * bc * p.b2);
+    /* A x dr/dA = f1 A x H - f3 Q */
+    ja[0] = f1 * (p.a1 * p.h2 - p.a2 * p.h1) - f3 * p.q0;
+    ja[1] = f1 * (p.a2 * p.h0 - p.a0 * p.h2) - f3 * p.q1;
+    ja[2] = f1 * (p.a0 * p.h1 - p.a1 * p.h0) - f3 * p.q2;
+    /* dr/dw = (R o1) x dr/dc + A x dr/dA */
+    j[0] = p.p1 * j[5] - p.p2 * j[4] + ja[0];
+    j[1] = p.p2 * j[3] - p.p0 * j[5] + ja[1];
+    j[2] = p.p0 * j[4] - p.p1 * j[3] + ja[2];
+    /* a turn at time 1: R^T (A x dr/dA); at time 2: B x dr/dB */
+    turn1[0] = R[0] * ja[0] + R[3] * ja[1] + R[6] * ja[2];
+    turn1[1] = R[1] * ja[0] + R[4] * ja[1] + R[7] * ja[2];
+    turn1[2] = R[2] * ja[0] + R[5] * ja[1] + R[8] * ja[2];
+    turn2[0] = f1 * (p.b1 * p.q2 - p.b2 * p.q1) + f2 * p.n1 * bc * p.h0;
+    turn2[1] = f1 * (p.b2 * p.q0 - p.b0 * p.q2) + f2 * p.n1 * bc * p.h1;
+    turn2[2] = f1 * (p.b0 * p.q1 - p.b1 * p.q0) + f2 * p.n1 * bc * p.h2;
+    return r + p.marker;
+}
+
 /* d r / d p of one pair for the camera's perturbations of one kind (0: its
  * centre moves along each axis, 1: it turns about each axis), applied at
  * time 1 when at1, at time 2 when at2; dr[3] per axis. A centre enters the
  * residual only through c = tau + R o1 - o2 (sampson.h), so moving o1 by
  * e_k is moving tau by R e_k and moving o2 by e_k is moving tau by -e_k:
- * the position derivatives are the pair's translation row jt of J (no
- * residuals to evaluate). A turn of the bearings is differenced. */
-static void camera_derivative(const double *R, const double *tau, const double *o1,
-                              const double *d1, const double *o2, const double *d2, int kind,
-                              int at1, int at2, const double jt[3], double (*turns)[9],
-                              double dr[3])
+ * the position derivatives are the pair's translation row jt of J. */
+static void camera_derivative(const double *R, int kind, int at1, int at2, const double jt[3],
+                              const double turn1[3], const double turn2[3], double dr[3])
 {
-    int k, s;
-    if (kind == 0) {
-        for (k = 0; k < 3; k++)
-            dr[k] = (at1 ? jt[0] * R[k] + jt[1] * R[3 + k] + jt[2] * R[6 + k] : 0.0) -
-                    (at2 ? jt[k] : 0.0);
-        return;
-    }
-    for (k = 0; k < 3; k++) {
-        double r[2];
-        for (s = 0; s < 2; s++) {
-            double b1[3], b2[3];
-            const double *q = turns[2 * k + s];
-            memcpy(b1, d1, sizeof b1);
-            memcpy(b2, d2, sizeof b2);
-            if (at1)
-                mat_vec(q, d1, b1);
-            if (at2)
-                mat_vec(q, d2, b2);
-            r[s] = sampson_residual(R, tau, o1, b1, o2, b2);
-        }
-        dr[k] = (r[0] - r[1]) / (2.0 * H_ANG);
-    }
+    int k;
+    for (k = 0; k < 3; k++)
+        dr[k] = kind == 0 ? (at1 ? jt[0] * R[k] + jt[1] * R[3 + k] + jt[2] * R[6 + k] : 0.0) -
+                                (at2 ? jt[k] : 0.0)
+                          : (at1 ? turn1[k] : 0.0) + (at2 ? turn2[k] : 0.0);
 }
 
 /* B (6 x 3, row-major) += w J dr^T */
@@ -128,8 +157,8 @@ int mcg_calibration_scale_std(int n, const double *o1, const double *d1, const d
                               double loss_scale, double *rel_std, double cov[36],
                               double *work, size_t lwork)
 {
-    double c[3] = {0.0, 0.0, 0.0}, tau[3], rc[3], turns[6][9], rturn[6][9], h[36] = {0};
-    double hinv[36], scale, h_t, var = 0.0, u[3];
+    double c[3] = {0.0, 0.0, 0.0}, tau[3], rc[3], h[36] = {0};
+    double hinv[36], scale, var = 0.0, u[3];
     int i, k, a, b, cam;
     if (!o1 || !d1 || !o2 || !d2 || !cam1 || !cam2 || !extrinsic_std || !R || !t || !rel_std ||
         !cov || (!work && lwork))
@@ -177,18 +206,11 @@ int mcg_calibration_scale_std(int n, const double *o1, const double *d1, const d
     scale = sqrt(dot3(tau, tau));
     if (!(scale > 1e-9))
         scale = 1e-9;
-    h_t = H_REL * scale;
-    for (k = 0; k < 3; k++) {
-        axis_turn(k, H_ANG, turns[2 * k]);
-        axis_turn(k, -H_ANG, turns[2 * k + 1]);
-        mul33(turns[2 * k], R, rturn[2 * k]);
-        mul33(turns[2 * k + 1], R, rturn[2 * k + 1]);
-    }
     memset(work, 0, 36 * (size_t)n_cameras * sizeof *work);
 
     /* one pass: J^T W J and, per camera and kind, J^T W dr/dp */
     for (i = 0; i < n; i++) {
-        double p1[3], p2[3], q1[3], q2[3], j[6], r0, w, n1, n2;
+        double p1[3], p2[3], q1[3], q2[3], j[6], turn1[3], turn2[3], r0, w, n1, n2;
         for (k = 0; k < 3; k++) {
             p1[k] = o1[3 * i + k] - c[k];
             p2[k] = o2[3 * i + k] - c[k];
@@ -199,21 +221,10 @@ int mcg_calibration_scale_std(int n, const double *o1, const double *d1, const d
             q1[k] = d1[3 * i + k] / n1;
             q2[k] = d2[3 * i + k] / n2;
         }
-        r0 = sampson_residual(R, tau, p1, q1, p2, q2);
-        if (!isfinite(r0))
+        r0 = pair_derivatives(R, tau, p1, q1, p2, q2, j, turn1, turn2);
+        if (!isfinite(r0) || !all_finite(j, 6) || !all_finite(turn1, 3) || !all_finite(turn2, 3))
             return MCG_EINVAL; /* a zero direction, or magnitudes that overflow */
         w = (weights ? weights[i] : 1.0) * loss_weight(loss, r0, loss_scale);
-        for (k = 0; k < 3; k++) {
-            double tp[3], tm[3];
-            memcpy(tp, tau, sizeof tp);
-            memcpy(tm, tau, sizeof tm);
-            tp[k] += h_t;
-            tm[k] -= h_t;
-            j[k] = (sampson_residual(rturn[2 * k], tau, p1, q1, p2, q2) -
-                    sampson_residual(rturn[2 * k + 1], tau, p1, q1, p2, q2)) / (2.0 * H_ANG);
-            j[3 + k] = (sampson_residual(R, tp, p1, q1, p2, q2) -
-                        sampson_residual(R, tm, p1, q1, p2, q2)) / (2.0 * h_t);
-        }
         for (a = 0; a < 6; a++)
             for (b = 0; b < 6; b++)
                 h[6 * a + b] += w * j[a] * j[b];
@@ -228,7 +239,7 @@ int mcg_calibration_scale_std(int n, const double *o1, const double *d1, const d
                 double dr[3];
                 if (extrinsic_std[2 * id + kind] == 0.0)
                     continue;
-                camera_derivative(R, tau, p1, q1, p2, q2, kind, at1, at2, j + 3, turns, dr);
+                camera_derivative(R, kind, at1, at2, j + 3, turn1, turn2, dr);
                 add_outer(work + 36 * (size_t)id + 18 * kind, w, j, dr);
             }
         }

@@ -2,7 +2,7 @@
  * sampson.h -- the Sampson angular residual of one ray pair (thesis eq. 8.15
  * applied to the generalized epipolar constraint, eq. 8.16), shared by the
  * kernels that evaluate it pair by pair: refine.c (mcg_gec_residuals, the
- * refinement's rows) and calibration_std.c (the central differences of the
+ * refinement's rows) and calibration_std.c (the derivatives of the
  * calibration error's propagation). Not installed.
  */
 #ifndef MCGEOM_SAMPSON_H

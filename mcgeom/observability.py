@@ -347,9 +347,9 @@ def calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
     ``|tau|`` is ``sum_j (u^T d tau / d p_j)^2 sigma_j^2`` with ``u = tau /
     |tau|`` and ``sigma_j`` from ``extrinsic_std``: an (M, 2) array (or one
     pair) of per-camera 1-sigma position (metres per axis) and rotation
-    (radians per axis) errors, independent across cameras and axes. Jacobians
-    by central differences (the residuals are smooth), in one C pass over the
-    pairs (``_core.calibration_scale_std``, csrc/calibration_std.c).
+    (radians per axis) errors, independent across cameras and axes. Analytic derivatives of the
+    residuals, in one C pass over the pairs (``_core.calibration_scale_std``,
+    csrc/calibration_std.c).
 
     Returns ``(rel_std, cov)``: the relative std of ``|tau|`` (0 when every
     std is 0, inf when the motion is not determined by the rays: singular
