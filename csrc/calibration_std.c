@@ -28,8 +28,8 @@
  *   A x dr/dA        the bearings' turn at time 1 seen in the rig2 frame, and
  *                    with R (o1) x dr/dc the rotation row of J;
  *   B x dr/dB        the bearings' turn at time 2.
- * dr/dc and A x dr/dA are those of the refinement's rows (refine.c,
- * block_rows: derived on the same raw form); B x dr/dB follows the same way:
+ * dr/dc and dr/dw are the refinement's row (sampson.h, sampson_jacobian),
+ * and A x dr/dA = dr/dw - (R o1) x dr/dc; B x dr/dB follows the same way:
  * with E = B.Q, Q = c x A, H = B x c and den = |B|^2|Q|^2 + |A|^2|H|^2 - 2E^2,
  * dr/dB = f1 Q - f2 (|Q|^2 B + |A|^2 c x H), f1 = s (1 + 2 r^2), f2 = r s^2,
  * s = den^-1/2, so B x dr/dB = f1 B x Q + f2 |A|^2 (B.c) H (B.H = 0). On the
@@ -90,39 +90,26 @@ static double pair_derivatives(const double R[9], const double tau[3], const dou
                                double j[6], double turn1[3], double turn2[3])
 {
     sampson_terms p;
-    double on, s, r, f1, f2, f3, ac, bc, ja[3];
+    sampson_row w;
+    double pv[3], pj[3], ja[3];
+    int k;
     sampson_pair(R, tau, o1, d1, o2, d2, &p);
-    on = p.dd > p.lo ? 1.0 : 0.0; /* off on the pi/2 cap: r is constant */
-    s = 1.0 / sqrt(p.m);
-    r = p.e * s;
-    f1 = on * s * (1.0 + 2.0 * r * r);
-    f2 = on * r * s * s;
-    ac = p.a0 * p.c0 + p.a1 * p.c1 + p.a2 * p.c2;
-    bc = p.b0 * p.c0 + p.b1 * p.c1 + p.b2 * p.c2;
-    f3 = f2 * p.n2 * ac;
-    /* dr/dc = f1 A x B - f2 (2 |A|^2 |B|^2 c - |B|^2 (A.c) A - |A|^2 (B.c) B) */
-    j[3] = f1 * (p.a1 * p.b2 - p.a2 * p.b1) -
-           f2 * (2.0 * p.n1 * p.n2 * p.c0 - p.n2 * ac * p.a0 - p.n1 * bc * p.b0);
-    j[4] = f1 * (p.a2 * p.b0 - p.a0 * p.b2) -
-           f2 * (2.0 * p.n1 * p.n2 * p.c1 - p.n2 * ac * p.a1 - p.n1 * bc * p.b1);
-    j[5] = f1 * (p.a0 * p.b1 - p.a1 * p.b0) -
-           f2 * (2.0 * p.n1 * p.n2 * p.c2 - p.n2 * ac * p.a2 - p.n1 * bc * p.b2);
-    /* A x dr/dA = f1 A x H - f3 Q */
-    ja[0] = f1 * (p.a1 * p.h2 - p.a2 * p.h1) - f3 * p.q0;
-    ja[1] = f1 * (p.a2 * p.h0 - p.a0 * p.h2) - f3 * p.q1;
-    ja[2] = f1 * (p.a0 * p.h1 - p.a1 * p.h0) - f3 * p.q2;
-    /* dr/dw = (R o1) x dr/dc + A x dr/dA */
-    j[0] = p.p1 * j[5] - p.p2 * j[4] + ja[0];
-    j[1] = p.p2 * j[3] - p.p0 * j[5] + ja[1];
-    j[2] = p.p0 * j[4] - p.p1 * j[3] + ja[2];
+    sampson_jacobian(&p, &w);
+    memcpy(j, w.j, sizeof w.j);
+    /* A x dr/dA = dr/dw - (R o1) x dr/dt */
+    pv[0] = p.p0;
+    pv[1] = p.p1;
+    pv[2] = p.p2;
+    cross3(pv, j + 3, pj);
+    for (k = 0; k < 3; k++)
+        ja[k] = j[k] - pj[k];
     /* a turn at time 1: R^T (A x dr/dA); at time 2: B x dr/dB */
-    turn1[0] = R[0] * ja[0] + R[3] * ja[1] + R[6] * ja[2];
-    turn1[1] = R[1] * ja[0] + R[4] * ja[1] + R[7] * ja[2];
-    turn1[2] = R[2] * ja[0] + R[5] * ja[1] + R[8] * ja[2];
-    turn2[0] = f1 * (p.b1 * p.q2 - p.b2 * p.q1) + f2 * p.n1 * bc * p.h0;
-    turn2[1] = f1 * (p.b2 * p.q0 - p.b0 * p.q2) + f2 * p.n1 * bc * p.h1;
-    turn2[2] = f1 * (p.b0 * p.q1 - p.b1 * p.q0) + f2 * p.n1 * bc * p.h2;
-    return r + p.marker;
+    for (k = 0; k < 3; k++)
+        turn1[k] = R[k] * ja[0] + R[3 + k] * ja[1] + R[6 + k] * ja[2];
+    turn2[0] = w.f1 * (p.b1 * p.q2 - p.b2 * p.q1) + w.f2 * p.n1 * w.bc * p.h0;
+    turn2[1] = w.f1 * (p.b2 * p.q0 - p.b0 * p.q2) + w.f2 * p.n1 * w.bc * p.h1;
+    turn2[2] = w.f1 * (p.b0 * p.q1 - p.b1 * p.q0) + w.f2 * p.n1 * w.bc * p.h2;
+    return w.r + p.marker;
 }
 
 /* d r / d p of one pair for the camera's perturbations of one kind (0: its

@@ -165,35 +165,14 @@ static void block_rows(int nb, const double *restrict o1, const double *restrict
     int k;
     for (k = 0; k < nb; k++) {
         sampson_terms p;
-        double s, rr, f1, f2, f3, ac, bc, k0, k1, k2, v0, v1, v2, jt0, jt1, jt2, on;
+        sampson_row w;
+        int i;
         sampson_pair(rm, tv, o1 + 3 * k, d1 + 3 * k, o2 + 3 * k, d2 + 3 * k, &p);
-        /* 1 on the Sampson branch (a select, not a branch: vectorisable) */
-        on = p.dd > p.lo ? 1.0 : 0.0;
-        s = 1.0 / sqrt(p.m);
-        rr = p.e * s;
-        rb[k] = rr + p.marker;
-        ok[k] = on;
-        f1 = on * s * (1.0 + 2.0 * rr * rr);
-        f2 = on * rr * s * s;
-        ac = p.a0 * p.c0 + p.a1 * p.c1 + p.a2 * p.c2;
-        bc = p.b0 * p.c0 + p.b1 * p.c1 + p.b2 * p.c2;
-        k0 = p.a1 * p.b2 - p.a2 * p.b1;
-        k1 = p.a2 * p.b0 - p.a0 * p.b2;
-        k2 = p.a0 * p.b1 - p.a1 * p.b0;
-        v0 = 2.0 * p.n1 * p.n2 * p.c0 - p.n2 * ac * p.a0 - p.n1 * bc * p.b0;
-        v1 = 2.0 * p.n1 * p.n2 * p.c1 - p.n2 * ac * p.a1 - p.n1 * bc * p.b1;
-        v2 = 2.0 * p.n1 * p.n2 * p.c2 - p.n2 * ac * p.a2 - p.n1 * bc * p.b2;
-        jt0 = f1 * k0 - f2 * v0;
-        jt1 = f1 * k1 - f2 * v1;
-        jt2 = f1 * k2 - f2 * v2;
-        f3 = f2 * p.n2 * ac;
-        /* dr/dw = p x dr/dt + f1 A x H - f3 Q */
-        jb[0][k] = p.p1 * jt2 - p.p2 * jt1 + f1 * (p.a1 * p.h2 - p.a2 * p.h1) - f3 * p.q0;
-        jb[1][k] = p.p2 * jt0 - p.p0 * jt2 + f1 * (p.a2 * p.h0 - p.a0 * p.h2) - f3 * p.q1;
-        jb[2][k] = p.p0 * jt1 - p.p1 * jt0 + f1 * (p.a0 * p.h1 - p.a1 * p.h0) - f3 * p.q2;
-        jb[3][k] = jt0;
-        jb[4][k] = jt1;
-        jb[5][k] = jt2;
+        sampson_jacobian(&p, &w);
+        rb[k] = w.r + p.marker;
+        ok[k] = w.on;
+        for (i = 0; i < 6; i++)
+            jb[i][k] = w.j[i];
     }
 }
 

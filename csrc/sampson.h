@@ -2,8 +2,8 @@
  * sampson.h -- the Sampson angular residual of one ray pair (thesis eq. 8.15
  * applied to the generalized epipolar constraint, eq. 8.16), shared by the
  * kernels that evaluate it pair by pair: refine.c (mcg_gec_residuals, the
- * refinement's rows) and calibration_std.c (the derivatives of the
- * calibration error's propagation). Not installed.
+ * refinement's rows, sampson_jacobian) and calibration_std.c (the derivatives
+ * of the calibration error's propagation). Not installed.
  */
 #ifndef MCGEOM_SAMPSON_H
 #define MCGEOM_SAMPSON_H
@@ -81,6 +81,56 @@ static inline void sampson_pair(const double *rm, const double *tv, const double
     x = s->n1 + s->n2 + s->dd;
     mm = s->n1 < s->n2 ? s->n1 : s->n2;
     s->marker = 0.0 * x + (mm >= SAMPSON_DIR2_MIN ? 0.0 : NAN);
+}
+
+/* The residual of one pair and its row of the Jacobian, derived on the raw
+ * form above (left perturbation R <- exp([dw]x) R, t <- t + dt): with
+ * s = m^-1/2, r = E s, f1 = s (1 + 2 r^2) and f2 = r s^2 (both 0 on the
+ * pi/2 cap, where r is constant),
+ *     dr/dt = f1 A x B - f2 (2 |A|^2 |B|^2 c - |B|^2 (A.c) A - |A|^2 (B.c) B),
+ *     dr/dw = p x dr/dt + f1 A x H - f3 Q,  f3 = f2 |B|^2 (A.c),
+ * the last two terms being A x dr/dA. One definition for the refinement's
+ * rows (refine.c) and the calibration error's derivatives
+ * (calibration_std.c, which also uses f1, f2 and B.c). Branch-free. */
+typedef struct {
+    double r;          /* E s, without the invalid-pair marker */
+    double on;         /* 1 on the Sampson branch, 0 on the cap */
+    double f1, f2, bc; /* the factors above and B.c */
+    double j[6];       /* dr/dw, dr/dt */
+} sampson_row;
+
+static inline void sampson_jacobian(const sampson_terms *p, sampson_row *w)
+{
+    double s, rr, f1, f2, f3, ac, bc, k0, k1, k2, v0, v1, v2, jt0, jt1, jt2, on;
+    /* 1 on the Sampson branch (a select, not a branch: vectorisable) */
+    on = p->dd > p->lo ? 1.0 : 0.0;
+    s = 1.0 / sqrt(p->m);
+    rr = p->e * s;
+    f1 = on * s * (1.0 + 2.0 * rr * rr);
+    f2 = on * rr * s * s;
+    ac = p->a0 * p->c0 + p->a1 * p->c1 + p->a2 * p->c2;
+    bc = p->b0 * p->c0 + p->b1 * p->c1 + p->b2 * p->c2;
+    k0 = p->a1 * p->b2 - p->a2 * p->b1;
+    k1 = p->a2 * p->b0 - p->a0 * p->b2;
+    k2 = p->a0 * p->b1 - p->a1 * p->b0;
+    v0 = 2.0 * p->n1 * p->n2 * p->c0 - p->n2 * ac * p->a0 - p->n1 * bc * p->b0;
+    v1 = 2.0 * p->n1 * p->n2 * p->c1 - p->n2 * ac * p->a1 - p->n1 * bc * p->b1;
+    v2 = 2.0 * p->n1 * p->n2 * p->c2 - p->n2 * ac * p->a2 - p->n1 * bc * p->b2;
+    jt0 = f1 * k0 - f2 * v0;
+    jt1 = f1 * k1 - f2 * v1;
+    jt2 = f1 * k2 - f2 * v2;
+    f3 = f2 * p->n2 * ac;
+    w->r = rr;
+    w->on = on;
+    w->f1 = f1;
+    w->f2 = f2;
+    w->bc = bc;
+    w->j[0] = p->p1 * jt2 - p->p2 * jt1 + f1 * (p->a1 * p->h2 - p->a2 * p->h1) - f3 * p->q0;
+    w->j[1] = p->p2 * jt0 - p->p0 * jt2 + f1 * (p->a2 * p->h0 - p->a0 * p->h2) - f3 * p->q1;
+    w->j[2] = p->p0 * jt1 - p->p1 * jt0 + f1 * (p->a0 * p->h1 - p->a1 * p->h0) - f3 * p->q2;
+    w->j[3] = jt0;
+    w->j[4] = jt1;
+    w->j[5] = jt2;
 }
 
 /* The residual of one pair (radians), as mcg_gec_residuals: NaN for an

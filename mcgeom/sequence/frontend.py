@@ -332,10 +332,11 @@ class FrontEnd:
                 and threshold_px > 0):
             raise ValueError(f"threshold_px must be a positive number, got {threshold_px!r}")
         self.rig = rig
-        self.detector = FeatureDetector(features, n_features)
-        # one detector per camera: the cameras of a frame are detected in
-        # parallel threads (OpenCV releases the GIL), none shared between two
-        self._detectors = [FeatureDetector(features, n_features) for _ in rig.cameras]
+        #: one detector per camera: the cameras of a frame are detected in
+        #: parallel threads (OpenCV releases the GIL), none shared between two
+        self.detectors = [FeatureDetector(features, n_features) for _ in rig.cameras]
+        #: the descriptors' distance (cv2.NORM_L2 for SIFT, NORM_HAMMING for ORB)
+        self.norm = self.detectors[0].norm
         self.ratio = float(ratio)
         self.geometric_check = bool(geometric_check)
         self.threshold_px = float(threshold_px)
@@ -356,7 +357,7 @@ class FrontEnd:
 
         def one(i: int) -> Keypoints:
             c = self.rig.cameras[i]
-            return self._detectors[i].detect(images[i], (c.width, c.height),
+            return self.detectors[i].detect(images[i], (c.width, c.height),
                                              f"frame {k}, camera {i} ({c.name!r})")
 
         return list(pool.map(one, range(n)))
@@ -412,7 +413,7 @@ class FrontEnd:
         cross_m, cross_k = {}, {}
         for i, j, _ in self.cross_pairs:
             a, b, s = match_descriptors(feats[i].descriptors, feats[j].descriptors,
-                                        self.detector.norm, self.ratio)
+                                        self.norm, self.ratio)
             ok = calibrated_inliers(self.rig, i, j, feats[i].pixels[a], feats[j].pixels[b],
                                     self.threshold_px)
             cross_m[(i, j)], cross_k[(i, j)] = len(a), int(ok.sum())
@@ -424,7 +425,7 @@ class FrontEnd:
             im, ik = [], []
             for i in range(len(feats)):
                 a, b, s = match_descriptors(prev[i].descriptors, feats[i].descriptors,
-                                            self.detector.norm, self.ratio)
+                                            self.norm, self.ratio)
                 ok = (essential_inliers(self.rig, i, prev[i].pixels[a], feats[i].pixels[b],
                                         self.threshold_px)
                       if self.geometric_check else np.ones(len(a), bool))
