@@ -3,7 +3,9 @@
  *
  * Implements the "cls.c" section of mcgeom.h:
  *   - mcg_cls_general: min |A x| s.t. |C x| = 1, thesis Algorithm 3
- *     (Hartley & Zisserman, Multiple View Geometry, A5.4.2);
+ *     (Hartley & Zisserman, Multiple View Geometry, A5.4.2), with its last
+ *     step taken as a generalized SVD of the pair (A'_1 projected, D1)
+ *     rather than an SVD of A'_1 D1^{-1} (see step 5);
  *   - mcg_cls_partial: the special case C = [I_p | 0] of thesis Algorithm 4,
  *     i.e. min |A_1 x_1 + A_2 x_2| s.t. |x_1| = 1 with the free part
  *     x_2 = -A_2^+ A_1 x_1 and x_1 the solution of (A_2 A_2^+ - I) A_1 x_1 = 0
@@ -141,8 +143,10 @@ size_t mcg_cls_general_work_size(int m, int n, int k)
     kk = (size_t)k;
     mn = min_sz(mm, nn);
     /* The rank r of C is only known at run time: every block is sized for
-     * the worst case over r (all sizes are monotone in the column count). */
-    sw = max_sz(svd_ws0(kk, nn), svd_ws0(mm, nn));
+     * the worst case over r (all sizes are monotone in the column count;
+     * K has at most 2 r rows) */
+    sw = max_sz(max_sz(svd_ws0(kk, nn), svd_ws0(mm, nn)),
+                svd_ws0(2 * nn, nn));
     if (sw == 0)
         return 0;
     ws = mul_sz(nn, nn, &ok);                               /* V of C */
@@ -152,12 +156,18 @@ size_t mcg_cls_general_work_size(int m, int n, int k)
     ws = add_sz(ws, mul_sz(mm, mn, &ok), &ok);              /* U_2 */
     ws = add_sz(ws, nn, &ok);                               /* s_2 */
     ws = add_sz(ws, mul_sz(nn, nn, &ok), &ok);              /* V_2 */
-    ws = add_sz(ws, mul_sz(mm, nn, &ok), &ok);              /* A'' */
-    ws = add_sz(ws, mul_sz(mn, nn, &ok), &ok);              /* U^T A'' */
-    ws = add_sz(ws, mul_sz(nn, nn, &ok), &ok);              /* V'' */
-    ws = add_sz(ws, nn, &ok);                               /* s'' */
+    ws = add_sz(ws, mul_sz(mm, nn, &ok), &ok);              /* M */
+    ws = add_sz(ws, nn, &ok);                               /* s_M */
+    ws = add_sz(ws, mul_sz(nn, nn, &ok), &ok);              /* V_M */
+    ws = add_sz(ws, mul_sz(2 * nn, nn, &ok), &ok);          /* K */
+    ws = add_sz(ws, mul_sz(2 * nn, nn, &ok), &ok);          /* U_K */
+    ws = add_sz(ws, nn, &ok);                               /* s_K */
+    ws = add_sz(ws, mul_sz(nn, nn, &ok), &ok);              /* V_K */
+    ws = add_sz(ws, mul_sz(mn, nn, &ok), &ok);              /* U^T M */
+    ws = add_sz(ws, mul_sz(nn, nn, &ok), &ok);              /* V of U_K1 */
+    ws = add_sz(ws, nn, &ok);                               /* its s */
     ws = add_sz(ws, mm, &ok);                               /* A'_1 x'_1 */
-    ws = add_sz(ws, mul_sz(3, nn, &ok), &ok);               /* x', x'', tmp */
+    ws = add_sz(ws, mul_sz(3, nn, &ok), &ok);               /* x', y, tmp */
     ws = add_sz(ws, sw, &ok);
     return ok ? ws : 0;
 }
@@ -165,9 +175,9 @@ size_t mcg_cls_general_work_size(int m, int n, int k)
 int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
                     double *x, double *resid, double *work, size_t lwork)
 {
-    size_t mm, nn, kk, mn, ws, sw_len, r, n2, mn2, r2, i, j, l;
-    double *vc, *d, *ap, *a2, *u2, *s2, *v2, *app, *t, *vpp, *spp, *z;
-    double *xp, *xpp, *tmp, *sw;
+    size_t mm, nn, kk, mn, ws, sw_len, r, n2, mn2, r2, q, i, j, l;
+    double *vc, *d, *ap, *a2, *u2, *s2, *v2, *mt, *sm, *vm, *km, *uk, *sk;
+    double *vk, *t, *vy, *sy, *z, *xp, *y, *tmp, *sw, dnorm;
     int st;
 
     ws = mcg_cls_general_work_size(m, n, k);
@@ -191,14 +201,20 @@ int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
     u2 = a2 + mm * nn;
     s2 = u2 + mm * mn;
     v2 = s2 + nn;
-    app = v2 + nn * nn;
-    t = app + mm * nn;
-    vpp = t + mn * nn;
-    spp = vpp + nn * nn;
-    z = spp + nn;
+    mt = v2 + nn * nn;
+    sm = mt + mm * nn;
+    vm = sm + nn;
+    km = vm + nn * nn;
+    uk = km + 2 * nn * nn;
+    sk = uk + 2 * nn * nn;
+    vk = sk + nn;
+    t = vk + nn * nn;
+    vy = t + mn * nn;
+    sy = vy + nn * nn;
+    z = sy + nn;
     xp = z + mm;
-    xpp = xp + nn;
-    tmp = xpp + nn;
+    y = xp + nn;
+    tmp = y + nn;
     sw = tmp + nn;
     sw_len = lwork - (size_t)(sw - work);
 
@@ -222,10 +238,10 @@ int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
                 acc += a[i * nn + l] * vc[l * nn + j];
             ap[i * nn + j] = acc;
         }
-    /* A'' = A'_1 D1^{-1}, A'_2 copied contiguous for its SVD */
+    /* M = A'_1 (m x r), A'_2 copied contiguous for their SVDs */
     for (i = 0; i < mm; ++i) {
         for (j = 0; j < r; ++j)
-            app[i * r + j] = ap[i * nn + j] / d[j];
+            mt[i * r + j] = ap[i * nn + j];
         for (j = 0; j < n2; ++j)
             a2[i * n2 + j] = ap[i * nn + r + j];
     }
@@ -237,15 +253,52 @@ int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
         r2 = count_above(s2, mn2,
                          (double)max_sz(mm, n2) * DBL_EPSILON * s2[0]);
     }
-    /* 4. A'' = (A'_2 A'_2^+ - I) A'_1 D1^{-1} */
-    project_out(mm, r, app, u2, mn2, r2, t);
-    /* 5. min |A'' x''| s.t. |x''| = 1 */
-    st = smallest_right_sv(mm, r, app, spp, vpp, xpp, sw, sw_len);
+    /* 4. M = (A'_2 A'_2^+ - I) A'_1 */
+    project_out(mm, r, mt, u2, mn2, r2, t);
+    /* 5. min |M x'_1| s.t. |D1 x'_1| = 1. Algorithm 3 substitutes
+     * x'' = D1 x'_1 and takes the smallest singular vector of M D1^{-1};
+     * a small d_j (a nearly singular C) makes that column huge, and an SVD
+     * accurate to eps s_max then misses the minimum (fuzz_cls: 45 % off
+     * with d_j = 4e-15, a direction the minimiser does not even use). The
+     * pair (M, D1) is taken instead through the SVD of the stacked
+     * K = [S_M V_M^T / s_M0; D1 / d_0] = U_K S_K V_K^T, which has no small
+     * divisor (the generalized SVD route, Van Loan 1976; Golub & Van Loan
+     * 8.7.4); S_M V_M^T (q = min(m, r) rows) has the norms |M x| of M.
+     * With w = S_K V_K^T x'_1, M's part is U_K1 w and D1's U_K2 w, and
+     * |U_K1 w|^2 + |U_K2 w|^2 = |w|^2, so the ratio is least for w the
+     * smallest right singular vector of U_K1 (the first q rows of U_K). */
+    st = mcg_svd(m, (int)r, mt, NULL, sm, vm, sw, sw_len);
     if (st != MCG_OK)
         return st;
-    /* 6. x'_1 = D1^{-1} x'', x'_2 = -A'_2^+ A'_1 x'_1 */
+    q = min_sz(mm, r);
+    for (i = 0; i < q; ++i)
+        for (j = 0; j < r; ++j)
+            km[i * r + j] = sm[0] > 0.0 ? vm[j * r + i] * (sm[i] / sm[0]) : 0.0;
+    memset(km + q * r, 0, r * r * sizeof(double));
     for (j = 0; j < r; ++j)
-        xp[j] = xpp[j] / d[j];
+        km[(q + j) * r + j] = d[j] / d[0];
+    st = mcg_svd((int)(q + r), (int)r, km, uk, sk, vk, sw, sw_len);
+    if (st != MCG_OK)
+        return st;
+    /* S_K is singular only if M and D1 nearly share a null direction (the
+     * ratio there is 0 / 0 at the working precision) */
+    if (!(sk[r - 1] > 0.0))
+        return MCG_EDEGENERATE;
+    st = smallest_right_sv(q, r, uk, sy, vy, y, sw, sw_len);
+    if (st != MCG_OK)
+        return st;
+    /* 6. x'_1 = V_K S_K^{-1} w scaled to |D1 x'_1| = 1,
+     * x'_2 = -A'_2^+ A'_1 x'_1 */
+    for (j = 0; j < r; ++j)
+        tmp[j] = y[j] / sk[j];
+    matvec(r, r, vk, r, tmp, xp);
+    for (j = 0; j < r; ++j)
+        tmp[j] = d[j] * xp[j];
+    dnorm = norm_scaled(tmp, r);
+    if (!(dnorm > 0.0) || !isfinite(dnorm))
+        return MCG_ENUMERIC;
+    for (j = 0; j < r; ++j)
+        xp[j] /= dnorm;
     if (n2 > 0) {
         matvec(mm, r, ap, nn, xp, z);
         apply_neg_pinv(mm, n2, u2, mn2, s2, v2, r2, z, xp + r, tmp);

@@ -398,12 +398,39 @@ def test_cls_general_wide_c_vs_generalized_eigenproblem(m, n, k, seed):
     lam = np.linalg.eigvalsh(Li @ C.T @ C @ Li.T)[-1]
     assert abs(np.linalg.norm(C @ x) - 1) <= 1e-12
     assert abs(resid - 1 / np.sqrt(lam)) <= 1e-10 * resid
-    # first-order optimality: A^T A x = resid^2 C^T C x; Algorithm 3 divides
-    # by the singular values of C, so x is accurate to ~ eps cond(C)
+    # first-order optimality: A^T A x = resid^2 C^T C x; x = V_K S_K^-1 w
+    # (cls.c, step 6) is accurate to ~ eps cond(C)
     sc = np.linalg.svd(C, compute_uv=False)
     cond_c = sc[0] / sc[min(k, n) - 1]
     g = A.T @ (A @ x) - resid**2 * C.T @ (C @ x)
     assert np.abs(g).max() <= 1e-14 * cond_c * m * np.abs(A).max() ** 2 * np.abs(x).max()
+
+
+@SETTINGS
+@given(m=st.integers(8, 30), n=st.integers(2, 8), log_d=st.floats(-15.0, -9.0), seed=seeds)
+def test_cls_general_nearly_singular_c_vs_null_space_reference(m, n, log_d, seed):
+    """C with one singular value d << 1 (above the rank cut): a feasible x
+    gains nothing from that direction (it would need a component ~ 1 / d),
+    so the minimum equals, to O(d^2), that of the problem with the direction
+    moved into C's null space, which numpy solves with no small divisor.
+    Found by fuzz_cls: dividing A V's columns by d (Algorithm 3 as written)
+    lost up to 45 % of the minimum to the SVD's eps s_max accuracy."""
+    rng = _rng(seed)
+    A = rng.standard_normal((m, n))
+    U, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    V, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    d = rng.uniform(0.5, 1.0, n)
+    d[-1] = 10.0**log_d
+    C = U @ np.diag(d) @ V.T
+    x, resid = _core.cls_general(A, C)
+    # reference: x = W a + v b with |diag(d[:-1]) a| = 1, b free
+    W, v = V[:, :-1], V[:, -1:]
+    Av = A @ v
+    P = np.eye(m) - Av @ np.linalg.pinv(Av)  # (I - A v (A v)^+)
+    s = np.linalg.svd(P @ A @ W / d[:-1], compute_uv=False)
+    assert abs(np.linalg.norm(C @ x) - 1) <= 1e-12 * (1 + np.linalg.norm(x))
+    assert abs(resid - np.linalg.norm(A @ x)) <= 1e-14 * (1 + resid) * np.linalg.norm(x)
+    assert abs(resid - s[-1]) <= 1e-10 * s[0]
 
 
 def test_cls_general_zero_c_is_degenerate():

@@ -219,7 +219,9 @@ int mcg_gec_rows(int n, const double *rays1, const double *rays2,
  * Hartley & Zisserman A5.4.2). x: n values; resid (may be NULL) = |A x|.
  * m, k in [1, 2^20], n in [1, 4096]; lwork >= mcg_cls_general_work_size.
  * MCG_EINVAL: sizes, NULL a / c / x / work, NaN/inf; MCG_ENOMEM;
- * MCG_EDEGENERATE if C = 0; MCG_ENUMERIC if an inner SVD fails. */
+ * MCG_EDEGENERATE if C = 0, or if a direction nearly null for A (after its
+ * free part) is also nearly null for C (the ratio there is 0 / 0 at the
+ * working precision); MCG_ENUMERIC if an inner SVD fails. */
 size_t mcg_cls_general_work_size(int m, int n, int k);
 int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
                     double *x, double *resid, double *work, size_t lwork);
