@@ -142,8 +142,11 @@ static inline void fz_doubles(fz_in *in, double *x, size_t n)
 
 /* The layout of an array: filled entry by entry (each a fz_double), or with
  * structure that random bytes rarely produce: rank-deficient (a copy of an
- * earlier row, up to a factor), a constant, or rows scaled by a huge or
- * tiny factor (a graded matrix). rows x cols row-major. */
+ * earlier row, up to a factor), nearly so (the same plus 1e-9 .. 1e-15 of
+ * the row's own entries: singular values just above the rank cuts, where
+ * fuzz_cls found Algorithm 3 losing its minimum), a constant, or rows
+ * scaled by a huge or tiny factor (a graded matrix). rows x cols
+ * row-major. */
 static inline void fz_matrix(fz_in *in, double *a, size_t rows, size_t cols)
 {
     uint8_t layout = fz_u8(in);
@@ -154,6 +157,15 @@ static inline void fz_matrix(fz_in *in, double *a, size_t rows, size_t cols)
         for (i = 2; i < rows; ++i)
             for (j = 0; j < cols; ++j)
                 a[i * cols + j] = a[(i % 2) * cols + j] * (double)(i + 1);
+        break;
+    case 4: /* nearly rank deficient: the upper layout bits pick the size */
+        {
+            double rel = pow(10.0, -9.0 - (double)((layout >> 3) % 7));
+            for (i = 2; i < rows; ++i)
+                for (j = 0; j < cols; ++j)
+                    a[i * cols + j] = a[(i % 2) * cols + j] * (double)(i + 1) +
+                                      rel * a[i * cols + j];
+        }
         break;
     case 2: /* constant */
         for (i = 0; i < rows * cols; ++i)
