@@ -271,9 +271,11 @@ int mcg_cls_general(int m, int n, int k, const double *a, const double *c,
     if (st != MCG_OK)
         return st;
     q = min_sz(mm, r);
-    for (i = 0; i < q; ++i)
+    for (i = 0; i < q; ++i) {
+        const double si = sm[0] > 0.0 ? sm[i] / sm[0] : 0.0; /* M = 0: any x */
         for (j = 0; j < r; ++j)
-            km[i * r + j] = sm[0] > 0.0 ? vm[j * r + i] * (sm[i] / sm[0]) : 0.0;
+            km[i * r + j] = vm[j * r + i] * si;
+    }
     memset(km + q * r, 0, r * r * sizeof(double));
     for (j = 0; j < r; ++j)
         km[(q + j) * r + j] = d[j] / d[0];

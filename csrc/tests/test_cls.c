@@ -176,41 +176,28 @@ static void test_general(void)
               "general with C = [I|0] equals partial (x up to sign)", e,
               1e-12);
     }
-    /* C = diag(1, ..., 1, d) with d << 1 above the rank cut (fuzz_cls
-     * found a 1.3e-3 error; 45 % in tests): the minimiser needs no
-     * component ~ 1 / d along e_n, so the minimum equals, to O(d^2), the
-     * one with x[n-1] free, i.e. partial with p = n - 1 */
+    /* C diagonal, C_ll = 0.5 + l / 16, except C_pp = d << 1 above the rank
+     * cut (fuzz_cls found a 1.3e-3 error; 45 % in tests): the minimiser
+     * needs no component ~ 1 / d along e_p, so the minimum equals, to
+     * O(d^2), the one with x[p] free: partial (p = 7 constrained columns
+     * A_l / C_ll, then the free column A_p) */
     {
         static const double dd[3] = {1e-9, 1e-13, 4e-15};
         double x1[8], x2[8], r1, r2, worst = 0.0;
         int rank2, trial, l;
         for (trial = 0; trial < 30; ++trial) {
+            const int p = trial % 8; /* the small direction, any axis */
             randn(a, 12 * 8);
             memset(c, 0, sizeof(double) * 8 * 8);
-            for (i = 0; i < 8; ++i)
-                c[i * 8 + i] = 0.5 + 0.5 * (double)i / 8.0;
-            c[63] = dd[trial % 3];
-            /* a column swap moves the small direction off the last axis */
-            for (l = 0; l < 8; ++l) {
-                double tmp = c[l * 8 + 7];
-                c[l * 8 + 7] = c[l * 8 + trial % 8];
-                c[l * 8 + trial % 8] = tmp;
-            }
-            for (i = 0; i < 12; ++i) {
-                double tmp = a[i * 8 + 7];
-                a[i * 8 + 7] = a[i * 8 + trial % 8];
-                a[i * 8 + trial % 8] = tmp;
-            }
+            for (l = 0; l < 8; ++l)
+                c[l * 8 + l] = l == p ? dd[trial % 3] : 0.5 + 0.5 * (double)l / 8.0;
             mcg_cls_general(12, 8, 8, a, c, x1, &r1, work, LWORK);
-            /* undo the swap for partial (its free part is x[7]) and scale
-             * its constrained part by the diagonal of C */
             for (i = 0; i < 12; ++i) {
-                double tmp = a[i * 8 + 7];
-                a[i * 8 + 7] = a[i * 8 + trial % 8];
-                a[i * 8 + trial % 8] = tmp;
-                for (l = 0; l < 7; ++l)
-                    b1[i * 8 + l] = a[i * 8 + l] / (0.5 + 0.5 * (double)l / 8.0);
-                b1[i * 8 + 7] = a[i * 8 + 7];
+                int col = 0;
+                for (l = 0; l < 8; ++l)
+                    if (l != p)
+                        b1[i * 8 + col++] = a[i * 8 + l] / c[l * 8 + l];
+                b1[i * 8 + 7] = a[i * 8 + p];
             }
             mcg_cls_partial(12, 8, 7, b1, 0.0, x2, &r2, &rank2, work, LWORK);
             worst = fmax(worst, fabs(r1 - r2) / r2);
