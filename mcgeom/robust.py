@@ -328,7 +328,7 @@ class _Scorer:
 #: fewest correspondences the final refinement (``refine_centred``) can fit
 _MIN_REFIT = 6
 #: the final refinement fits the correspondences within this many thresholds
-#: (csrc/robust.c WIDE; the confidence counts them as the consensus)
+#: (csrc/robust_internal.h WIDE; the confidence counts them as the consensus)
 WIDE = 2.0
 
 

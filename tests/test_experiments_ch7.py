@@ -38,7 +38,7 @@ def test_wrong_scale_near_the_critical_motion_is_flagged():
     """The draw where a wrong-scale hypothesis won the search with 10 %
     cross-camera pairs and 1 of 4 estimates off by more than 30 % was called
     observable (bad_flagged_fraction 0.75 before the final scale search and
-    the widened local optimisation of csrc/robust.c)."""
+    the widened local optimisation of csrc/robust_lo.c)."""
     s = experiment_ch7.summary(experiment_ch7.run(40, seed=8, cross=0.1))
     print(s)
     assert s["bad_flagged_fraction"] >= 0.9

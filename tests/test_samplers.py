@@ -215,7 +215,7 @@ def test_upright_is_not_trapped_by_a_locally_optimised_wrong_motion(k):
     0, the vertical 0.2 deg off): a near-pure rotation (|t| ~1 cm, 0.2-0.3 of
     the pairs) was locally optimised first, and the hypotheses near the
     truth, each tilted by the vertical's error, lost the MSAC to it: 0.2-0.3
-    deg, |t| 98 % off, called observable. The challenge of csrc/robust.c
+    deg, |t| 98 % off, called observable. The challenge of csrc/robust_offer.c
     (RIVAL_WIDE) lets them win after their own local optimisation: the
     upright estimate matches 5+1's inliers."""
     from mcgeom.experiments.peer_solvers import RANSAC_CASES

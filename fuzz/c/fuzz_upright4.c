@@ -10,7 +10,7 @@
  * every solution is finite, a rotation (orthonormal, det +1) and maps the
  * unit g1 onto the unit g2 (the constraint that defines the solver).
  * Modes 2 and 3: the same for the central 3-point solver of upright4.c
- * (mcg_upright3_central, internal.h; robust.c's upright 3+1 samples) on a
+ * (mcg_upright3_central, internal.h; robust_sample_5p1.c's upright 3+1 samples) on a
  * one-camera scene (3 intra-camera pairs) and on arbitrary bearings: on
  * MCG_OK 0 <= n <= 6, each rotation maps g1 onto g2 and each direction is
  * finite and of unit length.
