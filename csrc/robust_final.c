@@ -307,7 +307,7 @@ double robust_scale_profile(ctx *c, const mcg_robust_result *res, const unsigned
         memcpy(R, res->R, sizeof R);
         memcpy(t, res->t, sizeof t);
         if (robust_refine_subset(c, m, cen, weights != NULL, c->opt.loss, res->loss_scale, 0, R, t,
-                          &rr) != MCG_OK)
+                                 &rr) != MCG_OK)
             return 0.0;
         base = rr.final_cost;
     }
@@ -326,7 +326,7 @@ double robust_scale_profile(ctx *c, const mcg_robust_result *res, const unsigned
         if (f[j] >= 0.5 && f[j] <= 2.0) /* (the zero profile's 1 % is beyond the model) */
             profile_start(fr->info, res->t, shift, f[j], cen, R, t);
         st = robust_refine_subset(c, m, cen, weights != NULL, c->opt.loss, res->loss_scale, 1, R, t,
-                           &rr);
+                                  &rr);
         if (st != MCG_OK)
             break;
         worst = fmin(worst, gain * (rr.final_cost - base) / fr->sigma2);

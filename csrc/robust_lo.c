@@ -235,7 +235,7 @@ void robust_local_optimise_held(ctx *c, const double *w, int hold)
         if (c->n_inl < MIN_REFIT)
             return;
         m = robust_gather(c, c->rbest, c->opt.threshold * (round == 0 ? wide : 1.0), w, cen,
-                   c->n_inl > LO_MAX ? (double)LO_MAX / c->n_inl : 1.0);
+                          c->n_inl > LO_MAX ? (double)LO_MAX / c->n_inl : 1.0);
         if (m < MIN_REFIT)
             return;
         memcpy(R, c->R, sizeof R);
