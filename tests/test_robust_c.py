@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from mcgeom import _core, robust, synth
+from mcgeom.robust import _verdict
 from mcgeom.observability import scale_profile
 from mcgeom.pixel_noise import camera_table, pixels_per_radian
 from problems import (assert_unconfirmed_partial_fit, generic_outlier_problem, rot_err,
@@ -166,13 +167,22 @@ def test_c_path_agrees_with_the_python_drivers():
 
 
 def test_verdict_on_a_sample_of_the_inliers_agrees(monkeypatch):
-    """Beyond VERDICT_SAMPLE intra-camera inliers the verdict runs on a sample of
-    them (issue 19): forced here on 800 rays, it agrees with the verdict on all."""
+    """Beyond VERDICT_SAMPLE intra-camera inliers the verdict of the Python
+    search runs on a sample of them (issue 19): forced here on 800 rays, it
+    agrees with the verdict on all. (The C search's verdict takes its O(N)
+    evidence from C and never samples: strategy "minimal" runs the Python
+    loop; before session 29 this test ran the C search and the sample was
+    never drawn.)"""
     rig, p, R, t = _problem(3, n=800, outliers=0.2)
     f = pixels_per_radian(rig, p.rays)
-    full = robust.ransac(p.rays, threshold=1.0, focal=f)
-    monkeypatch.setattr(robust, "VERDICT_SAMPLE", 100)
-    sampled = robust.ransac(p.rays, threshold=1.0, focal=f)
+    full = robust.ransac(p.rays, threshold=1.0, focal=f, strategy="minimal")
+    monkeypatch.setattr(_verdict, "VERDICT_SAMPLE", 100)
+    seen = []
+    sample = _verdict._verdict_sample
+    monkeypatch.setattr(_verdict, "_verdict_sample",
+                        lambda *a: seen.append(len(sample(*a)[0])) or sample(*a))
+    sampled = robust.ransac(p.rays, threshold=1.0, focal=f, strategy="minimal")
+    assert seen and seen[0] < len(p.rays)   # the verdict ran on a sample
     assert np.count_nonzero(full.inliers & (p.rays.cam1 == p.rays.cam2)) > 100
     assert sampled.scale.observable == full.scale.observable
     # the same cameras and cross-camera inliers: the same critical angle and evidence

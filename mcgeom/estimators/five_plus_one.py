@@ -200,7 +200,7 @@ def _from_camera(rays: RayPairs, a: int, refine: bool) -> tuple[float, dict, Opt
     if not refine:
         return sol["cost"], sol, None
     # all six degrees of freedom even if |t| is not observable: holding a wrong
-    # |t| would bend R and the direction (see mcgeom.robust._finish); with 6
+    # |t| would bend R and the direction (see mcgeom.robust._python_search.finish); with 6
     # rays the square system polishes the minimal solution
     try:
         out = _refine_all(rays, sol["R"], sol["t"], False)
@@ -346,7 +346,7 @@ def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
     if not verdict.observable:
         info["t_direction"] = travel_direction(rays, np.ones(len(rays), bool), R, t)
         if in_mirrored_minimum(info["t_direction"], t):
-            # no metric estimate (as mcgeom.robust._conclude): its length
+            # no metric estimate (as mcgeom.robust._verdict.conclude): its length
             # goes along the travel
             info["t_metric"] = float(np.linalg.norm(t)) * info["t_direction"]
             info["scale_determined"] = False

@@ -56,7 +56,7 @@ def _initial(rays: RayPairs, initial: InitialLike, loss_scale: float
             return m.R, m.t, False, report["chosen"], m, report
         # the start's metric t even where its verdict made t a unit vector:
         # holding |t| at a wrong length bends R to compensate (see
-        # mcgeom.robust._finish)
+        # mcgeom.robust._python_search.finish)
         return (m.R, metric_translation(m), bool(m.scale.observable), report["chosen"], None,
                 report)
     if isinstance(initial, RigMotion):
