@@ -54,8 +54,8 @@
  * and scale profile converged on a random FINAL_SUB of the pairs and then
  * polished on all (FINAL_POLISH steps); the workspace stays ~16.5 n.
  *
- * Other samplers (opt.sampler, issue 21; "the upright and 6-point samples"
- * below): MCG_SAMPLER_UPRIGHT4 with the vertical known draws, when some
+ * Other samplers (opt.sampler, issue 21; robust_samplers.c):
+ * MCG_SAMPLER_UPRIGHT4 with the vertical known draws, when some
  * camera has 3 intra-camera pairs, 3+1 samples as the two-stage 5+1 does
  * (3 pairs of a camera -> mcg_upright3_central: its rotation and direction
  * of travel; the scale as for 5+1; w^3), else 4 pairs of any cameras solved
