@@ -55,6 +55,19 @@ static inline size_t add_sz(size_t a, size_t b, int *ok)
 static inline size_t max_sz(size_t a, size_t b) { return a > b ? a : b; }
 static inline size_t min_sz(size_t a, size_t b) { return a < b ? a : b; }
 
+/* the largest |x_i| (0 for n = 0) */
+static inline double max_abs(const double *x, size_t n)
+{
+    double mx = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        double ax = fabs(x[i]);
+        if (ax > mx)
+            mx = ax;
+    }
+    return mx;
+}
+
 /* 1 if none of the n values is NaN or +-inf */
 static inline int all_finite(const double *x, size_t n)
 {

@@ -70,9 +70,9 @@ static int finite_rays(int n, const double *o1, const double *d1, const double *
 /* One pass over the rays: validate, normalise (Algorithm 2 step 1) and add
  * each generalized epipolar row (eq. 8.16) to the Gram matrix. */
 MCG_AVX2_CLONE
-int linear17_accumulate(int n, const double *o1, const double *d1,
-                        const double *o2, const double *d2,
-                        double *m, double origin[3], double *scale)
+static int accumulate(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2,
+                      double *m, double origin[3], double *scale)
 {
     double o[3], ss, s, mp[NX][NXP];
     int k, i, j;
@@ -120,6 +120,16 @@ int linear17_accumulate(int n, const double *o1, const double *d1,
         for (j = i; j < NX; j++)
             m[i * NX + j] = m[j * NX + i] = mp[i][j];
     return MCG_OK;
+}
+
+/* (the clone's dispatch, an ifunc, stays local to this file: a global
+ * target_clones function exports its ifunc and resolver symbols whatever
+ * -fvisibility says, and libmcgeom.so exports mcgeom.h's functions alone) */
+int linear17_accumulate(int n, const double *o1, const double *d1,
+                        const double *o2, const double *d2,
+                        double *m, double origin[3], double *scale)
+{
+    return accumulate(n, o1, d1, o2, d2, m, origin, scale);
 }
 
 /* Classify from the null space of A_R^T A_R (= M_RR): the structural
@@ -238,10 +248,10 @@ static int plain_svd_refine(const double *m, double e[9], double r[9])
 
 /* Linear step: the 9-vector e of E (and the R part r) minimising |A x|. */
 MCG_AVX2_CLONE
-int linear17_linear_step(const double *m, int gc_case,
-                         const double *wr, const double *vr, double pinv_rtol,
-                         double rtol, double tr_m, double e[9], double r[9],
-                         mcg_linear17_result *res)
+static int linear_step(const double *m, int gc_case,
+                       const double *wr, const double *vr, double pinv_rtol,
+                       double rtol, double tr_m, double e[9], double r[9],
+                       mcg_linear17_result *res)
 {
     int i, j, k;
     {
@@ -300,6 +310,17 @@ int linear17_linear_step(const double *m, int gc_case,
     if (gc_case == MCG_GC_MOST_GENERAL)
         return plain_svd_refine(m, e, r);
     return MCG_OK;
+}
+
+/* (the clone's dispatch, an ifunc, stays local to this file: a global
+ * target_clones function exports its ifunc and resolver symbols whatever
+ * -fvisibility says, and libmcgeom.so exports mcgeom.h's functions alone) */
+int linear17_linear_step(const double *m, int gc_case,
+                         const double *wr, const double *vr, double pinv_rtol,
+                         double rtol, double tr_m, double e[9], double r[9],
+                         mcg_linear17_result *res)
+{
+    return linear_step(m, gc_case, wr, vr, pinv_rtol, rtol, tr_m, e, r, res);
 }
 
 /* Rotation candidates: the two rotations of E = [t]x R (twisted pair) and,

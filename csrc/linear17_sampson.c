@@ -46,8 +46,8 @@
 #define SAMPSON_LANES 4
 
 MCG_AVX2_CLONE
-double linear17_sampson_pass(const raydata *rd, const double r[9], const double t[3],
-                             double h[36], double g[6])
+static double sampson_pass(const raydata *rd, const double r[9], const double t[3],
+                           double h[36], double g[6])
 {
     double hl[21][SAMPSON_LANES], gl[6][SAMPSON_LANES], cl[SAMPSON_LANES];
     double ro[3], sr[9];
@@ -214,6 +214,15 @@ double linear17_sampson_pass(const raydata *rd, const double r[9], const double 
     }
 }
 
+/* (the clone's dispatch, an ifunc, stays local to this file: a global
+ * target_clones function exports its ifunc and resolver symbols whatever
+ * -fvisibility says, and libmcgeom.so exports mcgeom.h's functions alone) */
+double linear17_sampson_pass(const raydata *rd, const double r[9], const double t[3],
+                             double h[36], double g[6])
+{
+    return sampson_pass(rd, r, t, h, g);
+}
+
 /* Levenberg-Marquardt on the Sampson angular error from the linear estimate
  * (R, t) of the normalised frame: the alternation of ch. 8.4.3 taken to the
  * geometric optimum instead of the algebraic one. The algebraic cost
@@ -261,7 +270,7 @@ int linear17_geometric_refine(const raydata *rd, const mcg_linear17_options *o,
     double negligible = 0.5 * STEP_STD * STEP_STD / (rd->n > 6 ? rd->n - 6 : 1);
     int it, i, j;
     *converged = 0;
-    *cost = linear17_sampson_pass(rd, r, t, h, g);
+    *cost = sampson_pass(rd, r, t, h, g);
     *cost0 = *cost;
     for (it = 0; it < o->max_iterations; it++) {
         double a[36], rhs[6], d[6], dr[9], rn[9], tn[3], cn, nw, nt, lim, sc;
@@ -310,7 +319,7 @@ int linear17_geometric_refine(const raydata *rd, const mcg_linear17_options *o,
             if (!small && lambda <= 1e-4 && pred <= negligible * *cost &&
                 nw * sc <= LOCAL_STEP && nt * sc <= LOCAL_STEP * sqrt(dot3(t, t))) {
                 /* shorter than STEP_STD standard deviations: the last step */
-                cn = linear17_sampson_pass(rd, rn, tn, NULL, NULL);
+                cn = sampson_pass(rd, rn, tn, NULL, NULL);
                 if (cn <= *cost) {
                     memcpy(r, rn, sizeof rn);
                     memcpy(t, tn, sizeof tn);
@@ -334,7 +343,7 @@ int linear17_geometric_refine(const raydata *rd, const mcg_linear17_options *o,
             it++;
             break;
         }
-        cn = linear17_sampson_pass(rd, rn, tn, hn, gn);
+        cn = sampson_pass(rd, rn, tn, hn, gn);
         if (cn <= *cost) {
             double dec = *cost - cn;
             memcpy(r, rn, sizeof rn);

@@ -180,7 +180,7 @@ int mcg_sym_eig_tridiag(int n, double *a, double *w, double *v);
  * alias b. MCG_EINVAL: n outside [1, 64], NULL, NaN/inf. */
 int mcg_spd_solve(int n, const double *a, const double *b, double *x);
 
-/* Rotations (3 x 3, row-major). Angle-axis w: |w| = angle in radians,
+/* (rotations.c) Rotations (3 x 3, row-major). Angle-axis w: |w| = angle in radians,
  * in [0, pi] on output (any length on input). Quaternions q = (w, x, y, z),
  * Hamilton convention, R = rotation that maps vectors as R v (active).
  * All return MCG_EINVAL for NULL pointers or NaN/inf; the *_from_rot ones

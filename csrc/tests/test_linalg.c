@@ -1,5 +1,6 @@
 /*
- * test_linalg.c -- plain-C checks of csrc/linalg.c against independent facts:
+ * test_linalg.c -- plain-C checks of csrc/linalg.c and csrc/rotations.c
+ * against independent facts:
  * reconstruction and orthogonality (QR, SVD), singular values of matrices
  * built with known spectra (U diag(s) V^T with U, V products of Householder
  * reflections generated here, s down to 1e-12), the four Moore-Penrose

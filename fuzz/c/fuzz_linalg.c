@@ -1,7 +1,7 @@
 /*
  * fuzz_linalg.c -- libFuzzer harness of the dense algebra of linalg.c:
  * mcg_qr, mcg_svd, mcg_pinv, mcg_sym_eig, mcg_sym_eig_tridiag,
- * mcg_spd_solve, the rotation helpers and mcg_project_so3 (and
+ * mcg_spd_solve, the rotation helpers and mcg_project_so3 (rotations.c; and
  * mcg_status_message). The first byte picks the routine.
  *
  * Invariants (on MCG_OK): finite outputs; QR: Q orthonormal columns, R upper
