@@ -179,7 +179,7 @@ def _ransac(rays: RayPairs, method: str, options: RansacOptions, focal: Any,
             return m
     if in_c:
         return ransac_c(rays, f, options, pixel_cameras, t_start, calibration_std, method,
-                         solver_options or {}, from_rig and pixel_cameras is not None)
+                        solver_options or {}, from_rig and pixel_cameras is not None)
     rng = np.random.default_rng(options.seed)
     scorer = Scorer(rays, options.threshold, f, options, motion_focal)
     check_threshold_angle(options.threshold, scorer.loss_scale, f)
@@ -206,6 +206,6 @@ def _ransac(rays: RayPairs, method: str, options: RansacOptions, focal: Any,
              "sample_size": info_est.min_sample}
     if scorer.best is None or scorer.best_inliers.sum() < max(6, info_est.min_sample):
         return nothing_found(rays, scorer, options, method, t_start, max(6, info_est.min_sample),
-                              f" ({scorer.n_hyp} hypotheses from {iterations} samples)", ended)
+                             f" ({scorer.n_hyp} hypotheses from {iterations} samples)", ended)
     return finish(rays, scorer, options, method, iterations, t_start, calibration_std,
-                   dict(ended, iterations=samples) if samples else None)
+                  dict(ended, iterations=samples) if samples else None)

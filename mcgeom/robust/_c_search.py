@@ -92,9 +92,9 @@ def _solver_keywords(method: str, solver_options: dict) -> dict:
 
 
 def ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions,
-              pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
-              t_start: float, calibration_std: Any = None, method: str = "five_plus_one",
-              solver_options: Optional[dict] = None, from_rig: bool = False) -> RigMotion:
+             pixel_cameras: Optional[tuple[np.ndarray, np.ndarray]],
+             t_start: float, calibration_std: Any = None, method: str = "five_plus_one",
+             solver_options: Optional[dict] = None, from_rig: bool = False) -> RigMotion:
     """The methods of :data:`C_SAMPLERS`: the search and the final refinement
     in one C call (``_core.robust_rig_motion``, csrc/robust.c), the verdict here.
     ``from_rig``: the rays' ids are those of the rig of ``pixel_cameras`` and
@@ -135,7 +135,7 @@ def ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions
         check_threshold_angle(options.threshold, options.threshold, focal)
     elif options.threshold > MAX_THRESHOLD_RAD * float(np.minimum.reduce(focal)):
         check_threshold_angle(options.threshold, options.threshold / float(np.median(focal)),
-                               focal)
+                              focal)
     seed = _c_seed(options)
     # (a caller's camera table is checked there)
     prechecked = ids32 and (focal is None or focal.flags.c_contiguous) and \
@@ -254,7 +254,7 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
             else "local"
         info["found_rate"] = out["found_rate"]
     unconfirmed = unconfirmed_reason(out["stop"], out["iterations"], out["sample_size"],
-                               out["confidence"])
+                                     out["confidence"])
     fit = None
     if out["refinement"] is not None:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)
@@ -268,8 +268,8 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
     # the RMS residual of the inliers and the verdict's evidence come from C
     # (no Python pass over the rays: issue 19)
     return conclude(rays, R, t, None, inl, fit, out["loss_scale"],
-                     math.hypot(*out["t_hypothesis"].tolist()), options, method,
-                     info, t_start,
-                     out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
-                     c_ids=(cam1, cam2, n_cameras, out["mask"], out["verdict"]),
-                     zero_profile=float(out["zero_profile"]), unconfirmed=unconfirmed)
+                    math.hypot(*out["t_hypothesis"].tolist()), options, method,
+                    info, t_start,
+                    out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
+                    c_ids=(cam1, cam2, n_cameras, out["mask"], out["verdict"]),
+                    zero_profile=float(out["zero_profile"]), unconfirmed=unconfirmed)

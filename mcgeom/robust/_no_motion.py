@@ -71,8 +71,8 @@ def _threshold_too_small(rays: RayPairs, scorer: "Scorer", options: RansacOption
 
 
 def nothing_found(rays: RayPairs, scorer: "Scorer", options: RansacOptions, method: str,
-                   t_start: float, need: int, counts: str,
-                   ended: Optional[dict] = None) -> RigMotion:
+                  t_start: float, need: int, counts: str,
+                  ended: Optional[dict] = None) -> RigMotion:
     """No motion explains ``need`` correspondences: a static rig or pure
     rotation (:func:`_no_translation`), else DegenerateError; ``ended`` (how
     the search ended: ``iterations``, ``hypotheses``, ``stop``,
@@ -109,6 +109,8 @@ def _capped_message(rays: RayPairs, method: str, need: int, ended: dict) -> str:
 
 
 def per_camera_counts(rays: RayPairs) -> str:
+    """The intra-camera correspondences of each camera and the cross-camera
+    ones, for the messages of a search that found nothing."""
     if rays.cam1 is None:
         return "camera ids unknown"
     same = rays.cam1 == rays.cam2

@@ -112,6 +112,9 @@ def _finite(v: Any) -> bool:
 
 
 def focal_array(focal: Union[None, float, np.ndarray], n: int) -> Optional[np.ndarray]:
+    """``focal`` (pixels per radian: one value or ``n``) as ``n`` positive
+    finite float64s, C-contiguous; None stays None (radians). ValueError
+    otherwise."""
     if focal is None:
         return None
     f = np.asarray(focal, dtype=np.float64)

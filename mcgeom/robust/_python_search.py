@@ -34,7 +34,7 @@ def check_solver_options(solver: Callable, method: str, solver_options: dict) ->
 
 
 def run_proposer(info_est, rays: RayPairs, scorer: Scorer, options: RansacOptions,
-                  rng: np.random.Generator) -> int:
+                 rng: np.random.Generator) -> int:
     """Score the proposer's motions until one explains the expected inlier ratio."""
     iterations = 0
     # a proposer's motions come out of a robust search with its own local
@@ -58,7 +58,7 @@ def run_proposer(info_est, rays: RayPairs, scorer: Scorer, options: RansacOption
 
 
 def run_minimal(info_est, rays: RayPairs, scorer: Scorer, options: RansacOptions,
-                 rng: np.random.Generator, solver_options: dict) -> int:
+                rng: np.random.Generator, solver_options: dict) -> int:
     """Classic LO-RANSAC loop over minimal samples with the adaptive stop."""
     sampler = info_est.sampler or (lambda r, g: sample_across_cameras(r, info_est.min_sample, g))
     k_needed = options.max_iters
@@ -79,8 +79,8 @@ def run_minimal(info_est, rays: RayPairs, scorer: Scorer, options: RansacOptions
 
 
 def finish(rays: RayPairs, scorer: Scorer, options: RansacOptions, method: str,
-            iterations: int, t_start: float, calibration_std: Any = None,
-            sampled: Optional[dict] = None) -> RigMotion:
+           iterations: int, t_start: float, calibration_std: Any = None,
+           sampled: Optional[dict] = None) -> RigMotion:
     """Final robust refinement on the inliers, verdict and diagnostics.
     ``sampled``: how the minimal samples' search ended (``iterations`` =
     samples drawn, ``stop``, ``sample_size``), None when no sample was drawn
@@ -137,8 +137,8 @@ def finish(rays: RayPairs, scorer: Scorer, options: RansacOptions, method: str,
                     confidence=search_confidence(sampled["iterations"],
                                                  sampled["sample_size"], w))
         unconfirmed = unconfirmed_reason(sampled["stop"], sampled["iterations"],
-                                   sampled["sample_size"], info["confidence"])
+                                         sampled["sample_size"], info["confidence"])
     fit = (out, used, scale_used, w_used) if options.refine else None
     return conclude(rays, R, t, r, inl, fit, scorer.loss_scale, np.linalg.norm(scorer.best[1]),
-                     options, method, info, t_start, calibration_std=calibration_std,
-                     unconfirmed=unconfirmed)
+                    options, method, info, t_start, calibration_std=calibration_std,
+                    unconfirmed=unconfirmed)

@@ -144,7 +144,7 @@ class Scorer:
                 # about the inlier set, and near the critical motion a free
                 # fit slides |t| towards infinity (the final stage frees it)
                 out = refine_fit(self.rays.take(inl), R, t, self.loss_scale, "cauchy",
-                              self._w(inl), fix_scale=True)
+                                 self._w(inl), fix_scale=True)
             except (ValueError, ArithmeticError):
                 return
             r = self.residuals(out["R"], out["t"])
@@ -190,6 +190,8 @@ WIDE = 2.0
 
 
 def refine_fit(rays: RayPairs, R: np.ndarray, t: np.ndarray, loss_scale: float, loss: str,
-            weights: Optional[np.ndarray] = None, fix_scale: bool = False) -> dict:
+               weights: Optional[np.ndarray] = None, fix_scale: bool = False) -> dict:
+    """:func:`mcgeom.geometry.refine_centred` of (R, t) on ``rays`` (rig frame;
+    ``loss_scale`` in radians; ``fix_scale`` holds the centroid's |t|)."""
     return refine_centred(rays, R, t, loss=loss, loss_scale=loss_scale, weights=weights,
                           fix_scale=fix_scale)

@@ -35,7 +35,7 @@ def search_confidence(samples: int, sample_size: int, inlier_fraction: float) ->
 
 
 def unconfirmed_reason(stop: str, samples: int, sample_size: int, confidence: float
-                 ) -> Optional[str]:
+                       ) -> Optional[str]:
     """The verdict's reason when a cap (``stop`` not "confidence") ended the
     search at a ``confidence`` below :data:`CONFIRMED`, else None."""
     if stop == "confidence" or confidence >= CONFIRMED:
@@ -48,12 +48,12 @@ def unconfirmed_reason(stop: str, samples: int, sample_size: int, confidence: fl
 
 
 def conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarray],
-              inl: np.ndarray, fit: Optional[tuple], loss_scale: float, n0: float,
-              options: RansacOptions, method: str, info: dict, t_start: float,
-              profile: Optional[float] = None, calibration_std: Any = None,
-              rms: Optional[float] = None, c_ids: Optional[tuple] = None,
-              zero_profile: float = float("nan"),
-              unconfirmed: Optional[str] = None) -> RigMotion:
+             inl: np.ndarray, fit: Optional[tuple], loss_scale: float, n0: float,
+             options: RansacOptions, method: str, info: dict, t_start: float,
+             profile: Optional[float] = None, calibration_std: Any = None,
+             rms: Optional[float] = None, c_ids: Optional[tuple] = None,
+             zero_profile: float = float("nan"),
+             unconfirmed: Optional[str] = None) -> RigMotion:
     """Scale verdict and the returned ``RigMotion`` of a robust estimate.
 
     ``r`` are the residuals at the final (R, t) (pixels when thresholds are),
