@@ -127,6 +127,9 @@
  * 5.17 -> 4.55 M) */
 #define ZERO_PROFILE_BOUND 9.0
 
+/* largest |t_i| handed to mcg_verdict_stats (its bound is 1e150) */
+#define VERDICT_T_MAX 1e149
+
 /* doubles of the solutions of one upright or 6-point sample (R and t) */
 #define MINIMAL_SOLUTIONS_SIZE (12 * MCG_SIXPT_MAX_SOLUTIONS)
 
@@ -683,9 +686,23 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
          * Python); the still angle as mcgeom.observability.scale_verdict_stats */
         double still = isfinite(res->loss_scale)
                            ? c.opt.verdict_still_factor * res->loss_scale : 0.0;
+        double tv[3], big = 0.0;
+        int i;
         still = still >= 4.0 ? 3.5 : (still >= 0.0 ? still : 0.0);
+        /* The evidence at t shortened to VERDICT_T_MAX when the motion's
+         * |t| lies beyond it (mcg_verdict_stats refuses entries above
+         * 1e150, and the call returned no evidence: fuzz_robust, the local
+         * 6-point sampler's unrefined best on 23 pairs of 3 cameras at |t|
+         * 1.6e150; test_fuzz_regressions.c). Its direction is kept, and
+         * with a baseline that dwarfs the rig the depths' signs
+         * (cheirality) and the travel direction are those of the
+         * unshortened t. */
+        for (i = 0; i < 3; i++)
+            big = fabs(res->t[i]) > big ? fabs(res->t[i]) : big;
+        for (i = 0; i < 3; i++)
+            tv[i] = big > VERDICT_T_MAX ? res->t[i] * (VERDICT_T_MAX / big) : res->t[i];
         res->have_verdict = mcg_verdict_stats(n, o1, d1, o2, d2, cam1, cam2, n_cameras, mask,
-                                              res->R, res->t, still, &res->verdict, c.vwork,
+                                              res->R, tv, still, &res->verdict, c.vwork,
                                               mcg_verdict_stats_work_size(n_cameras)) == MCG_OK;
     }
     res->seconds = now_seconds() - t_start;
