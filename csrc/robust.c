@@ -686,7 +686,8 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
          * Python); the still angle as mcgeom.observability.scale_verdict_stats */
         double still = isfinite(res->loss_scale)
                            ? c.opt.verdict_still_factor * res->loss_scale : 0.0;
-        double tv[3], big = 0.0;
+        const double big = max_abs(res->t, 3);
+        double tv[3];
         int i;
         still = still >= 4.0 ? 3.5 : (still >= 0.0 ? still : 0.0);
         /* The evidence at t shortened to VERDICT_T_MAX when the motion's
@@ -697,8 +698,6 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
          * with a baseline that dwarfs the rig the depths' signs
          * (cheirality) and the travel direction are those of the
          * unshortened t. */
-        for (i = 0; i < 3; i++)
-            big = fabs(res->t[i]) > big ? fabs(res->t[i]) : big;
         for (i = 0; i < 3; i++)
             tv[i] = big > VERDICT_T_MAX ? res->t[i] * (VERDICT_T_MAX / big) : res->t[i];
         res->have_verdict = mcg_verdict_stats(n, o1, d1, o2, d2, cam1, cam2, n_cameras, mask,
