@@ -19,7 +19,11 @@
  * picks the clone at load time; elsewhere (clang, musl -- no ifunc --,
  * other CPUs) the plain function alone. Only "avx2", never "fma": without
  * fused multiply-adds every product and sum rounds as in the default clone,
- * so the results are the same to the bit on every CPU (issue 22). */
+ * so the results are the same to the bit on every CPU (issue 22).
+ * Only on static functions: a global target_clones function exports its
+ * ifunc and resolver symbols whatever -fvisibility says, and libmcgeom.so
+ * exports mcgeom.h's functions alone (.ci/c_checks); a clone that another
+ * file calls sits behind a plain wrapper. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
     defined(__linux__) && defined(__GLIBC__)
 #define MCG_AVX2_CLONE __attribute__((target_clones("avx2", "default")))

@@ -122,9 +122,7 @@ static int accumulate(int n, const double *o1, const double *d1,
     return MCG_OK;
 }
 
-/* (the clone's dispatch, an ifunc, stays local to this file: a global
- * target_clones function exports its ifunc and resolver symbols whatever
- * -fvisibility says, and libmcgeom.so exports mcgeom.h's functions alone) */
+/* the plain entry of the static clone above (internal.h, MCG_AVX2_CLONE) */
 int linear17_accumulate(int n, const double *o1, const double *d1,
                         const double *o2, const double *d2,
                         double *m, double origin[3], double *scale)
@@ -312,9 +310,7 @@ static int linear_step(const double *m, int gc_case,
     return MCG_OK;
 }
 
-/* (the clone's dispatch, an ifunc, stays local to this file: a global
- * target_clones function exports its ifunc and resolver symbols whatever
- * -fvisibility says, and libmcgeom.so exports mcgeom.h's functions alone) */
+/* the plain entry of the static clone above (internal.h, MCG_AVX2_CLONE) */
 int linear17_linear_step(const double *m, int gc_case,
                          const double *wr, const double *vr, double pinv_rtol,
                          double rtol, double tr_m, double e[9], double r[9],

@@ -214,9 +214,7 @@ static double sampson_pass(const raydata *rd, const double r[9], const double t[
     }
 }
 
-/* (the clone's dispatch, an ifunc, stays local to this file: a global
- * target_clones function exports its ifunc and resolver symbols whatever
- * -fvisibility says, and libmcgeom.so exports mcgeom.h's functions alone) */
+/* the plain entry of the static clone above (internal.h, MCG_AVX2_CLONE) */
 double linear17_sampson_pass(const raydata *rd, const double r[9], const double t[3],
                              double h[36], double g[6])
 {

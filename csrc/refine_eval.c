@@ -359,9 +359,7 @@ static void evaluate(int n, const double *o1, const double *d1, const double *o2
     acc->bad = !isfinite(cost) || !isfinite(swr2);
 }
 
-/* (the clone's dispatch, an ifunc, stays local to this file: a global
- * target_clones function exports its ifunc and resolver symbols whatever
- * -fvisibility says, and libmcgeom.so exports mcgeom.h's functions alone) */
+/* the plain entry of the static clone above (internal.h, MCG_AVX2_CLONE) */
 void refine_evaluate(int n, const double *o1, const double *d1, const double *o2,
                      const double *d2, const double *wts, const lossfn *l,
                      const double r[9], const double t[3], accum *acc)
