@@ -50,7 +50,7 @@ _SAMPLERS = (
      "camera solved with the vertical (Fraundorfer et al. 2010) + 1 for the scale, as "
      "5+1, when some camera has 3; else 4-samples of any cameras (Sweeney et al. 2014, "
      "Lee et al. 2014); its smaller samples pay off where outliers are many: measured "
-     "2.0-5.2x faster than 5+1 at 50-60 % outliers, 1.15x at 30 %, 0.82-0.87x without "
+     "2.4-6.1x faster than 5+1 at 50-60 % outliers, 1.3-1.4x at 30 %, 0.99-1.06x without "
      "outliers (mcgeom experiment peer_solvers --part ransac --outliers 0 0.3 0.5 0.6)"),
     ("five_plus_one",
      "else, when some camera has >= 5 intra-camera correspondences: 5 of one camera + 1 "

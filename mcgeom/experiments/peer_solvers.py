@@ -58,11 +58,11 @@ machine), which on the cases with a 5-point camera would only measure that.
 instead of its own: the upright sampler's smaller samples (w^3 against
 5+1's w^5) pay off once outliers are many, while with few outliers both
 searches draw a handful of samples and share the same local optimisation
-and final refinement (measured, 40 problems, vertical 0.2 deg off: Ladybug
-head upright vs 5+1 0.82x / 1.15x / 2.01x / 4.04x as fast at 0 / 30 / 50 /
-60 % outliers, the car rig turning 0.87x / 1.16x / 2.42x / 5.18x; without
-outliers the upright search also searches its best's scale once more,
-whose |t| carries the vertical's error). After each case a line
+and final refinement (measured in session 30, 40 problems, vertical 0.2 deg
+off: Ladybug head upright vs 5+1 0.99x / 1.33x / 2.40x / 4.78x as fast at
+0 / 30 / 50 / 60 % outliers, the car rig turning 1.06x / 1.43x / 2.92x /
+6.05x; without outliers the upright search also searches its best's scale
+once more, whose |t| carries the vertical's error). After each case a line
 compares the façade with 17-point RANSAC at the same success rate
 (:func:`equal_success`): at 40 % outliers a 17-pair sample is all inliers
 once in ~6,000 draws, so 17-point RANSAC at the default cap mostly fails
