@@ -130,6 +130,13 @@
 /* largest |t_i| handed to mcg_verdict_stats (its bound is 1e150) */
 #define VERDICT_T_MAX 1e149
 
+/* Largest |coordinate| of an origin (metres): mcg_verdict_stats's bound.
+ * Beyond it the call cannot gather the verdict's evidence it promises (a
+ * camera at 1e151 m came back MCG_OK with 7 of 400 pairs as inliers and no
+ * evidence; in Python the verdict's own call then failed after the
+ * search), and no estimate means anything there: such input is refused. */
+#define MAX_ORIGIN 1e150
+
 /* doubles of the solutions of one upright or 6-point sample (R and t) */
 #define MINIMAL_SOLUTIONS_SIZE (12 * MCG_SIXPT_MAX_SOLUTIONS)
 
@@ -260,6 +267,16 @@ size_t mcg_robust_work_size(int n, int n_cameras)
     return ok ? s : 0;
 }
 
+/* 1 when every |x_i| <= bound (false for NaN and inf): the origins' test */
+static int within(const double *x, size_t n, double bound)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (!(fabs(x[i]) <= bound))
+            return 0;
+    return 1;
+}
+
 static int check_inputs(int n, const double *o1, const double *d1, const double *o2,
                         const double *d2, const int *cam1, const int *cam2, int n_cameras,
                         const double *focal, const double *cam_axes, const double *cam_focal)
@@ -267,8 +284,8 @@ static int check_inputs(int n, const double *o1, const double *d1, const double 
     int k;
     if (n < 6 || n > MAX_PAIRS || n_cameras < 1 || n_cameras > MAX_CAMERAS)
         return MCG_EINVAL;
-    if (!all_finite(o1, 3 * (size_t)n) || !all_finite(d1, 3 * (size_t)n) ||
-        !all_finite(o2, 3 * (size_t)n) || !all_finite(d2, 3 * (size_t)n))
+    if (!within(o1, 3 * (size_t)n, MAX_ORIGIN) || !all_finite(d1, 3 * (size_t)n) ||
+        !within(o2, 3 * (size_t)n, MAX_ORIGIN) || !all_finite(d2, 3 * (size_t)n))
         return MCG_EINVAL;
     for (k = 0; k < n; k++) {
         if (cam1[k] < 0 || cam1[k] >= n_cameras || cam2[k] < 0 || cam2[k] >= n_cameras)

@@ -21,6 +21,7 @@ import numpy as np
 
 from ._mcgeom_cffi import ffi, lib
 from .errors import DegenerateError, InfeasibleError, NumericalError
+from .validation import check_origins
 
 __all__ = [
     "qr", "svd", "pinv", "sym_eig", "spd_solve",
@@ -524,6 +525,8 @@ def _ray_error(status: int, what: str, arrays: tuple, extra: tuple = ()) -> None
             if not (np.einsum("ij,ij->i", a, a) >= 1e-100).all():
                 raise ValueError(f"{what}: {name} contains a zero-length direction "
                                  "(|d| < 1e-50)")
+        for name, a in (("origins1", arrays[0]), ("origins2", arrays[2])):
+            check_origins(f"{what}: {name}", a)
         raise ValueError(f"{what}: coordinates so large that the computation overflows")
     _check(status, what)
 

@@ -11,8 +11,8 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from .validation import (as_camera_ids, as_vectors, check_directions, check_rotation,
-                         check_vector3)
+from .validation import (as_camera_ids, as_vectors, check_directions, check_origins,
+                         check_rotation, check_vector3)
 
 __all__ = ["RayPairs", "ScaleVerdict", "RigMotion", "MotionFocal", "make_scale_verdict",
            "make_rig_motion"]
@@ -68,13 +68,17 @@ class RayPairs:
         return self.origins1.shape[0]
 
     def check_finite(self) -> None:
-        """Raise ValueError naming the first array that holds NaN or inf, or a
-        direction of zero length (the C kernels check both themselves;
+        """Raise ValueError naming the first array that holds NaN or inf, an
+        origin coordinate beyond :data:`mcgeom.validation.MAX_ORIGIN` (1e150 m)
+        or a direction of zero length (the C kernels check these themselves;
         estimators that do numpy work before reaching them call this: a zero
-        direction would otherwise become NaN bearings deep inside them)."""
+        direction would otherwise become NaN bearings deep inside them, and a
+        far origin overflow there)."""
         for name in ("origins1", "dirs1", "origins2", "dirs2"):
             if not np.all(np.isfinite(getattr(self, name))):
                 raise ValueError(f"rays.{name} contains NaN or inf")
+        for name in ("origins1", "origins2"):
+            check_origins(f"rays.{name}", getattr(self, name))
         for name in ("dirs1", "dirs2"):
             check_directions(f"rays.{name}", getattr(self, name))
 

@@ -14,10 +14,10 @@ from typing import Any, Optional
 
 import numpy as np
 
-__all__ = ["MAX_CAMERA_ID", "ROTATION_TOL", "MIN_DIRECTION_NORM", "numeric", "rotation_problem",
-           "check_rotation", "check_vector3", "check_pixels", "check_points", "check_int",
-           "as_vectors", "as_camera_ids", "integral_camera_ids", "check_directions",
-           "check_seed", "check_poses"]
+__all__ = ["MAX_CAMERA_ID", "ROTATION_TOL", "MIN_DIRECTION_NORM", "MAX_ORIGIN", "numeric",
+           "rotation_problem", "check_rotation", "check_vector3", "check_pixels", "check_points",
+           "check_int", "as_vectors", "as_camera_ids", "integral_camera_ids", "check_directions",
+           "check_origins", "check_seed", "check_poses"]
 
 #: tolerance of max |R^T R - I| for a matrix to count as a rotation
 ROTATION_TOL = 1e-6
@@ -145,6 +145,13 @@ MAX_CAMERA_ID = 2 ** 20 - 1
 #: (the C kernels' bound, csrc/include/mcgeom.h: |d| < 1e-50 is MCG_EINVAL)
 MIN_DIRECTION_NORM = 1e-50
 
+#: largest |coordinate| of a ray origin (metres): the bound of the C kernels
+#: whose products of origins must stay finite (mcg_verdict_stats, and
+#: mcg_robust_rig_motion, which gathers its evidence). No rig lies 1e150 m
+#: away; the estimators that check rays in numpy (RayPairs.check_finite) refuse
+#: such origins with the same message instead of failing deep inside
+MAX_ORIGIN = 1e150
+
 
 def check_directions(what: str, d: np.ndarray) -> None:
     """ValueError naming ``what`` if a row of the (N, 3) float64 array ``d`` is shorter
@@ -154,6 +161,17 @@ def check_directions(what: str, d: np.ndarray) -> None:
     if short.size:
         raise ValueError(f"{what} contains a zero-length direction (row {short[0]}; "
                          f"|d| < {MIN_DIRECTION_NORM:g})")
+
+
+def check_origins(what: str, o: np.ndarray) -> None:
+    """ValueError naming ``what`` and the row if a coordinate of the (N, 3)
+    float64 array ``o`` exceeds :data:`MAX_ORIGIN` in magnitude (finite
+    values; NaN and inf are the finiteness check's)."""
+    far = np.flatnonzero(np.abs(o).max(axis=1, initial=0.0) > MAX_ORIGIN)
+    if far.size:
+        bound = f"{MAX_ORIGIN:.0e}".replace("e+", "e")
+        raise ValueError(f"{what} has a coordinate beyond {bound} m in magnitude "
+                         f"(row {far[0]}): origins are camera centres in metres")
 
 
 def integral_camera_ids(what: str, arr: np.ndarray) -> np.ndarray:

@@ -964,6 +964,33 @@ def test_directions_tiny():
         assert rot_err(est(scaled, name).R, MOTION[0]) < R_TOL, name
 
 
+@row("origins-far", "a camera whose centre lies 1e151 m away (finite origins beyond 1e150)",
+     "`ValueError`: rays.origins1 has a coordinate beyond 1e150 m in magnitude (row k): every "
+     "estimator that checks rays in numpy, `robust.ransac` and the C search (which returned "
+     "`MCG_OK` without the verdict's evidence); linear17 and refine normalise the rays and "
+     "return a direction only (scale not observable)")
+def test_origins_far():
+    r = rays()
+    cam0 = r.cam1 == 0
+    assert cam0.any() and np.array_equal(r.cam1, r.cam2)
+    o1, o2 = r.origins1.copy(), r.origins2.copy()
+    o1[cam0] = o2[cam0] = [1e151, 0.0, 0.0]   # one centre per camera, as 5+1 asks
+    far = with_rays(origins1=o1, origins2=o2)
+    row = int(np.flatnonzero(cam0)[0])
+    msg = rf"origins1 has a coordinate beyond 1e150 m in magnitude \(row {row}\)"
+    for name in names():
+        if name in ("linear17", "refine"):
+            assert not est(far, name).scale.observable, name
+        else:
+            with raises(ValueError, "rays." + msg):
+                est(far, name)
+    with raises(ValueError, "robust_rig_motion: " + msg):
+        mcgeom.robust.ransac(far, "five_plus_one", seed=1)
+    # 1e150 itself is accepted by the C search (the bound is |x| <= 1e150)
+    o1[cam0] = o2[cam0] = [1e150, 0.0, 0.0]
+    mcgeom.robust.ransac(with_rays(origins1=o1, origins2=o2), "five_plus_one", seed=1)
+
+
 @row("ids-integral-float", "camera ids as floats with whole values (1.0, 2.0: what `np.loadtxt` "
      "gives), to the façade, `Rig.ray_pairs` and `RayPairs`",
      "accepted everywhere: the same motion as integer ids (one rule, "

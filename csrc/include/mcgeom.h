@@ -1229,7 +1229,8 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * intra-camera correspondences, fewer than 17 pairs with MCG_SAMPLER_EIGEN
  * or MCG_SAMPLER_LINEAR17,
  * a static rig, degenerate scenes),
- * MCG_EINVAL (NULL, sizes, camera ids out of range, NaN/inf, zero
+ * MCG_EINVAL (NULL, sizes, camera ids out of range, NaN/inf, an origin
+ * coordinate above 1e150 in magnitude (mcg_verdict_stats's bound), zero
  * directions, focal <= 0, bad options: an unknown sampler, a zero-length or
  * non-finite g1/g2 with MCG_SAMPLER_UPRIGHT4; with central samples -- 5+1,
  * the upright 3+1 -- a camera whose rays do not share one origin at both

@@ -631,6 +631,36 @@ static void status_case(void)
               0.0);
         o2[3 * 9 + 1] = keep;
     }
+    {
+        /* camera 0 1e151 m away (one origin, as 5+1 asks): beyond
+         * mcg_verdict_stats's bound the evidence cannot be gathered, and it
+         * came back MCG_OK with 7 of 400 pairs and no evidence; refused.
+         * At 1e150 it is accepted (the test is |x| <= 1e150). */
+        double keep1[3 * 40], keep2[3 * 40];
+        const double at[2] = {1e151, 1e150};
+        int i;
+        memcpy(keep1, o1, sizeof keep1);
+        memcpy(keep2, o2, sizeof keep2);
+        mcg_robust_default_options(&opt);
+        opt.max_iterations = 1;
+        opt.verdict_still_factor = 3.0;
+        for (i = 0; i < 2; i++) {
+            for (k = 0; k < 40; k++) {
+                if (cam1[k] == 0)
+                    o1[3 * k] = at[i];
+                if (cam2[k] == 0)
+                    o2[3 * k] = at[i];
+            }
+            st = mcg_robust_rig_motion(40, o1, d1, o2, d2, cam1, cam2, NCAM, NULL, NULL, NULL,
+                                       &opt, &res, mask, NULL, work, lwork);
+            if (i == 0)
+                check_status(st, MCG_EINVAL, "a camera 1e151 m away");
+            else
+                check(st != MCG_EINVAL, "a camera 1e150 m away accepted", 0.0, 0.0);
+        }
+        memcpy(o1, keep1, sizeof keep1);
+        memcpy(o2, keep2, sizeof keep2);
+    }
     check(mcg_robust_work_size(5, 1) == 0 && mcg_robust_work_size(10, 0) == 0,
           "work size 0 for n < 6 or no camera", 0.0, 0.0);
 }
