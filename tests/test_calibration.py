@@ -328,6 +328,16 @@ def test_save_opencv_yaml_keeps_skew_and_long_distortion(tmp_path):
     assert C.load_opencv_yaml(tmp_path / "r.yaml") == rig
 
 
+def test_opencv_file_of_one_matrix(tmp_path):
+    """A FileStorage document whose root is a single !!opencv-matrix (fuzz_calibration:
+    the error's listing of the top-level keys raised a TypeError on it)."""
+    mat = tmp_path / "K.yml"
+    mat.write_text("%YAML:1.0\n---\n!!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                   "   data: [ 1210., 0., 960., 0., 1208., 600., 0., 0., 1. ]\n")
+    for load in (C.load_opencv_yaml, C.load_rig):
+        raises(f"{mat}: the top level is a single matrix, not named entries", load, mat)
+
+
 def test_opencv_lens_model_rules(tmp_path):
     # 4 coefficients without a model name are ambiguous ...
     four = variant(tmp_path, RIG4_YML, "      model: fisheye\n", "")

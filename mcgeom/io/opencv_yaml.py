@@ -186,7 +186,15 @@ def _read_filestorage(path: Any) -> dict:
         root = fs.root()
         if not root.isMap():
             raise ValueError(f"{where}: empty OpenCV FileStorage file (no top-level mapping)")
-        return _fs_node_to_python(root, where, "")
+        tree = _fs_node_to_python(root, where, "")
+        if not isinstance(tree, dict):
+            # a document whose root is tagged !!opencv-matrix (found by
+            # fuzz_calibration: the key listing of the error below then failed
+            # with a TypeError)
+            kind = "matrix" if isinstance(tree, np.ndarray) else type(tree).__name__
+            raise ValueError(f"{where}: the top level is a single {kind}, not named entries "
+                             "(a 'cameras' list, or M1, D1, M2, D2, R, T)")
+        return tree
     except cv2.error as exc:
         raise ValueError(f"{where}: malformed OpenCV FileStorage file ({_cv_error_text(exc)})") from None
     finally:
