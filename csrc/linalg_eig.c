@@ -155,19 +155,23 @@ static int jacobi_sweeps(size_t nn, double *a, double *v)
     return 0;
 }
 
+/* The argument checks of both eigen-solvers: 1 <= n <= max_n, no NULL, a
+ * and v distinct, a finite. */
+static int eig_args_ok(int n, size_t max_n, const double *a, const double *w, const double *v)
+{
+    return n >= 1 && (size_t)n <= max_n && a != NULL && w != NULL && v != NULL && a != v &&
+           all_finite(a, (size_t)n * (size_t)n);
+}
+
 int mcg_sym_eig(int n, double *a, double *w, double *v)
 {
     size_t nn, i, j;
     int e;
     double f2;
 
-    if (n < 1 || (size_t)n > MAX_COLS)
-        return MCG_EINVAL;
-    if (a == NULL || w == NULL || v == NULL || a == v)
+    if (!eig_args_ok(n, MAX_COLS, a, w, v))
         return MCG_EINVAL;
     nn = (size_t)n;
-    if (!all_finite(a, nn * nn))
-        return MCG_EINVAL;
 
     /* Symmetric part, scaled so that max |a_ij| is in [0.5, 1): no overflow
      * in (a_qq - a_pp) below, exact (power of two) and undone at the end.
@@ -356,13 +360,9 @@ int mcg_sym_eig_tridiag(int n, double *a, double *w, double *v)
     double e[SPD_MAX];
     size_t nn, i, j;
     int ex;
-    if (n < 1 || n > SPD_MAX)
-        return MCG_EINVAL;
-    if (a == NULL || w == NULL || v == NULL || a == v)
+    if (!eig_args_ok(n, SPD_MAX, a, w, v))
         return MCG_EINVAL;
     nn = (size_t)n;
-    if (!all_finite(a, nn * nn))
-        return MCG_EINVAL;
     /* no overflow or harmful underflow in the rotations */
     ex = scaled_symmetric_part(nn, a);
     tridiagonalize(nn, a, w, e, v);

@@ -319,35 +319,36 @@ int linear17_linear_step(const double *m, int gc_case,
     return linear_step(m, gc_case, wr, vr, pinv_rtol, rtol, tr_m, e, r, res);
 }
 
-/* Rotation candidates: the two rotations of E = [t]x R (twisted pair) and,
- * where the R part is not ambiguous (most-general case), the projection of
- * the R part itself. */
+/* One rotation of E's twisted pair: U w V^T from E's SVD, negated when its
+ * determinant is negative (E's sign is free). */
+static void twisted(const double u[9], const double w[9], const double v[9], double out[9])
+{
+    double uw[9];
+    int i;
+    mul33(u, w, uw);
+    mul33_abt(uw, v, out);
+    if (det33(out) < 0.0)
+        for (i = 0; i < 9; i++)
+            out[i] = -out[i];
+}
+
+/* Rotation candidates: the two rotations of E = [t]x R (twisted pair: W and
+ * W^T) and, where the R part is not ambiguous (most-general case), the
+ * projection of the R part itself. */
 int linear17_rotation_candidates(const double e[9], const double r[9], int use_r,
                                  double cand[4][9], int *ncand)
 {
-    double u[9], s[3], v[9], work[64], w[9] = {0, -1, 0, 1, 0, 0, 0, 0, 1};
-    double uw[9];
-    int nc = 0, i;
+    static const double w[9] = {0, -1, 0, 1, 0, 0, 0, 0, 1};
+    static const double wt[9] = {0, 1, 0, -1, 0, 0, 0, 0, 1};
+    double u[9], s[3], v[9], work[64];
+    int nc = 2, i;
     size_t lw = mcg_svd_work_size(3, 3);
     if (lw > 64)
         return MCG_ENOMEM;
     if (mcg_svd(3, 3, e, u, s, v, work, lw) != MCG_OK)
         return MCG_ENUMERIC;
-    mul33(u, w, uw);
-    mul33_abt(uw, v, cand[nc]);
-    if (det33(cand[nc]) < 0.0)
-        for (i = 0; i < 9; i++)
-            cand[nc][i] = -cand[nc][i];
-    nc++;
-    {
-        double wt[9] = {0, 1, 0, -1, 0, 0, 0, 0, 1};
-        mul33(u, wt, uw);
-        mul33_abt(uw, v, cand[nc]);
-        if (det33(cand[nc]) < 0.0)
-            for (i = 0; i < 9; i++)
-                cand[nc][i] = -cand[nc][i];
-        nc++;
-    }
+    twisted(u, w, v, cand[0]);
+    twisted(u, wt, v, cand[1]);
     if (use_r) {
         double rr[9], sg = det33(r) < 0.0 ? -1.0 : 1.0;
         for (i = 0; i < 9; i++)
