@@ -61,7 +61,7 @@ _SAMPLERS = (
      "solved by a local search (~1 ms a sample) whose rate of finding a sample's motion "
      "the search measures on its consensus and allows for (info['found_rate']), every "
      "256th sample by the complete homotopy solver (64 paths, 14-30 ms a sample); "
-     "6.4x faster than 17-point RANSAC on the 12-camera case of peer_solvers (a vertical "
+     "7.2x faster than 17-point RANSAC on the 12-camera case of peer_solvers (a vertical "
      "prior is faster still: the upright sampler draws 3+1, or 4 of any cameras)"),
 )
 
