@@ -81,6 +81,12 @@
 #define SING_RTOL 1e-10                  /* eigenvalue ratio treated as singular */
 #define MAX_TURN 0.5                     /* largest rotation step, radians */
 
+/* What a refinement moves (the step's parametrisation, reduced_system):
+ * all six degrees of freedom, t on the sphere |t| = |t0| (fix_scale), or t
+ * alone with R held (mcg_refine_translation: a rotation known from a gyro
+ * or ground truth). */
+enum { MOVE_ALL = 0, MOVE_FIX_SCALE = 1, MOVE_T_ONLY = 2 };
+
 void mcg_refine_default_options(mcg_refine_options *opt)
 {
     if (!opt)
@@ -131,35 +137,15 @@ static void tangent_basis(const double u[3], double b1[3], double b2[3])
     cross3(u, b1, b2);
 }
 
-/* Evidence on |t| from H at (R, t): info_cond = lambda_min / lambda_max of
- * the Schur complement S of the t-block, and var = u^T S^-1 u, u = t / |t|
- * (HUGE_VAL when S is singular along u). */
-static void scale_evidence(const double *h, const double t[3], double *cond,
-                           double *var)
+/* info_cond = lambda_min / lambda_max of a 3 x 3 information s of t, and
+ * var = u^T s^-1 u, u = t / |t| (HUGE_VAL when s is singular along u). */
+static void evidence_of(double s[9], const double t[3], double *cond, double *var)
 {
-    double hww[9], hwt[9], z[3], col[3], s[9], w[3], v[9], nt, u[3];
-    int i, k, st;
+    double w[3], v[9], nt, u[3];
+    int i, k;
     *cond = 0.0;
     *var = HUGE_VAL;
-    for (i = 0; i < 3; i++)
-        for (k = 0; k < 3; k++) {
-            hww[3 * i + k] = h[6 * i + k];
-            hwt[3 * i + k] = h[6 * i + 3 + k];
-            s[3 * i + k] = h[6 * (3 + i) + 3 + k];
-        }
-    for (k = 0; k < 3; k++) { /* S -= H_tw H_ww^-1 H_wt, column by column */
-        for (i = 0; i < 3; i++)
-            col[i] = hwt[3 * i + k];
-        if (mcg_spd_solve(3, hww, col, z) != MCG_OK)
-            return;
-        for (i = 0; i < 3; i++)
-            s[3 * i + k] -= hwt[0 + i] * z[0] + hwt[3 + i] * z[1] + hwt[6 + i] * z[2];
-    }
-    for (i = 0; i < 3; i++) /* symmetrise the rounding */
-        for (k = 0; k < i; k++)
-            s[3 * i + k] = s[3 * k + i] = 0.5 * (s[3 * i + k] + s[3 * k + i]);
-    st = mcg_sym_eig(3, s, w, v);
-    if (st != MCG_OK || !(w[2] > 0.0))
+    if (mcg_sym_eig(3, s, w, v) != MCG_OK || !(w[2] > 0.0))
         return;
     *cond = w[0] > 0.0 ? w[0] / w[2] : 0.0;
     nt = sqrt(dot3(t, t));
@@ -180,6 +166,37 @@ static void scale_evidence(const double *h, const double t[3], double *cond,
         }
         *var = acc;
     }
+}
+
+/* Evidence on |t| from H at (R, t) (evidence_of): of the Schur complement
+ * S = H_tt - H_tw H_ww^-1 H_wt of the t-block where R is estimated too,
+ * of H_tt itself where R is held (move = MOVE_T_ONLY: a known rotation has
+ * no uncertainty to marginalise). */
+static void scale_evidence(const double *h, const double t[3], int move, double *cond,
+                           double *var)
+{
+    double hww[9], hwt[9], z[3], col[3], s[9];
+    int i, k;
+    *cond = 0.0;
+    *var = HUGE_VAL;
+    for (i = 0; i < 3; i++)
+        for (k = 0; k < 3; k++) {
+            hww[3 * i + k] = h[6 * i + k];
+            hwt[3 * i + k] = h[6 * i + 3 + k];
+            s[3 * i + k] = h[6 * (3 + i) + 3 + k];
+        }
+    for (k = 0; k < 3 && move != MOVE_T_ONLY; k++) { /* S -= H_tw H_ww^-1 H_wt */
+        for (i = 0; i < 3; i++)
+            col[i] = hwt[3 * i + k];
+        if (mcg_spd_solve(3, hww, col, z) != MCG_OK)
+            return;
+        for (i = 0; i < 3; i++)
+            s[3 * i + k] -= hwt[0 + i] * z[0] + hwt[3 + i] * z[1] + hwt[6 + i] * z[2];
+    }
+    for (i = 0; i < 3; i++) /* symmetrise the rounding */
+        for (k = 0; k < i; k++)
+            s[3 * i + k] = s[3 * k + i] = 0.5 * (s[3 * i + k] + s[3 * k + i]);
+    evidence_of(s, t, cond, var);
 }
 
 /* The argument checks of mcg_refine_motion (its header comment lists them);
@@ -214,18 +231,18 @@ static int check_inputs(int n, const double *o1, const double *d1, const double 
 }
 
 /* The Gauss-Newton system of one iteration in the step's parameters: with
- * P (6 x m) the parametrisation of the step [dw; dt] (the identity, or
- * [dw; B u] with fix_scale, B an orthonormal basis of the tangent plane of
- * the sphere |t| = rho0 at t), hm = P^T H P and gm = P^T g (m x m, m).
- * Returns m. */
-static int reduced_system(const accum *cur, int fix, const double tv[3], double rho0,
+ * P (6 x m) the parametrisation of the step [dw; dt] (the identity; [dw; B u]
+ * with fix_scale, B an orthonormal basis of the tangent plane of the sphere
+ * |t| = rho0 at t; [0; dt] with R held), hm = P^T H P and gm = P^T g
+ * (m x m, m). Returns m. */
+static int reduced_system(const accum *cur, int move, const double tv[3], double rho0,
                           double pm[6][6], double *hm, double *gm)
 {
-    int i, m = fix ? 5 : 6;
+    int i, m = move == MOVE_ALL ? 6 : (move == MOVE_FIX_SCALE ? 5 : 3);
     memset(pm, 0, 36 * sizeof(double));
     for (i = 0; i < 3; i++)
-        pm[i][i] = 1.0;
-    if (fix) {
+        pm[move == MOVE_T_ONLY ? 3 + i : i][i] = 1.0;
+    if (move == MOVE_FIX_SCALE) {
         double u[3], b1[3] = {0, 0, 0}, b2[3] = {0, 0, 0};
         for (i = 0; i < 3; i++)
             u[i] = tv[i] / rho0;
@@ -234,11 +251,11 @@ static int reduced_system(const accum *cur, int fix, const double tv[3], double 
             pm[3 + i][3] = b1[i];
             pm[3 + i][4] = b2[i];
         }
-    } else {
+    } else if (move == MOVE_ALL) {
         for (i = 3; i < 6; i++)
             pm[i][i] = 1.0;
     }
-    if (!fix) {
+    if (move == MOVE_ALL) {
         memcpy(hm, cur->h, 36 * sizeof(double));
         memcpy(gm, cur->g, 6 * sizeof(double));
     } else { /* hm = P^T H P, gm = P^T g */
@@ -329,19 +346,24 @@ static double predicted_decrease(const double *hm, const double *ngm, const doub
     return pred;
 }
 
-/* The candidate motion: R <- exp([dw]x) R, t <- t + dt, retracted onto the
- * sphere |t| = rho0 with fix_scale. 0 if the rotation cannot be formed. */
+/* The candidate motion: R <- exp([dw]x) R (R itself, to the bit, when it
+ * is held), t <- t + dt, retracted onto the sphere |t| = rho0 with
+ * fix_scale. 0 if the rotation cannot be formed. */
 static int candidate_motion(const double dfull[6], const double r[9], const double tv[3],
-                            int fix, double rho0, double rn[9], double tn[3])
+                            int move, double rho0, double rn[9], double tn[3])
 {
     double dr[9];
     int i;
-    if (mcg_rot_from_angle_axis(dfull, dr) != MCG_OK)
-        return 0;
-    mul33(dr, r, rn);
+    if (move == MOVE_T_ONLY) {
+        memcpy(rn, r, 9 * sizeof(double));
+    } else {
+        if (mcg_rot_from_angle_axis(dfull, dr) != MCG_OK)
+            return 0;
+        mul33(dr, r, rn);
+    }
     for (i = 0; i < 3; i++)
         tn[i] = tv[i] + dfull[3 + i];
-    if (fix) {
+    if (move == MOVE_FIX_SCALE) {
         double nn = sqrt(dot3(tn, tn));
         for (i = 0; i < 3; i++)
             tn[i] *= rho0 / nn;
@@ -368,7 +390,7 @@ static int candidate_motion(const double dfull[6], const double r[9], const doub
 static void extrapolate(int n, const double *o1, const double *d1, const double *o2,
                         const double *d2, const double *weights, const lossfn *lf,
                         const double *ngm, const double *dx, int m, const double dfull[6],
-                        const double r[9], const double tv[3], int fix, double rho0,
+                        const double r[9], const double tv[3], int move, double rho0,
                         double t_lim, double cost0, double rn[9], double tn[3], accum *trial)
 {
     double slope = 0.0, curv, a, nw, ndt, d2f[6], r2[9], t2[3];
@@ -391,7 +413,7 @@ static void extrapolate(int n, const double *o1, const double *d1, const double 
         return;
     for (i = 0; i < 6; i++)
         d2f[i] = a * dfull[i];
-    if (!candidate_motion(d2f, r, tv, fix, rho0, r2, t2))
+    if (!candidate_motion(d2f, r, tv, move, rho0, r2, t2))
         return;
     refine_evaluate(n, o1, d1, o2, d2, weights, lf, r2, t2, &ext);
     if (ext.bad || !(ext.cost < trial->cost))
@@ -444,6 +466,7 @@ typedef struct {
                      within a factor 2 of 1 */
     int reason, converged;
     int trials; /* steps tried, accepted or not (res->iterations) */
+    int move;   /* MOVE_*: the parameters the steps move */
 } lm_state;
 
 /* A failed step (not solvable, or not decreasing the cost): raise the
@@ -471,10 +494,10 @@ static int lm_iteration(int n, const double *o1, const double *d1, const double 
 {
     double pm[6][6], hm[36], gm[6], dx[6], dfull[6], rn[9], tn[3];
     double maxd = 0.0, gmax = 0.0, pred, nw, ndt, nt, actual, a = relaxation(lm->ratio);
-    int i, m, accepted, small, fix = o->fix_scale;
+    int i, m, accepted, small, move = lm->move;
     accum trial;
 
-    m = reduced_system(cur, fix, tv, rho0, pm, hm, gm);
+    m = reduced_system(cur, move, tv, rho0, pm, hm, gm);
     for (i = 0; i < m; i++) {
         if (hm[m * i + i] > maxd)
             maxd = hm[m * i + i];
@@ -512,7 +535,7 @@ static int lm_iteration(int n, const double *o1, const double *d1, const double 
         dx[i] *= a;
     limit_step(pm, m, tv, ell, dx, dfull);
     pred = predicted_decrease(hm, gm, dx, m);
-    if (!candidate_motion(dfull, r, tv, fix, rho0, rn, tn)) {
+    if (!candidate_motion(dfull, r, tv, move, rho0, rn, tn)) {
         lm->reason = MCG_REFINE_STOP_STALLED;
         return 1;
     }
@@ -530,7 +553,7 @@ static int lm_iteration(int n, const double *o1, const double *d1, const double 
         lm->ratio = curvature_ratio(a, gain);
         /* (a step short even at CURV_MAX: the line search) */
         if (lm->ratio > CURV_MAX && gain > EXTRAP_GAIN)
-            extrapolate(n, o1, d1, o2, d2, weights, lf, gm, dx, m, dfull, r, tv, fix, rho0,
+            extrapolate(n, o1, d1, o2, d2, weights, lf, gm, dx, m, dfull, r, tv, move, rho0,
                         0.5 * (nt > ell ? nt : ell), cur->cost, rn, tn, &trial);
         actual = cur->cost - trial.cost;
         memcpy(r, rn, sizeof rn);
@@ -580,20 +603,12 @@ static int final_statistics(const accum *cur, const double tv[3], double pdim,
     res->rms = sqrt(cur->swr2 / cur->sw);
     res->sigma2 = cur->som > pdim ? cur->somr2 / (cur->som - pdim) : HUGE_VAL;
     nt = sqrt(dot3(tv, tv));
-    scale_evidence(cur->h, tv, &res->info_cond, &var);
+    scale_evidence(cur->h, tv, lm->move, &res->info_cond, &var);
     if (isfinite(var) && isfinite(res->sigma2) && nt > 0.0)
         res->scale_rel_std = sqrt(res->sigma2 * var) / nt;
     else
         res->scale_rel_std = HUGE_VAL;
     return MCG_OK;
-}
-
-int mcg_refine_motion(int n, const double *o1, const double *d1,
-                      const double *o2, const double *d2, const double *weights,
-                      const mcg_refine_options *opt, double R[9], double t[3],
-                      mcg_refine_result *res)
-{
-    return mcg_refine_motion_until(n, o1, d1, o2, d2, weights, opt, -HUGE_VAL, R, t, res);
 }
 
 /* mcg_refine_motion that also stops (converged, MCG_REFINE_STOP_COST) as
@@ -603,10 +618,13 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
  * robust.c's zero profile. */
 #define ABOVE_STEPS 100.0
 
-int mcg_refine_motion_until(int n, const double *o1, const double *d1, const double *o2,
-                            const double *d2, const double *weights,
-                            const mcg_refine_options *opt, double cost_target, double R[9],
-                            double t[3], mcg_refine_result *res)
+/* The refinement of (R, t) (move: MOVE_ALL or MOVE_FIX_SCALE from
+ * opt->fix_scale, or MOVE_T_ONLY), stopping at cost_target as
+ * mcg_refine_motion_until does. */
+static int refine_run(int n, const double *o1, const double *d1, const double *o2,
+                      const double *d2, const double *weights, const mcg_refine_options *opt,
+                      int t_only, double cost_target, double R[9], double t[3],
+                      mcg_refine_result *res)
 {
     mcg_refine_options o;
     lossfn lf;
@@ -623,6 +641,8 @@ int mcg_refine_motion_until(int n, const double *o1, const double *d1, const dou
     st = check_inputs(n, o1, d1, o2, d2, weights, opt, R, t, &o);
     if (st != MCG_OK)
         return st;
+    if (t_only && o.fix_scale)
+        return MCG_EINVAL; /* R held and |t| held: mcg_refine_translation refuses */
     if (mcg_project_so3(R, r) != MCG_OK) /* exact rotation from here on */
         return MCG_EINVAL;
     memcpy(tv, t, sizeof tv);
@@ -631,7 +651,8 @@ int mcg_refine_motion_until(int n, const double *o1, const double *d1, const dou
         if (!(rho0 > 0.0))
             return MCG_EINVAL; /* no sphere to stay on */
     }
-    pdim = o.fix_scale ? 5.0 : 6.0;
+    lm.move = t_only ? MOVE_T_ONLY : (o.fix_scale ? MOVE_FIX_SCALE : MOVE_ALL);
+    pdim = lm.move == MOVE_ALL ? 6.0 : (lm.move == MOVE_FIX_SCALE ? 5.0 : 3.0);
     lf.loss = o.loss;
     lf.s = o.loss_scale;
     lf.s2 = o.loss_scale * o.loss_scale;
@@ -649,7 +670,7 @@ int mcg_refine_motion_until(int n, const double *o1, const double *d1, const dou
         return MCG_EDEGENERATE; /* every weight is zero */
     {
         double tr = 0.0;
-        for (i = 0; i < 6; i++)
+        for (i = t_only ? 3 : 0; i < 6; i++) /* (of the parameters that move) */
             tr += cur.h[7 * i];
         if (!(tr > 0.0))
             return MCG_EDEGENERATE; /* no ray constrains the motion here */
@@ -688,7 +709,38 @@ int mcg_refine_motion_until(int n, const double *o1, const double *d1, const dou
     st = final_statistics(&cur, tv, pdim, &lm, res);
     if (st != MCG_OK)
         return st;
-    memcpy(R, r, sizeof r);
+    if (!t_only)
+        memcpy(R, r, sizeof r);
     memcpy(t, tv, sizeof tv);
     return MCG_OK;
+}
+
+int mcg_refine_motion_until(int n, const double *o1, const double *d1, const double *o2,
+                            const double *d2, const double *weights,
+                            const mcg_refine_options *opt, double cost_target, double R[9],
+                            double t[3], mcg_refine_result *res)
+{
+    return refine_run(n, o1, d1, o2, d2, weights, opt, 0, cost_target, R, t, res);
+}
+
+int mcg_refine_motion(int n, const double *o1, const double *d1,
+                      const double *o2, const double *d2, const double *weights,
+                      const mcg_refine_options *opt, double R[9], double t[3],
+                      mcg_refine_result *res)
+{
+    return refine_run(n, o1, d1, o2, d2, weights, opt, 0, -HUGE_VAL, R, t, res);
+}
+
+/* R held: the driver works on a copy of it (it writes R only where it moves
+ * it) */
+int mcg_refine_translation(int n, const double *o1, const double *d1, const double *o2,
+                           const double *d2, const double *weights,
+                           const mcg_refine_options *opt, const double R[9], double t[3],
+                           mcg_refine_result *res)
+{
+    double r[9];
+    if (!R)
+        return refine_run(n, o1, d1, o2, d2, weights, opt, 1, -HUGE_VAL, NULL, t, res);
+    memcpy(r, R, sizeof r);
+    return refine_run(n, o1, d1, o2, d2, weights, opt, 1, -HUGE_VAL, r, t, res);
 }

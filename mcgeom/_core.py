@@ -31,7 +31,8 @@ __all__ = [
     "Linear17Options", "linear17", "linear17_raw", "linear17_static_raw", "linear17_dict",
     "L17_OFFSETS",
     "GC_CASE_NAMES",
-    "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "LOSS_NAMES", "REFINE_STOP_NAMES",
+    "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "refine_translation",
+    "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
     "skyline_eig",
     "essential5", "essential_decompose",
@@ -671,6 +672,38 @@ def _not_rotation(R: np.ndarray) -> bool:
     return bool(np.abs(R @ R.T - np.eye(3)).max() > 1e-6 or np.linalg.det(R) <= 0)
 
 
+def _refine_options(loss: str, loss_scale: float, max_iterations: int, fix_scale: bool,
+                    cost_tolerance: float, step_tolerance: float, initial_lambda: float,
+                    t: np.ndarray) -> Any:
+    """The checked ``mcg_refine_options`` of :func:`refine_motion` and
+    :func:`refine_translation` (ValueError naming a bad one)."""
+    if not isinstance(loss, str) or loss not in LOSS_NAMES:
+        raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
+    opt = ffi.new("mcg_refine_options *")
+    lib.mcg_refine_default_options(opt)
+    opt.loss = LOSS_NAMES[loss]
+    for name, val, ok, want in (
+            ("loss_scale", loss_scale, lambda v: v > 0, "a finite number > 0 (radians)"),
+            ("cost_tolerance", cost_tolerance, lambda v: v >= 0, "a finite number >= 0"),
+            ("step_tolerance", step_tolerance, lambda v: v >= 0, "a finite number >= 0"),
+            ("initial_lambda", initial_lambda, lambda v: 0 <= v <= 1e16, "in [0, 1e16]")):
+        try:
+            v = float(val)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be {want}, got {val!r}") from None
+        if not (np.isfinite(v) and ok(v)):
+            raise ValueError(f"{name} must be {want}, got {val!r}")
+        setattr(opt, name, v)
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
+            or not 0 <= int(max_iterations) <= 10000:
+        raise ValueError(f"max_iterations must be an integer in 0..10000, got {max_iterations!r}")
+    opt.max_iterations = int(max_iterations)
+    opt.fix_scale = 1 if fix_scale else 0
+    if fix_scale and not np.linalg.norm(t) > 0:
+        raise ValueError("fix_scale needs a non-zero t0 (the sphere |t| = |t0| to stay on)")
+    return opt
+
+
 def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any, t0: Any,
                   *, weights: Any = None, loss: str = "none", loss_scale: float = 1e-3,
                   max_iterations: int = 50, fix_scale: bool = False,
@@ -699,30 +732,8 @@ def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
     n = rays[0].shape[0]
     R = _arr("R0", R0, (3, 3)).copy()  # small: checked here, refined in place
     t = _arr("t0", t0, (3,)).copy()
-    if not isinstance(loss, str) or loss not in LOSS_NAMES:
-        raise ValueError(f"loss must be one of {sorted(LOSS_NAMES)}, got {loss!r}")
-    opt = ffi.new("mcg_refine_options *")
-    lib.mcg_refine_default_options(opt)
-    opt.loss = LOSS_NAMES[loss]
-    for name, val, ok, want in (
-            ("loss_scale", loss_scale, lambda v: v > 0, "a finite number > 0 (radians)"),
-            ("cost_tolerance", cost_tolerance, lambda v: v >= 0, "a finite number >= 0"),
-            ("step_tolerance", step_tolerance, lambda v: v >= 0, "a finite number >= 0"),
-            ("initial_lambda", initial_lambda, lambda v: 0 <= v <= 1e16, "in [0, 1e16]")):
-        try:
-            v = float(val)
-        except (TypeError, ValueError):
-            raise ValueError(f"{name} must be {want}, got {val!r}") from None
-        if not (np.isfinite(v) and ok(v)):
-            raise ValueError(f"{name} must be {want}, got {val!r}")
-        setattr(opt, name, v)
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
-            or not 0 <= int(max_iterations) <= 10000:
-        raise ValueError(f"max_iterations must be an integer in 0..10000, got {max_iterations!r}")
-    opt.max_iterations = int(max_iterations)
-    opt.fix_scale = 1 if fix_scale else 0
-    if fix_scale and not np.linalg.norm(t) > 0:
-        raise ValueError("fix_scale needs a non-zero t0 (the sphere |t| = |t0| to stay on)")
+    opt = _refine_options(loss, loss_scale, max_iterations, fix_scale, cost_tolerance,
+                          step_tolerance, initial_lambda, t)
     w, w_ptr = _weights(weights, n)
     res = ffi.new("mcg_refine_result *")
     st = lib.mcg_refine_motion(n, *map(_p, rays), w_ptr, opt, _p(R), _p(t), res)
@@ -732,6 +743,36 @@ def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
                              "(|R R^T - I| > 1e-6 or det R <= 0)")
         _ray_error(st, "refine_motion", rays)
     return _refine_dict(res, R, t)
+
+
+def refine_translation(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any, t0: Any,
+                       *, weights: Any = None, loss: str = "none", loss_scale: float = 1e-3,
+                       max_iterations: int = 50, cost_tolerance: float = 1e-10,
+                       step_tolerance: float = 1e-10, initial_lambda: float = 1e-4) -> dict:
+    """The translation of rig2_from_rig1 for the known rotation ``R``
+    (``mcg_refine_translation``): :func:`refine_motion` with ``R`` held, from
+    ``t0`` (metres). The same arguments (no ``fix_scale``) and the same dict;
+    ``R`` is the given one, ``sigma2`` has 3 degrees of freedom removed, and
+    ``scale_rel_std`` / ``info_cond`` are those of the t-block ``H_tt`` (R
+    known: nothing marginalised); ``information`` is still the full 6 x 6,
+    whose ``H_tw`` gives the effect of an error of R. Raises ValueError on
+    bad input, DegenerateError if no ray constrains t at the start.
+    """
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+    n = rays[0].shape[0]
+    Rk = _arr("R", R, (3, 3)).copy()
+    t = _arr("t0", t0, (3,)).copy()
+    opt = _refine_options(loss, loss_scale, max_iterations, False, cost_tolerance,
+                          step_tolerance, initial_lambda, t)
+    w, w_ptr = _weights(weights, n)
+    res = ffi.new("mcg_refine_result *")
+    st = lib.mcg_refine_translation(n, *map(_p, rays), w_ptr, opt, _p(Rk), _p(t), res)
+    if st != lib.MCG_OK:
+        if st == lib.MCG_EINVAL and _not_rotation(Rk):
+            raise ValueError("refine_translation: R is not a rotation matrix "
+                             "(|R R^T - I| > 1e-6 or det R <= 0)")
+        _ray_error(st, "refine_translation", rays)
+    return _refine_dict(res, Rk, t)
 
 
 def _refine_dict(res: Any, R: np.ndarray, t: np.ndarray,

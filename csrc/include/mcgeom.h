@@ -475,6 +475,28 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
                       const double *weights, const mcg_refine_options *opt,
                       double R[9], double t[3], mcg_refine_result *res);
 
+/* mcg_refine_motion with the rotation held: the translation t (metres) of
+ * rig2_from_rig1 minimising the same cost C for the given R (a rotation
+ * known from a gyro, an IMU or ground truth; only read), by the same
+ * Levenberg-Marquardt steps in t alone. The linear solution of the known-
+ * rotation constraint (thesis ch. 6: (R d1 x d2) . t = -(d2^T R m1 +
+ * m2^T R d1), an algebraic error) is a biased start: it pulls |t| short
+ * wherever the scale rests on the small offset terms (intra-camera rays of a
+ * rig that turned a few degrees: 5-50 % short at 0.5 px, several of its own
+ * standard deviations); its Sampson optimum is not. res as for
+ * mcg_refine_motion, except: sigma2 = sum W r^2 / (sum W - 3);
+ * scale_rel_std = sqrt(sigma2 u^T H_tt^-1 u) / |t| and info_cond the
+ * eigenvalue ratio of H_tt (R is known: nothing to marginalise); info the
+ * full 6 x 6 at (R, t), whose H_tw gives the first-order effect of an error
+ * of R, dt = -H_tt^-1 H_tw dw. The arguments and errors of
+ * mcg_refine_motion; MCG_EINVAL also for opt->fix_scale = 1 (with R held
+ * too, only t's direction would move); MCG_EDEGENERATE when no ray
+ * constrains t at the start. R untouched, t untouched on error. */
+int mcg_refine_translation(int n, const double *o1, const double *d1,
+                           const double *o2, const double *d2,
+                           const double *weights, const mcg_refine_options *opt,
+                           const double R[9], double t[3], mcg_refine_result *res);
+
 /* --------------------------------------------------------------- cone.c */
 
 /* Bits of mcg_cone_result.flags. */
