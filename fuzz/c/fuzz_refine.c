@@ -2,22 +2,25 @@
  * fuzz_refine.c -- libFuzzer harness of mcg_refine_motion, Levenberg-
  * Marquardt on SO(3) x R^3 of the Sampson angular error of the generalized
  * epipolar constraint (thesis eq. 8.15), robust losses by IRLS, weights,
- * fix_scale, and decoded options.
+ * fix_scale, and decoded options; and of mcg_refine_translation, the same
+ * with R held.
  *
  * Inputs: mode 0 a synthetic rig scene started near the true motion, mode 1
- * arbitrary arrays and start. Invariants: bad sizes, options, weights or a
+ * arbitrary arrays and start; modes 2 and 3 the same for
+ * mcg_refine_translation. Invariants: bad sizes, options, weights or a
  * start that is not a rotation give MCG_EINVAL and leave R, t untouched;
  * NaN/inf inputs never MCG_OK; on MCG_OK R is a rotation, t finite, the
  * cost did not increase, iterations <= max_iterations, the reason is one of
  * MCG_REFINE_STOP_*, n_used <= n, the statistics are not NaN, and with
- * fix_scale |t| is kept.
+ * fix_scale |t| is kept. mcg_refine_translation: R is never written,
+ * fix_scale gives MCG_EINVAL.
  */
 #include "fuzz_input.h"
 #include "mcgeom.h"
 
 /* routines selected by the first input byte (fuzz/make_corpus.py writes
  * seeds for each) */
-#define FUZZ_MODES 2
+#define FUZZ_MODES 4
 
 #define MAXN 64
 
@@ -29,12 +32,14 @@ static double norm3(const double *v)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_in in = fz_make(data, size);
-    int mode = fz_u8(&in) % FUZZ_MODES, valid, st, i, use_w, use_opt;
+    int mode = fz_u8(&in) % FUZZ_MODES, valid, st, i, use_w, use_opt, held;
     int n = fz_size(&in, 6, MAXN, &valid);
     static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], w[MAXN];
     double Rt[9], tt[3], R[9], t[3], R0[9], t0[3];
     mcg_refine_options opt;
     mcg_refine_result res;
+    held = mode >= 2; /* mcg_refine_translation */
+    mode %= 2;
     if (n == (1 << 21))
         n = (1 << 26) + 1; /* the limit is 2^26 pairs */
     if (!valid && n >= 6 && n <= (1 << 26))
@@ -57,7 +62,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         opt.initial_lambda = fz_range(&in, 0.0, 1e3);
     }
     if (!valid) {
-        st = mcg_refine_motion(n, o1, d1, o2, d2, NULL, &opt, R, t, &res);
+        st = held ? mcg_refine_translation(n, o1, d1, o2, d2, NULL, &opt, R, t, &res)
+                  : mcg_refine_motion(n, o1, d1, o2, d2, NULL, &opt, R, t, &res);
         FZ_CHECK(st == MCG_EINVAL, "refine(n = %d) returned %d", n, st);
         return 0;
     }
@@ -88,9 +94,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         w[i] = use_w == 1 ? fz_range(&in, 0.0, 3.0) : use_w == 2 ? fz_double(&in) : 1.0;
     memcpy(R0, R, sizeof R);
     memcpy(t0, t, sizeof t);
-    st = mcg_refine_motion(n, o1, d1, o2, d2, use_w ? w : NULL, use_opt ? &opt : NULL, R, t,
-                           &res);
+    if (held)
+        st = mcg_refine_translation(n, o1, d1, o2, d2, use_w ? w : NULL, use_opt ? &opt : NULL,
+                                    R, t, &res);
+    else
+        st = mcg_refine_motion(n, o1, d1, o2, d2, use_w ? w : NULL, use_opt ? &opt : NULL, R,
+                               t, &res);
     FZ_CHECK(fz_status_known(st), "refine status %d", st);
+    if (held) {
+        FZ_CHECK(memcmp(R, R0, sizeof R) == 0, "refine_translation wrote R (status %d)", st);
+        if (use_opt && opt.fix_scale)
+            FZ_CHECK(st == MCG_EINVAL, "refine_translation with fix_scale: %d", st);
+    }
     if (st != MCG_OK) {
         FZ_CHECK(memcmp(R, R0, sizeof R) == 0 && memcmp(t, t0, sizeof t) == 0,
                  "refine: R, t modified on error %d", st);
@@ -103,7 +118,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if (st != MCG_OK)
         return 0;
-    FZ_CHECK(fz_is_rotation(R, 1e-9), "refine: R not a rotation (%g)", fz_orth_err3(R));
+    FZ_CHECK(held || fz_is_rotation(R, 1e-9), "refine: R not a rotation (%g)", fz_orth_err3(R));
     FZ_CHECK(fz_all_finite(t, 3), "refine: non-finite t");
     FZ_CHECK(isfinite(res.initial_cost) && isfinite(res.final_cost) && isfinite(res.rms) &&
                  res.final_cost >= 0.0,
