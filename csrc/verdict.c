@@ -391,9 +391,12 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
         tau[i] = nt >= 20.0 * ns ? t[i] : t[i] + shift[i];
     if (!unit(tau, out->t_direction)) {
         int count;
-        const double m = nt > 1e-300 ? nt : 1e-300;
-        for (i = 0; i < 3; ++i)
-            out->t_direction[i] = t[i] / m;
+        /* t itself, made unit by unit()'s rescaling: t / |t| with |t| from
+         * dot3 lost precision where |t|^2 is subnormal (t ~ 1e-160: a
+         * direction of length 1.00001, fuzz finding 23); zero for t = 0 */
+        if (!unit(t, out->t_direction))
+            for (i = 0; i < 3; ++i)
+                out->t_direction[i] = 0.0;
         count_front(n, o1, d1, o2, d2, inlier, R, t, 1, &count);
         out->n_in_front = count;
         return MCG_OK;

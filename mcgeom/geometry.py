@@ -14,6 +14,7 @@ metres, unit directions), a motion ``(R, t)`` is rig2_from_rig1, ``X2 = R X1
 
 from __future__ import annotations
 
+import math
 from typing import Optional
 
 import numpy as np
@@ -47,6 +48,24 @@ def unit_rows(v: np.ndarray) -> np.ndarray:
     # (np.linalg.norm(axis=1, keepdims=True) costs several times this at a
     # few hundred rows)
     return v / np.sqrt(np.einsum("ij,ij->i", v, v))[:, None]
+
+
+def unit_vector(v: np.ndarray) -> Optional[np.ndarray]:
+    """``v / |v|`` for a 3-vector, of unit length to rounding for every finite
+    non-zero ``v`` (None for zero or non-finite): ``v`` is first divided by
+    its largest component, as |v|^2 underflows to a subnormal from |v| ~
+    1e-154 (``np.linalg.norm`` of a 1e-160 vector is 4e-5 off; fuzz
+    finding 23, csrc/verdict.c's unit() does the same)."""
+    v = np.asarray(v, dtype=np.float64).reshape(3)
+    with np.errstate(over="ignore", invalid="ignore"):   # (inf / NaN: None below)
+        s = float(v @ v)
+    if 1e-280 < s < 1e280:   # |v|^2 a normal double: as np.linalg.norm, to the bit
+        return v / math.sqrt(s)
+    m = float(np.max(np.abs(v)))
+    if not (m > 0.0 and math.isfinite(m)):
+        return None
+    w = v / m
+    return w / math.sqrt(float(w @ w))
 
 
 def displacements(R: np.ndarray, t: np.ndarray, centres: np.ndarray) -> np.ndarray:

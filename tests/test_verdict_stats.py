@@ -197,3 +197,26 @@ def test_robust_c_zero_profile_and_inlier_rms():
             assert out["zero_profile"] >= py * (1 - 1e-3) - 1e-6
             assert (out["zero_profile"] < 9.0) == (py < 9.0)
     assert seen > 0, "no problem reached the zero profile's branch"
+
+
+@pytest.mark.parametrize("x", [1e-160, 1.0])
+def test_travel_direction_of_a_tiny_t_is_unit(x):
+    # fuzz finding 23: where the centroid's travel t + R c - c is exactly 0
+    # the direction is t's own, and t / |t| of a t ~ 1e-161 (|t|^2
+    # subnormal) was 1e-5 off unit length, in C and numpy alike. One inlier
+    # at c = (x, 0, 0), t = -(R c - c): exact in both.
+    rig, p, R, _, _ = _problem(5, outliers=0.0)
+    rays = p.rays
+    R = synth.rotation_about([0, 0, 1], 0.5)
+    o1, o2 = rays.origins1.copy(), rays.origins2.copy()
+    o1[0] = o2[0] = (x, 0.0, 0.0)
+    rays = type(rays)(o1, rays.dirs1, o2, rays.dirs2, rays.cam1, rays.cam2)
+    inl = np.zeros(len(rays), bool)
+    inl[0] = True
+    c = np.array([x, 0.0, 0.0])
+    t = -(R[:, 0] * x - c)
+    s = _stats(rays, inl.astype(np.uint8), R, t, 1e-3)
+    py = travel_direction(rays, inl, R, t)
+    for u in (s["t_direction"], py):
+        assert abs(np.linalg.norm(u) - 1.0) < 1e-12
+    assert np.abs(s["t_direction"] - py).max() < 1e-12

@@ -252,6 +252,36 @@ static void test_straight_drive(void)
           "no inlier: nothing counted", (double)s.n_inliers, 0);
 }
 
+/* fuzz finding 23: where the centroid's travel tau = t + R c - c is exactly 0
+ * the direction falls back to t's own; t ~ 1e-161 has |t|^2 subnormal,
+ * and t / sqrt(t.t) was 1e-5 off unit length. One inlier at c = (x, 0, 0)
+ * (so that R c = x R e1 and the shift are exact) and t = -(R c - c). */
+static void test_tiny_travel_direction(void)
+{
+    double R[9], t[3] = {0, 0, 1}, x = 1e-160, shift[3], nd;
+    const double a = 0.5;
+    mcg_verdict_stats_result s;
+    int st, k;
+    double rr[9] = {cos(a), -sin(a), 0, sin(a), cos(a), 0, 0, 0, 1};
+    memcpy(R, rr, sizeof R);
+    scene(R, t, 0);
+    for (k = 0; k < N; ++k)
+        inl[k] = 2; /* used, no inlier */
+    inl[0] = 1;
+    o1[0] = o2[0] = x;
+    o1[1] = o2[1] = o1[2] = o2[2] = 0.0;
+    shift[0] = R[0] * x - x;
+    shift[1] = R[3] * x;
+    shift[2] = R[6] * x;
+    for (k = 0; k < 3; ++k)
+        t[k] = -shift[k];
+    st = mcg_verdict_stats(N, o1, d1, o2, d2, c1, c2, NC, inl, R, t, 1e-3, &s, work, 64);
+    nd = sqrt(s.t_direction[0] * s.t_direction[0] + s.t_direction[1] * s.t_direction[1] +
+              s.t_direction[2] * s.t_direction[2]);
+    check(st == MCG_OK && fabs(nd - 1.0) < 1e-12,
+          "t ~ 1e-161 with tau = 0: t_direction of unit length", fabs(nd - 1.0), 1e-12);
+}
+
 static void test_invalid(void)
 {
     double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t[3] = {0, 0, 1}, keep;
@@ -353,6 +383,7 @@ int main(void)
     test_still_count();
     test_straight_drive();
     test_scaled_directions();
+    test_tiny_travel_direction();
     test_invalid();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed ? 1 : 0;

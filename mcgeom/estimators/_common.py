@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ..geometry import counts_in_front, rcross, unit_rows
+from ..geometry import counts_in_front, rcross, unit_rows, unit_vector
 from ..types import RayPairs
 
 __all__ = ["camera_ids", "intra_counts", "travel_direction", "in_mirrored_minimum",
@@ -99,10 +99,10 @@ def travel_direction(rays: RayPairs, mask: np.ndarray, R: np.ndarray,
     # where |t| dwarfs the rotation-induced shift, t's own direction is the
     # better estimate (the centroid's motion differs from it by that shift)
     tau = t if np.linalg.norm(t) >= 20.0 * np.linalg.norm(shift) else t + shift
-    n = np.linalg.norm(tau)
-    if not n > 0:
-        return t / max(np.linalg.norm(t), 1e-300)
-    u = tau / n
+    u = unit_vector(tau)
+    if u is None:
+        ut = unit_vector(t)
+        return np.zeros(3) if ut is None else ut
     spread = np.sqrt(np.mean(np.sum((o1 - c) ** 2, axis=1))) if any_sel else 1.0
     L = max(1.0, 100.0 * spread, 100.0 * np.linalg.norm(shift))
     plus, minus = counts_in_front(o1, d1, o2, d2, R, -shift, (L * u, -L * u))
