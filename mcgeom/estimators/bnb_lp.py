@@ -49,8 +49,11 @@ Steps:
 7. the initial estimate is kept when its ``f`` equals the optimum within the
    LP precision (noise-free data: both are exact, the smooth one is exact to
    rounding);
-8. the scale verdict from the information of the Sampson cost at the result
-   (as for every estimator).
+8. the scale verdict from the information of the Sampson cost at the
+   least-squares optimum refined from the result, with the deviation of the
+   result's travel from that optimum's added to the relative std
+   (:func:`_scale_rel_std`: the L-infinity optimum scatters wider than the
+   least-squares one; ``info["scale_linf_vs_l2"]``).
 
 The guard's default level (5 robust sigmas: beyond it a Gaussian error has
 probability 6e-7) was chosen on the real recordings: at the 5+1 start the
@@ -371,6 +374,31 @@ def _worst(e: np.ndarray, level: float, budget: int) -> np.ndarray:
     return np.sort(idx)
 
 
+def _scale_rel_std(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> tuple[float, float]:
+    """The relative std of the cameras' travel |t + R c - c| (c their
+    centroid) at the L-infinity motion (R, t), metres, on the correspondences
+    it used: ``(rel_std, deviation)``. The Sampson refinement's first-order
+    std is that of the least-squares optimum; the L-infinity optimum, ruled
+    by the few largest errors, scatters wider (clean synthetic data, a
+    4-camera ring with intra-camera rays at 0.5 px, 30 problems: 9 of the 27
+    called metric were more than 3 of that std off, RMS 2.8 stds). So the
+    refinement is run to the least-squares optimum from (R, t), and the
+    relative deviation of the L-infinity travel from its travel is added in
+    quadrature (on those problems: none more than 3 stds off, RMS 0.96). inf
+    where the refinement fails."""
+    try:
+        fit = refine_centred(rays, R, t)
+    except (ValueError, DegenerateError):
+        return float("inf"), float("inf")
+    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    travel = np.linalg.norm(t + R @ c - c)
+    travel_l2 = np.linalg.norm(fit["t"] + fit["R"] @ c - c)
+    if not (travel_l2 > 0 and np.isfinite(travel)):
+        return float("inf"), float("inf")
+    dev = abs(float(travel / travel_l2) - 1.0)
+    return float(np.hypot(float(fit["scale_rel_std"]), dev)), dev
+
+
 @register(
     "bnb_lp",
     min_sample=_MIN_PAIRS,
@@ -520,11 +548,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
         from_initial = False
     R = _core.project_so3(R)
     cur = sub.take(np.flatnonzero(keep))
-    rel = float("inf")
-    try:
-        rel = float(refine_centred(cur, R, t, max_iterations=0)["scale_rel_std"])
-    except (ValueError, DegenerateError):
-        pass
+    rel, linf_vs_l2 = _scale_rel_std(cur, R, t)
     verdict = scale_verdict(cur, np.ones(len(cur), bool), R, t, rel, max_scale_rel_std,
                             not np.linalg.norm(t) > 0)
     t_metric = np.array(t)
@@ -556,7 +580,7 @@ def bnb_lp(rays: RayPairs, *, initial: InitialLike = None, mask: Any = None,
         "resolution": float(resolution), "n_used": len(cur),
         "groups": int(apex_groups(cur).max()) + 1, "t_metric": t_metric, "domain": "moving",
         "pruned": int(pruned_index.size), "pruned_index": pruned_index,
-        "prune_level": level, "rounds": rounds,
+        "prune_level": level, "rounds": rounds, "scale_linf_vs_l2": linf_vs_l2,
     }
     return RigMotion(R, np.asarray(t, float), verdict, "bnb_lp",
                      float(np.sqrt(np.mean(r ** 2))), mask_out, info)
