@@ -728,21 +728,10 @@ def refine_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R0: Any,
     Raises ValueError on bad input, DegenerateError if nothing constrains the
     motion at the start (e.g. every weight zero).
     """
-    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
-    n = rays[0].shape[0]
-    R = _arr("R0", R0, (3, 3)).copy()  # small: checked here, refined in place
-    t = _arr("t0", t0, (3,)).copy()
-    opt = _refine_options(loss, loss_scale, max_iterations, fix_scale, cost_tolerance,
-                          step_tolerance, initial_lambda, t)
-    w, w_ptr = _weights(weights, n)
-    res = ffi.new("mcg_refine_result *")
-    st = lib.mcg_refine_motion(n, *map(_p, rays), w_ptr, opt, _p(R), _p(t), res)
-    if st != lib.MCG_OK:
-        if st == lib.MCG_EINVAL and _not_rotation(R):
-            raise ValueError("refine_motion: R0 is not a rotation matrix "
-                             "(|R R^T - I| > 1e-6 or det R <= 0)")
-        _ray_error(st, "refine_motion", rays)
-    return _refine_dict(res, R, t)
+    return _refine(lib.mcg_refine_motion, "refine_motion", "R0",
+                   (origins1, dirs1, origins2, dirs2), R0, t0, weights,
+                   (loss, loss_scale, max_iterations, fix_scale, cost_tolerance, step_tolerance,
+                    initial_lambda))
 
 
 def refine_translation(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any, t0: Any,
@@ -758,21 +747,32 @@ def refine_translation(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: 
     whose ``H_tw`` gives the effect of an error of R. Raises ValueError on
     bad input, DegenerateError if no ray constrains t at the start.
     """
-    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 6)
+    return _refine(lib.mcg_refine_translation, "refine_translation", "R",
+                   (origins1, dirs1, origins2, dirs2), R, t0, weights,
+                   (loss, loss_scale, max_iterations, False, cost_tolerance, step_tolerance,
+                    initial_lambda))
+
+
+def _refine(kernel: Any, what: str, r_name: str, ray_args: tuple, R0: Any, t0: Any,
+            weights: Any, options: tuple) -> dict:
+    """One call of ``kernel`` (``mcg_refine_motion`` or ``mcg_refine_translation``,
+    named ``what``; the rotation argument named ``r_name``): the rays, start
+    and :func:`_refine_options` ``options`` checked, the dict of
+    :func:`_refine_dict`."""
+    rays = _ray_arrays(*ray_args, 6)
     n = rays[0].shape[0]
-    Rk = _arr("R", R, (3, 3)).copy()
+    R = _arr(r_name, R0, (3, 3)).copy()  # small: checked here, refined in place
     t = _arr("t0", t0, (3,)).copy()
-    opt = _refine_options(loss, loss_scale, max_iterations, False, cost_tolerance,
-                          step_tolerance, initial_lambda, t)
+    opt = _refine_options(*options, t)
     w, w_ptr = _weights(weights, n)
     res = ffi.new("mcg_refine_result *")
-    st = lib.mcg_refine_translation(n, *map(_p, rays), w_ptr, opt, _p(Rk), _p(t), res)
+    st = kernel(n, *map(_p, rays), w_ptr, opt, _p(R), _p(t), res)
     if st != lib.MCG_OK:
-        if st == lib.MCG_EINVAL and _not_rotation(Rk):
-            raise ValueError("refine_translation: R is not a rotation matrix "
+        if st == lib.MCG_EINVAL and _not_rotation(R):
+            raise ValueError(f"{what}: {r_name} is not a rotation matrix "
                              "(|R R^T - I| > 1e-6 or det R <= 0)")
-        _ray_error(st, "refine_translation", rays)
-    return _refine_dict(res, Rk, t)
+        _ray_error(st, what, rays)
+    return _refine_dict(res, R, t)
 
 
 def _refine_dict(res: Any, R: np.ndarray, t: np.ndarray,
