@@ -62,7 +62,8 @@ def _rotation(rotation: Any) -> np.ndarray:
     needs_rotation=True,
     recovers_scale=True,
     description="translation (metric where observable) for a known rotation: the linear "
-                "generalized epipolar constraint / bilinear relation of thesis ch. 6",
+                "generalized epipolar constraint / bilinear relation of thesis ch. 6, refined "
+                "to its Sampson optimum with R held",
     options={"rotation": "the known rotation R (rig2_from_rig1), required",
              "max_rel_std": "relative std of the travelled distance above which the scale "
                             "is reported unobservable (0.1)",
