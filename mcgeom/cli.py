@@ -1,7 +1,7 @@
 """The mcgeom command: demo (the main job on rendered images), odometry (an
-image sequence to a metric trajectory), batch (many sequences on Dask), methods (the registered estimators),
-bench (timings against references) and experiment (the thesis experiments
-and the real-data evaluations).
+image sequence to a metric trajectory), batch (many sequences on Dask),
+methods (the registered estimators), bench (timings against references) and
+experiment (the thesis experiments and the real-data evaluations).
 
 Printing, files and the progress bar only; the work is done by
 mcgeom.sequence and the modules of mcgeom.experiments, imported when their
