@@ -57,11 +57,13 @@
  * restrict: a clone does not inline its callees, and without it the
  * vectoriser gave up on block_rows' aliasing checks (scalar code). fix_scale
  * keeps |t| = |t0|: t moves on that sphere through a 2-dof tangent basis and
- * the retraction t <- |t0| (t + B u) / |t + B u|.
+ * the retraction t <- |t0| (t + B u) / |t + B u|. mcg_refine_translation
+ * holds R: the steps move t alone, and its std is read from H_tt (the
+ * known-rotation estimator's t: the linear one of thesis ch. 6 is biased).
  *
  * Uncertainty at the solution: the information matrix H = J^T W J (6 x 6,
- * [dw, dt]); sigma2 = sum omega r^2 / (sum omega - p) (p = 6, or 5 with
- * fix_scale); the t-block of H^-1 is the inverse of the Schur complement
+ * [dw, dt]); sigma2 = sum omega r^2 / (sum omega - p) (p = 6, 5 with
+ * fix_scale, 3 with R held); the t-block of H^-1 is the inverse of the Schur complement
  * S = H_tt - H_tw H_ww^-1 H_wt, so var|t| = sigma2 u^T S^-1 u with u = t/|t|.
  *
  * The parts (refine_internal.h: what they share): this file, the
