@@ -63,8 +63,9 @@
  *
  * Uncertainty at the solution: the information matrix H = J^T W J (6 x 6,
  * [dw, dt]); sigma2 = sum omega r^2 / (sum omega - p) (p = 6, 5 with
- * fix_scale, 3 with R held); the t-block of H^-1 is the inverse of the Schur complement
- * S = H_tt - H_tw H_ww^-1 H_wt, so var|t| = sigma2 u^T S^-1 u with u = t/|t|.
+ * fix_scale, 3 with R held); the t-block of H^-1 is the inverse of the
+ * Schur complement S = H_tt - H_tw H_ww^-1 H_wt, so var|t| = sigma2 u^T S^-1 u
+ * with u = t/|t| (R held: S = H_tt).
  *
  * The parts (refine_internal.h: what they share): this file, the
  * Levenberg-Marquardt driver (options, checks, steps, trust region,
