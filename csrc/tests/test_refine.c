@@ -697,8 +697,9 @@ static void test_translation(void)
         }
     }
     gn = norm(g);
-    check(gn <= 1e-6 * sqrt(jn) * sqrt(rn2), "refine_translation: gradient of the reference cost ~ 0",
-          gn, 1e-6 * sqrt(jn) * sqrt(rn2));
+    check(gn <= 1e-6 * sqrt(jn) * sqrt(rn2),
+          "refine_translation: gradient of the reference cost ~ 0", gn,
+          1e-6 * sqrt(jn) * sqrt(rn2));
     for (i = 0; i < 3; i++)
         for (j = 0; j < 3; j++) {
             h[3 * i + j] = 0.0;
