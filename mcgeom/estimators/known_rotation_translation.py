@@ -63,7 +63,7 @@ def _rotation(rotation: Any) -> np.ndarray:
     recovers_scale=True,
     description="translation (metric where observable) for a known rotation: the linear "
                 "generalized epipolar constraint / bilinear relation of thesis ch. 6, refined "
-                "to its Sampson optimum with R held",
+                "to its Sampson optimum with R held (so metric from 6 correspondences on)",
     options={"rotation": "the known rotation R (rig2_from_rig1), required",
              "max_rel_std": "relative std of the travelled distance above which the scale "
                             "is reported unobservable (0.1)",
@@ -74,10 +74,14 @@ def known_rotation_translation(rays: RayPairs, *, rotation: Any = None,
                                max_rel_std: Optional[float] = None,
                                rotation_std: Optional[float] = None) -> RigMotion:
     """Translation t (metres, rig2_from_rig1: X2 = R X1 + t) of a rig motion with
-    known rotation ``rotation`` from >= 3 ray correspondences (rig frame).
+    known rotation ``rotation`` from >= 3 ray correspondences (rig frame): the
+    linear solution of ch. 6 refined to the Sampson optimum with R held
+    (:func:`_known`), metric only from 6 correspondences on (fewer: the unit
+    direction).
 
     Returns a ``RigMotion`` with ``R = rotation``; ``info`` holds the
-    multi-view result (eigenvalues, timing). When the rotation alone explains
+    multi-view result (eigenvalues, timing), the linear solution
+    (``t_linear``) and the refinement's summary. When the rotation alone explains
     the intra-camera correspondences (a static rig or a pure rotation, the
     shared test of :mod:`mcgeom.estimators._static`) ``t = 0`` with the
     verdict "no translation detected". ``rotation_std`` (radians per axis,
