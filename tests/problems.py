@@ -104,10 +104,11 @@ def assert_unconfirmed_partial_fit(partial, full, samples: int, sample_size: int
     assert np.linalg.norm(partial.info["t_metric"]) > 0.0
 
 
-def ring_intra_problem(rng: np.random.Generator, n: int = 300):
+def ring_intra_problem(rng: np.random.Generator, n: int = 300, outliers: float = 0.0):
     """Intra-camera rays of a 4-camera ring (radius 0.25 m, cameras looking
     out) turning 3-17 deg and travelling 1 m, bearings with 1e-3 rad noise
-    (0.5 px at f = 500 px); points 2-20 m away."""
+    (0.5 px at f = 500 px); points 2-20 m away; ``outliers`` of them with a
+    random time-2 bearing."""
     R = synth.random_rotation(rng, 0.3)
     while np.degrees(np.arccos((np.trace(R) - 1) / 2)) < 3:
         R = synth.random_rotation(rng, 0.3)
@@ -124,4 +125,7 @@ def ring_intra_problem(rng: np.random.Generator, n: int = 300):
     d2 /= np.linalg.norm(d2, axis=1, keepdims=True)
     d1 = d + rng.normal(scale=1e-3, size=(n, 3))
     d2 = d2 + rng.normal(scale=1e-3, size=(n, 3))
+    if outliers > 0:   # (drawn last: the problems without outliers stay the same)
+        bad = rng.random(n) < outliers
+        d2[bad] = rng.normal(size=(int(bad.sum()), 3))
     return RayPairs(o, d1, o.copy(), d2, cam, cam), R, t

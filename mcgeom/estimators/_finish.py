@@ -19,6 +19,7 @@ from ..observability import scale_profile, scale_verdict
 from ._static import check_static
 from ..types import RayPairs, RigMotion
 from ._common import travel_direction
+from ._outliers import guard_verdict
 
 __all__ = ["refine_and_report"]
 
@@ -77,6 +78,10 @@ def refine_and_report(rays: RayPairs, starts: list, method: str,
             rel = float("inf")
     everything = np.ones(len(rays), bool)
     verdict = scale_verdict(rays, everything, R, t, rel, max_scale_rel_std, fixed)
+    # every correspondence was taken as an inlier: a fit pulled by gross
+    # outliers is no metric estimate (mcgeom.estimators._outliers)
+    verdict, info["outlier_move_stds"] = guard_verdict(rays, R, t, verdict, method,
+                                                       max_scale_rel_std)
     info["t_metric"] = np.array(t)
     if not verdict.observable:
         nt = np.linalg.norm(t)

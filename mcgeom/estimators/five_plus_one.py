@@ -38,6 +38,7 @@ from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
 from ..validation import integral_camera_ids
 from ._common import camera_ids, in_mirrored_minimum, intra_counts, travel_direction
+from ._outliers import guard_verdict
 from ._static import with_static_check
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
 from .five_plus_one_minimal import (PRIMARY_RULE, critical_angles, exact_candidates,
@@ -334,15 +335,21 @@ def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
     # the first-order std, which says whether a metric estimate exists at all
     verdict = scale_verdict(rays, np.ones(len(rays), bool), R, t, rel, max_scale_rel_std,
                             fixed, profile=info.get("scale_profile", float("nan")))
+    # every correspondence was taken as an inlier: a fit pulled by gross
+    # outliers is no metric estimate (mcgeom.estimators._outliers)
+    observable = verdict.observable
+    verdict, info["outlier_move_stds"] = guard_verdict(rays, R, t, verdict, "five_plus_one",
+                                                       max_scale_rel_std)
+    pulled = observable and not verdict.observable
     info["t_metric"] = np.array(t)   # metric estimate, whatever the verdict
     # t is the maximum-likelihood metric estimate wherever the data define a
     # scale at all (the verdict says how far to trust it), a unit direction
     # where they do not (mcgeom.observability.scale_determined)
     zero = float("nan")
-    if not verdict.observable and out is not None and len(rays) > 6 and \
+    if not verdict.observable and out is not None and len(rays) > 6 and not pulled and \
             scale_determined(rel, fixed):
         zero = scale_profile(rays, R, t, out["final_cost"], out["sigma2"], (ZERO_FACTOR,))
-    info["scale_determined"] = scale_determined(rel, fixed, zero)
+    info["scale_determined"] = scale_determined(rel, fixed, zero) and not pulled
     if not verdict.observable:
         info["t_direction"] = travel_direction(rays, np.ones(len(rays), bool), R, t)
         if in_mirrored_minimum(info["t_direction"], t):

@@ -28,6 +28,7 @@ from ..errors import DegenerateError
 from ..observability import critical_angle
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
+from ._outliers import guard_verdict
 from ._static import with_static_check
 
 __all__ = ["known_rotation_translation", "solve", "DEFAULT_ROTATION_STD"]
@@ -184,12 +185,17 @@ def _known(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float],
                       + ("" if rot_std == 0 else " with the rotation's error"))
         rel = rel_all
     t_metric = np.array(t, float)
-    if not observable and np.linalg.norm(t) > 0:
-        t = t / np.linalg.norm(t)  # the direction only
     verdict = ScaleVerdict(observable, reason, v.conditioning, rel,
                            critical_angle(rays, R, t))
+    # every correspondence was taken as an inlier: a fit pulled by gross
+    # outliers is no metric estimate (mcgeom.estimators._outliers; R held)
+    verdict, moved = guard_verdict(rays, R, t, verdict, "known_rotation_translation", limit,
+                                   hold_rotation=True)
+    observable = verdict.observable
+    if not observable and np.linalg.norm(t) > 0:
+        t = t / np.linalg.norm(t)  # the direction only
     info = {"eigenvalues": res.eigenvalues, "converged": res.converged, "timing": res.timing,
-            "metric": observable, "t_linear": t_lin,
+            "metric": observable, "t_linear": t_lin, "outlier_move_stds": moved,
             "refinement": None if ref is None else
             {k: ref[k] for k in ("iterations", "reason", "rms", "sigma2", "scale_rel_std")}}
     info["t_metric"] = t_metric   # metric estimate, whatever the verdict

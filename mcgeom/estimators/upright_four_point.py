@@ -35,7 +35,7 @@ gravity vectors in the rig frames at times 1 and 2 (any non-zero length),
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 
