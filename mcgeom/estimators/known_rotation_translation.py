@@ -140,7 +140,7 @@ def _known(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float],
 
     The linear solution of ch. 6 minimises an algebraic error, and that pulls
     |t| short wherever the scale rests on the small offset terms of the
-    constraint: on a 4-camera ring (radius 0.25 m) turning 5-15 deg, intra-
+    constraint: on a 4-camera ring (radius 0.25 m) turning 3-17 deg, intra-
     camera rays at 0.5 px, |t| came out 6-51 % short (mean 23 %) with a
     relative std of 2-6 %, more than 3 of its stds off in 39 of 40 problems.
     So it is only the start of a Sampson refinement of t with R held
