@@ -388,20 +388,7 @@ static void finish_jacobi(size_t nn, double *w, double *vt, double *s,
         double a2 = dot(w + k * nn, w + k * nn, nn);
         s[k] = (a2 < dead2) ? 0.0 : sqrt(a2);
     }
-    /* selection sort: O(nn^2) comparisons, nn row swaps, no index array */
-    for (k = 0; k + 1 < nn; ++k) {
-        size_t best = k;
-        for (l = k + 1; l < nn; ++l)
-            if (s[l] > s[best])
-                best = l;
-        if (best != k) {
-            double t = s[k];
-            s[k] = s[best];
-            s[best] = t;
-            swap_rows(w + k * nn, w + best * nn, nn);
-            swap_rows(vt + k * nn, vt + best * nn, nn);
-        }
-    }
+    sort_with_rows(nn, s, 1, w, vt); /* singular values descending */
     nz = 0;
     for (k = 0; k < nn; ++k) {
         if (s[k] > 0.0) {

@@ -155,26 +155,6 @@ static int jacobi_sweeps(size_t nn, double *a, double *v)
     return 0;
 }
 
-/* Eigenvalues w (nn) in ascending order, the rows of the nn x nn rows (their
- * eigenvectors) moved along: a selection sort, nn row swaps at most, as
- * both eigen-solvers finish. */
-static void sort_ascending(size_t nn, double *w, double *rows)
-{
-    size_t i, j;
-    for (i = 0; i + 1 < nn; ++i) {
-        size_t best = i;
-        for (j = i + 1; j < nn; ++j)
-            if (w[j] < w[best])
-                best = j;
-        if (best != i) {
-            double t = w[i];
-            w[i] = w[best];
-            w[best] = t;
-            swap_rows(rows + i * nn, rows + best * nn, nn);
-        }
-    }
-}
-
 /* The argument checks of both eigen-solvers: 1 <= n <= max_n, no NULL, a
  * and v distinct, a finite. */
 static int eig_args_ok(int n, size_t max_n, const double *a, const double *w, const double *v)
@@ -207,7 +187,7 @@ int mcg_sym_eig(int n, double *a, double *w, double *v)
 
     for (i = 0; i < nn; ++i)
         w[i] = a[i * nn + i];
-    sort_ascending(nn, w, v); /* (v's rows are the eigenvectors here) */
+    sort_with_rows(nn, w, 0, v, NULL); /* (v's rows are the eigenvectors here) */
     f2 = pow2_or_zero(e);
     for (i = 0; i < nn; ++i) {
         w[i] = mul_pow2(w[i], e, f2);
@@ -380,7 +360,7 @@ int mcg_sym_eig_tridiag(int n, double *a, double *w, double *v)
             a[j * nn + i] = v[i * nn + j];
     if (!tridiagonal_qr(nn, w, e, a))
         return MCG_ENUMERIC;
-    sort_ascending(nn, w, a); /* (a's rows are the eigenvectors) */
+    sort_with_rows(nn, w, 0, a, NULL); /* (a's rows are the eigenvectors) */
     for (i = 0; i < nn; ++i)
         for (j = 0; j < nn; ++j)
             v[j * nn + i] = a[i * nn + j];

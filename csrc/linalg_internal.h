@@ -53,4 +53,28 @@ static inline void swap_rows(double *x, double *y, size_t n)
     }
 }
 
+/* Selection sort of the nn keys, ascending (descending = 0) or descending,
+ * the rows (nn doubles each) of a and, unless NULL, of b moved with them:
+ * O(nn^2) comparisons, at most nn - 1 swaps, no index array. The SVD
+ * (descending singular values, rows of w and vt) and the eigen-solvers
+ * (ascending eigenvalues, rows of v) both finish with it. */
+static inline void sort_with_rows(size_t nn, double *key, int descending, double *a, double *b)
+{
+    size_t i, j;
+    for (i = 0; i + 1 < nn; ++i) {
+        size_t best = i;
+        for (j = i + 1; j < nn; ++j)
+            if (descending ? key[j] > key[best] : key[j] < key[best])
+                best = j;
+        if (best != i) {
+            double t = key[i];
+            key[i] = key[best];
+            key[best] = t;
+            swap_rows(a + i * nn, a + best * nn, nn);
+            if (b)
+                swap_rows(b + i * nn, b + best * nn, nn);
+        }
+    }
+}
+
 #endif /* MCGEOM_LINALG_INTERNAL_H */

@@ -712,8 +712,7 @@ static int refine_run(int n, const double *o1, const double *d1, const double *o
     st = final_statistics(&cur, tv, pdim, &lm, res);
     if (st != MCG_OK)
         return st;
-    if (!t_only)
-        memcpy(R, r, sizeof r);
+    memcpy(R, r, sizeof r); /* (held: r is R projected, and R a copy) */
     memcpy(t, tv, sizeof tv);
     return MCG_OK;
 }
@@ -734,8 +733,8 @@ int mcg_refine_motion(int n, const double *o1, const double *d1,
     return refine_run(n, o1, d1, o2, d2, weights, opt, 0, -HUGE_VAL, R, t, res);
 }
 
-/* R held: the driver works on a copy of it (it writes R only where it moves
- * it) */
+/* R held: the driver works on a copy of it (R is const; the driver writes
+ * its projection onto SO(3) back into the copy) */
 int mcg_refine_translation(int n, const double *o1, const double *d1, const double *o2,
                            const double *d2, const double *weights,
                            const mcg_refine_options *opt, const double R[9], double t[3],

@@ -153,6 +153,20 @@ def _rotation_angles(d1: np.ndarray, d2: np.ndarray, R: np.ndarray) -> np.ndarra
     return np.arctan2(np.linalg.norm(rcross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
 
 
+def origin_centroid(rays: RayPairs) -> np.ndarray:
+    """The centroid of the ray origins at both times (metres, rig frame): the
+    point whose travel ``t + R c - c`` the scale verdicts judge (it does not
+    depend on where the user put the rig origin)."""
+    return 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+
+
+def centroid_travel(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
+    """Length of the travel of the origins' centroid c under rig2_from_rig1
+    ``(R, t)``, ``|t + R c - c|`` (metres)."""
+    c = origin_centroid(rays)
+    return float(np.linalg.norm(t + R @ c - c))
+
+
 def refine_centred(rays: RayPairs, R: np.ndarray, t: np.ndarray, **options) -> dict:
     """``_core.refine_motion`` run in a frame centred on the cameras' centroid.
 
@@ -164,7 +178,7 @@ def refine_centred(rays: RayPairs, R: np.ndarray, t: np.ndarray, **options) -> d
     ``options`` are those of ``_core.refine_motion`` (loss, loss_scale in
     radians, weights, fix_scale, iteration and tolerance settings).
     """
-    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    c = origin_centroid(rays)
     R = np.asarray(R, dtype=np.float64)
     # a pure shift of the origins (directions unchanged): the arithmetic of
     # ``rays.in_frame(I, -c)`` without building and re-validating a RayPairs

@@ -30,8 +30,8 @@ from typing import Optional
 import numpy as np
 
 from . import _core
-from .geometry import (count_in_front, displacements, rcross, refine_centred, rotation_fit,
-                       same_camera)
+from .geometry import (count_in_front, displacements, origin_centroid, rcross, refine_centred,
+                       rotation_fit, same_camera)
 from .types import RayPairs, ScaleVerdict
 
 __all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
@@ -141,7 +141,7 @@ def scale_profile(rays: RayPairs, R: np.ndarray, t: np.ndarray, cost: float, sig
     if not (np.isfinite(sigma2) and sigma2 > 0):
         return 0.0
     worst = np.inf
-    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
+    c = origin_centroid(rays)
     shift = np.asarray(R) @ c - c
     for f in factors:
         try:

@@ -46,7 +46,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
-from ..geometry import refine_centred
+from ..geometry import centroid_travel, refine_centred
 from ..types import RayPairs, ScaleVerdict
 
 __all__ = ["OUTLIER_MOVE_STDS", "travel_moved", "guard_verdict"]
@@ -85,9 +85,8 @@ def travel_moved(rays: RayPairs, R: np.ndarray, t: np.ndarray, rel_std: float,
             fit = refine_centred(rays, R, t, loss="cauchy", loss_scale=s)
     except (ValueError, DegenerateError):
         return float("nan")
-    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
-    before = float(np.linalg.norm(t + R @ c - c))
-    after = float(np.linalg.norm(fit["t"] + fit["R"] @ c - c))
+    before = centroid_travel(rays, R, t)
+    after = centroid_travel(rays, fit["R"], fit["t"])
     if not before > 0:
         return 0.0
     return abs(after / before - 1.0) / rel_std

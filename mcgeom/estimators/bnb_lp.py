@@ -81,7 +81,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError, NumericalError
-from ..geometry import refine_centred
+from ..geometry import centroid_travel, refine_centred
 from ..observability import scale_verdict
 from ..registry import get, register, resolve_lp_backend
 from ..types import RayPairs, RigMotion, ScaleVerdict
@@ -390,12 +390,11 @@ def _scale_rel_std(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> tuple[float,
         fit = refine_centred(rays, R, t)
     except (ValueError, DegenerateError):
         return float("inf"), float("inf")
-    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
-    travel = np.linalg.norm(t + R @ c - c)
-    travel_l2 = np.linalg.norm(fit["t"] + fit["R"] @ c - c)
+    travel = centroid_travel(rays, R, t)
+    travel_l2 = centroid_travel(rays, fit["R"], fit["t"])
     if not (travel_l2 > 0 and np.isfinite(travel)):
         return float("inf"), float("inf")
-    dev = abs(float(travel / travel_l2) - 1.0)
+    dev = abs(travel / travel_l2 - 1.0)
     return float(np.hypot(float(fit["scale_rel_std"]), dev)), dev
 
 

@@ -37,7 +37,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError, InfeasibleError
-from ..geometry import rcross, refine_centred, unit_rows
+from ..geometry import centroid_travel, rcross, refine_centred, unit_rows
 from ..observability import scale_verdict
 from ..registry import register
 from ..types import RayPairs, RigMotion
@@ -334,7 +334,6 @@ def _scale_evidence(used: RayPairs, R: np.ndarray, t: np.ndarray,
     except (ValueError, DegenerateError):
         return float("inf"), float("nan")
     rel = float(ls["scale_rel_std"])
-    c = 0.5 * (used.origins1.mean(axis=0) + used.origins2.mean(axis=0))
-    tau = np.linalg.norm(t + R @ c - c)
-    tau_ls = np.linalg.norm(ls["t"] + ls["R"] @ c - c)
+    tau = centroid_travel(used, R, t)
+    tau_ls = centroid_travel(used, ls["R"], ls["t"])
     return rel, (tau / tau_ls if tau_ls > 0 else float("inf"))

@@ -26,6 +26,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import DegenerateError
+from ..geometry import centroid_travel
 from ..registry import register
 from ..types import RayPairs, RigMotion
 from ..validation import check_rotation
@@ -75,12 +76,6 @@ def _default_starts(rays: RayPairs) -> list[np.ndarray]:
     return starts
 
 
-def _travel(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
-    """Length of the travel of the origins' centroid c, |t + R c - c| (metres)."""
-    c = 0.5 * (rays.origins1.mean(axis=0) + rays.origins2.mean(axis=0))
-    return float(np.linalg.norm(t + R @ c - c))
-
-
 def _solve(rays: RayPairs, rotation_start: Any, max_iterations: int) -> dict:
     """The eigensolver from ``rotation_start`` (None: linear17's rotation)."""
     R0 = _start(rays, rotation_start)
@@ -92,8 +87,8 @@ def _solve(rays: RayPairs, rotation_start: Any, max_iterations: int) -> dict:
         # result whose centroid hardly travels, from a start that clearly did,
         # is that trivial solution, not the motion: keep the start.
         r0 = _core.eigensolver(*args, R0, 0)
-        if r0["has_scale"] and _travel(rays, r["R"], r["t"]) < 1e-2 * _travel(rays, r0["R"],
-                                                                               r0["t"]):
+        if r0["has_scale"] and (centroid_travel(rays, r["R"], r["t"])
+                                < 1e-2 * centroid_travel(rays, r0["R"], r0["t"])):
             r0["trivial_avoided"] = True
             return r0
     return r
