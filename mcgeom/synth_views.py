@@ -12,9 +12,11 @@ from typing import Optional
 
 import numpy as np
 
-from .synth import RngLike, as_rng, perturb_directions, random_rotation
+from .rig import Rig
+from .synth import RngLike, as_rng, perturb_directions, random_rotation, rotation_about
 
-__all__ = ["ViewSequence", "circle_sequence", "similarity_align", "spiral_measure"]
+__all__ = ["ViewSequence", "circle_sequence", "rig_drive_sequence", "similarity_align",
+           "spiral_measure"]
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,47 @@ def circle_sequence(n_views: int = 101, n_points: int = 1000, radius: float = 10
     if sigma > 0:
         bearings = perturb_directions(bearings, sigma, gen)
     return ViewSequence(centres, rotations, points, track, view, bearings, origins)
+
+
+def rig_drive_sequence(rig: Rig, yaws_deg, step: float = 1.0, n_points: int = 1500,
+                       sigma_px: float = 0.5, rng: RngLike = None) -> ViewSequence:
+    """A rig driving forward on the ground plane: ``step`` metres per frame
+    along its x axis (z up), turning by ``yaws_deg[k]`` degrees during step k
+    (the step is the chord of the turn), through ``n_points`` random points
+    25 m around the path, between 4 m below and 6 m above it and at least 3 m
+    from it. Each camera of ``rig`` that sees a point makes it a track of its
+    own (intra-camera tracks only: without overlap, the critical case of
+    thesis ch. 7.3.2 when the rig does not turn), its pixels perturbed by
+    ``sigma_px`` (Gaussian per coordinate). Bearings and ``origins`` are in
+    the rig frame (view frame), ``rotations`` view_from_world, ``centres``
+    world (frame 0 at the origin), metres."""
+    gen = as_rng(rng)
+    R, c, yaw = [np.eye(3)], [np.zeros(3)], 0.0
+    for dy in yaws_deg:
+        mid = np.radians(yaw + 0.5 * dy)
+        yaw += float(dy)
+        c.append(c[-1] + step * np.array([np.cos(mid), np.sin(mid), 0.0]))
+        R.append(rotation_about((0.0, 0.0, 1.0), np.radians(yaw)))    # world_from_rig
+    R, c = np.array(R), np.array(c)
+    lo, hi = c.min(axis=0) - 25.0, c.max(axis=0) + 25.0
+    pts = gen.uniform([lo[0], lo[1], -4.0], [hi[0], hi[1], 6.0], size=(4 * n_points, 3))
+    near = np.min(np.linalg.norm(pts[:, None, :2] - c[None, :, :2], axis=2), axis=1)
+    pts = pts[near > 3.0][:n_points]
+    n_cams = len(rig.cameras)
+    track, view, bearings, origins = [], [], [], []
+    for k in range(len(c)):
+        x_rig = (pts - c[k]) @ R[k]                      # R^T (X - c), row-wise
+        for i in range(n_cams):
+            px, vis = rig.project(i, x_rig)
+            idx = np.flatnonzero(vis)
+            noisy = px[idx] + sigma_px * gen.standard_normal((len(idx), 2))
+            o, d = rig.rays(np.full(len(idx), i), noisy)
+            track.append(n_cams * idx + i)
+            view.append(np.full(len(idx), k))
+            bearings.append(d)
+            origins.append(o)
+    return ViewSequence(c, np.transpose(R, (0, 2, 1)), pts, np.concatenate(track),
+                        np.concatenate(view), np.concatenate(bearings), np.concatenate(origins))
 
 
 def similarity_align(est: np.ndarray, true: np.ndarray) -> tuple[np.ndarray, float]:

@@ -211,11 +211,15 @@ def _known(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float],
 
 
 def _solve(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float]):
-    """The two-view case of :func:`mcgeom.multiview.translations_from_tracks`."""
+    """The two-view case of :func:`mcgeom.multiview.translations_from_tracks`,
+    without its bundle adjustment: the estimator refines the linear t itself
+    (``_core.refine_translation``: the Sampson optimum of the two views, which
+    needs no points)."""
     n = len(rays)
     k = np.arange(n)
     return multiview.translations_from_tracks(
         np.r_[k, k], np.r_[np.zeros(n, np.int64), np.ones(n, np.int64)],
         np.vstack([rays.dirs1, rays.dirs2]), np.stack([np.eye(3), R]),
         origins=np.vstack([rays.origins1, rays.origins2]), relation="bilinear",
-        solver="constrained", max_rel_std=0.1 if max_rel_std is None else float(max_rel_std))
+        solver="constrained", max_rel_std=0.1 if max_rel_std is None else float(max_rel_std),
+        refine=False)

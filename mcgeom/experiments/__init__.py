@@ -23,6 +23,9 @@ __all__ = ["EXPERIMENTS", "load"]
 EXPERIMENTS: dict[str, tuple[str, str]] = {
     "ch6": ("ch6", "thesis ch. 6.5.1: known-rotation translations of 101 views on a "
                    "circle, bilinear/trilinear x plain/constrained"),
+    "ch6_rig_scale": ("ch6_rig_scale", "thesis ch. 6 with a rig's offsets: is the metric scale "
+                                       "of the algebraic solution and of its bundle adjustment "
+                                       "within its std? (4-camera ring, no overlap)"),
     "ch7": ("ch7", "thesis ch. 7.5.2: scale observability of the 8-camera vehicle rig"),
     "ch8": ("ch8", "thesis ch. 8.5.1: linear17 next to PoseLib on three rigs (needs poselib)"),
     "ch9": ("ch9", "thesis ch. 10.5.1 set-up: E+SOCP next to linear17 and five_plus_one"),
