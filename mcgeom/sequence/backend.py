@@ -33,26 +33,30 @@
    tracks' relative lengths); a step is never chained with a unit-length or
    guessed ``t``.
 
-Why ``metric_from="steps"`` and ``window=2`` by default (measured):
+Why ``metric_from="steps"`` and ``window=2`` by default (measured). The
+tracks' metric centres come from the bundle adjustment of
+:mod:`mcgeom.multiview_refine` (their algebraic least squares came out short
+and over-confident; the figures in brackets are theirs, before it):
 
 * KITTI-00 frames 13-76 (stereo, every step observable; ``mcgeom experiment
   odometry_kitti00``): ATE after SE(3) alignment / scale drift: tracks,
-  window 2: 0.227 m / -1.00 %; window 3: 0.234 m / -1.05 %; window 4:
-  0.251 m / -1.14 %; steps, window 2: 0.246 m / -1.10 % (true path 59.5 m;
-  naive chaining of the steps: 0.246 m). Windows beyond 2 only add
-  long-baseline relations with noisier coefficients (as ch6_kitti found for
-  "all"); the two metrics nearly tie.
-* The rendered loop of ``mcgeom demo`` (every step observable): with the
-  segment's shape from the ch. 6 solve the turns bent (steps of 0.38-0.71 m
-  against 0.93 m true; ATE 0.62 m); with the observed steps' own two-frame
-  motions, ATE 0.024 m (0.03 % of 82 m).
+  window 2, 3 or 4: 0.219 m / -0.95 % (0.227-0.251 m / -1.00 to -1.14 %);
+  steps, window 2: 0.247 m / -1.10 % (true path 59.5 m; naive chaining of
+  the steps: 0.246 m). The windows only change the algebraic start.
+* The rendered loop of ``mcgeom demo`` (every step observable): tracks ATE
+  0.027 m, RPE 0.002 m per step, back end 31.5 s (0.62 m: the turns bent);
+  steps ATE 0.024 m, RPE 0.005 m, back end 5.1 s. With every step observed,
+  "steps" skips the bundle adjustment (its lengths are not used).
 * Synthetic 4-camera ring without overlap, straight - 3 turns of 15 deg -
-  straight (tests/test_backend.py): the straight steps carried with the
-  metric from "tracks" come out 6.7 % short (only the turns weakly fix the
-  offsets' scale in the algebraic least squares, which is biased); from
-  "steps" within 4 %. On a near-critical straight stretch the "tracks"
-  system even reports a metric scale with a wrong sign (its verdict is
-  over-confident there), which the two-frame verdicts do not.
+  straight (tests/test_backend.py, 6 seeds): the straight steps carried
+  with the metric from "tracks" are within 0.3-0.6 % of the truth (5.4-6.8 %
+  short), from "steps" within 0.2-0.5 %; one turn of 20 deg among straight
+  steps: within 0.8 % both. On a near-critical straight stretch the algebraic
+  "tracks" system reported a metric scale with a wrong sign; the two-frame
+  verdicts and the bundle adjustment's do not.
+
+So "tracks" is as accurate but costs a bundle adjustment of every segment;
+"steps" keeps the robust two-frame motions where they are metric.
 """
 
 from __future__ import annotations
@@ -320,10 +324,18 @@ def _solve_segment(track: np.ndarray, view: np.ndarray, origins: np.ndarray,
     docstring, steps 3 and 4)."""
     # view_from_world of the ch. 6 convention = R_world_rig^T
     rotations = np.transpose(Rloc[a:b + 2], (0, 2, 1))
+    # the bundle adjustment behind a metric verdict of the tracks (the
+    # algebraic one is over-confident, mcgeom.multiview_refine) only where
+    # the result is used: the tracks' metric, or the lengths of steps that
+    # have none of their own (on the rendered demo loop, every step
+    # observed, it cost 22 s of a 26 s back end for the same trajectory)
+    refine = metric_from == "tracks" or not all(observed)
     r = translations_from_tracks(track, view, bearings, rotations, origins=origins,
                                  relation="trilinear", solver="constrained", pairs="window",
-                                 window=window)
-    info = {"tracks_verdict": r.scale, "residual_rms": r.residual_rms,
+                                 window=window, refine=refine)
+    # (without the bundle adjustment the tracks' own verdict is the algebraic
+    # one, over-confident: not reported)
+    info = {"tracks_verdict": r.scale if refine else None, "residual_rms": r.residual_rms,
             "unconnected_views": r.unconnected_views}
     c = r.centres - r.centres[0]
     if not np.all(np.isfinite(c)):
