@@ -493,10 +493,16 @@ def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max
     rel, s_alg = travel
     summary = None
     if refiner is not None:
-        fit = refiner(c)
+        try:
+            fit = refiner(c)
+        except ValueError as exc:   # too long tracks for its memory guard
+            return (ScaleVerdict(False, f"metric centres not verified: {exc} (refine=False "
+                                 "gives the algebraic ones, whose std is over-confident)",
+                                 conditioning=cond, rel_std=float("inf")), c_hom, False, None)
         if fit is None:
-            return (ScaleVerdict(False, "the bundle adjustment of the centres found too few "
-                                 "observations to estimate the noise: scale not observable",
+            return (ScaleVerdict(False, "the bundle adjustment of the centres has no "
+                                 "redundancy left to estimate the noise from, or a singular "
+                                 "information: scale not observable",
                                  conditioning=cond, rel_std=float("inf")), c_hom, False, None)
         c = fit.centres[1:].reshape(-1)
         travel = _travel_std(lap, fit.first, fit.ptr, c + shift, fit.sigma2,

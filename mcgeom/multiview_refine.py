@@ -47,13 +47,22 @@ from .errors import NumericalError
 
 __all__ = ["CentresFit", "refine_centres", "covisible_profile", "MAX_TRACK_PAIRS"]
 
-#: pairs of (track, view) entries of one track (ordered, the Schur complement's
-#: terms) at most, over all tracks: a memory guard
-MAX_TRACK_PAIRS = 20_000_000
+#: pairs of (track, view) entries of one track (the Schur complement's terms,
+#: 8 bytes each) at most, over all tracks: a memory guard
+MAX_TRACK_PAIRS = 50_000_000
+
+#: pairs whose 3 x 3 terms are formed at a time (~100 MB of temporaries)
+PAIR_CHUNK = 1 << 19
 
 #: a track's rays are parallel (no parallax) when the smallest eigenvalue of
 #: sum (I - x x^T) is below this fraction of its largest (two rays ~0.001 deg apart)
 PARALLEL_EIG = 1e-10
+
+#: a point's 3 x 3 information gets this fraction of its trace on the
+#: diagonal before it is inverted: a point whose rays became parallel during
+#: the iterations (depth unconstrained) then moves only where its rays say,
+#: and its block stays invertible; 1e-12 changes no well-conditioned point
+POINT_RIDGE = 1e-12
 
 #: relative decrease of the cost below which the iterations stop
 COST_TOL = 1e-12
@@ -107,22 +116,22 @@ def _sum_by(index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
     return out.reshape((size,) + values.shape[1:])
 
 
-def _pairs_within(group: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All ordered pairs (i, j), i = j included, of entries with the same ``group``."""
-    order = np.argsort(group, kind="stable")
-    g = group[order]
-    starts = np.flatnonzero(np.r_[True, g[1:] != g[:-1]])
-    lengths = np.diff(np.r_[starts, len(order)])
-    total = int(np.sum(lengths.astype(np.int64) ** 2))
+def _lower_pairs(group: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (i, j) of entries of one group (``group`` sorted), i at or
+    after j: the lower triangle of each group's block, the diagonal included
+    (int32 indices)."""
+    starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
+    lengths = np.diff(np.r_[starts, len(group)])
+    total = int(np.sum(lengths.astype(np.int64) * (lengths + 1) // 2))
     if total > MAX_TRACK_PAIRS:
         raise ValueError(f"the tracks give {total} pairs of views (more than "
                          f"{MAX_TRACK_PAIRS}) for the bundle adjustment: split long tracks")
     a, b = [], []
     for length in np.unique(lengths):
-        s = starts[lengths == length]
-        i, j = np.divmod(np.arange(length * length), length)
-        a.append(order[s[:, None] + i[None, :]].reshape(-1))
-        b.append(order[s[:, None] + j[None, :]].reshape(-1))
+        i, j = np.tril_indices(int(length))
+        s = starts[lengths == length].astype(np.int32)
+        a.append((s[:, None] + i[None, :].astype(np.int32)).reshape(-1))
+        b.append((s[:, None] + j[None, :].astype(np.int32)).reshape(-1))
     return np.concatenate(a), np.concatenate(b)
 
 
@@ -159,18 +168,17 @@ class _Structure:
         self.n_entries = len(ukey)
         self.e_track, e_view = ukey // ms, ukey % ms
         self.e_unknown = e_view - 1          # -1: the gauge view
-        e1, e2 = _pairs_within(self.e_track)
-        u1, u2 = self.e_unknown[e1], self.e_unknown[e2]
-        lower = (u1 >= 0) & (u2 >= 0) & (u1 >= u2)
-        self.e1, self.e2 = e1[lower], e2[lower]
-        rows = 3 * u1[lower][:, None, None] + np.arange(3)[None, :, None]
-        cols = 3 * u2[lower][:, None, None] + np.arange(3)[None, None, :]
-        rows, cols = np.broadcast_arrays(rows, cols)
-        self.in_env = rows >= cols
-        r, c = rows[self.in_env], cols[self.in_env]
-        if np.any(c < first[r]):
+        # (the entries are sorted by track, then view: a pair's first entry
+        # is the later view, so its block lies in the lower envelope)
+        e1, e2 = _lower_pairs(self.e_track)
+        free = (self.e_unknown[e1] >= 0) & (self.e_unknown[e2] >= 0)
+        self.e1, self.e2 = e1[free], e2[free]
+        u = 3 * np.arange(ms - 1)
+        # env index of entry (3 u1 + a, 3 u2 + b): row_base[u1, a] + 3 u2 + b
+        self.row_base = np.stack([ptr[u + a] - first[u + a] for a in range(3)], axis=1)
+        low = 3 * self.e_unknown[self.e2]
+        if np.any(low < first[3 * self.e_unknown[self.e1]]):
             raise ValueError("the skyline profile misses a pair of views that share a track")
-        self.env_idx = ptr[r] + c - first[r]
         self.env = int(ptr[-1])
 
     def residuals(self, c: np.ndarray, X: np.ndarray):
@@ -194,10 +202,25 @@ class _Structure:
         """The Schur complement S = U - W V^-1 W^T (envelope) and its right-hand
         side, with the Marquardt damping mu (diagonals times 1 + mu), and V^-1."""
         Vd = V * (1.0 + mu * np.eye(3))[None] if mu else V
-        Vinv = np.linalg.inv(Vd)
+        Vinv = np.linalg.inv(Vd + POINT_RIDGE * np.trace(V, axis1=1, axis2=2)[:, None, None]
+                             * np.eye(3)[None])
         Q = M @ Vinv[self.e_track]                                  # M_e V_p^-1
-        S = np.bincount(self.env_idx, minlength=self.env,
-                        weights=-(Q[self.e1] @ M[self.e2])[self.in_env])
+        S = np.zeros(self.env)
+        for k in range(0, len(self.e1), PAIR_CHUNK):
+            e1, e2 = self.e1[k:k + PAIR_CHUNK], self.e2[k:k + PAIR_CHUNK]
+            blk = -(Q[e1] @ M[e2])
+            u1, u2 = self.e_unknown[e1], self.e_unknown[e2]
+            col = 3 * u2
+            off = u1 != u2           # (a diagonal block: its lower triangle)
+            idx, wts = [], []
+            for a in range(3):
+                base = self.row_base[u1, a] + col
+                for b in range(3):
+                    sel = off if b > a else slice(None)
+                    idx.append((base + b)[sel])
+                    wts.append(blk[:, a, b][sel])
+            S += np.bincount(np.concatenate(idx), weights=np.concatenate(wts),
+                             minlength=self.env)
         free = self.e_unknown >= 0
         U = _sum_by(self.e_unknown[free], M[free], self.ms - 1)
         if mu:

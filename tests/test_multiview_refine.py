@@ -174,3 +174,13 @@ def test_ch6_rig_scale_experiment_reduced():
     assert alg["metric"] == 3 and alg["beyond_3_std"] == 3
     assert ba["metric"] == 3 and ba["beyond_3_std"] == 0 and ba["metric_and_wrong"] == 0
     assert abs(ba["median_error"]) < 0.01
+
+
+def test_tracks_beyond_the_memory_guard_give_no_metric_and_say_why(monkeypatch):
+    import mcgeom.multiview_refine as mr
+    track, view, b, o, rot, _ = ring_tracks([10.0] * 3, 0)
+    monkeypatch.setattr(mr, "MAX_TRACK_PAIRS", 100)
+    r = multiview.translations_from_tracks(track, view, b, rot, origins=o)
+    assert not r.scale.observable
+    assert "split long tracks" in r.scale.reason and "refine=False" in r.scale.reason
+    assert np.all(np.isfinite(r.centres))
