@@ -51,8 +51,9 @@ With ``origins`` the algebraic centres are then refined by a bundle
 adjustment of the centres and the tracks' points on angular residuals, the
 rotations held (:mod:`mcgeom.multiview_refine`), and the scale verdict is read
 from that fit's covariance: the algebraic least squares weigh each relation by
-the size of its coefficients, not by its noise, and its centres came out up to
-77 % short at a first-order std of 0.1-0.8 % (see that module).
+the size of its coefficients, not by its noise, and its centres came out
+6-98 % short at a first-order relative std of 0.1-5 % (see that module and
+``mcgeom experiment ch6_rig_scale``).
 """
 
 from __future__ import annotations
