@@ -45,13 +45,13 @@ and over-confident; the figures in brackets are theirs, before it):
   the steps: 0.246 m). The windows only change the algebraic start.
 * The rendered loop of ``mcgeom demo`` (every step observable): tracks ATE
   0.027 m, RPE 0.002 m per step, back end 31.5 s (0.62 m: the turns bent);
-  steps ATE 0.024 m, RPE 0.005 m, back end 5.1 s. With every step observed,
-  "steps" skips the bundle adjustment (its lengths are not used).
+  steps ATE 0.024 m, RPE 0.005 m, back end 5.1 s ("steps" runs no bundle
+  adjustment: it takes only the tracks' relative lengths).
 * Synthetic 4-camera ring without overlap, straight - 3 turns of 15 deg -
   straight (tests/test_backend.py, 6 seeds): the straight steps carried
   with the metric from "tracks" are within 0.3-0.6 % of the truth (5.4-6.8 %
-  short), from "steps" within 0.2-0.5 %; one turn of 20 deg among straight
-  steps: within 0.8 % both. On a near-critical straight stretch the algebraic
+  short), from "steps" within 0.2-0.9 %; one turn of 20 deg among straight
+  steps: within 0.8 % (1.4-2.5 %) and 0.6 %. On a near-critical straight stretch the algebraic
   "tracks" system reported a metric scale with a wrong sign; the two-frame
   verdicts and the bundle adjustment's do not.
 
@@ -326,10 +326,12 @@ def _solve_segment(track: np.ndarray, view: np.ndarray, origins: np.ndarray,
     rotations = np.transpose(Rloc[a:b + 2], (0, 2, 1))
     # the bundle adjustment behind a metric verdict of the tracks (the
     # algebraic one is over-confident, mcgeom.multiview_refine) only where
-    # the result is used: the tracks' metric, or the lengths of steps that
-    # have none of their own (on the rendered demo loop, every step
-    # observed, it cost 22 s of a 26 s back end for the same trajectory)
-    refine = metric_from == "tracks" or not all(observed)
+    # that metric is used: "steps" takes only the relative lengths of the
+    # tracks' steps and rescales them by the observed steps, so a common
+    # bias of the algebraic lengths cancels (carried steps of the synthetic
+    # ring: 0.2-0.9 % off without it, 0.2-0.8 % with it), and the refinement
+    # took 22 s of a 26 s back end on the demo loop
+    refine = metric_from == "tracks"
     r = translations_from_tracks(track, view, bearings, rotations, origins=origins,
                                  relation="trilinear", solver="constrained", pairs="window",
                                  window=window, refine=refine)
