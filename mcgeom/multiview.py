@@ -517,6 +517,11 @@ def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max
                                  conditioning=cond, rel_std=float("inf")), c_hom, False, summary)
         rel, s_fit = travel
         summary["algebraic_travel"] = s_alg / s_fit
+        if not fit.converged:
+            return (ScaleVerdict(False, f"the bundle adjustment of the centres did not "
+                                 f"converge in {fit.iterations} iterations: metric centres not "
+                                 f"verified (relative std {rel:.3g} at its last step)",
+                                 conditioning=cond, rel_std=rel), c_hom, False, summary)
     if rel <= max_rel_std:
         how = "bundle adjustment" if summary else "algebraic least squares"
         return (ScaleVerdict(True, f"metric scale fixed by the rig's camera offsets "

@@ -184,3 +184,16 @@ def test_tracks_beyond_the_memory_guard_give_no_metric_and_say_why(monkeypatch):
     assert not r.scale.observable
     assert "split long tracks" in r.scale.reason and "refine=False" in r.scale.reason
     assert np.all(np.isfinite(r.centres))
+
+
+def test_an_unconverged_adjustment_is_not_metric(monkeypatch):
+    """One iteration from the algebraic centres (50 % short at 2 deg a step)
+    is no optimum: its std does not certify a scale."""
+    import mcgeom.multiview as mv
+    real = mv.refine_centres
+    monkeypatch.setattr(mv, "refine_centres",
+                        lambda *a, **k: real(*a, **{**k, "max_iterations": 1}))
+    track, view, b, o, rot, _ = ring_tracks([2.0] * 6, 0)
+    r = multiview.translations_from_tracks(track, view, b, rot, origins=o)
+    assert not r.scale.observable and "did not converge" in r.scale.reason
+    assert r.refinement["iterations"] == 1 and not r.refinement["converged"]
