@@ -51,9 +51,9 @@ and over-confident; the figures in brackets are theirs, before it):
   straight (tests/test_backend.py, 6 seeds): the straight steps carried
   with the metric from "tracks" are within 0.3-0.6 % of the truth (5.4-6.8 %
   short), from "steps" within 0.2-0.9 %; one turn of 20 deg among straight
-  steps: within 0.8 % (1.4-2.5 %) and 0.6 %. On a near-critical straight stretch the algebraic
-  "tracks" system reported a metric scale with a wrong sign; the two-frame
-  verdicts and the bundle adjustment's do not.
+  steps: within 0.8 % (1.4-2.5 %) and 0.6 %. On a near-critical straight
+  stretch the algebraic "tracks" system reported a metric scale with a wrong
+  sign; the two-frame verdicts and the bundle adjustment's do not.
 
 So "tracks" is as accurate but costs a bundle adjustment of every segment;
 "steps" keeps the robust two-frame motions where they are metric.
