@@ -322,8 +322,8 @@ def refine_centres(track: np.ndarray, view: np.ndarray, x: np.ndarray, w: np.nda
         fac = _core.skyline_cholesky(first, ptr, st.reduced(M, h, V, gX, 0.0)[0])
     except (ArithmeticError, NumericalError, np.linalg.LinAlgError):
         return None
-    return CentresFit(c, X, labels, first, ptr, fac, 2.0 * cost / dof, float(np.sqrt(cost / n_obs)), it,
-                      converged, n_obs, n_pts, dof)
+    return CentresFit(c, X, labels, first, ptr, fac, 2.0 * cost / dof,
+                      float(np.sqrt(cost / n_obs)), it, converged, n_obs, n_pts, dof)
 
 
 def covisible_profile(track: np.ndarray, view: np.ndarray, pos: np.ndarray, n_views: int
