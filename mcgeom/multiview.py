@@ -315,7 +315,9 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
     adjustment of :func:`mcgeom.multiview_refine.refine_centres` and judge the
     scale from its covariance (False: the algebraic solution and its
     first-order std, which is over-confident; for callers that refine
-    themselves).
+    themselves). Either std takes the rotations as exact: rotations off by
+    more than ~0.01 deg add a scale error it does not contain (see
+    :mod:`mcgeom.multiview_refine`).
 
     Long real tracks: the algebraic residual of a relation between views far
     apart carries the noise of its coefficients times the long baseline, so
