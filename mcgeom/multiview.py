@@ -59,6 +59,7 @@ the size of its coefficients, not by its noise, and its centres came out
 from __future__ import annotations
 
 import itertools
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Any, Optional
@@ -93,7 +94,9 @@ class TranslationResult:
     bundle adjustment ran): ``iterations``, ``converged``, ``rms`` (angular
     residual, radians), ``n_observations`` and ``n_points`` used, and
     ``algebraic_rel_std``, ``algebraic_travel`` (the algebraic solution's
-    relative std and its travelled distance |G c| relative to the refined one).
+    relative std and its travelled distance |G c| relative to the refined one),
+    and with ``rotation_std`` the rotations' part ``rotation_rel_std`` of the
+    scale's relative std (the verdict's ``rel_std`` combines it with the noise's).
     """
 
     centres: np.ndarray
@@ -296,7 +299,8 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
                              solver: str = "constrained", pairs: str = "all",
                              window: Optional[int] = None, max_rel_std: float = 0.1,
                              max_iter: int = 500, tol: float = 1e-13,
-                             refine: bool = True) -> TranslationResult:
+                             refine: bool = True, rotation_std: float = 0.0
+                             ) -> TranslationResult:
     """Centres of m views with known rotations from tracks (thesis ch. 6).
 
     ``track`` (N,) and ``view`` (N,) label each observation; ``bearings`` (N, 3)
@@ -315,9 +319,14 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
     adjustment of :func:`mcgeom.multiview_refine.refine_centres` and judge the
     scale from its covariance (False: the algebraic solution and its
     first-order std, which is over-confident; for callers that refine
-    themselves). Either std takes the rotations as exact: rotations off by
-    more than ~0.01 deg add a scale error it does not contain (see
-    :mod:`mcgeom.multiview_refine`).
+    themselves). ``rotation_std`` (radians, with ``refine``): the standard
+    deviation of each view's rotation error (independent per view, about
+    every axis); its first-order effect on the travelled distance (the
+    bundle adjustment's sensitivity to the rotations) is added to the scale's
+    std. At 0 the rotations are taken as exact: rotations off by 0.01 deg
+    already put a few scales beyond 3 of their stds (see
+    :mod:`mcgeom.multiview_refine`); pass the rotations' error when they are
+    estimated.
 
     Long real tracks: the algebraic residual of a relation between views far
     apart carries the noise of its coefficients times the long baseline, so
@@ -332,6 +341,13 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
         raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
     if pairs not in PAIRS:
         raise ValueError(f"pairs must be one of {PAIRS}, got {pairs!r}")
+    if not (isinstance(rotation_std, (int, float)) and math.isfinite(rotation_std)
+            and rotation_std >= 0.0):
+        raise ValueError(f"rotation_std must be a finite number >= 0 (radians), got "
+                         f"{rotation_std!r}")
+    if rotation_std > 0.0 and not refine:
+        raise ValueError("rotation_std needs the bundle adjustment (refine=True): the "
+                         "algebraic solution has no sensitivity to the rotations")
     q = 2 if relation == "bilinear" else 3
     if window is None:
         window = q - 1
@@ -400,7 +416,7 @@ def translations_from_tracks(track: Any, view: Any, bearings: Any, rotations: An
         else None
     verdict, c_unknown, metric, refinement = _choose(origins, N, gvec, const, first, ptr,
                                                      c_hom, lam1, n_rows, n, pk, max_rel_std,
-                                                     shift, refiner)
+                                                     shift, refiner, float(rotation_std))
     t_solve = time.perf_counter()
 
     centres = np.full((m, 3), np.nan)
@@ -455,14 +471,15 @@ def _sky_matvec(a: np.ndarray, first: np.ndarray, ptr: np.ndarray, x: np.ndarray
 
 
 def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max_rel_std,
-            shift, refiner=None):
+            shift, refiner=None, rotation_std=0.0):
     """The centres (unknowns), whether they are metric, the scale verdict and
     the refinement's summary (None without one). ``shift``: per unknown, the
     mean offset of the view's rays relative to the gauge view's (the scale
     evidence is the distance travelled by the cameras' centroids, which does
     not depend on where the rig frame's origin is). ``refiner(c) ->
     CentresFit or None``: the bundle adjustment from the algebraic unknowns
-    c, whose covariance then decides the verdict."""
+    c, whose covariance (and ``rotation_std``'s effect, radians per view)
+    then decides the verdict."""
     cond = float(np.sqrt(max(lam1, 0.0)))
     if origins is None:
         return (ScaleVerdict(False, "central views: the scale of the centres is not "
@@ -493,7 +510,7 @@ def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max
     if travel is None:
         return (ScaleVerdict(False, "no translation detected: scale not observable",
                              conditioning=cond, rel_std=float("inf")), c_hom, False, None)
-    rel, s_alg = travel
+    rel, s_alg, _ = travel
     summary = None
     if refiner is not None:
         try:
@@ -517,8 +534,13 @@ def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max
         if travel is None:
             return (ScaleVerdict(False, "no translation detected: scale not observable",
                                  conditioning=cond, rel_std=float("inf")), c_hom, False, summary)
-        rel, s_fit = travel
+        rel, s_fit, y = travel
         summary["algebraic_travel"] = s_alg / s_fit
+        if rotation_std > 0.0:
+            # ds = -(G^T S^-1 g) . dw: the rotations' share of the std
+            rot = rotation_std * float(np.linalg.norm(fit.rotation_term(y))) / s_fit
+            summary["rotation_rel_std"] = rot
+            rel = math.hypot(rel, rot)
         if not fit.converged:
             return (ScaleVerdict(False, f"the bundle adjustment of the centres did not "
                                  f"converge in {fit.iterations} iterations: metric centres not "
@@ -535,7 +557,7 @@ def _choose(origins, N, gvec, const, first, ptr, c_hom, lam1, n_rows, n, pk, max
 
 
 def _travel_std(lap, first, ptr, c, sigma2, solve, lap_first=None, lap_ptr=None):
-    """(relative std, length) of the travelled distance |G c| = sqrt(c^T L c)
+    """(relative std, length, S^-1 g) of the travelled distance |G c| = sqrt(c^T L c)
     of the unknowns ``c`` (the cameras' centroids: the shift included), L =
     ``lap`` in the skyline profile (``lap_first``, ``lap_ptr``; default
     ``first``, ``ptr``), whose covariance is ``sigma2`` times the inverse that
@@ -546,7 +568,8 @@ def _travel_std(lap, first, ptr, c, sigma2, solve, lap_first=None, lap_ptr=None)
     if not s2 > 0:
         return None
     g = Lc / np.sqrt(s2)
-    return float(np.sqrt(max(sigma2 * float(g @ solve(g)), 0.0)) / np.sqrt(s2)), float(np.sqrt(s2))
+    y = solve(g)
+    return float(np.sqrt(max(sigma2 * float(g @ y), 0.0)) / np.sqrt(s2)), float(np.sqrt(s2)), y
 
 
 def _laplacian_env(first, ptr, pk):

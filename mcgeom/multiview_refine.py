@@ -29,14 +29,19 @@ system is stored and factored in the skyline form of :mod:`mcgeom.multiview`
 residual variance is the first-order covariance of the centres, from which
 the caller judges the metric scale.
 
-The rotations are taken as exact: the covariance is that of the centres given
-them. Rotation errors add a scale error the std does not contain: with every
-view's rotation perturbed by 0.01 deg (about the two-frame estimates' error)
-the ring turning 2 deg a step stayed within its std (median error 0.9 %,
-std 0.9 %, 10 sequences), at 0.05 deg it did not (6.7 % at a std of 1.2 %,
-3 of 10 metric and wrong); on KITTI-00 with the ground-truth rotations the
-path came out 1.0 % short at a relative std of 0.02 % (``mcgeom experiment
-ch6_kitti``). Rotations known to better than ~0.01 deg are assumed.
+The rotations are taken as exact by the covariance itself; their errors
+enter through ``CentresFit.rotation_term`` (the centres' first-order shift
+per rotation error, by the implicit function theorem at the optimum), which
+:func:`mcgeom.multiview.translations_from_tracks` turns into the scale's std
+for a given ``rotation_std``. Measured on the ring turning 2 or 10 deg a
+step, every view's rotation turned by 0.01 or 0.05 deg about a random axis
+(20 sequences each): taken as exact, 3-5 (0.01 deg) and 12-14 (0.05 deg) of
+20 were more than 3 stds off, RMS error/std 1.9-2.2 and 7.3-7.6, 5 metric
+and wrong at 2 deg / 0.05 deg; with ``rotation_std`` equal to the error,
+none, RMS 0.53-0.59 (conservative: the error's std about each axis is
+1/sqrt(3) of it). On KITTI-00 with the ground-truth rotations, taken as
+exact, the path came out 1.0 % short at a relative std of 0.02 %
+(``mcgeom experiment ch6_kitti``).
 
 Tracks are taken as outlier-free (the sequence back end drops the outliers of
 each step first). A track whose rays are parallel (no parallax: its point
@@ -46,8 +51,8 @@ at the starting centres, is left out.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Optional
+from dataclasses import dataclass, field
+from typing import Callable, Optional
 
 import numpy as np
 
@@ -90,7 +95,11 @@ class CentresFit:
     component (rad^2) over ``dof`` = 2 n_observations - 3 n_points - 3 (ms - 1)
     degrees of freedom; ``rms`` the RMS angular component (radians).
     ``points`` (n_points, 3): the tracks' points (world frame, metres) of the
-    track labels ``point_tracks``.
+    track labels ``point_tracks``. ``rotation_term(y)``: for a vector y of the
+    unknown centre coordinates, G^T y (ms, 3), where -S^-1 G is the first-order
+    shift of the centres per rotation error of each view (radians about the
+    world axes, applied to its bearings and offsets): the derivative of a
+    function of the centres with gradient g is -(G^T S^-1 g) per view and axis.
     """
     centres: np.ndarray
     points: np.ndarray
@@ -105,6 +114,8 @@ class CentresFit:
     n_observations: int
     n_points: int
     dof: int
+    rotation_term: Callable[[np.ndarray], np.ndarray] = field(repr=False, compare=False,
+                                                              default=None)
 
 
 def _tangent_bases(x: np.ndarray) -> np.ndarray:
@@ -328,11 +339,36 @@ def refine_centres(track: np.ndarray, view: np.ndarray, x: np.ndarray, w: np.nda
             break
     M, h, V, gX = st.normal_terms(r, u, rho)
     try:
-        fac = _core.skyline_cholesky(first, ptr, st.reduced(M, h, V, gX, 0.0)[0])
+        S, _, Vinv = st.reduced(M, h, V, gX, 0.0)
+        fac = _core.skyline_cholesky(first, ptr, S)
     except (ArithmeticError, NumericalError, np.linalg.LinAlgError):
         return None
     return CentresFit(c, X, labels, first, ptr, fac, 2.0 * cost / dof,
-                      float(np.sqrt(cost / n_obs)), it, converged, n_obs, n_pts, dof)
+                      float(np.sqrt(cost / n_obs)), it, converged, n_obs, n_pts, dof,
+                      _rotation_term(st, u, rho, M, Vinv))
+
+
+def _rotation_term(st: "_Structure", u: np.ndarray, rho: np.ndarray, M: np.ndarray,
+                   Vinv: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """G^T y of :class:`CentresFit` at the optimum. A rotation error dw of a
+    view turns its bearing x and offset w alike (x + dw x x, w + dw x w); the
+    residual r = B^T u (B turning with x) moves by D dw, D's rows b_i x u +
+    a_i x w (b_i, a_i the rows of B and of A = d r / d X). With the centres
+    moved by y and the points re-optimised for them (dX_p = V_p^-1 sum M y),
+    the residuals move by q_k = A_k (dX_p - y_v), and G^T y = sum_k D_k^T q_k
+    per view (the implicit function theorem at the optimum)."""
+    A = (st.B - (st.B @ u[:, :, None]) * u[:, None, :]) / rho[:, None, None]
+    D = np.cross(st.B, u[:, None, :]) + np.cross(A, st.w[:, None, :])
+    view_of_entry = st.e_unknown + 1
+
+    def rotation_term(y: np.ndarray) -> np.ndarray:
+        yv = np.vstack([np.zeros(3), np.asarray(y, float).reshape(-1, 3)])
+        dX = (Vinv @ _sum_by(st.e_track, (M @ yv[view_of_entry][:, :, None])[:, :, 0],
+                             st.n_pts)[:, :, None])[:, :, 0]
+        q = (A @ (dX[st.tid] - yv[st.vp])[:, :, None])[:, :, 0]
+        return _sum_by(st.vp, np.einsum("kai,ka->ki", D, q), st.ms)
+
+    return rotation_term
 
 
 def covisible_profile(track: np.ndarray, view: np.ndarray, pos: np.ndarray, n_views: int

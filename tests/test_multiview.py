@@ -209,6 +209,8 @@ def test_rig_pure_translation_intra_camera_is_critical():
     ({"relation": "quadrilinear"}, "relation"), ({"solver": "qr"}, "solver"),
     ({"pairs": "some"}, "pairs"), ({"relation": "trilinear", "pairs": "window", "window": 1},
                                    "window"),
+    ({"rotation_std": -1e-4}, "rotation_std"), ({"rotation_std": float("nan")}, "rotation_std"),
+    ({"rotation_std": 1e-4, "refine": False}, "rotation_std needs the bundle adjustment"),
 ])
 def test_bad_options(kwargs, match):
     track, view, b, rot, c, _ = random_views(0, m=4)

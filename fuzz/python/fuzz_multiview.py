@@ -8,8 +8,8 @@ decoded offsets (or central views), 1-40 points each seen by a decoded run
 of views through one camera; the exact bearings, then damaged as real data
 can be (NaN/inf/huge/denormal entries, zero bearings, a bearing replaced by
 an arbitrary vector, a repeated observation, all points at one place), or
-arbitrary floats altogether; the relation, solver, pairs, window, refine and
-max_rel_std decoded. Outcomes: a TranslationResult whose centres are finite
+arbitrary floats altogether; the relation, solver, pairs, window, refine,
+max_rel_std and rotation_std decoded. Outcomes: a TranslationResult whose centres are finite
 for the solved views and NaN for the others, a metric verdict only with
 origins, a finite relative std at most max_rel_std and a finite refinement
 summary; or ValueError / McgeomError with a message.
@@ -97,6 +97,7 @@ def TestOneInput(data: bytes) -> None:
               pairs=multiview.PAIRS[fdp.ConsumeIntInRange(0, 1)],
               window=fdp.ConsumeIntInRange(1, 4), refine=fdp.ConsumeBool(),
               max_rel_std=fdp.ConsumeFloatInRange(0.0, 1.0))
+    kw["rotation_std"] = fdp.ConsumeFloatInRange(0.0, 0.01) if kw["refine"] else 0.0
     try:
         r = multiview.translations_from_tracks(track, view, bear, rot, origins=org, **kw)
     except _common.ALLOWED as exc:
@@ -116,7 +117,9 @@ def TestOneInput(data: bytes) -> None:
     if r.refinement is not None:
         if org is None or not kw["refine"]:
             raise _common.Finding(f"{what}: a refinement without being asked")
-        if not (np.isfinite(r.refinement["rms"]) and r.refinement["iterations"] >= 0):
+        rot = r.refinement.get("rotation_rel_std", 0.0)
+        if not (np.isfinite(r.refinement["rms"]) and r.refinement["iterations"] >= 0
+                and rot >= 0.0):
             raise _common.Finding(f"{what}: refinement summary {r.refinement}")
 
 
