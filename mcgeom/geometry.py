@@ -24,7 +24,7 @@ from .types import RayPairs
 
 __all__ = ["find_essential_mat", "rcross", "unit_rows", "displacements", "same_camera", "count_in_front",
            "counts_in_front", "rotation_only_fit", "rotation_fit", "rotation_only_residuals",
-           "refine_centred"]
+           "refine_centred", "line_normal_equations"]
 
 
 def rcross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -151,6 +151,23 @@ def _rotation_angles(d1: np.ndarray, d2: np.ndarray, R: np.ndarray) -> np.ndarra
     """Angles (radians) between unit ``d2`` and ``R d1``, row by row."""
     rd1 = d1 @ R.T
     return np.arctan2(np.linalg.norm(rcross(rd1, d2), axis=1), np.einsum("ij,ij->i", rd1, d2))
+
+
+def line_normal_equations(group: np.ndarray, points: np.ndarray, dirs: np.ndarray,
+                          n_groups: int) -> tuple[np.ndarray, np.ndarray]:
+    """The normal equations ``A X = rhs`` of the point nearest (least squares of
+    the distances) to the lines ``points + s dirs`` of each group: per group
+    ``A = sum (I - d d^T)`` (G, 3, 3) and ``rhs = sum (I - d d^T) p`` (G, 3).
+    ``group`` (N,) in ``[0, n_groups)``, ``dirs`` (N, 3) unit, ``points``
+    (N, 3) (any unit: X comes out in it). A group of parallel lines leaves A
+    singular; the caller decides what to do with it."""
+    P = np.eye(3)[None] - dirs[:, :, None] * dirs[:, None, :]
+    Pp = np.einsum("nij,nj->ni", P, points)
+    A = np.stack([np.bincount(group, weights=P[:, i, j], minlength=n_groups)
+                  for i in range(3) for j in range(3)], axis=1).reshape(-1, 3, 3)
+    rhs = np.stack([np.bincount(group, weights=Pp[:, i], minlength=n_groups)
+                    for i in range(3)], axis=1)
+    return A, rhs
 
 
 def origin_centroid(rays: RayPairs) -> np.ndarray:

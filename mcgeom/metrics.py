@@ -18,7 +18,7 @@ import numpy as np
 from .validation import check_int, check_points, check_poses
 
 __all__ = ["rotation_error", "translation_errors", "rotation_angle", "motion_errors",
-           "loop_closure_error", "path_length", "align_se3", "absolute_trajectory_error",
+           "loop_closure_error", "path_length", "polyline_length", "align_se3", "absolute_trajectory_error",
            "relative_pose_error", "scale_drift"]
 
 
@@ -100,11 +100,16 @@ def _pose_pair(est_poses: np.ndarray, gt_poses: np.ndarray) -> tuple[np.ndarray,
     return est, gt
 
 
+def polyline_length(positions: np.ndarray) -> float:
+    """Length of the polyline through ``positions`` (N, 3), in their unit:
+    sum of ``|p_{k+1} - p_k|``; 0 for one position."""
+    return float(np.sum(np.linalg.norm(np.diff(positions, axis=0), axis=1)))
+
+
 def path_length(poses: np.ndarray) -> float:
     """Length (metres) of the polyline through the positions of world_from_rig
     ``poses`` (N, 4, 4): sum of ``|t_{k+1} - t_k|``; 0 for one pose."""
-    T = check_poses("poses", poses)
-    return float(np.sum(np.linalg.norm(np.diff(T[:, :3, 3], axis=0), axis=1)))
+    return polyline_length(check_poses("poses", poses)[:, :3, 3])
 
 
 def align_se3(est_positions: np.ndarray, gt_positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

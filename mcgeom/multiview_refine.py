@@ -58,6 +58,7 @@ import numpy as np
 
 from . import _core
 from .errors import NumericalError
+from .geometry import line_normal_equations
 
 __all__ = ["CentresFit", "refine_centres", "covisible_profile", "MAX_TRACK_PAIRS"]
 
@@ -160,9 +161,7 @@ def _triangulate(x: np.ndarray, a: np.ndarray, tid: np.ndarray, n_points: int
     """The least-squares point of the rays ``a + s x`` of each track (nearest to
     them all) and whether it is usable: rays not parallel, point in front of
     every ray."""
-    P = np.eye(3)[None] - x[:, :, None] * x[:, None, :]
-    A = _sum_by(tid, P, n_points)
-    rhs = _sum_by(tid, np.einsum("kij,kj->ki", P, a), n_points)
+    A, rhs = line_normal_equations(tid, a, x, n_points)
     ev = np.linalg.eigvalsh(A)
     ok = ev[:, 0] > PARALLEL_EIG * ev[:, 2]
     X = np.zeros((n_points, 3))
@@ -177,7 +176,7 @@ class _Structure:
     (track, view) entries and the envelope positions of the Schur terms."""
 
     def __init__(self, tid, vp, x, w, ms, first, ptr):
-        self.tid, self.vp, self.x, self.w, self.ms = tid, vp, x, w, ms
+        self.tid, self.vp, self.w, self.ms = tid, vp, w, ms
         self.first, self.ptr = first, ptr
         self.n_pts = int(tid.max()) + 1
         self.B = _tangent_bases(x)
@@ -208,11 +207,14 @@ class _Structure:
         u = d / rho[:, None]
         return (self.B @ u[:, :, None])[:, :, 0], u, rho
 
-    def normal_terms(self, r, u, rho):
-        """Per (track, view) entry M = sum A^T A, h = sum A^T r (A = d r / d X =
-        -d r / d c = B (I - u u^T) / rho), and per point V = sum M, gX = sum h."""
+    def jacobian(self, u, rho):
+        """A = d r / d X = -d r / d c = B (I - u u^T) / rho per observation (K, 2, 3)."""
         # (matmul on the stacks: numpy's einsum takes several times as long)
-        A = (self.B - (self.B @ u[:, :, None]) * u[:, None, :]) / rho[:, None, None]
+        return (self.B - (self.B @ u[:, :, None]) * u[:, None, :]) / rho[:, None, None]
+
+    def normal_terms(self, r, A):
+        """Per (track, view) entry M = sum A^T A, h = sum A^T r (A of
+        :meth:`jacobian`), and per point V = sum M, gX = sum h."""
         At = A.transpose(0, 2, 1)
         M = _sum_by(self.entry, At @ A, self.n_entries)
         h = _sum_by(self.entry, (At @ r[:, :, None])[:, :, 0], self.n_entries)
@@ -313,7 +315,7 @@ def refine_centres(track: np.ndarray, view: np.ndarray, x: np.ndarray, w: np.nda
     cost = 0.5 * float(np.sum(r * r))
     mu, converged, it = 1e-4, False, 0
     for it in range(1, max_iterations + 1):
-        M, h, V, gX = st.normal_terms(r, u, rho)
+        M, h, V, gX = st.normal_terms(r, st.jacobian(u, rho))
         stepped = False
         while not stepped and mu < 1e16:
             S, rhs, Vinv = st.reduced(M, h, V, gX, mu)
@@ -337,7 +339,8 @@ def refine_centres(track: np.ndarray, view: np.ndarray, x: np.ndarray, w: np.nda
             # (no step lowers the cost: a minimum to the precision of the cost)
             converged = True
             break
-    M, h, V, gX = st.normal_terms(r, u, rho)
+    A = st.jacobian(u, rho)
+    M, h, V, gX = st.normal_terms(r, A)
     try:
         S, _, Vinv = st.reduced(M, h, V, gX, 0.0)
         fac = _core.skyline_cholesky(first, ptr, S)
@@ -345,10 +348,10 @@ def refine_centres(track: np.ndarray, view: np.ndarray, x: np.ndarray, w: np.nda
         return None
     return CentresFit(c, X, labels, first, ptr, fac, 2.0 * cost / dof,
                       float(np.sqrt(cost / n_obs)), it, converged, n_obs, n_pts, dof,
-                      _rotation_term(st, u, rho, M, Vinv))
+                      _rotation_term(st, u, A, M, Vinv))
 
 
-def _rotation_term(st: "_Structure", u: np.ndarray, rho: np.ndarray, M: np.ndarray,
+def _rotation_term(st: "_Structure", u: np.ndarray, A: np.ndarray, M: np.ndarray,
                    Vinv: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
     """G^T y of :class:`CentresFit` at the optimum. A rotation error dw of a
     view turns its bearing x and offset w alike (x + dw x x, w + dw x w); the
@@ -357,7 +360,6 @@ def _rotation_term(st: "_Structure", u: np.ndarray, rho: np.ndarray, M: np.ndarr
     moved by y and the points re-optimised for them (dX_p = V_p^-1 sum M y),
     the residuals move by q_k = A_k (dX_p - y_v), and G^T y = sum_k D_k^T q_k
     per view (the implicit function theorem at the optimum)."""
-    A = (st.B - (st.B @ u[:, :, None]) * u[:, None, :]) / rho[:, None, None]
     D = np.cross(st.B, u[:, None, :]) + np.cross(A, st.w[:, None, :])
     view_of_entry = st.e_unknown + 1
 

@@ -50,6 +50,7 @@ from typing import Optional
 import numpy as np
 
 from mcgeom import multiview
+from mcgeom.metrics import polyline_length
 from mcgeom.estimators.known_rotation_translation import known_rotation_translation
 from mcgeom.synth_views import similarity_align, spiral_measure
 from mcgeom.types import RayPairs
@@ -127,11 +128,6 @@ def cut_tracks(track: np.ndarray, view: np.ndarray, max_len: int) -> np.ndarray:
     return out
 
 
-def path_length(c: np.ndarray) -> float:
-    """Length of the polyline through the centres ``c`` (m, 3), their unit."""
-    return float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum())
-
-
 def chained_two_view(track, view, bearings, origins, rotations) -> np.ndarray:
     """Centres from known_rotation_translation on each consecutive frame pair
     (the shared landmarks' rays: cam0-cam0, cam1-cam1, cam0-cam1, cam1-cam0),
@@ -177,7 +173,7 @@ def evaluate(first: int = FIRST_GOOD_FRAME, last: int = 76, windows=(None, 0),
     out(f"KITTI-00 frames {first}-{last}: {len(rotations)} views, {len(np.unique(track))} "
         f"landmarks seen in >= 2 frames, {len(track)} rays (cam0 + cam1), track length "
         f"median {np.median(lengths):.0f} / max {lengths.max()} frames; true path "
-        f"{path_length(gt):.2f} m")
+        f"{polyline_length(gt):.2f} m")
     out(f"{'variant':>50} {'RMS [m]':>9} {'end [m]':>9} {'path ratio':>11} "
         f"{'RMS sim [m]':>12} {'spiral':>7} {'scale':>14} {'s':>7}")
     res = {}
@@ -246,7 +242,7 @@ def _row(c: np.ndarray, gt: np.ndarray, observable: bool, seconds: float) -> dic
     err = np.linalg.norm(c[ok] - gt[ok], axis=1)
     aligned, rms_sim = similarity_align(c[ok], gt[ok])
     return {"rms": float(np.sqrt(np.mean(err ** 2))), "end": float(err[-1]),
-            "scale": path_length(c[ok]) / path_length(gt[ok]), "rms_sim": float(rms_sim),
+            "scale": polyline_length(c[ok]) / polyline_length(gt[ok]), "rms_sim": float(rms_sim),
             "spiral": spiral_measure(aligned, gt[ok]),
             "observable": bool(observable), "seconds": seconds, "views": int(ok.sum())}
 

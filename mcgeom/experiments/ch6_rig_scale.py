@@ -26,6 +26,7 @@ import time
 import numpy as np
 
 from .. import multiview, synth
+from ..metrics import polyline_length
 from ..synth_views import rig_drive_sequence
 from .common import Progress, add_count_and_seed, no_progress
 
@@ -33,10 +34,6 @@ __all__ = ["run", "add_arguments", "run_cli", "YAWS"]
 
 #: yaw per step (deg) of the sequences: straight (critical), near-critical, turning
 YAWS = (0.0, 0.5, 2.0, 10.0, 20.0)
-
-
-def _travel(c: np.ndarray) -> float:
-    return float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum())
 
 
 def run(trials: int = 20, seed: int = 0, yaws=YAWS, frames: int = 6, sigma: float = 0.5,
@@ -48,7 +45,7 @@ def run(trials: int = 20, seed: int = 0, yaws=YAWS, frames: int = 6, sigma: floa
     jobs = [(y, k) for y in yaws for k in range(trials)]
     for yaw, k in progress(jobs, total=len(jobs), desc="ch6_rig_scale"):
         seq = rig_drive_sequence(rig, [yaw] * frames, sigma_px=sigma, rng=seed + k)
-        true = _travel(seq.centres)
+        true = polyline_length(seq.centres)
         for rel in relations:
             for refine in (False, True):
                 t0 = time.perf_counter()
@@ -56,7 +53,7 @@ def run(trials: int = 20, seed: int = 0, yaws=YAWS, frames: int = 6, sigma: floa
                                                        seq.rotations, origins=seq.origins,
                                                        relation=rel, refine=refine)
                 dt = time.perf_counter() - t0
-                err = _travel(r.centres) / true - 1.0 if r.scale.observable else float("nan")
+                err = polyline_length(r.centres) / true - 1.0 if r.scale.observable else float("nan")
                 cells.setdefault((yaw, rel, refine), []).append(
                     (r.scale.observable, err, r.scale.rel_std, dt))
     rows = []

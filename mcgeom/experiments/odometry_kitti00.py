@@ -35,12 +35,12 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from mcgeom.metrics import absolute_trajectory_error
+from mcgeom.metrics import absolute_trajectory_error, polyline_length
 from mcgeom.odometry import chain
 from mcgeom.sequence import Tracks, estimate_trajectory
 
 from . import real_data as erd
-from .ch6_kitti import FIRST_GOOD_FRAME, load_observations, path_length
+from .ch6_kitti import FIRST_GOOD_FRAME, load_observations
 from .common import Progress, import_peer, no_progress, non_negative_int, write_line
 
 #: (name, options of estimate_trajectory)
@@ -73,13 +73,13 @@ def _at(centres: np.ndarray) -> np.ndarray:
 def _row(centres: np.ndarray, gt: np.ndarray, seconds: float, note: str) -> dict:
     ok = np.all(np.isfinite(centres), axis=1)
     g = gt[:, :3, 3]
-    length = path_length(g)
+    length = polyline_length(g)
     # RMS after the rigid motion (no scale) that best maps the estimate onto
     # the truth (Umeyama 1991 without the scale factor), as evo computes it
     ate = (absolute_trajectory_error(_at(centres[ok]), gt[ok])["rmse"] if ok.sum() >= 3
            else float("nan"))
     return {"ate": ate, "ate_pct": 100.0 * ate / length,
-            "drift_pct": 100.0 * (path_length(centres[ok]) / path_length(g[ok]) - 1.0),
+            "drift_pct": 100.0 * (polyline_length(centres[ok]) / polyline_length(g[ok]) - 1.0),
             "end": float(np.linalg.norm(centres[-1] - g[-1])) if ok[-1] else float("nan"),
             "frames": int(ok.sum()), "seconds": seconds, "note": note}
 
@@ -132,7 +132,7 @@ def evaluate(first: int = FIRST_GOOD_FRAME, last: int = 76, threshold: float = 1
     rig, tracks, gt = load(first, last, root)
     out(f"KITTI-00 frames {first}-{last}: {tracks.n_frames} frames, {len(tracks)} "
         f"observations of {len(np.unique(tracks.track))} landmarks (cam0 + cam1); true path "
-        f"{path_length(gt[:, :3, 3]):.2f} m")
+        f"{polyline_length(gt[:, :3, 3]):.2f} m")
     res = {}
     traj = None
     for name, opts in progress(VARIANTS, total=len(VARIANTS), desc="variants"):

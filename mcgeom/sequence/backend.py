@@ -74,6 +74,8 @@ import numpy as np
 
 from .. import cv
 from ..errors import DegenerateError, NumericalError
+from ..geometry import line_normal_equations
+from ..metrics import polyline_length
 from ..multiview import translations_from_tracks
 from ..rig import Rig
 from ..types import RigMotion
@@ -250,10 +252,6 @@ def _groups(motions: list, links: np.ndarray, min_links: int) -> list[tuple[int,
     return groups
 
 
-def _path_length(c: np.ndarray) -> float:
-    return float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum())
-
-
 def _triangulation_angles(track: np.ndarray, view: np.ndarray, origins: np.ndarray,
                           bearings: np.ndarray, R_world_rig: np.ndarray,
                           centres: np.ndarray) -> np.ndarray:
@@ -266,12 +264,8 @@ def _triangulation_angles(track: np.ndarray, view: np.ndarray, origins: np.ndarr
     d = np.einsum("nij,nj->ni", R, bearings)
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     # sum_k (I - d d^T) X = sum_k (I - d d^T) o, per track
-    P = np.eye(3) - d[:, :, None] * d[:, None, :]
     ids, inv = np.unique(track, return_inverse=True)
-    A = np.zeros((len(ids), 3, 3))
-    rhs = np.zeros((len(ids), 3))
-    np.add.at(A, inv, P)
-    np.add.at(rhs, inv, np.einsum("nij,nj->ni", P, o))
+    A, rhs = line_normal_equations(inv, o, d, len(ids))
     A += 1e-12 * np.eye(3)            # a track of parallel rays: any point on them
     X = np.linalg.solve(A, rhs[..., None])[..., 0]
     v = X[inv] - o
@@ -375,7 +369,7 @@ def _solve_segment(track: np.ndarray, view: np.ndarray, origins: np.ndarray,
         # (median 2.4, up to 94 deg), where the two-frame travel directions
         # are within 0.05 deg (now the steps' directions: mean 0.02 deg).
         out = _chain_steps(motions, Rloc, a, b, observed, d, 1.0)
-        length = _path_length(out)
+        length = polyline_length(out)
         return out / length if length > 0 else out, False, "none", info
     # the shape from the tracks, its scale from the observed steps' two-frame
     # metric lengths: min_s sum_k (s |dc_k| - |t_k|)^2
