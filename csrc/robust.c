@@ -113,20 +113,6 @@
  * (the bench cases, 150-320 pairs, are below the cap: unchanged). */
 #define SCALE_PAIRS 512
 
-/* mcgeom.observability's ZERO_FACTOR (|t| shrunk to 1 %: a static rig?);
- * tests/test_robust_c.py checks that the two copies agree */
-#define ZERO_FACTOR 0.01
-
-/* observability.scale_determined's bound on the zero profile (a vanishing
- * translation not excluded at 3 sigma): the zero profile is only compared
- * with it, so its fit stops once below (the value is then an upper bound),
- * or once evidently above (mcg_refine_motion_until: more than 100 times
- * its last step's decrease above; issue 19, the fits crept down for up to
- * 50 steps 10-20x above the bound: C instructions per estimate, 20
- * problems of `mcgeom bench robust`, ladybug6 8.98 -> 8.22 M, car8
- * 5.17 -> 4.55 M) */
-#define ZERO_PROFILE_BOUND 9.0
-
 /* largest |t_i| handed to mcg_verdict_stats (its bound is 1e150) */
 #define VERDICT_T_MAX 1e149
 
@@ -174,6 +160,7 @@ void mcg_robust_default_options(mcg_robust_options *opt)
     opt->g1[0] = opt->g1[1] = opt->g1[2] = 0.0;
     opt->g2[0] = opt->g2[1] = opt->g2[2] = 0.0;
     opt->verdict_still_factor = 0.0;
+    opt->extrinsic_std = NULL;
 }
 
 static int check_options(const mcg_robust_options *o)
@@ -259,8 +246,10 @@ size_t mcg_robust_work_size(int n, int n_cameras)
     s = add_sz(s, 2 * ints_as_doubles(nn) + scale_work_own(n), &ok);
     /* the solutions of one minimal sample (the 6-point solver's are the most) */
     s = add_sz(s, robust_sample_work_size(), &ok);
-    /* the verdict's evidence (opt.verdict_still_factor) */
+    /* the verdict's evidence (opt.verdict_still_factor) and its calibration
+     * part (opt.extrinsic_std) */
     s = add_sz(s, mcg_verdict_stats_work_size(n_cameras), &ok);
+    s = add_sz(s, mcg_calibration_std_work_size(n_cameras), &ok);
     /* the two-stage 5+1: each camera's record score, its subset's offsets
      * and indices */
     s = add_sz(s, rec_size(n, n_cameras), &ok);
@@ -279,9 +268,14 @@ static int within(const double *x, size_t n, double bound)
 
 static int check_inputs(int n, const double *o1, const double *d1, const double *o2,
                         const double *d2, const int *cam1, const int *cam2, int n_cameras,
-                        const double *focal, const double *cam_axes, const double *cam_focal)
+                        const double *focal, const double *cam_axes, const double *cam_focal,
+                        const double *extrinsic_std)
 {
     int k;
+    if (extrinsic_std && n_cameras >= 1 && n_cameras <= MAX_CAMERAS)
+        for (k = 0; k < 2 * n_cameras; k++)
+            if (!(isfinite(extrinsic_std[k]) && extrinsic_std[k] >= 0.0))
+                return MCG_EINVAL;
     if (n < 6 || n > MAX_PAIRS || n_cameras < 1 || n_cameras > MAX_CAMERAS)
         return MCG_EINVAL;
     if (!within(o1, 3 * (size_t)n, MAX_ORIGIN) || !all_finite(d1, 3 * (size_t)n) ||
@@ -331,7 +325,8 @@ static void carve(ctx *c, double *work)
         c->xwork = scale_work_aliased(c->n) ? c->sub : x;
         c->msol = x + scale_work_own(c->n);
         c->vwork = c->msol + robust_sample_work_size();
-        c->rec = c->vwork + mcg_verdict_stats_work_size(c->ncam);
+        c->cwork = c->vwork + mcg_verdict_stats_work_size(c->ncam);
+        c->rec = c->cwork + mcg_calibration_std_work_size(c->ncam);
         c->rec_off = (int *)(c->rec + c->ncam);
         c->rec_idx = (int *)(c->rec + c->ncam + ints_as_doubles((size_t)c->ncam + 1));
     }
@@ -480,7 +475,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     double t_start, deadline;
     int st, k, iters = 0, k_needed;
     double cen[3];
-    const double *wlo;
+    const double *wlo, *wp;
 
     if (!o1 || !d1 || !o2 || !d2 || !cam1 || !cam2 || !res || !mask || !work)
         return MCG_EINVAL;
@@ -495,7 +490,8 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         mcg_robust_default_options(&c.opt);
     if (!check_options(&c.opt))
         return MCG_EINVAL;
-    st = check_inputs(n, o1, d1, o2, d2, cam1, cam2, n_cameras, focal, cam_axes, cam_focal);
+    st = check_inputs(n, o1, d1, o2, d2, cam1, cam2, n_cameras, focal, cam_axes, cam_focal,
+                      c.opt.extrinsic_std);
     if (st != MCG_OK)
         return st;
     if (lwork < mcg_robust_work_size(n, n_cameras))
@@ -662,9 +658,9 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     memcpy(res->R, c.R, sizeof c.R);
     memcpy(res->t, c.t, sizeof c.t);
     res->zero_profile = NAN;
+    /* the weights of the scale profiles (the final refinement's) */
+    wp = weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL);
     if (res->refined && c.opt.max_scale_rel_std > 0.0) {
-        const double *wp =
-            weights ? weights : (focal && (cam_axes || !c.const_focal) ? c.fsc : NULL);
         const double srs = res->refinement.scale_rel_std,
                      k1 = 1.0 + 3.0 * c.opt.max_scale_rel_std;
         const double f[2] = {1.0 / k1, k1}, f0[1] = {ZERO_FACTOR};
@@ -720,6 +716,8 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         res->have_verdict = mcg_verdict_stats(n, o1, d1, o2, d2, cam1, cam2, n_cameras, mask,
                                               res->R, tv, still, &res->verdict, c.vwork,
                                               mcg_verdict_stats_work_size(n_cameras)) == MCG_OK;
+        /* the verdict itself (robust_verdict.c) */
+        robust_scale_verdict(&c, res, mask, weights, wp);
     }
     res->seconds = now_seconds() - t_start;
     return MCG_OK;

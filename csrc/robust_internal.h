@@ -33,6 +33,21 @@
 /* mcgeom.observability's UNDETERMINED_REL_STD: above it the data define no
  * metric scale at all (tests/test_robust_c.py checks that the copies agree) */
 #define UNDETERMINED_REL_STD 1.0
+/* mcgeom.observability's ZERO_FACTOR (|t| shrunk to 1 %: a static rig?);
+ * tests/test_robust_c.py checks that the two copies agree; robust.c and
+ * robust_verdict.c compute it */
+#define ZERO_FACTOR 0.01
+
+/* observability.scale_determined's bound on the zero profile (a vanishing
+ * translation not excluded at 3 sigma): the zero profile is only compared
+ * with it, so its fit stops once below (the value is then an upper bound),
+ * or once evidently above (mcg_refine_motion_until: more than 100 times
+ * its last step's decrease above; issue 19, the fits crept down for up to
+ * 50 steps 10-20x above the bound: C instructions per estimate, 20
+ * problems of `mcgeom bench robust`, ladybug6 8.98 -> 8.22 M, car8
+ * 5.17 -> 4.55 M) */
+#define ZERO_PROFILE_BOUND 9.0
+
 /* pairs of the upright sampler's challenge subset (robust_offer.c) */
 #define RIVAL_SUB 64
 /* preemptive scoring from this many pairs on (robust_score.c) */
@@ -84,6 +99,7 @@ typedef struct {
     int *xorder;     /* its proposal order (line_scale draws it afresh) */
     double *msol;    /* the solutions of an upright / 6-point sample */
     double *vwork;   /* mcg_verdict_stats's workspace */
+    double *cwork;   /* mcg_calibration_scale_std's (the verdict's) */
     /* the two-stage 5+1 (REC_PAIRS): on when records is 1 */
     int records;
     double *rec;     /* per camera: the record inlier count on its subset */
@@ -242,5 +258,9 @@ void robust_rescale_refined(ctx *c, mcg_robust_result *res, unsigned char *mask,
 double robust_scale_profile(ctx *c, const mcg_robust_result *res, const unsigned char *mask,
                             const double *weights, const double *f, int nf, double stop_below);
 void robust_fill_covariance(mcg_robust_result *res);
+
+/* robust_verdict.c: the scale verdict of the result (res->scale) */
+void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *mask,
+                          const double *weights, const double *wp);
 
 #endif /* MCGEOM_ROBUST_INTERNAL_H */

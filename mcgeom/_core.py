@@ -1328,7 +1328,7 @@ SAMPLER_NAMES = {
     "eigensolver": lib.MCG_SAMPLER_EIGEN,
     "linear17": lib.MCG_SAMPLER_LINEAR17,
 }
-_SAMPLER_OF = {v: k for k, v in SAMPLER_NAMES.items()}
+SAMPLER_OF = {v: k for k, v in SAMPLER_NAMES.items()}
 #: the samplers that take central samples (5+1, the upright 3+1; "auto" may
 #: be 5+1), whose cameras must each have one centre: the others draw pairs
 #: of any cameras
@@ -1407,7 +1407,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                       gravity1: Any = None, gravity2: Any = None,
                       verdict_still_factor: float = 0.0,
                       prechecked: bool = False,
-                      search_info: Optional[dict] = None) -> Optional[dict]:
+                      search_info: Optional[dict] = None,
+                      extrinsic_std: Optional[np.ndarray] = None) -> Optional[dict]:
     """The whole robust estimate in C (``mcg_robust_rig_motion``).
 
     Rays as for :func:`gec_residuals` (rig frames at times 1 and 2, origins the
@@ -1459,6 +1460,18 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     the dict of :func:`verdict_stats` over the inliers at (R, t) with
     ``still_angle`` = that factor x ``loss_scale`` (3.5 from 4 up), from
     the same call (None otherwise, or beyond 2^20 pairs), ``sample_size``
+    ``scale`` (with ``verdict_still_factor`` > 0, else None): the scale
+    verdict of the call (``mcg_robust_scale``, csrc/robust_verdict.c) as a
+    dict -- ``reason`` (a value of ``SCALE_REASONS``), ``observable``,
+    ``determined``, ``translation_detected``, ``slid`` (-1: not judged),
+    ``t`` (the translation to report: metric when determined, else the unit
+    direction of travel, 0 when static), ``t_metric``, ``rel_std`` (noise
+    and calibration), ``rel_std_noise``, ``rel_std_calibration``,
+    ``verdict_rel_std``, ``profile``, ``front_fraction``, ``still_median``
+    (radians) and ``covariance`` (6, 6, with the calibration part), with
+    ``extrinsic_std`` (n_cameras, 2) float64 C-contiguous (metres,
+    radians per camera; None: the calibration known exactly) the
+    calibration error whose effect enters ``rel_std``; ``sample_size``
     (pairs per sample of the adaptive stop: 5 for 5+1, 3 and 4 for the
     upright sampler's 3+1 and 4-point samples, 6 for the 6-point, 17 for the
     eigensolver and linear17), ``confidence`` (1 - (1 - found_rate
@@ -1513,6 +1526,11 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     opt = ffi.new("mcg_robust_options *")
     ffi.memmove(opt, raw, _ROBUST_OPTIONS_SIZE)
     opt.seed = int(seed) % (1 << 64) if seed is not None else 0
+    ext = None   # (kept alive through the call: the options point into it)
+    if extrinsic_std is not None:
+        ext = extrinsic_std if prechecked else \
+            _f64("extrinsic_std", extrinsic_std, (int(n_cameras), 2))
+        opt.extrinsic_std = ffi.cast("const double *", _p(ext))
     if sampler == "upright_four_point":
         for name, g, field in (("gravity1", gravity1, opt.g1), ("gravity2", gravity2, opt.g2)):
             if g is None:
@@ -1551,6 +1569,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
                 raise ValueError("cam_axes contains NaN or inf")
             if cf is not None and not (np.isfinite(cf).all() and (cf > 0).all()):
                 raise ValueError("cam_focal must be finite and > 0 (pixels)")
+            if ext is not None and not (np.isfinite(ext).all() and (ext >= 0).all()):
+                raise ValueError("extrinsic_std must be finite and >= 0")
             if sampler in _CENTRAL_SAMPLERS:
                 _one_centre_error(rays, ids)
         _ray_error(st, "robust_rig_motion", rays)
@@ -1562,7 +1582,14 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
 _RES_SIZE = ffi.sizeof("mcg_robust_result")
 _RES_AT = {k: ffi.offsetof("mcg_robust_result", *f) // 8 for k, f in (
     ("covariance", ("covariance",)), ("information", ("refinement", "info")),
-    ("R_fit", ("verdict", "R_fit")), ("t_direction", ("verdict", "t_direction")))}
+    ("R_fit", ("verdict", "R_fit")), ("t_direction", ("verdict", "t_direction")),
+    ("scale_t", ("scale", "t")), ("scale_t_metric", ("scale", "t_metric")),
+    ("scale_covariance", ("scale", "covariance")))}
+
+#: the reasons of the C scale verdict (``mcg_robust_scale.reason``), by value
+SCALE_REASONS = {getattr(lib, "MCG_SCALE_" + k): k.lower() for k in (
+    "OBSERVABLE", "NO_REDUNDANCY", "ONE_CAMERA", "CRITICAL", "UNCERTAIN", "CHEIRALITY",
+    "UNCONFIRMED", "STATIC", "UNDECIDED")}
 
 
 def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
@@ -1590,8 +1617,73 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
         "scale_profile": res.scale_profile, "zero_profile": res.zero_profile,
         "inlier_rms": res.inlier_rms, "refinement": refinement,
         "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
-        "sampler": _SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
+        "sampler": SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
         "confidence": res.confidence, "found_rate": res.found_rate,
+        "scale": _scale_dict(res.scale, f) if res.have_scale else None,
+        "_res": res, "_f": f,
+    }
+
+
+def robust_pinhole_raw(intr: np.ndarray, rot: np.ndarray, centres: np.ndarray,
+                       focal: np.ndarray, ids1: np.ndarray, ids2: np.ndarray, px1: np.ndarray,
+                       px2: np.ndarray, options: tuple, seed: int,
+                       extrinsic_std: Optional[np.ndarray]) -> Optional[tuple]:
+    """``mcg_robust_rig_motion_pinhole`` -- the robust estimate from the pixels
+    of a rig of undistorted pinholes, its scale verdict included -- for a
+    caller that made every array itself (the rig's tables of
+    :attr:`mcgeom.rig.Rig.pinhole_tables`, ``extrinsic_std`` its
+    :attr:`~mcgeom.rig.Rig.calibration_error` or None, (N, 2) float64 and (N,)
+    int64 C-contiguous pixels and ids; not checked here, values are by the
+    kernel). ``options``: the arguments of :func:`robust_rig_motion` from
+    ``threshold`` to ``verdict_still_factor`` but the seed, as a tuple in
+    their order (threshold, prob, min_iterations, max_iterations,
+    max_seconds, lo_rounds, refine, loss, max_scale_rel_std, sampler,
+    verdict_still_factor; checked once per distinct tuple). Returns None
+    for N outside the kernel's bounds, else ``(status, res, buf, mask)``:
+    ``res`` the ``mcg_robust_result *``, ``buf`` the float64 buffer whose
+    ``[:N]`` are the final refinement's weights and whose ``[N:]`` is the
+    workspace (the rays at ``[N:13 N]``, as o1, d1, o2, d2 blocks of (N, 3),
+    and the pixels per radian at ``[13 N:14 N]``; the camera ids as int32 at
+    ``[14 N:...]``), ``mask`` the (N,) uint8 mask."""
+    n, m = px1.shape[0], intr.shape[0]
+    lwork = lib.mcg_robust_pinhole_work_size(n, m)
+    if lwork == 0:
+        return None
+    raw = _robust_options(*options)
+    opt = ffi.new("mcg_robust_options *")
+    ffi.memmove(opt, raw, _ROBUST_OPTIONS_SIZE)
+    opt.seed = seed % (1 << 64)
+    if extrinsic_std is not None:
+        opt.extrinsic_std = ffi.cast("const double *", _p(extrinsic_std))
+    buf = np.empty(n + lwork)
+    mask = np.empty(n, dtype=np.uint8)
+    res = ffi.new("mcg_robust_result *")
+    st = lib.mcg_robust_rig_motion_pinhole(
+        n, m, _p(intr), _p(rot), _p(centres), _p(focal), ffi.from_buffer("long long[]", ids1),
+        ffi.from_buffer("long long[]", ids2), _p(px1), _p(px2), opt, res,
+        ffi.from_buffer("unsigned char[]", mask), _p(buf), _p(buf[n:]), lwork)
+    return st, res, buf, mask
+
+
+def robust_struct(res: Any) -> np.ndarray:
+    """A float64 copy of an ``mcg_robust_result`` (its arrays at the offsets
+    of ``_RES_AT``)."""
+    return np.frombuffer(ffi.buffer(res, _RES_SIZE), dtype=np.float64).copy()
+
+
+def _scale_dict(s: Any, f: np.ndarray) -> dict:
+    """The ``scale`` entry of :func:`robust_rig_motion` from its
+    ``mcg_robust_scale`` (``f``: the result struct's copy, whose views its
+    arrays are)."""
+    i, j, k = _RES_AT["scale_t"], _RES_AT["scale_t_metric"], _RES_AT["scale_covariance"]
+    return {
+        "reason": SCALE_REASONS.get(s.reason, "unknown"), "observable": bool(s.observable),
+        "determined": bool(s.determined), "translation_detected": bool(s.translation_detected),
+        "slid": s.slid, "t": f[i:i + 3], "t_metric": f[j:j + 3], "rel_std": s.rel_std,
+        "rel_std_noise": s.rel_std_noise, "rel_std_calibration": s.rel_std_calibration,
+        "verdict_rel_std": s.verdict_rel_std, "profile": s.profile,
+        "front_fraction": s.front_fraction, "still_median": s.still_median,
+        "covariance": f[k:k + 36].reshape(6, 6),
     }
 
 

@@ -310,12 +310,17 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     if not (points2.shape[0] == n and _plain(cameraIds1, np.int64, 1) and
             _plain(ids2, np.int64, 1) and cameraIds1.shape[0] == n and ids2.shape[0] == n):
         return None
-    # (the kernel checks the pixels and the ids against the rig)
+    opts = _robust.ransac_options(1.0 if threshold is None else threshold, prob, maxIters, seed)
+    if gravity1 is None:
+        # pixels in, the verdict out, in one C call (the kernel checks the
+        # pixels and the ids against the rig)
+        tables = rig.pinhole_tables
+        return None if tables is None else _robust.estimate_pinhole_c(
+            tables, points1, points2, cameraIds1, ids2, opts, rig.calibration_error)
     out = pinhole_ray_pairs(rig, points1, points2, cameraIds1, ids2)
     if out is None:
         return None
     rays, ppr = out
-    opts = _robust.ransac_options(1.0 if threshold is None else threshold, prob, maxIters, seed)
     # (the sampler of choose_sampler, picked by the C search: "auto"; with a
     # vertical prior the upright 4-point one, as _gravity_method picks)
     method, prior = ("auto", None) if gravity1 is None else \

@@ -37,7 +37,7 @@ from .types import RayPairs, ScaleVerdict
 __all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
            "scale_determined", "UNDETERMINED_REL_STD", "ZERO_FACTOR", "calibration_scale_std",
            "combine_rel_std", "total_scale_std", "no_parallax", "with_calibration",
-           "scale_verdict_stats"]
+           "scale_verdict_stats", "verdict_text"]
 
 #: relative std of ``|t|`` above which the data define no metric scale at all:
 #: a one-sigma interval that reaches zero bounds neither the length nor (with
@@ -284,42 +284,62 @@ def _verdict(n_in: int, n_cross: int, n_centres: int, crit: float, rel_std: floa
     inliers of which ``n_cross`` cross-camera, ``n_centres`` cameras with
     intra-camera inliers and their critical angle ``crit`` (radians);
     ``in_front()`` the number of inliers in front of the cameras (asked
-    only when the scale would otherwise be called observable)."""
-    if n_in <= _MOTION_DOF:
+    only when the scale would otherwise be called observable). The rule is
+    the C library's (``mcg_scale_reason``, csrc/robust_verdict.c: the one
+    the robust search's own verdict applies), the words :func:`verdict_text`."""
+    # (direction_only: the refinement had to fix |t|, no std to judge)
+    rel = float("inf") if direction_only else float(rel_std)
+    reason = _core.lib.mcg_scale_reason(n_in, n_cross, n_centres, crit, rel, max_rel_std,
+                                        profile, -1)
+    n_front = -1
+    if reason < 0:
+        n_front = int(in_front())
+        reason = _core.lib.mcg_scale_reason(n_in, n_cross, n_centres, crit, rel, max_rel_std,
+                                            profile, n_front)
+    name = _core.SCALE_REASONS[reason]
+    return ScaleVerdict(name == "observable",
+                        verdict_text(name, n_in, n_cross, n_centres, crit, rel_std,
+                                     max_rel_std, profile, n_front / n_in if n_in else 0.0),
+                        float("nan"), float("inf") if name == "no_redundancy" else float(rel_std),
+                        crit)
+
+
+def verdict_text(reason: str, n_in: int, n_cross: int, n_centres: int, crit: float,
+                 rel_std: float, max_rel_std: float, profile: float,
+                 front: float = float("nan")) -> str:
+    """The words of a scale verdict: ``reason`` a value of
+    :data:`mcgeom._core.SCALE_REASONS` other than ``static``, ``unconfirmed``
+    and ``undecided`` (whose texts quote other evidence), with the evidence
+    of :func:`_verdict` (``front`` the fraction of the inliers in front of
+    the cameras, for ``cheirality``)."""
+    if reason == "no_redundancy":
         # no redundancy: the motion fits its 6 correspondences exactly whatever
         # the noise (a zero residual says nothing about |t|), and a minimal
         # 5+1 problem has up to ten exact solutions of which several can put
         # every point in front of the cameras (44 % of the noise-free
         # configurations of ``mcgeom experiment minimal_5p1``): nothing tells
         # the physical one
-        return ScaleVerdict(False, f"no redundancy: {n_in} correspondences for the "
-                                   f"{_MOTION_DOF} unknowns of the motion; other exact "
-                                   "solutions may exist and no uncertainty can be estimated",
-                            float("nan"), float("inf"), crit)
+        return (f"no redundancy: {n_in} correspondences for the {_MOTION_DOF} unknowns of "
+                "the motion; other exact solutions may exist and no uncertainty can be "
+                "estimated")
     evidence = (f"relative std of |t| {rel_std:.3g}, critical angle {math.degrees(crit):.3g} deg "
                 f"over {n_centres} cameras, {n_cross} cross-camera inliers")
     if math.isfinite(profile):
         sigmas = math.sqrt(max(profile, 0.0))
         evidence += f", |t| x/ {1 + 3 * max_rel_std:.2g} excluded at {sigmas:.2g} sigma"
-    if (direction_only or not math.isfinite(rel_std) or rel_std > max_rel_std
-            or (math.isfinite(profile) and profile < 9.0)):
-        if n_cross == 0 and n_centres < 2:
-            why = "one camera only and no cross-camera correspondence"
-        elif n_cross == 0 and crit < math.radians(0.05):
-            why = ("critical motion: camera displacements parallel (no rotation, thesis "
-                   "ch. 7.3.2, Theorem 3)")
-        else:
-            why = "scale too uncertain for the noise (near-critical motion)"
-        return ScaleVerdict(False, f"{why}; {evidence}", float("nan"), float(rel_std), crit)
-    # last guard against a confident wrong answer: a metric motion must put
-    # its inliers in front of the cameras (a flipped or twisted solution that
-    # survived the search puts most of them behind)
-    front = in_front() / n_in if n_in else 0.0
-    if front < 0.5:
-        return ScaleVerdict(False, f"cheirality fails: only {100 * front:.0f} % of the inliers "
-                                   f"triangulate in front of the cameras (a wrong solution?); "
-                                   f"{evidence}", float("nan"), float(rel_std), crit)
-    return ScaleVerdict(True, f"scale observable: {evidence}", float("nan"), float(rel_std), crit)
+    if reason == "observable":
+        return f"scale observable: {evidence}"
+    if reason == "cheirality":
+        # last guard against a confident wrong answer: a metric motion must put
+        # its inliers in front of the cameras (a flipped or twisted solution
+        # that survived the search puts most of them behind)
+        return (f"cheirality fails: only {100 * front:.0f} % of the inliers triangulate in "
+                f"front of the cameras (a wrong solution?); {evidence}")
+    why = {"one_camera": "one camera only and no cross-camera correspondence",
+           "critical": ("critical motion: camera displacements parallel (no rotation, thesis "
+                        "ch. 7.3.2, Theorem 3)"),
+           "uncertain": "scale too uncertain for the noise (near-critical motion)"}[reason]
+    return f"{why}; {evidence}"
 
 
 # ------------------------------------------------ calibration error of the rig

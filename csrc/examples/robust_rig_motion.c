@@ -13,7 +13,12 @@
  *      local optimisation, adaptive stop, final refinement) with a
  *      caller-allocated workspace of mcg_robust_work_size doubles;
  *   3. checks: rotation and metric translation against the truth, the
- *      returned mask against the outliers planted, R orthonormal.
+ *      returned mask against the outliers planted, R orthonormal, and the
+ *      call's scale verdict (res.scale: the metric scale is observable);
+ *   4. the same rig driving straight ahead without rotation and without
+ *      cross-camera pairs: the critical motion of thesis ch. 7.3.2, whose
+ *      data fix no metric scale. The verdict must say so and report a unit
+ *      direction of travel, never a metric-looking t.
  * The exit status is 0 iff all checks pass.
  *
  * Usage: robust_rig_motion [correspondences]   (default 400, at least 40)
@@ -58,14 +63,14 @@ static void unit(double v[3])
     v[2] /= s;
 }
 
-/* Pair k: camera k % N_CAMERAS at time 1, the same or (every 5th pair) the
- * next camera at time 2; the first n_out pairs are outliers. */
-static void synthesize(int n, int n_out, const double R[9], const double t[3], double *o1,
-                       double *d1, double *o2, double *d2, int *cam1, int *cam2)
+/* Pair k: camera k % N_CAMERAS at time 1, the same or (every 5th pair, when
+ * cross) the next camera at time 2; the first n_out pairs are outliers. */
+static void synthesize(int n, int n_out, int cross, const double R[9], const double t[3],
+                       double *o1, double *d1, double *o2, double *d2, int *cam1, int *cam2)
 {
     int k, i;
     for (k = 0; k < n; ++k) {
-        int a = k % N_CAMERAS, b = k % 5 == 4 ? (a + 1) % N_CAMERAS : a;
+        int a = k % N_CAMERAS, b = cross && k % 5 == 4 ? (a + 1) % N_CAMERAS : a;
         double ya = 2.0 * PI * a / N_CAMERAS, yb = 2.0 * PI * b / N_CAMERAS;
         double ca[3] = {RING_RADIUS * cos(ya), RING_RADIUS * sin(ya), 0.0};
         double cb[3] = {RING_RADIUS * cos(yb), RING_RADIUS * sin(yb), 0.0};
@@ -114,7 +119,11 @@ int main(int argc, char **argv)
 {
     const double w_true[3] = {0.08, -0.15, 0.12}; /* angle-axis, radians */
     const double t_true[3] = {0.40, -0.25, 0.10}; /* metres */
-    double R_true[9], *o1, *d1, *o2, *d2, *work, dt = 0.0, nt = 0.0, orth = 0.0;
+    /* the rig's calibration error per camera: 2 mm (per axis) for its centre,
+     * 0.1 mrad for its orientation; it enters the verdict's std of |t| */
+    const double extrinsic_std[2 * N_CAMERAS] = {2e-3, 1e-4, 2e-3, 1e-4, 2e-3, 1e-4, 2e-3, 1e-4};
+    const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, t_straight[3] = {0.0, 0.8, 0.0};
+    double R_true[9], *o1, *d1, *o2, *d2, *work, dt = 0.0, nt = 0.0, orth = 0.0, nu;
     int *cam1, *cam2, n = 400, n_out, st, k, i, j, caught = 0, lost = 0;
     unsigned char *mask;
     size_t lwork;
@@ -148,7 +157,7 @@ int main(int argc, char **argv)
         printf("FAIL mcg_rot_from_angle_axis: %s\n", mcg_status_message(st));
         return 1;
     }
-    synthesize(n, n_out, R_true, t_true, o1, d1, o2, d2, cam1, cam2);
+    synthesize(n, n_out, 1, R_true, t_true, o1, d1, o2, d2, cam1, cam2);
     printf("%d cameras, %d correspondences (%d outliers), bearing noise %.0e rad; "
            "true t = (%.2f, %.2f, %.2f) m\n", N_CAMERAS, n, n_out, BEARING_NOISE, t_true[0],
            t_true[1], t_true[2]);
@@ -156,6 +165,12 @@ int main(int argc, char **argv)
     mcg_robust_default_options(&opt);
     opt.threshold = 4.0 * BEARING_NOISE; /* radians: no focal lengths given */
     opt.seed = 1;
+    /* the scale verdict in the same call (res.scale): metric only when the
+     * relative std of |t| is at most 10 % and |t| x/ 1.3 is excluded at 3
+     * sigma; 1.5 noise levels for the rotation-only (static rig) test */
+    opt.max_scale_rel_std = 0.1;
+    opt.verdict_still_factor = 1.5;
+    opt.extrinsic_std = extrinsic_std;
     st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, N_CAMERAS, NULL, NULL, NULL, &opt,
                                &res, mask, NULL, work, lwork);
     if (st != MCG_OK) {
@@ -163,9 +178,11 @@ int main(int argc, char **argv)
         return 1;
     }
     printf("%d samples, %d hypotheses, %d local optimisations, %d inliers, %.2f ms; "
-           "t = (%.4f, %.4f, %.4f) m, relative std of |t| %.3g\n", res.iterations,
-           res.hypotheses, res.local_optimizations, res.n_inliers, 1e3 * res.seconds, res.t[0],
-           res.t[1], res.t[2], res.refinement.scale_rel_std);
+           "t = (%.4f, %.4f, %.4f) m, relative std of |t| %.3g (noise %.3g, calibration "
+           "%.3g): %s\n", res.iterations, res.hypotheses, res.local_optimizations, res.n_inliers,
+           1e3 * res.seconds, res.scale.t[0], res.scale.t[1], res.scale.t[2], res.scale.rel_std,
+           res.scale.rel_std_noise, res.scale.rel_std_calibration,
+           mcg_scale_reason_string(res.scale.reason));
 
     for (i = 0; i < 3; ++i) {
         dt += (res.t[i] - t_true[i]) * (res.t[i] - t_true[i]);
@@ -185,11 +202,32 @@ int main(int argc, char **argv)
            rotation_error_deg(res.R, R_true), 0.2);
     expect(sqrt(dt / nt) < 0.05, "metric translation: |t - t_true| / |t_true|", sqrt(dt / nt),
            0.05);
-    expect(res.refinement.scale_rel_std < 0.1, "relative std of |t| (scale observable)",
-           res.refinement.scale_rel_std, 0.1);
+    expect(res.have_scale && res.scale.observable && res.scale.reason == MCG_SCALE_OBSERVABLE,
+           "scale verdict: observable (1 = yes)", res.scale.observable, 1);
+    expect(res.scale.rel_std <= 0.1, "relative std of |t| (noise and calibration)",
+           res.scale.rel_std, 0.1);
     expect(caught >= 0.95 * n_out, "outliers rejected (count)", caught, 0.95 * n_out);
     expect(lost <= 0.1 * (n - n_out), "inliers rejected (count)", lost, 0.1 * (n - n_out));
     expect(orth < 1e-9, "max |R R^T - I|", orth, 1e-9);
+
+    /* 4. driving straight, intra-camera pairs only: no metric scale */
+    synthesize(n, n_out, 0, I3, t_straight, o1, d1, o2, d2, cam1, cam2);
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, cam1, cam2, N_CAMERAS, NULL, NULL, NULL, &opt,
+                               &res, mask, NULL, work, lwork);
+    if (st != MCG_OK) {
+        printf("FAIL mcg_robust_rig_motion (straight): %s\n", mcg_status_message(st));
+        return 1;
+    }
+    nu = sqrt(res.scale.t[0] * res.scale.t[0] + res.scale.t[1] * res.scale.t[1] +
+              res.scale.t[2] * res.scale.t[2]);
+    printf("driving straight, no cross-camera pairs: t = (%.4f, %.4f, %.4f), relative std "
+           "of |t| %.3g: %s\n", res.scale.t[0], res.scale.t[1], res.scale.t[2],
+           res.scale.rel_std, mcg_scale_reason_string(res.scale.reason));
+    expect(res.have_scale && !res.scale.observable, "critical motion: scale not observable "
+           "(0 = right)", res.scale.observable, 0);
+    expect(!res.scale.determined && fabs(nu - 1.0) < 1e-12, "  and t a unit direction: "
+           "| |t| - 1 |", fabs(nu - 1.0), 1e-12);
+    expect(res.scale.t[1] > 0.99, "  along the travel: t_y of the unit t", res.scale.t[1], 0.99);
 
     free(o1);
     free(d1);

@@ -1080,7 +1080,106 @@ typedef struct {
                             inliers, res->verdict) with still_angle = this
                             factor x res->loss_scale (3.5 from 4 up), in the
                             same call; 0 = not, finite in [0, 1e6] [0] */
+    /* The scale verdict in C (ABI: one more appended field, see above): */
+    const double *extrinsic_std; /* NULL (the calibration known exactly), or
+                            2 n_cameras values >= 0: per camera the 1-sigma
+                            error of its centre (metres per axis) and of its
+                            orientation (radians per axis); their effect on
+                            |t| (mcg_calibration_scale_std) enters
+                            res->scale.rel_std [NULL] */
 } mcg_robust_options;
+
+/* mcg_robust_scale.reason: the verdict on the metric scale of a robust
+ * estimate (thesis ch. 7.3.2; mcgeom.observability's verdict, whose texts
+ * say the same). Only MCG_SCALE_OBSERVABLE presents t as metric. */
+enum {
+    MCG_SCALE_OBSERVABLE = 0,    /* relative std of |t| (noise and calibration)
+                                    at most max_scale_rel_std, |t| x/ (1 + 3
+                                    max_scale_rel_std) excluded at 3 sigma by
+                                    the scale profile, and at least half of
+                                    the inliers in front of the cameras */
+    MCG_SCALE_NO_REDUNDANCY = 1, /* 6 inliers or fewer: the motion fits them
+                                    exactly, no uncertainty can be estimated */
+    MCG_SCALE_ONE_CAMERA = 2,    /* too uncertain: one camera with intra-camera
+                                    inliers and no cross-camera inlier */
+    MCG_SCALE_CRITICAL = 3,      /* too uncertain: no cross-camera inlier and
+                                    the cameras' displacements parallel within
+                                    0.05 deg (no rotation, thesis Theorem 3) */
+    MCG_SCALE_UNCERTAIN = 4,     /* too uncertain for the noise (near-critical
+                                    motion, or the calibration error) */
+    MCG_SCALE_CHEIRALITY = 5,    /* fewer than half of the inliers triangulate
+                                    in front of the cameras (a wrong solution?) */
+    MCG_SCALE_UNCONFIRMED = 6,   /* a cap ended the search at a confidence
+                                    below 0.5: the consensus may be a partial
+                                    fit */
+    MCG_SCALE_STATIC = 7,        /* no translation detected: a pure rotation
+                                    explains 90 % of the intra-camera inliers
+                                    within 1.5 noise levels (static rig, pure
+                                    rotation, scene at infinity); t = 0 */
+    MCG_SCALE_UNDECIDED = 8      /* the evidence is incomplete (no verdict
+                                    evidence gathered, intra-camera bearings of
+                                    rank < 2 for the rotation-only test, or a
+                                    failed calibration propagation): not
+                                    metric; mcgeom's Python layer decides these
+                                    with numpy */
+};
+
+/* The scale verdict of mcg_robust_rig_motion (res->scale, when
+ * res->have_scale): what to report and why. */
+typedef struct {
+    int reason;             /* MCG_SCALE_* */
+    int observable;         /* 1 iff reason is MCG_SCALE_OBSERVABLE */
+    int determined;         /* 1: t below is the metric maximum-likelihood
+                               estimate (trusted only when observable);
+                               0: t is a unit direction (or 0, static) */
+    int translation_detected; /* 0 for MCG_SCALE_STATIC */
+    int slid;               /* 1: not observable and the refined t slid out
+                               along the flat |t| valley (|t| over 10 x the
+                               hypothesis' |t|, or within ~25 deg of the
+                               mirrored travel direction); -1: not judged
+                               (observable, static or undecided) */
+    double t[3];            /* the translation to report: metric when
+                               determined, else the unit direction of travel
+                               (0 for MCG_SCALE_STATIC) */
+    double t_metric[3];     /* the metric estimate whatever the verdict (the
+                               hypothesis' length along the travel direction
+                               when slid) */
+    double rel_std;         /* relative std of |t|, noise and calibration in
+                               quadrature (HUGE_VAL without a refinement or
+                               with a singular one) */
+    double rel_std_noise;   /* the refinement's part (NaN without one) */
+    double rel_std_calibration; /* the calibration part (0 with
+                               extrinsic_std NULL; NaN without a refinement) */
+    double verdict_rel_std; /* rel_std as the verdict quotes it (HUGE_VAL for
+                               MCG_SCALE_NO_REDUNDANCY) */
+    double profile;         /* the scale profile the verdict read (NaN: none,
+                               it was not needed) */
+    double front_fraction;  /* inliers in front / inliers (NaN: not asked) */
+    double still_median;    /* MCG_SCALE_STATIC: median angle (radians) of the
+                               intra-camera inliers under the pure rotation */
+    double covariance[36];  /* res->covariance plus the calibration part
+                               (order [dw rad, dtau m]) */
+} mcg_robust_scale;
+
+/* A short text for an MCG_SCALE_* value (static storage; "unknown" for any
+ * other value). */
+const char *mcg_scale_reason_string(int reason);
+
+/* The reason of the scale verdict from its evidence (mcgeom.observability's
+ * rule, thesis ch. 7.3.2): n_inliers of which n_cross cross-camera,
+ * n_cameras_intra cameras with intra-camera inliers and their critical
+ * angle (radians, mcg_verdict_stats), rel_std the relative std of |t|
+ * (noise and calibration; HUGE_VAL: none), max_rel_std the bound of a
+ * metric verdict, profile the scale profile at 1 +- 3 max_rel_std (NaN: not
+ * computed), n_in_front the inliers in front of the cameras. Returns
+ * MCG_SCALE_NO_REDUNDANCY (n_inliers <= 6), MCG_SCALE_ONE_CAMERA,
+ * MCG_SCALE_CRITICAL or MCG_SCALE_UNCERTAIN (rel_std not finite or above
+ * max_rel_std, or profile below 9), MCG_SCALE_CHEIRALITY (under half in
+ * front) or MCG_SCALE_OBSERVABLE; -1 when n_in_front < 0 (not counted) and
+ * only it can decide. The static and unconfirmed verdicts are the
+ * caller's (mcg_robust_rig_motion gives all of them in res->scale). */
+int mcg_scale_reason(int n_inliers, int n_cross, int n_cameras_intra, double critical_angle,
+                     double rel_std, double max_rel_std, double profile, int n_in_front);
 
 /* mcg_robust_options.sampler: how hypotheses are drawn */
 enum {
@@ -1124,8 +1223,9 @@ enum {
 typedef struct {
     double R[9];            /* rig2_from_rig1 rotation (row-major) */
     double t[3];            /* translation, metres (the unit of the origins);
-                               metric only if the data fix the scale: judge
-                               that with refinement.scale_rel_std */
+                               metric only if the data fix the scale: the
+                               verdict res->scale says so, and gives the t
+                               to report */
     double t_hypothesis[3]; /* t of the best hypothesis before the final
                                refinement (its length is the 5+1 scale) */
     double score;           /* MSAC score of that hypothesis (threshold^2) */
@@ -1185,6 +1285,12 @@ typedef struct {
                                consensus' motion (in (0, 1); the adaptive
                                stop and confidence use found_rate w^6); 1
                                for the complete solvers */
+    /* The scale verdict in C (ABI: appended fields, see above): */
+    int have_scale;         /* 1 when scale holds the verdict (the call
+                               returned MCG_OK with
+                               opt->verdict_still_factor > 0) */
+    mcg_robust_scale scale; /* the verdict: whether t is metric, the t to
+                               report, and why (MCG_SCALE_*) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
@@ -1192,7 +1298,7 @@ void mcg_robust_default_options(mcg_robust_options *opt);
 
 /* Doubles of workspace for mcg_robust_rig_motion: about 17.5 n + 300 up to
  * 4096 pairs, 16.5 n + 4400 up to 16383, 16.5 n + 62000 beyond, plus
- * 3.5 n_cameras (0 for n outside [6, 2^26] or n_cameras outside [1, 4096]). */
+ * 39.5 n_cameras (0 for n outside [6, 2^26] or n_cameras outside [1, 4096]). */
 size_t mcg_robust_work_size(int n, int n_cameras);
 
 /* Robust rig motion rig2_from_rig1 from n ray correspondences with
@@ -1246,7 +1352,14 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * pixel scaling at the motion (mcg_sampson_pixel_scale). opt: NULL =
  * defaults. Outputs: res; mask (n bytes): bit 0 inlier, bit 1 used by the
  * final refinement; weights (may be NULL): the final refinement's weights
- * (0 for unused pairs). Returns MCG_OK, MCG_EDEGENERATE when no motion
+ * (0 for unused pairs). With opt->verdict_still_factor > 0, res->scale is
+ * the scale verdict (csrc/robust_verdict.c; mcg_robust_scale): the
+ * relative std of |t| from the final refinement and the calibration error
+ * of opt->extrinsic_std in quadrature, the scale profiles, the evidence of
+ * res->verdict, and the cap's confidence decide whether t is metric, and
+ * res->scale.t is the translation to report (metric, the unit direction of
+ * travel, or 0 for a static rig); a profile the verdict needs and the call
+ * had not computed is computed then. Returns MCG_OK, MCG_EDEGENERATE when no motion
  * explains 6 correspondences (res has the counts; e.g. no camera with 5
  * intra-camera correspondences, fewer than 17 pairs with MCG_SAMPLER_EIGEN
  * or MCG_SAMPLER_LINEAR17,
@@ -1278,6 +1391,36 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                           const double *cam_focal, const mcg_robust_options *opt,
                           mcg_robust_result *res, unsigned char *mask, double *weights,
                           double *work, size_t lwork);
+/* -------------------------------------------------------- robust_pinhole.c */
+
+/* Doubles of workspace of mcg_robust_rig_motion_pinhole: mcg_robust_work_size
+ * plus 14 n + 3 n_cameras (0 outside its bounds). */
+size_t mcg_robust_pinhole_work_size(int n, int n_cameras);
+
+/* The robust rig motion rig2_from_rig1 from n pixel correspondences of a rig
+ * of n_cameras undistorted pinholes (the whole job of mcgeom.cv.estimate for
+ * such a rig): the rays and pixels per radian of mcg_pinhole_ray_pairs
+ * (intr, rot, centres, focal, ids1, ids2, px1, px2 as there; focal is
+ * required), then mcg_robust_rig_motion on them with threshold in pixels:
+ * focal = each pair's pixels per radian, cam_axes the cameras' optical axes
+ * (row 2 of each rot), cam_focal = focal. opt, res, mask, weights as for
+ * mcg_robust_rig_motion (with opt->verdict_still_factor > 0, res->scale
+ * says whether t is metric). On return work[0 .. 12 n) holds the rays o1,
+ * d1, o2, d2 (n x 3 each, rig frames, metres) and work[12 n .. 13 n) the
+ * pixels per radian (whatever the status, once the pixels were converted).
+ * MCG_EINVAL: NULL pointers, n, n_cameras outside [1, 4096] or the pixels'
+ * and tables' errors of mcg_pinhole_ray_pairs, and those of
+ * mcg_robust_rig_motion; MCG_EDEGENERATE: fewer than 6 distinct
+ * correspondences (rays and ids; repeats constrain nothing more), or
+ * mcg_robust_rig_motion's; MCG_ENOMEM: lwork below
+ * mcg_robust_pinhole_work_size. */
+int mcg_robust_rig_motion_pinhole(int n, int n_cameras, const double *intr, const double *rot,
+                                  const double *centres, const double *focal,
+                                  const long long *ids1, const long long *ids2,
+                                  const double *px1, const double *px2,
+                                  const mcg_robust_options *opt, mcg_robust_result *res,
+                                  unsigned char *mask, double *weights, double *work,
+                                  size_t lwork);
 /* ------------------------------------------------------ calibration_std.c */
 
 /* Doubles of workspace of mcg_calibration_scale_std (0 for n_cameras outside

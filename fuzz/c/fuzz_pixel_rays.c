@@ -8,7 +8,12 @@
  * NULL focal with ppr, ids out of range, NaN/inf in a table or pixel give
  * MCG_EINVAL; *bad is -1 or the index of a pixel whose bearing overflows;
  * on MCG_OK every origin is its camera's centre, every bearing is unit,
- * and every pixels-per-radian value is finite and > 0.
+ * and every pixels-per-radian value is finite and > 0. With ppr, the same
+ * input through mcg_robust_rig_motion_pinhole (the robust estimate from
+ * pixels, at most 10 samples): where the ray pass fails it fails with the
+ * same status (EINVAL below 6 pairs); otherwise its workspace holds the
+ * ray pass's rays and pixels per radian bit for bit, and on MCG_OK R is a
+ * rotation and the scale verdict is there.
  */
 #include "fuzz_input.h"
 #include "mcgeom.h"
@@ -17,6 +22,54 @@
 
 #define MAXN 64
 #define MAXM 8
+
+/* mcg_robust_rig_motion_pinhole on the same input (see the file comment);
+ * st_rays: the ray pass's status */
+static void robust_from_pixels(int n, int m, const double *intr, const double *rot,
+                               const double *cen, const double *foc, const long long *ids1,
+                               const long long *ids2, const double *px1, const double *px2,
+                               const double *o1, const double *d1, const double *o2,
+                               const double *d2, const double *ppr, int st_rays, uint64_t seed)
+{
+    static unsigned char mask[MAXN];
+    static double wts[MAXN];
+    const size_t lwork = mcg_robust_pinhole_work_size(n, m);
+    mcg_robust_options opt;
+    mcg_robust_result res;
+    double *work;
+    int st;
+    if (n < 6) {
+        FZ_CHECK(lwork == 0, "pinhole work size %zu for n = %d", lwork, n);
+        return;
+    }
+    mcg_robust_default_options(&opt);
+    opt.threshold = 1.0;
+    opt.max_iterations = 10;
+    opt.max_seconds = 0.2;
+    opt.seed = seed;
+    opt.max_scale_rel_std = 0.1;
+    opt.verdict_still_factor = 1.5;
+    work = fz_alloc(lwork);
+    st = mcg_robust_rig_motion_pinhole(n, m, intr, rot, cen, foc, ids1, ids2, px1, px2, &opt,
+                                       &res, mask, wts, work, lwork);
+    FZ_CHECK(fz_status_known(st), "robust_rig_motion_pinhole status %d", st);
+    if (st_rays != MCG_OK) {
+        FZ_CHECK(st == st_rays, "robust_rig_motion_pinhole %d where the ray pass gave %d", st,
+                 st_rays);
+    } else {
+        const size_t b = 3 * (size_t)n * sizeof(double);
+        FZ_CHECK(memcmp(work, o1, b) == 0 && memcmp(work + 3 * n, d1, b) == 0 &&
+                     memcmp(work + 6 * n, o2, b) == 0 && memcmp(work + 9 * n, d2, b) == 0 &&
+                     memcmp(work + 12 * n, ppr, (size_t)n * sizeof(double)) == 0,
+                 "robust_rig_motion_pinhole: rays differ from the ray pass (status %d)", st);
+        if (st == MCG_OK) {
+            FZ_CHECK(fz_is_rotation(res.R, 1e-9), "robust_rig_motion_pinhole: R not a rotation");
+            FZ_CHECK(res.have_scale == res.have_verdict, "robust_rig_motion_pinhole: verdict %d, "
+                     "evidence %d", res.have_scale, res.have_verdict);
+        }
+    }
+    free(work);
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -72,6 +125,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     st = mcg_pinhole_ray_pairs(n, m, intr, rot, cen, foc, ids1, ids2, px1, px2, o1, d1, o2, d2,
                                want_ppr ? ppr : NULL, &bad);
     FZ_CHECK(fz_status_known(st), "pinhole_ray_pairs status %d", st);
+    if (want_ppr)
+        robust_from_pixels(n, m, intr, rot, cen, foc, ids1, ids2, px1, px2, o1, d1, o2, d2, ppr,
+                           st, fz_u64(&in));
     FZ_CHECK(bad == -1 || (st == MCG_EINVAL && bad >= 0 && bad < 2 * n),
              "pinhole_ray_pairs: bad = %d with status %d", bad, st);
     ok_tables = fz_all_finite(intr, 5 * (size_t)m) && fz_all_finite(rot, 9 * (size_t)m) &&

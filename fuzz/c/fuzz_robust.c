@@ -6,7 +6,8 @@
  * cross-camera pairs, a few entries arbitrary), mode 1 arbitrary arrays;
  * camera ids (1 in 16 out of range), optional per-pair focal lengths and
  * camera table, options valid or not (threshold, prob, iteration budgets,
- * LO rounds, loss), the sampler (a byte: 5+1, upright 4-point with the
+ * LO rounds, loss), the calibration table of the verdict (none, or 2 per
+ * camera, 1 in 16 arbitrary), the sampler (a byte: 5+1, upright 4-point with the
  * true vertical in mode 0 and arbitrary vectors in mode 1 -- zero, NaN,
  * huge --, 6-point, AUTO, the eigensolver, linear17, the local 6-point, or 1 in 16 an
  * unknown one), the verdict's evidence asked for or not, and a workspace 1
@@ -27,7 +28,14 @@
  * one asked for (AUTO: 5+1 or the local 6-point), its found_rate in (0, 1]
  * (1 but for the local 6-point), the verdict's evidence is there
  * exactly when asked for and counts the mask's inliers, and the covariance
- * is finite (or HUGE_VAL everywhere).
+ * is finite (or HUGE_VAL everywhere). The scale verdict (res.scale, with
+ * the evidence): a known reason; observable exactly for
+ * MCG_SCALE_OBSERVABLE, and then determined with rel_std <=
+ * max_scale_rel_std; a determined t is res.t, an undetermined one (not
+ * static, not undecided) a unit vector, a static one 0; rel_std never
+ * negative or NaN; unconfirmed exactly when a cap ended the search below a
+ * confidence of 0.5 (reasons other than static and undecided). A negative
+ * or non-finite calibration std is MCG_EINVAL.
  * Bounded time: max_iterations <= 200 (<= 3 with the 6-point sampler,
  * whose solver takes about a second per sample under the sanitizers, <= 20
  * with the local one) and
@@ -129,9 +137,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_in in = fz_make(data, size);
     int mode = fz_u8(&in) % FUZZ_MODES, valid, st, i, ncams, ids_ok = 1, opt_ok, f_ok = 1;
+    int ext_ok = 1;
     int n = fz_size(&in, 6, MAXN, &valid), use_focal, use_table, short_work, cnt0, cnt1;
     static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], res_chk[MAXN];
-    static double focal[MAXN], axes[3 * MAXCAM], cfocal[MAXCAM], wts[MAXN];
+    static double focal[MAXN], axes[3 * MAXCAM], cfocal[MAXCAM], wts[MAXN], ext[2 * MAXCAM];
     static int cam1[MAXN], cam2[MAXN];
     static unsigned char mask[MAXN];
     double R[9], tt[3], *work;
@@ -233,6 +242,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
     opt.verdict_still_factor = fz_u8(&in) & 1 ? fz_range(&in, 0.0, 10.0) : 0.0;
+    if (fz_u8(&in) & 1) { /* the verdict's calibration table */
+        for (i = 0; i < 2 * ncams; ++i) {
+            ext[i] = fz_u8(&in) % 16 == 0 ? fz_double(&in) : fz_range(&in, 0.0, 0.01);
+            ext_ok &= isfinite(ext[i]) && ext[i] >= 0.0;
+        }
+        opt.extrinsic_std = ext;
+    }
     if (fz_u8(&in) % 16 == 0) {
         switch (fz_u8(&in) % 4) {
         case 0: opt.threshold = fz_double(&in); break;
@@ -252,8 +268,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                mask, wts, work, lwork - (size_t)short_work);
     free(work);
     FZ_CHECK(fz_status_known(st), "unknown status %d", st);
-    if (!ids_ok || !opt_ok || !f_ok || (use_table && !fz_all_finite(axes, 3 * (size_t)ncams))) {
-        FZ_CHECK(st == MCG_EINVAL, "bad ids/options/focal/axes gave status %d", st);
+    if (!ids_ok || !opt_ok || !f_ok || !ext_ok ||
+        (use_table && !fz_all_finite(axes, 3 * (size_t)ncams))) {
+        FZ_CHECK(st == MCG_EINVAL, "bad ids/options/focal/axes/calibration gave status %d", st);
         return 0;
     }
     if (!fz_all_finite(o1, 3 * (size_t)n) || !fz_all_finite(d1, 3 * (size_t)n) ||
@@ -329,6 +346,35 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                    res.verdict.n_in_front <= res.n_inliers),
              "verdict counts %d inliers (%d in front), the mask %d", res.verdict.n_inliers,
              res.verdict.n_in_front, res.n_inliers);
+    /* the scale verdict */
+    FZ_CHECK(res.have_scale == res.have_verdict, "verdict %d with evidence %d", res.have_scale,
+             res.have_verdict);
+    if (res.have_scale) {
+        const mcg_robust_scale *v = &res.scale;
+        const double nt = sqrt(v->t[0] * v->t[0] + v->t[1] * v->t[1] + v->t[2] * v->t[2]);
+        FZ_CHECK(v->reason >= MCG_SCALE_OBSERVABLE && v->reason <= MCG_SCALE_UNDECIDED,
+                 "scale reason %d", v->reason);
+        FZ_CHECK(v->observable == (v->reason == MCG_SCALE_OBSERVABLE),
+                 "observable %d with reason %d", v->observable, v->reason);
+        FZ_CHECK(!v->observable || (v->determined && v->rel_std <= opt.max_scale_rel_std),
+                 "observable with determined %d, rel_std %g", v->determined, v->rel_std);
+        FZ_CHECK(!(v->rel_std < 0.0) && !isnan(v->rel_std), "rel_std %g", v->rel_std);
+        FZ_CHECK((v->reason == MCG_SCALE_STATIC) == (!v->translation_detected &&
+                                                      v->reason != MCG_SCALE_UNDECIDED),
+                 "static reason %d, translation detected %d", v->reason,
+                 v->translation_detected);
+        if (v->reason == MCG_SCALE_STATIC)
+            FZ_CHECK(nt == 0.0, "static verdict with |t| %g", nt);
+        else if (v->determined)
+            FZ_CHECK(memcmp(v->t, res.t, sizeof res.t) == 0, "determined t is not res.t");
+        else if (v->reason != MCG_SCALE_UNDECIDED)
+            FZ_CHECK(fabs(nt - 1.0) <= 1e-9, "undetermined t of length %.17g", nt);
+        if (v->reason != MCG_SCALE_STATIC && v->reason != MCG_SCALE_UNDECIDED)
+            FZ_CHECK((v->reason == MCG_SCALE_UNCONFIRMED) ==
+                         (res.stop != MCG_ROBUST_STOP_CONFIDENCE && !(res.confidence >= 0.5)),
+                     "reason %d with stop %d and confidence %g", v->reason, res.stop,
+                     res.confidence);
+    }
     /* the covariance: finite, or HUGE_VAL everywhere (no SPD information) */
     {
         int n_huge = 0, n_fin = 0;

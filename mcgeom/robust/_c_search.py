@@ -19,7 +19,7 @@ from ._no_motion import (MAX_THRESHOLD_RAD, FITS_RAD, check_threshold_angle, not
                          per_camera_counts)
 from ._options import C_SAMPLERS, RansacOptions
 from ._scoring import Scorer
-from ._verdict import conclude, unconfirmed_reason
+from ._verdict import C_WORDED, conclude, conclude_c, unconfirmed_reason
 
 
 def _camera_count(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, int]:
@@ -141,9 +141,11 @@ def ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions
     prechecked = ids32 and (focal is None or focal.flags.c_contiguous) and \
         (pixel_cameras is None or from_rig)
 
+    ext = _extrinsic_table(calibration_std, n_cameras)
+
     def search(threshold: float, refine: bool, ended: Optional[dict] = None) -> Optional[dict]:
         return _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
-                         threshold, refine, method, seed, prechecked, solver_kw, ended)
+                         threshold, refine, method, seed, prechecked, solver_kw, ended, ext)
 
     ended: dict = {}
     out = search(options.threshold, options.refine, ended)
@@ -200,12 +202,81 @@ def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.
     n_cameras = len(cam_focal)
     # (ids of the rig's cameras, checked by its ray kernel: int32 for C)
     cam1, cam2 = rays.cam1.astype(np.int32), rays.cam2.astype(np.int32)
+    # (the rig's calibration table: float64 C-contiguous (n_cameras, 2), >= 0)
     out = _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
-                    options.threshold, options.refine, method, _c_seed(options), True, solver_kw)
+                    options.threshold, options.refine, method, _c_seed(options), True, solver_kw,
+                    None, calibration_std)
     if out is None or out["n_inliers"] <= 6:
         return None
     return _c_conclude(rays, out, focal, options, out["sampler"], t_start, calibration_std,
                        cam1, cam2, n_cameras)
+
+
+def _search_info(res: Any, method: str) -> dict:
+    """``info``'s entries of the search (``res``: the ``mcg_robust_result *``
+    of the C search, ``method`` the sampler it used)."""
+    sampler = _core.SAMPLER_OF[res.sampler]
+    info = {"iterations": res.iterations, "hypotheses": res.hypotheses,
+            "local_optimizations": res.local_optimizations, "score": res.score,
+            "stop": _core.ROBUST_STOP_NAMES.get(res.stop, "unknown"), "c_seconds": res.seconds,
+            "sampler": method, "sample_size": res.sample_size, "confidence": res.confidence}
+    if sampler.startswith("six_point"):
+        info["six_point_solver"] = "homotopy" if sampler == "six_point_homotopy" else "local"
+        info["found_rate"] = res.found_rate
+    return info
+
+
+def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
+                       ids2: np.ndarray, options: RansacOptions,
+                       calibration_std: Optional[np.ndarray]) -> Optional[RigMotion]:
+    """The robust estimate of :func:`mcgeom.cv.estimate` from the pixels of a
+    rig of undistorted pinholes in one C call (``_core.robust_pinhole_raw``:
+    the rays, the search, the final refinement and the scale verdict), the
+    verdict worded here: :func:`ransac_rig_c`'s RigMotion for ``method``
+    "auto" without its Python steps (issue 19). ``tables`` the rig's
+    :attr:`~mcgeom.rig.Rig.pinhole_tables`, ``calibration_std`` its
+    :attr:`~mcgeom.rig.Rig.calibration_error`; pixels (N, 2) float64 and
+    ids (N,) int64, C-contiguous (their values are the kernel's to check).
+    None where :func:`ransac_rig_c` returns None or its ray pass refuses the
+    input (a bad pixel or id, fewer than 6 distinct correspondences, no
+    consensus, a threshold above 1 rad at some pair): the caller's general
+    path then decides, and names what is wrong."""
+    n = px1.shape[0]
+    if n <= 6 or options.strategy != "auto":
+        return None
+    t_start = time.perf_counter()
+    intr, rot, centres, focal = tables
+    got = _core.robust_pinhole_raw(
+        intr, rot, centres, focal, ids1, ids2, px1, px2,
+        (options.threshold, options.prob, min(options.min_iters, options.max_iters),
+         int(options.max_iters), options.max_seconds,
+         options.lo_max_rounds if options.local_optimization else 0, options.refine,
+         options.loss, options.max_scale_rel_std, "auto", NO_PARALLAX_FACTOR),
+        _c_seed(options), calibration_std)
+    if got is None:
+        return None
+    st, res, buf, mask = got
+    w = buf[n:]     # (the kernel's workspace: rays, pixels per radian, ids)
+    if st != _core.STATUS_OK or res.n_inliers <= 6 or \
+            options.threshold > MAX_THRESHOLD_RAD * float(np.minimum.reduce(w[12 * n:13 * n])):
+        return None
+    method = _core.SAMPLER_OF[res.sampler]
+    info = _search_info(res, method)
+    unconfirmed = unconfirmed_reason(info["stop"], res.iterations, res.sample_size,
+                                     res.confidence)
+    inl = (mask & 1).view(bool)
+    if res.have_scale and res.scale.reason in C_WORDED:
+        return conclude_c(res, _core.robust_struct(res), inl, options, method, info, t_start,
+                          unconfirmed)
+    # a verdict the numpy layer decides (static, undecided): the rays and
+    # the dict of the general conclusion, from the same call
+    rays = RayPairs.prechecked(*(w[3 * n * b:3 * n * (b + 1)].reshape(n, 3) for b in range(4)),
+                               ids1, ids2)
+    ids32 = w[13 * n:].view(np.int32)
+    out = _core._robust_result(res, mask, buf[:n])
+    out["extrinsic_std_given"] = calibration_std is not None
+    return _c_conclude(rays, out, w[12 * n:13 * n], options, method, t_start, calibration_std,
+                       ids32[:n], ids32[n:2 * n], len(focal))
 
 
 def _c_seed(options: RansacOptions) -> int:
@@ -218,14 +289,18 @@ def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int
               focal: Optional[np.ndarray], cam_axes: Optional[np.ndarray],
               cam_focal: Optional[np.ndarray], options: RansacOptions, threshold: float,
               refine: bool, method: str, seed: int, prechecked: bool,
-              solver_kw: dict, search_info: Optional[dict] = None) -> Optional[dict]:
+              solver_kw: dict, search_info: Optional[dict] = None,
+              extrinsic_std: Optional[np.ndarray] = None) -> Optional[dict]:
     """One C search (``_core.robust_rig_motion``) with ``options`` at
-    ``threshold``, the verdict's evidence gathered in the same call
-    (``solver_kw`` from :func:`_solver_keywords`: the vertical, or the
-    6-point sampler's solver); None when it found no motion
-    (``search_info`` then says how the search ended)."""
+    ``threshold``, the verdict's evidence and the verdict itself gathered in
+    the same call (``solver_kw`` from :func:`_solver_keywords`: the vertical,
+    or the 6-point sampler's solver; ``extrinsic_std`` the calibration table
+    of :func:`_extrinsic_table`, None: none given to C); None when it found
+    no motion (``search_info`` then says how the search ended). The result's
+    ``extrinsic_std_given`` says whether the C verdict saw the calibration
+    error."""
     kw = dict(solver_kw)
-    return _core.robust_rig_motion(
+    out = _core.robust_rig_motion(
         rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, cam1, cam2, n_cameras,
         focal=focal, cam_axes=cam_axes, cam_focal=cam_focal, threshold=threshold,
         prob=options.prob, min_iterations=min(options.min_iters, options.max_iters),
@@ -233,7 +308,28 @@ def _c_search(rays: RayPairs, cam1: np.ndarray, cam2: np.ndarray, n_cameras: int
         lo_rounds=options.lo_max_rounds if options.local_optimization else 0,
         refine=refine, loss=options.loss, max_scale_rel_std=options.max_scale_rel_std,
         sampler=kw.pop("sampler", method), prechecked=prechecked,
-        verdict_still_factor=NO_PARALLAX_FACTOR, search_info=search_info, **kw)
+        verdict_still_factor=NO_PARALLAX_FACTOR, search_info=search_info,
+        extrinsic_std=extrinsic_std, **kw)
+    if out is not None:
+        out["extrinsic_std_given"] = extrinsic_std is not None
+    return out
+
+
+def _extrinsic_table(calibration_std: Any, n_cameras: int) -> Optional[np.ndarray]:
+    """``calibration_std`` (as :func:`mcgeom.robust.ransac` takes it: one
+    (position m, rotation rad) pair for every camera, or (M, 2) per camera id)
+    as the C verdict's table, float64 C-contiguous (n_cameras, 2); None when
+    there is none or it is not such a table of finite values >= 0 (the
+    verdict in Python then propagates it, and names what is wrong)."""
+    if calibration_std is None or n_cameras < 1:
+        return None
+    sig = np.asarray(calibration_std, dtype=np.float64)
+    if sig.shape == (2,):
+        sig = np.tile(sig, (n_cameras, 1))
+    if sig.ndim != 2 or sig.shape[1] != 2 or sig.shape[0] < n_cameras:
+        return None
+    sig = np.ascontiguousarray(sig[:n_cameras])
+    return sig if np.isfinite(sig).all() and (sig >= 0).all() else None
 
 
 def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options: RansacOptions,
@@ -243,18 +339,14 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
     with ``verdict_still_factor`` :data:`NO_PARALLAX_FACTOR`, not None) on
     ``rays`` (camera ids ``cam1``/``cam2`` as passed to it): the verdict here."""
     R, t, inl = out["R"], out["t"], out["inliers"]
-    info = {k: out[k] for k in ("iterations", "hypotheses", "local_optimizations", "score",
-                                "stop")}
-    info["c_seconds"] = out["seconds"]
-    info["sampler"] = method
-    info["sample_size"] = out["sample_size"]
-    info["confidence"] = out["confidence"]
-    if out["sampler"].startswith("six_point"):
-        info["six_point_solver"] = "homotopy" if out["sampler"] == "six_point_homotopy" \
-            else "local"
-        info["found_rate"] = out["found_rate"]
-    unconfirmed = unconfirmed_reason(out["stop"], out["iterations"], out["sample_size"],
-                                     out["confidence"])
+    res = out["_res"]
+    info = _search_info(res, method)
+    unconfirmed = unconfirmed_reason(info["stop"], res.iterations, res.sample_size,
+                                     res.confidence)
+    if res.have_scale and res.scale.reason in C_WORDED and \
+            (calibration_std is None or out.get("extrinsic_std_given", False)):
+        # the search decided the verdict itself (csrc/robust_verdict.c)
+        return conclude_c(res, out["_f"], inl, options, method, info, t_start, unconfirmed)
     fit = None
     if out["refinement"] is not None:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)
