@@ -257,8 +257,15 @@ def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np
         return None
     st, res, buf, mask = got
     w = buf[n:]     # (the kernel's workspace: rays, pixels per radian, ids)
-    if st != _core.STATUS_OK or res.n_inliers <= 6 or \
-            options.threshold > MAX_THRESHOLD_RAD * float(np.minimum.reduce(w[12 * n:13 * n])):
+    if st != _core.STATUS_OK or res.n_inliers <= 6:
+        return None
+    # a threshold above MAX_THRESHOLD_RAD at some pair (ransac_rig_c's test):
+    # each pair's pixels per radian is at least its cameras' smaller focal
+    # length (csrc/pixel_rays.c: a bearing's variance is at most 1 / f^2),
+    # so the pairs are looked at only when the rig's smallest focal allows it
+    if options.threshold > MAX_THRESHOLD_RAD * (1.0 - 1e-9) * float(
+            np.minimum.reduce(focal)) and options.threshold > MAX_THRESHOLD_RAD * float(
+            np.minimum.reduce(w[12 * n:13 * n])):
         return None
     method = _core.SAMPLER_OF[res.sampler]
     info = _search_info(res, method)

@@ -191,7 +191,8 @@ def conclude_c(res: Any, f: np.ndarray, inl: np.ndarray, options: RansacOptions,
         k = _AT["scale_covariance"]
         info.update(scale_rel_std_noise=noise, scale_rel_std_calibration=cal,
                     covariance=f[k:k + 36].reshape(6, 6))
-    info.update(inlier_ratio=float(true_fraction(inl)), time_s=time.perf_counter() - t_start)
+    # (the inlier count of the mask, from C: true_fraction(inl)'s value)
+    info.update(inlier_ratio=res.n_inliers / inl.size, time_s=time.perf_counter() - t_start)
     profile = float("nan")
     if res.refined and rel_std <= options.max_scale_rel_std:
         profile = info["scale_profile"] = sc.profile
@@ -213,6 +214,8 @@ def conclude_c(res: Any, f: np.ndarray, inl: np.ndarray, options: RansacOptions,
         k = _AT["t_direction"]
         info["t_direction"] = f[k:k + 3]
         info["t_slid"] = sc.slid == 1
+        if sc.slid == 1:   # the hypothesis' length along the travel, as conclude
+            info["t_metric"] = math.hypot(*f[12:15].tolist()) * f[k:k + 3]
     info["scale_determined"] = bool(sc.determined)
     k = _AT["scale_t"]
     return RigMotion(f[:9].reshape(3, 3), f[k:k + 3],
