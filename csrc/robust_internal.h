@@ -189,6 +189,20 @@ static inline double pair_residual(const ctx *c, const double R[9], const double
            (c->focal ? c->focal[k] : 1.0);
 }
 
+/* Copy pair k's rays (o1, d1, o2, d2) to row m of the gather buffers
+ * (sub: four blocks of stride 3 n). */
+static inline void robust_copy_pair(ctx *c, size_t k, int m)
+{
+    const size_t n = (size_t)c->n, r = 3 * (size_t)m;
+    int i;
+    for (i = 0; i < 3; i++) {
+        c->sub[r + i] = c->o1[3 * k + i];
+        c->sub[3 * n + r + i] = c->d1[3 * k + i];
+        c->sub[6 * n + r + i] = c->o2[3 * k + i];
+        c->sub[9 * n + r + i] = c->d2[3 * k + i];
+    }
+}
+
 /* median of x[0..n) as numpy's (mean of the two middle values for even n),
  * computed on the scratch copy y (internal.h's median_inplace) */
 static inline double median(const double *x, double *y, int n)

@@ -81,8 +81,7 @@ int robust_gather(ctx *c, const double *res, double limit, const double *w, doub
     int k, m = 0, i;
     /* keep < 1: each selected pair is taken with that probability */
     const uint64_t cut = keep < 1.0 ? (uint64_t)(keep * 18446744073709551615.0) : UINT64_MAX;
-    double *so1 = c->sub, *sd1 = c->sub + 3 * (size_t)c->n, *so2 = c->sub + 6 * (size_t)c->n,
-           *sd2 = c->sub + 9 * (size_t)c->n;
+    double *so1 = c->sub, *so2 = c->sub + 6 * (size_t)c->n;
     /* rows from n - nsub on hold the preemptive subset during the search
      * (LO gathers ~LO_MAX of the inliers, but the upright sampler's first
      * round takes every pair within LO_WIDE thresholds of a poor hypothesis,
@@ -92,13 +91,9 @@ int robust_gather(ctx *c, const double *res, double limit, const double *w, doub
     for (k = 0; k < c->n && m < rows; k++) {
         if (!(res[k] < limit) || (cut != UINT64_MAX && rng_next(&c->rng) > cut))
             continue;
-        for (i = 0; i < 3; i++) {
-            so1[3 * m + i] = c->o1[3 * k + i];
-            sd1[3 * m + i] = c->d1[3 * k + i];
-            so2[3 * m + i] = c->o2[3 * k + i];
-            sd2[3 * m + i] = c->d2[3 * k + i];
+        robust_copy_pair(c, (size_t)k, m);
+        for (i = 0; i < 3; i++)
             cen[i] += c->o1[3 * k + i] + c->o2[3 * k + i];
-        }
         c->wsub[m] = w ? w[k] : 1.0;
         m++;
     }

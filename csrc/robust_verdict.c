@@ -94,12 +94,7 @@ static int calibration_part(ctx *c, const mcg_robust_result *res, const unsigned
     for (k = 0; k < n; k++) {
         if (!(mask[k] & 2))
             continue;
-        for (i = 0; i < 3; i++) {
-            so1[3 * m + i] = c->o1[3 * k + i];
-            sd1[3 * m + i] = c->d1[3 * k + i];
-            so2[3 * m + i] = c->o2[3 * k + i];
-            sd2[3 * m + i] = c->d2[3 * k + i];
-        }
+        robust_copy_pair(c, k, m);
         id1[m] = c->cam1[k];
         id2[m] = c->cam2[k];
         top = id1[m] > top ? id1[m] : top;
