@@ -1627,7 +1627,8 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
 def robust_pinhole_raw(intr: np.ndarray, rot: np.ndarray, centres: np.ndarray,
                        focal: np.ndarray, ids1: np.ndarray, ids2: np.ndarray, px1: np.ndarray,
                        px2: np.ndarray, options: tuple, seed: int,
-                       extrinsic_std: Optional[np.ndarray]) -> Optional[tuple]:
+                       extrinsic_std: Optional[np.ndarray],
+                       gravity: Optional[tuple] = None) -> Optional[tuple]:
     """``mcg_robust_rig_motion_pinhole`` -- the robust estimate from the pixels
     of a rig of undistorted pinholes, its scale verdict included -- for a
     caller that made every array itself (the rig's tables of
@@ -1638,7 +1639,9 @@ def robust_pinhole_raw(intr: np.ndarray, rot: np.ndarray, centres: np.ndarray,
     ``threshold`` to ``verdict_still_factor`` but the seed, as a tuple in
     their order (threshold, prob, min_iterations, max_iterations,
     max_seconds, lo_rounds, refine, loss, max_scale_rel_std, sampler,
-    verdict_still_factor; checked once per distinct tuple). Returns None
+    verdict_still_factor; checked once per distinct tuple); ``gravity`` the
+    checked vertical ``(g1, g2)`` of the upright sampler (3-vectors, rig
+    frames 1 and 2), None for the others. Returns None
     for N outside the kernel's bounds, else ``(status, res, buf, mask)``:
     ``res`` the ``mcg_robust_result *``, ``buf`` the float64 buffer whose
     ``[:N]`` are the final refinement's weights and whose ``[N:]`` is the
@@ -1655,6 +1658,8 @@ def robust_pinhole_raw(intr: np.ndarray, rot: np.ndarray, centres: np.ndarray,
     opt.seed = seed % (1 << 64)
     if extrinsic_std is not None:
         opt.extrinsic_std = ffi.cast("const double *", _p(extrinsic_std))
+    if gravity is not None:
+        opt.g1, opt.g2 = gravity[0].tolist(), gravity[1].tolist()
     buf = np.empty(n + lwork)
     mask = np.empty(n, dtype=np.uint8)
     res = ffi.new("mcg_robust_result *")

@@ -32,8 +32,7 @@ import numpy as np
 from . import registry
 from . import robust as _robust   # (the name robust is estimate()'s flag)
 from .errors import ScaleNotObservableWarning
-from .pixel_noise import (camera_table, pinhole_ray_pairs, ray_pairs_per_radian,
-                          sampson_pixel_scale)
+from .pixel_noise import camera_table, ray_pairs_per_radian, sampson_pixel_scale
 from .rig import Rig
 from .types import RigMotion
 from .validation import integral_camera_ids
@@ -297,8 +296,9 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     undistorted pinholes, float64 C-contiguous (N, 2) pixels and int64 (N,)
     camera ids --
     in the fewest Python steps (issue 19: a call after other work pays ~5x
-    the warm cost of each step): the ray kernel checks the pixels and ids
-    itself, then :func:`mcgeom.robust.ransac_rig_c`. None for any other input
+    the warm cost of each step): one C call from the pixels to the verdict
+    (:func:`mcgeom.robust.estimate_pinhole_c`), whose kernel checks the
+    pixels and ids itself. None for any other input
     or whatever those decline (a refused pixel or id, too few or repeated
     correspondences, no consensus ...): the general path of :func:`estimate`
     then runs, whose checks name what is wrong. The same RigMotion as that
@@ -311,22 +311,16 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
             _plain(ids2, np.int64, 1) and cameraIds1.shape[0] == n and ids2.shape[0] == n):
         return None
     opts = _robust.ransac_options(1.0 if threshold is None else threshold, prob, maxIters, seed)
-    if gravity1 is None:
-        # pixels in, the verdict out, in one C call (the kernel checks the
-        # pixels and the ids against the rig)
-        tables = rig.pinhole_tables
-        return None if tables is None else _robust.estimate_pinhole_c(
-            tables, points1, points2, cameraIds1, ids2, opts, rig.calibration_error)
-    out = pinhole_ray_pairs(rig, points1, points2, cameraIds1, ids2)
-    if out is None:
+    tables = rig.pinhole_tables
+    if tables is None:
         return None
-    rays, ppr = out
-    # (the sampler of choose_sampler, picked by the C search: "auto"; with a
-    # vertical prior the upright 4-point one, as _gravity_method picks)
-    method, prior = ("auto", None) if gravity1 is None else \
-        (RIG_UPRIGHT_RANSAC, {"gravity1": gravity1, "gravity2": gravity2})
-    return _robust.ransac_rig_c(rays, method, opts, ppr, camera_table(rig),
-                                rig.calibration_error, prior)
+    # pixels in, the verdict out, in one C call (the kernel checks the pixels
+    # and the ids against the rig). The sampler: choose_sampler's, picked by
+    # the C search; with a vertical prior the upright 4-point one, as
+    # _gravity_method picks
+    return _robust.estimate_pinhole_c(
+        tables, points1, points2, cameraIds1, ids2, opts, rig.calibration_error,
+        None if gravity1 is None else {"gravity1": gravity1, "gravity2": gravity2})
 
 
 def _plain(a: Any, dtype: type, ndim: int) -> bool:

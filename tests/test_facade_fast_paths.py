@@ -266,7 +266,7 @@ def test_facade_with_mask_and_calibration_is_the_general_path(seed):
 @pytest.mark.parametrize("seed,make_rig", [(2, synth.ladybug2), (3, synth.vehicle8)])
 def test_plain_input_takes_the_one_call_path_with_the_same_answer(seed, make_rig, monkeypatch):
     """float64 pixels and int64 ids of a pinhole rig go through
-    robust.ransac_rig_c (one C call, the sampler picked in C); anything else
+    robust.estimate_pinhole_c (one C call, the sampler picked in C); anything else
     (here: ids as lists) through ransac_prechecked. Same answer, bit for bit."""
     rig, p = _problem(seed, make_rig)
     with warnings.catch_warnings():

@@ -32,9 +32,9 @@ from mcgeom import _core, cv, synth
 from mcgeom.experiments.bench.robust import CASES
 from mcgeom.observability import (NO_PARALLAX_FRACTION, NO_PARALLAX_MIN, _MOTION_DOF,
                                   _verdict)
-from mcgeom.pixel_noise import camera_table, pinhole_ray_pairs
+from mcgeom.pixel_noise import camera_table, pinhole_ray_pairs, sampson_pixel_scale
 from mcgeom.rig import Rig
-from mcgeom.robust import _c_search, ransac_options, ransac_rig_c
+from mcgeom.robust import _c_search, ransac_options, ransac_prechecked
 from mcgeom.robust._verdict import CONFIRMED
 
 SOURCE = Path(__file__).resolve().parents[1] / "csrc" / "robust_verdict.c"
@@ -128,9 +128,11 @@ def test_c_verdict_one_camera_and_large_calibration(monkeypatch):
     assert "scale too uncertain for the noise (near-critical motion)" in seen
 
 
-def test_pixel_entry_is_the_two_calls():
+@pytest.mark.parametrize("vertical", [False, True])
+def test_pixel_entry_is_the_rays_search(vertical):
     """``estimate_pinhole_c`` (pixels in, one C call) gives what the rays of
-    ``pinhole_ray_pairs`` through ``ransac_rig_c`` give, bit for bit."""
+    ``pinhole_ray_pairs`` through ``ransac_prechecked`` give, bit for bit --
+    with the vertical known too (the upright sampler)."""
     make_rig, n, outl, noise, motion = CASES["ladybug6 300c 30%out"]
     rig = Rig(make_rig().cameras, None)
     rng = np.random.default_rng(5)
@@ -138,11 +140,15 @@ def test_pixel_entry_is_the_two_calls():
         R, t = motion(rng)
         p = synth.make_problem(rig, R, t, n, rng, pixel_noise=noise, outlier_fraction=outl)
         opts = ransac_options(1.0, 0.999, 1000, i)
+        g = {"gravity1": np.array([0.0, 0.0, 1.0]), "gravity2": R[:, 2]} if vertical else None
         a = _c_search.estimate_pinhole_c(rig.pinhole_tables, p.pixels1, p.pixels2, p.cam1,
-                                         p.cam2, opts, rig.calibration_error)
+                                         p.cam2, opts, rig.calibration_error, g)
         rays, ppr = pinhole_ray_pairs(rig, p.pixels1, p.pixels2, p.cam1, p.cam2)
-        b = ransac_rig_c(rays, "auto", opts, ppr, camera_table(rig), rig.calibration_error)
+        b = ransac_prechecked(rays, "upright_four_point" if vertical else "five_plus_one", opts,
+                              ppr, sampson_pixel_scale(rig), rig.calibration_error,
+                              camera_table(rig), g)
         assert a is not None and b is not None
+        assert a.info["sampler"] == b.info["sampler"]
         _motions(a, b, f"problem {i}")
 
 

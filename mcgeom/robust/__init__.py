@@ -32,8 +32,7 @@ import numpy as np
 from .. import registry
 from ..estimators.five_plus_one import minimal_answer
 from ..types import MotionFocal, RayPairs, RigMotion
-from ._c_search import (estimate_pinhole_c, ransac_c,  # noqa: F401 (mcgeom.cv's)
-                        ransac_rig_c)
+from ._c_search import estimate_pinhole_c, ransac_c  # noqa: F401 (mcgeom.cv's)
 from ._no_motion import check_threshold_angle, nothing_found
 from ._options import C_SAMPLERS, RansacOptions, focal_array, ransac_options
 from ._python_search import check_solver_options, finish, run_minimal, run_proposer

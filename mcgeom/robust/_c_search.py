@@ -9,7 +9,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from .. import _core, registry
+from .. import _core
 from ..estimators._common import camera_ids
 # the vertical's checks (the messages name gravity1/gravity2) of the upright solver
 from ..estimators.upright_four_point import check_gravity
@@ -17,7 +17,7 @@ from ..observability import NO_PARALLAX_FACTOR
 from ..types import RayPairs, RigMotion
 from ._no_motion import (MAX_THRESHOLD_RAD, FITS_RAD, check_threshold_angle, nothing_found,
                          per_camera_counts)
-from ._options import C_SAMPLERS, RansacOptions
+from ._options import RansacOptions
 from ._scoring import Scorer
 from ._verdict import C_WORDED, conclude, conclude_c, unconfirmed_reason
 
@@ -169,49 +169,6 @@ def ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions
                        n_cameras)
 
 
-def ransac_rig_c(rays: RayPairs, method: str, options: RansacOptions, focal: np.ndarray,
-                 pixel_cameras: tuple[np.ndarray, np.ndarray], calibration_std: Any,
-                 solver_options: Optional[dict] = None) -> Optional[RigMotion]:
-    """The ordinary case of :func:`ransac_prechecked` with a C sampler, in
-    the fewest Python steps (issue 19: every step of a call that follows
-    other work, e.g. a feature matcher, costs ~5x its warm time; this path
-    measured 0.11 ms of Python per cold estimate where the general one took
-    0.6 ms): one C call, then the verdict.
-
-    Same preconditions as :func:`ransac_prechecked` (``pixel_cameras`` and
-    ``focal`` given); ``method`` a name of :data:`C_SAMPLERS` (the upright
-    one with its vertical in ``solver_options``, checked and named as by
-    :func:`ransac`), or ``"auto"``: the C search picks as
-    :func:`mcgeom.cv.choose_sampler` does (5+1 when a camera has 5
-    intra-camera correspondences, else the 6-point solver).
-    Returns the same RigMotion as :func:`ransac_prechecked`, or None where
-    that function decides something this one does not (6 correspondences or
-    fewer, a threshold above 1 rad, a search that found no consensus): the
-    caller then runs it, whose checks and messages apply. Repeated
-    correspondences are its DegenerateError, as there.
-    """
-    n = len(rays)
-    if n <= 6 or options.strategy != "auto" or \
-            options.threshold > MAX_THRESHOLD_RAD * float(np.minimum.reduce(focal)):
-        return None
-    solver_kw = _solver_keywords(method, solver_options or {})
-    registry.check_distinct(rays, 6 if method == "auto" else C_SAMPLERS[method],
-                            "five_plus_one" if method == "auto" else method)
-    t_start = time.perf_counter()
-    cam_focal, cam_axes = pixel_cameras
-    n_cameras = len(cam_focal)
-    # (ids of the rig's cameras, checked by its ray kernel: int32 for C)
-    cam1, cam2 = rays.cam1.astype(np.int32), rays.cam2.astype(np.int32)
-    # (the rig's calibration table: float64 C-contiguous (n_cameras, 2), >= 0)
-    out = _c_search(rays, cam1, cam2, n_cameras, focal, cam_axes, cam_focal, options,
-                    options.threshold, options.refine, method, _c_seed(options), True, solver_kw,
-                    None, calibration_std)
-    if out is None or out["n_inliers"] <= 6:
-        return None
-    return _c_conclude(rays, out, focal, options, out["sampler"], t_start, calibration_std,
-                       cam1, cam2, n_cameras)
-
-
 def _search_info(res: Any, method: str) -> dict:
     """``info``'s entries of the search (``res``: the ``mcg_robust_result *``
     of the C search, ``method`` the sampler it used)."""
@@ -228,22 +185,33 @@ def _search_info(res: Any, method: str) -> dict:
 
 def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
                        ids2: np.ndarray, options: RansacOptions,
-                       calibration_std: Optional[np.ndarray]) -> Optional[RigMotion]:
+                       calibration_std: Optional[np.ndarray],
+                       gravity: Optional[dict] = None) -> Optional[RigMotion]:
     """The robust estimate of :func:`mcgeom.cv.estimate` from the pixels of a
     rig of undistorted pinholes in one C call (``_core.robust_pinhole_raw``:
     the rays, the search, the final refinement and the scale verdict), the
-    verdict worded here: :func:`ransac_rig_c`'s RigMotion for ``method``
-    "auto" without its Python steps (issue 19). ``tables`` the rig's
+    verdict worded here: :func:`ransac_prechecked`'s RigMotion on the
+    pixels' rays for the sampler of :func:`mcgeom.cv.choose_sampler` (picked
+    by the C search) -- or, with ``gravity`` (``{"gravity1": g1, "gravity2":
+    g2}``, the vertical in rig frames 1 and 2, checked and named as by
+    :func:`ransac`), "upright_four_point" -- without its Python steps (issue
+    19: every step of a call that follows other work, e.g. a feature
+    matcher, costs ~5x its warm time). ``tables`` the rig's
     :attr:`~mcgeom.rig.Rig.pinhole_tables`, ``calibration_std`` its
     :attr:`~mcgeom.rig.Rig.calibration_error`; pixels (N, 2) float64 and
     ids (N,) int64, C-contiguous (their values are the kernel's to check).
-    None where :func:`ransac_rig_c` returns None or its ray pass refuses the
-    input (a bad pixel or id, fewer than 6 distinct correspondences, no
+    None where the kernel refuses the input or decides nothing (a bad pixel
+    or id, 6 correspondences or fewer, fewer than 6 distinct ones, no
     consensus, a threshold above 1 rad at some pair): the caller's general
     path then decides, and names what is wrong."""
     n = px1.shape[0]
     if n <= 6 or options.strategy != "auto":
         return None
+    sampler, vertical = "auto", None
+    if gravity is not None:
+        sampler = "upright_four_point"
+        kw = _solver_keywords(sampler, gravity)
+        vertical = (kw["gravity1"], kw["gravity2"])
     t_start = time.perf_counter()
     intr, rot, centres, focal = tables
     got = _core.robust_pinhole_raw(
@@ -251,15 +219,15 @@ def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np
         (options.threshold, options.prob, min(options.min_iters, options.max_iters),
          int(options.max_iters), options.max_seconds,
          options.lo_max_rounds if options.local_optimization else 0, options.refine,
-         options.loss, options.max_scale_rel_std, "auto", NO_PARALLAX_FACTOR),
-        _c_seed(options), calibration_std)
+         options.loss, options.max_scale_rel_std, sampler, NO_PARALLAX_FACTOR),
+        _c_seed(options), calibration_std, vertical)
     if got is None:
         return None
     st, res, buf, mask = got
     w = buf[n:]     # (the kernel's workspace: rays, pixels per radian, ids)
     if st != _core.STATUS_OK or res.n_inliers <= 6:
         return None
-    # a threshold above MAX_THRESHOLD_RAD at some pair (ransac_rig_c's test):
+    # a threshold above MAX_THRESHOLD_RAD at some pair (ransac_c's test):
     # each pair's pixels per radian is at least its cameras' smaller focal
     # length (csrc/pixel_rays.c: a bearing's variance is at most 1 / f^2),
     # so the pairs are looked at only when the rig's smallest focal allows it
