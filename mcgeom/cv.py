@@ -216,10 +216,12 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     """
     if not isinstance(rig, Rig):
         raise TypeError(f"rig must be an mcgeom.rig.Rig, got {type(rig).__name__}")
-    if (method == RIG_5P1_RANSAC and mask is None and robust is None and not options
-            and calibration_std is None and (gravity1 is None) == (gravity2 is None)):
+    fast = _ONE_CALL.get(method) if type(method) is str else None
+    if (fast is not None and mask is None and robust is None and not options
+            and calibration_std is None and (gravity1 is None) == (gravity2 is None)
+            and (gravity1 is None or fast == "auto")):
         m = _estimate_pinhole(points1, points2, cameraIds1, cameraIds2, rig, threshold, prob,
-                              maxIters, seed, gravity1, gravity2)
+                              maxIters, seed, gravity1, gravity2, fast)
         if m is not None:
             return m
     p1, p2 = _points("points1", points1), _points("points2", points2)
@@ -288,11 +290,20 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     return RigMotion(m.R, m.t, m.scale, m.method, m.residual_rms, inl, m.info)
 
 
+#: the methods :func:`estimate` runs in one C call from the pixels (for its
+#: common input), with the C search's sampler: the default method's is picked
+#: by the search as :func:`choose_sampler` picks it (the upright one with a
+#: vertical prior); ``ransac:five_plus_one`` forces 5+1
+_ONE_CALL = {RIG_5P1_RANSAC: "auto", "ransac:five_plus_one": "five_plus_one"}
+
+
 def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: Rig,
                       threshold: Any, prob: Any, maxIters: Any, seed: Any,
-                      gravity1: Any = None, gravity2: Any = None) -> Optional[RigMotion]:
-    """:func:`estimate` with its defaults (no mask, options or calibration
-    override; a vertical prior or none) for the common input -- a rig of
+                      gravity1: Any = None, gravity2: Any = None,
+                      sampler: str = "auto") -> Optional[RigMotion]:
+    """:func:`estimate` of a method of :data:`_ONE_CALL` (``sampler`` its C
+    search's) without a mask, options or calibration override (a vertical
+    prior or none) for the common input -- a rig of
     undistorted pinholes, float64 C-contiguous (N, 2) pixels and int64 (N,)
     camera ids --
     in the fewest Python steps (issue 19: a call after other work pays ~5x
@@ -320,7 +331,7 @@ def _estimate_pinhole(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: A
     # _gravity_method picks
     return _robust.estimate_pinhole_c(
         tables, points1, points2, cameraIds1, ids2, opts, rig.calibration_error,
-        None if gravity1 is None else {"gravity1": gravity1, "gravity2": gravity2})
+        None if gravity1 is None else {"gravity1": gravity1, "gravity2": gravity2}, sampler)
 
 
 def _plain(a: Any, dtype: type, ndim: int) -> bool:

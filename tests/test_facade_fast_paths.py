@@ -282,6 +282,28 @@ def test_plain_input_takes_the_one_call_path_with_the_same_answer(seed, make_rig
     assert fast.info["sampler"] == general.info["sampler"] == "five_plus_one"
 
 
+def test_forced_five_plus_one_takes_the_one_call_path_with_the_same_answer(monkeypatch):
+    """method='ransac:five_plus_one' (5+1 forced) also runs in one C call,
+    with the general path's answer bit for bit; where no camera has 5
+    intra-camera correspondences the general path names the problem."""
+    rig, p = _problem(6, synth.ladybug2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        general = cv.estimate(p.pixels1, p.pixels2, list(p.cam1), list(p.cam2), rig,
+                              method="ransac:five_plus_one", threshold=1.0, seed=6)
+        monkeypatch.setattr(robust, "ransac_prechecked",
+                            lambda *a, **k: pytest.fail("general path"))
+        fast = cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig,
+                           method="ransac:five_plus_one", threshold=1.0, seed=6)
+        monkeypatch.undo()
+    _same(general, fast)
+    assert fast.info["sampler"] == general.info["sampler"] == "five_plus_one"
+    keep = np.concatenate([np.flatnonzero((p.cam1 == k) & (p.cam2 == k))[:4] for k in range(6)])
+    with pytest.raises(ValueError, match="5 intra-camera"):
+        cv.estimate(p.pixels1[keep], p.pixels2[keep], p.cam1[keep], p.cam2[keep], rig,
+                    method="ransac:five_plus_one", threshold=1.0, seed=6)
+
+
 def test_one_call_path_picks_the_six_point_sampler_as_choose_sampler():
     """Four correspondences per camera: no 5+1 sample; the C search's "auto"
     picks the 6-point solver, as cv.choose_sampler does."""

@@ -186,13 +186,15 @@ def _search_info(res: Any, method: str) -> dict:
 def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np.ndarray,
                        ids2: np.ndarray, options: RansacOptions,
                        calibration_std: Optional[np.ndarray],
-                       gravity: Optional[dict] = None) -> Optional[RigMotion]:
+                       gravity: Optional[dict] = None,
+                       sampler: str = "auto") -> Optional[RigMotion]:
     """The robust estimate of :func:`mcgeom.cv.estimate` from the pixels of a
     rig of undistorted pinholes in one C call (``_core.robust_pinhole_raw``:
     the rays, the search, the final refinement and the scale verdict), the
     verdict worded here: :func:`ransac_prechecked`'s RigMotion on the
     pixels' rays for the sampler of :func:`mcgeom.cv.choose_sampler` (picked
-    by the C search) -- or, with ``gravity`` (``{"gravity1": g1, "gravity2":
+    by the C search; ``sampler`` "auto") or five_plus_one (``sampler``
+    "five_plus_one") -- or, with ``gravity`` (``{"gravity1": g1, "gravity2":
     g2}``, the vertical in rig frames 1 and 2, checked and named as by
     :func:`ransac`), "upright_four_point" -- without its Python steps (issue
     19: every step of a call that follows other work, e.g. a feature
@@ -207,7 +209,7 @@ def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np
     n = px1.shape[0]
     if n <= 6 or options.strategy != "auto":
         return None
-    sampler, vertical = "auto", None
+    vertical = None
     if gravity is not None:
         sampler = "upright_four_point"
         kw = _solver_keywords(sampler, gravity)
