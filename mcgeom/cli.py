@@ -277,7 +277,7 @@ def _bench_robust(args: argparse.Namespace) -> int:
                                            fit_worst_error, fixed_and_marginal)
 
     rows = bench_speed(_problems(args), progress=progress_bar)
-    print(f"robust: mcgeom.cv.estimate (pixels in, 5+1 in one C call, verdict in Python) vs "
+    print(f"robust: mcgeom.cv.estimate (pixels in: 5+1 and its scale verdict in one C call) vs "
           f"PoseLib estimate_generalized_relative_pose, {_problems(args)} problems per case, "
           f"1 px threshold; medians")
     print(f"{'case':<22} {'method':<19} {'rot deg':>8} {'scale err':>9} {'ms cold':>7} "
