@@ -717,7 +717,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                                               res->R, tv, still, &res->verdict, c.vwork,
                                               mcg_verdict_stats_work_size(n_cameras)) == MCG_OK;
         /* the verdict itself (robust_verdict.c) */
-        robust_scale_verdict(&c, res, mask, weights, wp);
+        robust_scale_verdict(&c, res, mask, wp);
     }
     res->seconds = now_seconds() - t_start;
     return MCG_OK;

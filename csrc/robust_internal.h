@@ -275,6 +275,6 @@ void robust_fill_covariance(mcg_robust_result *res);
 
 /* robust_verdict.c: the scale verdict of the result (res->scale) */
 void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *mask,
-                          const double *weights, const double *wp);
+                          const double *w);
 
 #endif /* MCGEOM_ROBUST_INTERNAL_H */

@@ -157,11 +157,11 @@ int mcg_scale_reason(int n_inliers, int n_cross, int n_cameras_intra, double cri
     return (double)n_in_front / n_inliers < 0.5 ? MCG_SCALE_CHEIRALITY : MCG_SCALE_OBSERVABLE;
 }
 
-/* The verdict of the result (res->scale; see mcg_robust_scale). weights:
- * the final refinement's per pair (the caller's output, or NULL); wp: those
- * the scale profiles use. Needs res->have_verdict (else undecided). */
+/* The verdict of the result (res->scale; see mcg_robust_scale). w: the
+ * final refinement's weights per pair (NULL: all equal), those the scale
+ * profiles use too. Needs res->have_verdict (else undecided). */
 void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *mask,
-                          const double *weights, const double *wp)
+                          const double *w)
 {
     mcg_robust_scale *s = &res->scale;
     const mcg_verdict_stats_result *v = &res->verdict;
@@ -186,7 +186,7 @@ void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *m
      * calibration part in quadrature (total_scale_std) */
     if (res->refined) {
         double cal;
-        if (calibration_part(c, res, mask, weights, &cal, s->covariance) != MCG_OK)
+        if (calibration_part(c, res, mask, w, &cal, s->covariance) != MCG_OK)
             return;
         s->rel_std_noise = res->refinement.scale_rel_std;
         s->rel_std_calibration = cal;
@@ -197,7 +197,7 @@ void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *m
         if (rel <= max_rel) {
             if (!isfinite(res->scale_profile)) {
                 const double k1 = 1.0 + 3.0 * max_rel, f[2] = {1.0 / k1, k1};
-                res->scale_profile = robust_scale_profile(c, res, mask, wp, f, 2, -HUGE_VAL);
+                res->scale_profile = robust_scale_profile(c, res, mask, w, f, 2, -HUGE_VAL);
             }
             profile = res->scale_profile;
         }
@@ -253,7 +253,7 @@ void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *m
             if (!isfinite(res->zero_profile)) {
                 const double f0[1] = {ZERO_FACTOR};
                 res->zero_profile =
-                    robust_scale_profile(c, res, mask, wp, f0, 1, ZERO_PROFILE_BOUND);
+                    robust_scale_profile(c, res, mask, w, f0, 1, ZERO_PROFILE_BOUND);
             }
             zero = res->zero_profile;
         }

@@ -10,7 +10,7 @@
  *    scale observable, t reported metric and equal to res->t, the
  *    calibration part of rel_std and of the covariance equal to an
  *    independent mcg_calibration_scale_std on the pairs the result says it
- *    used, rel_std their quadrature;
+ *    used, rel_std their quadrature, the same with the weights' output NULL;
  *  - the same rig driving straight without cross-camera pairs (the critical
  *    motion, thesis ch. 7.3.2): not observable, a unit t along the travel;
  *  - a static rig: the static verdict (t = 0) or no motion found;
@@ -235,6 +235,17 @@ static void observable_case(double *work, size_t lwork)
     check(res.scale.profile >= 9.0 && res.scale.front_fraction >= 0.5,
           "  its profile (>= 9) and cheirality (>= 0.5)", res.scale.profile, 9.0);
 
+    /* without the weights' output buffer the verdict weighs as the final
+     * refinement did (its own pixel scaling), the same as with it */
+    {
+        mcg_robust_result r2;
+        st = mcg_robust_rig_motion_pinhole(N, NCAM, intr, rot, centres, fmean, ids1, ids2, px1,
+                                           px2, &opt, &r2, mask, NULL, work, lwork);
+        check(st == MCG_OK && r2.scale.rel_std_calibration == res.scale.rel_std_calibration &&
+                  r2.scale.rel_std == res.scale.rel_std && r2.scale.reason == res.scale.reason,
+              "  the same verdict without the weights' output (NULL)",
+              r2.scale.rel_std_calibration - res.scale.rel_std_calibration, 0);
+    }
     /* no verdict without its evidence */
     opt.verdict_still_factor = 0.0;
     st = run(N, &opt, &res, work, lwork);
