@@ -64,8 +64,10 @@ static void robust_from_pixels(int n, int m, const double *intr, const double *r
                  "robust_rig_motion_pinhole: rays differ from the ray pass (status %d)", st);
         if (st == MCG_OK) {
             FZ_CHECK(fz_is_rotation(res.R, 1e-9), "robust_rig_motion_pinhole: R not a rotation");
-            FZ_CHECK(res.have_scale == res.have_verdict, "robust_rig_motion_pinhole: verdict %d, "
-                     "evidence %d", res.have_scale, res.have_verdict);
+            FZ_CHECK(res.have_scale && (res.have_verdict || res.scale.reason ==
+                                                                 MCG_SCALE_UNDECIDED),
+                     "robust_rig_motion_pinhole: verdict %d, evidence %d", res.have_scale,
+                     res.have_verdict);
         }
     }
     free(work);

@@ -347,8 +347,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              "verdict counts %d inliers (%d in front), the mask %d", res.verdict.n_inliers,
              res.verdict.n_in_front, res.n_inliers);
     /* the scale verdict */
-    FZ_CHECK(res.have_scale == res.have_verdict, "verdict %d with evidence %d", res.have_scale,
-             res.have_verdict);
+    FZ_CHECK(res.have_scale == (opt.verdict_still_factor > 0.0) &&
+                 (!res.have_scale || res.have_verdict || res.scale.reason == MCG_SCALE_UNDECIDED),
+             "verdict %d (reason %d) with evidence %d, factor %g", res.have_scale,
+             res.scale.reason, res.have_verdict, opt.verdict_still_factor);
     if (res.have_scale) {
         const mcg_robust_scale *v = &res.scale;
         const double nt = sqrt(v->t[0] * v->t[0] + v->t[1] * v->t[1] + v->t[2] * v->t[2]);
