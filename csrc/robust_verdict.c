@@ -173,7 +173,18 @@ void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *m
     res->have_scale = 1;
     s->reason = MCG_SCALE_UNDECIDED;
     s->slid = -1;
-    memcpy(s->t, res->t, sizeof s->t);
+    /* undecided: never a metric-looking t, the unit direction of res->t
+     * (scaled by its largest entry first: |t| may be near the doubles' end) */
+    {
+        double big = 0.0;
+        for (i = 0; i < 3; i++)
+            big = fabs(res->t[i]) > big ? fabs(res->t[i]) : big;
+        if (big > 0.0 && isfinite(big)) {
+            for (i = 0; i < 3; i++)
+                s->t[i] = res->t[i] / big;
+            unit3(s->t, s->t);
+        }
+    }
     memcpy(s->t_metric, res->t, sizeof s->t_metric);
     memcpy(s->covariance, res->covariance, sizeof s->covariance);
     s->rel_std = s->verdict_rel_std = HUGE_VAL;
@@ -234,6 +245,7 @@ void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *m
     s->reason = reason;
     s->observable = reason == MCG_SCALE_OBSERVABLE;
     s->determined = 1;
+    memcpy(s->t, res->t, sizeof s->t);
     if (s->observable)
         return;
 

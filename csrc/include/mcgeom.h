@@ -1140,7 +1140,9 @@ typedef struct {
                                (observable, static or undecided) */
     double t[3];            /* the translation to report: metric when
                                determined, else the unit direction of travel
-                               (0 for MCG_SCALE_STATIC) */
+                               (0 for MCG_SCALE_STATIC; for
+                               MCG_SCALE_UNDECIDED the unit direction of
+                               res->t) */
     double t_metric[3];     /* the metric estimate whatever the verdict (the
                                hypothesis' length along the travel direction
                                when slid) */

@@ -32,7 +32,8 @@
  * the evidence): a known reason; observable exactly for
  * MCG_SCALE_OBSERVABLE, and then determined with rel_std <=
  * max_scale_rel_std; a determined t is res.t, an undetermined one (not
- * static, not undecided) a unit vector (0 for res.t = 0), a static one 0; rel_std never
+ * static, not undecided) a unit vector (0 for res.t = 0), a static one 0,
+ * an undecided one unit (or 0); rel_std never
  * negative or NaN; unconfirmed exactly when a cap ended the search below a
  * confidence of 0.5 (reasons other than static and undecided). A negative
  * or non-finite calibration std is MCG_EINVAL.
@@ -367,6 +368,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                  v->translation_detected);
         if (v->reason == MCG_SCALE_STATIC)
             FZ_CHECK(nt == 0.0, "static verdict with |t| %g", nt);
+        else if (v->reason == MCG_SCALE_UNDECIDED) /* never metric-looking */
+            FZ_CHECK(fabs(nt - 1.0) <= 1e-9 || nt == 0.0, "undecided t of length %.17g", nt);
         else if (v->determined)
             FZ_CHECK(memcmp(v->t, res.t, sizeof res.t) == 0, "determined t is not res.t");
         else if (v->reason != MCG_SCALE_UNDECIDED) /* (the travel direction of t = 0 is 0) */
