@@ -1460,18 +1460,13 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     the dict of :func:`verdict_stats` over the inliers at (R, t) with
     ``still_angle`` = that factor x ``loss_scale`` (3.5 from 4 up), from
     the same call (None otherwise, or beyond 2^20 pairs), ``sample_size``
-    ``scale`` (with ``verdict_still_factor`` > 0, else None): the scale
-    verdict of the call (``mcg_robust_scale``, csrc/robust_verdict.c) as a
-    dict -- ``reason`` (a value of ``SCALE_REASONS``), ``observable``,
-    ``determined``, ``translation_detected``, ``slid`` (-1: not judged),
-    ``t`` (the translation to report: metric when determined, else the unit
-    direction of travel, 0 when static), ``t_metric``, ``rel_std`` (noise
-    and calibration), ``rel_std_noise``, ``rel_std_calibration``,
-    ``verdict_rel_std``, ``profile``, ``front_fraction``, ``still_median``
-    (radians) and ``covariance`` (6, 6, with the calibration part), with
-    ``extrinsic_std`` (n_cameras, 2) float64 C-contiguous (metres,
-    radians per camera; None: the calibration known exactly) the
-    calibration error whose effect enters ``rel_std``; ``sample_size``
+    ``_res`` (the ``mcg_robust_result *`` itself: with
+    ``verdict_still_factor`` > 0 its ``scale`` is the call's scale verdict,
+    csrc/robust_verdict.c, which :func:`mcgeom.robust._verdict.conclude_c`
+    reads; ``extrinsic_std`` (n_cameras, 2) float64 C-contiguous, metres and
+    radians per camera, None: the calibration known exactly, is the
+    calibration error whose effect enters its ``rel_std``) and ``_f`` (the
+    struct's float64 copy, :func:`robust_struct`), ``sample_size``
     (pairs per sample of the adaptive stop: 5 for 5+1, 3 and 4 for the
     upright sampler's 3+1 and 4-point samples, 6 for the 6-point, 17 for the
     eigensolver and linear17), ``confidence`` (1 - (1 - found_rate
@@ -1577,10 +1572,13 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     return _robust_result(res, mask, weights)
 
 
+__all__ += ["robust_pinhole_raw", "robust_struct", "scale_reason", "SCALE_REASONS",
+            "RESULT_OFFSETS"]
+
 #: float64 offsets of the arrays of an mcg_robust_result (one copy of the
 #: struct gives them all as views)
 _RES_SIZE = ffi.sizeof("mcg_robust_result")
-_RES_AT = {k: ffi.offsetof("mcg_robust_result", *f) // 8 for k, f in (
+RESULT_OFFSETS = {k: ffi.offsetof("mcg_robust_result", *f) // 8 for k, f in (
     ("covariance", ("covariance",)), ("information", ("refinement", "info")),
     ("R_fit", ("verdict", "R_fit")), ("t_direction", ("verdict", "t_direction")),
     ("scale_t", ("scale", "t")), ("scale_t_metric", ("scale", "t_metric")),
@@ -1601,12 +1599,12 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
     R, t = f[:9].reshape(3, 3), f[9:12]
     refinement = verdict = None
     if res.refined:
-        i = _RES_AT["information"]
+        i = RESULT_OFFSETS["information"]
         refinement = _refine_dict(res.refinement, R, t, f[i:i + 36].reshape(6, 6))
     if res.have_verdict:
-        i, j = _RES_AT["R_fit"], _RES_AT["t_direction"]
+        i, j = RESULT_OFFSETS["R_fit"], RESULT_OFFSETS["t_direction"]
         verdict = _verdict_dict(res.verdict, f[i:i + 9].reshape(3, 3), f[j:j + 3])
-    i = _RES_AT["covariance"]
+    i = RESULT_OFFSETS["covariance"]
     return {
         "R": R, "t": t, "t_hypothesis": f[12:15],
         "inliers": (mask & 1).view(bool), "used": (mask >> 1).view(bool), "mask": mask,
@@ -1619,7 +1617,6 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
         "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
         "sampler": SAMPLER_OF[res.sampler], "sample_size": res.sample_size,
         "confidence": res.confidence, "found_rate": res.found_rate,
-        "scale": _scale_dict(res.scale, f) if res.have_scale else None,
         "_res": res, "_f": f,
     }
 
@@ -1670,26 +1667,24 @@ def robust_pinhole_raw(intr: np.ndarray, rot: np.ndarray, centres: np.ndarray,
     return st, res, buf, mask
 
 
+def scale_reason(n_inliers: int, n_cross: int, n_cameras_intra: int, critical_angle: float,
+                 rel_std: float, max_rel_std: float, profile: float,
+                 n_in_front: int = -1) -> Optional[str]:
+    """The reason of the scale verdict from its evidence (``mcg_scale_reason``:
+    the rule of thesis ch. 7.3.2 that the C search's own verdict applies), a
+    value of :data:`SCALE_REASONS`; None when ``n_in_front`` is -1 (not
+    counted) and only it can decide. Arguments as
+    :func:`mcgeom.observability.scale_verdict`'s evidence (radians; ``profile``
+    NaN: not computed; ``rel_std`` inf: none)."""
+    r = lib.mcg_scale_reason(n_inliers, n_cross, n_cameras_intra, critical_angle, rel_std,
+                             max_rel_std, profile, n_in_front)
+    return None if r < 0 else SCALE_REASONS[r]
+
+
 def robust_struct(res: Any) -> np.ndarray:
     """A float64 copy of an ``mcg_robust_result`` (its arrays at the offsets
-    of ``_RES_AT``)."""
+    of ``RESULT_OFFSETS``)."""
     return np.frombuffer(ffi.buffer(res, _RES_SIZE), dtype=np.float64).copy()
-
-
-def _scale_dict(s: Any, f: np.ndarray) -> dict:
-    """The ``scale`` entry of :func:`robust_rig_motion` from its
-    ``mcg_robust_scale`` (``f``: the result struct's copy, whose views its
-    arrays are)."""
-    i, j, k = _RES_AT["scale_t"], _RES_AT["scale_t_metric"], _RES_AT["scale_covariance"]
-    return {
-        "reason": SCALE_REASONS.get(s.reason, "unknown"), "observable": bool(s.observable),
-        "determined": bool(s.determined), "translation_detected": bool(s.translation_detected),
-        "slid": s.slid, "t": f[i:i + 3], "t_metric": f[j:j + 3], "rel_std": s.rel_std,
-        "rel_std_noise": s.rel_std_noise, "rel_std_calibration": s.rel_std_calibration,
-        "verdict_rel_std": s.verdict_rel_std, "profile": s.profile,
-        "front_fraction": s.front_fraction, "still_median": s.still_median,
-        "covariance": f[k:k + 36].reshape(6, 6),
-    }
 
 
 def _one_centre_error(rays: tuple, ids: tuple) -> None:

@@ -289,14 +289,12 @@ def _verdict(n_in: int, n_cross: int, n_centres: int, crit: float, rel_std: floa
     the robust search's own verdict applies), the words :func:`verdict_text`."""
     # (direction_only: the refinement had to fix |t|, no std to judge)
     rel = float("inf") if direction_only else float(rel_std)
-    reason = _core.lib.mcg_scale_reason(n_in, n_cross, n_centres, crit, rel, max_rel_std,
-                                        profile, -1)
+    name = _core.scale_reason(n_in, n_cross, n_centres, crit, rel, max_rel_std, profile)
     n_front = -1
-    if reason < 0:
+    if name is None:
         n_front = int(in_front())
-        reason = _core.lib.mcg_scale_reason(n_in, n_cross, n_centres, crit, rel, max_rel_std,
-                                            profile, n_front)
-    name = _core.SCALE_REASONS[reason]
+        name = _core.scale_reason(n_in, n_cross, n_centres, crit, rel, max_rel_std, profile,
+                                  n_front)
     return ScaleVerdict(name == "observable",
                         verdict_text(name, n_in, n_cross, n_centres, crit, rel_std,
                                      max_rel_std, profile, n_front / n_in if n_in else 0.0),

@@ -168,7 +168,7 @@ def conclude(rays: RayPairs, R: np.ndarray, t: np.ndarray, r: Optional[np.ndarra
 #: fit; undecided) take :func:`conclude`
 C_WORDED = frozenset(k for k, v in _core.SCALE_REASONS.items()
                      if v not in ("static", "undecided"))
-_AT = _core._RES_AT
+_AT = _core.RESULT_OFFSETS
 
 
 def conclude_c(res: Any, f: np.ndarray, inl: np.ndarray, options: RansacOptions, method: str,
