@@ -55,22 +55,42 @@ def test_bench_robust_prints_the_cost_fit_over_sizes(capsys):
 
 
 def test_scaling_rows_are_medians_over_several_problems():
-    from mcgeom.experiments.bench.robust import _scaling_problems, bench_scaling
-    assert _scaling_problems(1000) == 15 and _scaling_problems(10 ** 6) == 3
+    from mcgeom.experiments.bench.robust_scaling import bench_scaling, scaling_problems
+    assert scaling_problems(1000) == 15 and scaling_problems(10 ** 6) == 3
     rows = bench_scaling(sizes=(300, 2000))
     for r, n in zip(rows, (300, 2000)):
-        assert r.n == n and r.problems == _scaling_problems(n) >= 3
+        assert r.n == n and r.problems == scaling_problems(n) >= 3
         # the median lies within the spread of the problems it is taken over
         assert 0 < r.us_per_corr_min <= r.us_per_corr <= r.us_per_corr_max
         assert r.seconds == pytest.approx(r.us_per_corr * n / 1e6)
         assert 0 < r.c_seconds < r.seconds and r.peak_mb > 0 and r.rot_deg < 0.5
+        # the search alone is part of the estimate; PoseLib ran on the same pixels
+        assert 0 < r.search_seconds < r.seconds
+        assert r.peer_seconds > 0 and r.peer_rot_deg < 0.5
+
+
+def test_ring_problem_pixels_are_its_rays():
+    """The scaling problem: pixels in the image at both times, its rays those
+    of the rig's pixels, the inliers on the true motion (Sampson residuals
+    at noise level) and about 20 % outliers off it."""
+    from mcgeom.experiments.bench.robust_scaling import ring_problem
+    from mcgeom.robust._scoring import residuals
+    p = ring_problem(4000, np.random.default_rng(3))
+    for px in (p.pixels1, p.pixels2):
+        assert px.shape == (4000, 2) and np.all(np.abs(px - [511.5, 383.5]) < [515, 387])
+    ref = p.rig.ray_pairs(p.pixels1, p.pixels2, p.cam)
+    assert np.array_equal(ref.dirs1, p.rays.dirs1) and np.array_equal(ref.dirs2, p.rays.dirs2)
+    assert np.bincount(p.cam).tolist() == [1000] * 4
+    res = residuals(p.rays, p.R, p.t) * 500.0   # ~pixels
+    off = np.mean(res > 5.0)
+    assert 0.15 < off < 0.22 and np.median(res) < 1.0
 
 
 def test_fixed_and_marginal_cost_fit():
     """The model seconds = fixed + marginal N is recovered from exact rows
     (across three decades, where an unweighted fit would ignore the
     smallest), and refused on one size."""
-    from mcgeom.experiments.bench.robust import ScaleRow, fixed_and_marginal
+    from mcgeom.experiments.bench.robust_scaling import ScaleRow, fixed_and_marginal
     rows = [ScaleRow(n, 1.8e-3 + 0.6e-6 * n, 0.0, 0.0, 1.0, 0.0, 0.8)
             for n in (1000, 10000, 100000, 1000000)]
     fixed, marginal = fixed_and_marginal(rows)

@@ -21,8 +21,8 @@ from mcgeom.rig import Rig
 
 from .common import import_peer
 
-__all__ = ["poselib_setup", "poselib_estimate", "poselib_motion", "DEFAULT_OPTIONS",
-           "TUNED_PEER", "POSELIB_SETTINGS"]
+__all__ = ["poselib_setup", "poselib_estimate", "poselib_estimate_pixels", "poselib_motion",
+           "DEFAULT_OPTIONS", "TUNED_PEER", "POSELIB_SETTINGS"]
 
 #: PoseLib's RANSAC options of the comparisons: its defaults but the 1 px
 #: threshold mcgeom gets too
@@ -61,16 +61,27 @@ def poselib_estimate(setup: tuple, p, ransac_options: Optional[dict] = None
 
     Raises ValueError when no camera pair has 5 matches or there is one match
     set only: PoseLib's 5+1 sampler would loop forever (see the module)."""
+    return poselib_estimate_pixels(setup, p.pixels1, p.pixels2, p.cam1, p.cam2, ransac_options)
+
+
+def poselib_estimate_pixels(setup: tuple, pixels1: np.ndarray, pixels2: np.ndarray,
+                            cam1: np.ndarray, cam2: np.ndarray,
+                            ransac_options: Optional[dict] = None
+                            ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`poselib_estimate` on pixel arrays: ``pixels1`` / ``pixels2`` (N, 2)
+    at times 1 and 2 in the cameras ``cam1`` / ``cam2`` (N,) of the rig of
+    ``setup``. The match sets are made from them in the call (PoseLib's input
+    format: one per camera pair), as a PoseLib user would."""
     poselib, exts, cams = setup
     matches = []
     m = len(cams)
     for i in range(m):
         for j in range(m):
-            sel = (p.cam1 == i) & (p.cam2 == j)
+            sel = (cam1 == i) & (cam2 == j)
             if sel.any():
                 pm = poselib.PairwiseMatches()
                 pm.cam_id1, pm.cam_id2 = i, j
-                pm.x1, pm.x2 = p.pixels1[sel], p.pixels2[sel]
+                pm.x1, pm.x2 = pixels1[sel], pixels2[sel]
                 matches.append(pm)
     if len(matches) < 2 or max(len(pm.x1) for pm in matches) < 5:
         raise ValueError("PoseLib's generalized RANSAC samples 5 matches of one camera pair "

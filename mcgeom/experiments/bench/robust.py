@@ -48,26 +48,18 @@ layer (the input checks, the verdict) is code that a cold call fetches
 again (measured, session 10: ring4 0.54 ms warm, 0.76 ms cold; PoseLib
 2.71 / 2.77 ms).
 
-Scaling: the robust estimate on 1e3 .. 1e6 correspondences of a 4-camera
-ring with 20 % outliers (rays in, :func:`mcgeom.robust.ransac`): seconds,
-microseconds per correspondence, and the peak memory allocated during the
-call (``tracemalloc``: numpy's buffers and the C workspace, which _core
-allocates with numpy) against the size of the input arrays, and the share of
-the time inside the C entry point (``info["c_seconds"]``); then the fit of
-the medians to a fixed cost per estimate plus a cost per correspondence
-(:func:`fixed_and_marginal`).
+Scaling: :mod:`.robust_scaling`.
 """
 
 from __future__ import annotations
 
 import time
-import tracemalloc
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Callable
 
 import numpy as np
 
-from mcgeom import metrics, robust, synth
+from mcgeom import metrics, synth
 from mcgeom.cv import estimate
 from mcgeom.rig import Rig
 
@@ -75,11 +67,13 @@ from ..common import Progress, no_progress
 from ..poselib_peer import POSELIB_SETTINGS, TUNED_PEER, poselib_estimate, poselib_setup
 from ..robust_vs_poselib import ring4, rot_scale_errors
 
-__all__ = ["SpeedRow", "ScaleRow", "bench_speed", "bench_scaling", "CASES", "WARM_BLOCK",
+__all__ = ["SpeedRow", "bench_speed", "generic_motion", "CASES", "WARM_BLOCK",
            "TUNED_PEER"]
 
 
-def _generic_motion(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def generic_motion(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A rotation of 3-17 deg about a random axis and a unit t in a random direction
+    (rig2_from_rig1, metres)."""
     R = synth.random_rotation(rng, 0.3)
     while metrics.rotation_error(R, np.eye(3)) < 0.05:
         R = synth.random_rotation(rng, 0.3)
@@ -96,8 +90,8 @@ def _forward_motion(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
 
 #: name: (rig, correspondences, outlier fraction, pixel noise, motion)
 CASES: dict[str, tuple[Callable[[], Rig], int, float, float, Callable]] = {
-    "ring4 4x50 0.5px": (ring4, 200, 0.0, 0.5, _generic_motion),
-    "ladybug6 300c 30%out": (synth.ladybug2, 300, 0.3, 0.5, _generic_motion),
+    "ring4 4x50 0.5px": (ring4, 200, 0.0, 0.5, generic_motion),
+    "ladybug6 300c 30%out": (synth.ladybug2, 300, 0.3, 0.5, generic_motion),
     "car8 forward 320c": (synth.vehicle8, 320, 0.0, 0.5, _forward_motion),
 }
 
@@ -210,111 +204,4 @@ def bench_speed(problems: int = 300, seed: int = 0,
                                  float(np.median(e[:, 1])), 1e3 * float(np.median(secs[meth])),
                                  float(np.median(outside)) if mine else float("nan"), *better,
                                  ms_warm=1e3 * float(np.median(warm[meth])), **cis))
-    return rows
-
-
-@dataclass
-class ScaleRow:
-    """One size of the scaling run: medians over ``problems`` problems."""
-    n: int
-    seconds: float
-    us_per_corr: float
-    peak_mb: float       # peak memory allocated during the call (tracemalloc)
-    input_mb: float      # the four ray arrays, the focal lengths and the camera ids
-    rot_deg: float
-    inlier_ratio: float
-    c_seconds: float = float("nan")   # of ``seconds``, inside the C entry point
-    problems: int = 1                 # the medians are over this many problems
-    us_per_corr_min: float = float("nan")   # the fastest and slowest of them
-    us_per_corr_max: float = float("nan")
-
-
-def _big_problem(n: int, rng: np.random.Generator, outliers: float = 0.2):
-    """Rays of a 4-camera ring (radius 0.25 m) moving by a generic motion, 0.5 px
-    noise at f = 500 px, ``outliers`` of them with a random time-2 bearing; built
-    with numpy directly (synth.make_problem draws point by point)."""
-    from mcgeom.types import RayPairs
-    R, t = _generic_motion(rng)
-    yaw = np.arange(4) * np.pi / 2
-    axes = np.stack([np.cos(yaw), np.sin(yaw), np.zeros(4)], axis=1)
-    centres = 0.25 * axes
-    cam = np.arange(n) % 4
-    d = axes[cam] + rng.uniform(-0.5, 0.5, size=(n, 3)) * np.array([1.0, 1.0, 0.6])
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    X = centres[cam] + d * rng.uniform(2.0, 20.0, size=(n, 1))
-    X2 = X @ R.T + t
-    d2 = X2 - centres[cam]
-    d2 /= np.linalg.norm(d2, axis=1, keepdims=True)
-    sig = 0.5 / 500.0
-    d1 = d + rng.normal(scale=sig, size=(n, 3))
-    d2 = d2 + rng.normal(scale=sig, size=(n, 3))
-    bad = rng.random(n) < outliers
-    d2[bad] = rng.normal(size=(int(bad.sum()), 3))
-    o = np.ascontiguousarray(centres[cam])
-    rays = RayPairs(o, np.ascontiguousarray(d1), o.copy(), np.ascontiguousarray(d2), cam, cam)
-    return rays, R, t
-
-
-def fixed_and_marginal(rows: Sequence[ScaleRow]) -> tuple[float, float]:
-    """The cost model ``seconds = fixed + marginal * N`` fitted to the median
-    times of the scaling rows (least squares of the relative errors, so that
-    1e3 counts as much as 1e6): ``(fixed seconds, marginal seconds per
-    correspondence)``. A cost per correspondence that falls with N is the
-    fixed part (the samples, local optimisations and final refinement, whose
-    number does not grow with N) spread over more correspondences: at N the
-    cost per correspondence is ``marginal + fixed / N``. Needs two sizes."""
-    if len({r.n for r in rows}) < 2:
-        raise ValueError("the fit needs rows of at least two sizes")
-    T = np.array([r.seconds for r in rows])
-    N = np.array([float(r.n) for r in rows])
-    (fixed, marginal), *_ = np.linalg.lstsq(np.stack([1.0 / T, N / T], axis=1),
-                                            np.ones(len(rows)), rcond=None)
-    return float(fixed), float(marginal)
-
-
-def fit_worst_error(rows: Sequence[ScaleRow], fixed: float, marginal: float) -> float:
-    """The largest relative error of ``fixed + marginal * N`` (seconds,
-    seconds per correspondence) against the rows' median seconds."""
-    return max(abs(fixed + marginal * r.n - r.seconds) / r.seconds for r in rows)
-
-
-def _scaling_problems(n: int) -> int:
-    """Problems timed at size ``n``: the time of one estimate moves by up to 3x
-    between problems (the samples drawn before the adaptive stop), so a single
-    draw per size says little about the cost per correspondence. About 1 s of
-    estimates per size, at least 3 and at most 15 problems."""
-    return int(min(15, max(3, 3e5 // n)))
-
-
-def bench_scaling(sizes=(1000, 10000, 100000, 1000000), seed: int = 0,
-                  progress: Progress = no_progress) -> list[ScaleRow]:
-    """Seconds, per-correspondence cost and peak memory of the robust estimate
-    per N: medians over :func:`_scaling_problems` problems (problem k drawn and
-    solved with seed ``seed + k``); the peak is that of problem 0's call."""
-    rows = []
-    for n in progress(list(sizes), total=len(sizes), desc="scaling"):
-        times, c_times, rot, inl = [], [], [], []
-        peak = inp = 0.0
-        for k in range(_scaling_problems(int(n))):
-            rng = np.random.default_rng(seed + k)
-            rays, R, t = _big_problem(int(n), rng)
-            focal = np.full(len(rays), 500.0)
-            if k == 0:
-                inp = (4 * rays.origins1.nbytes + focal.nbytes + 2 * rays.cam1.nbytes) / 1e6
-                robust.ransac(rays, "five_plus_one", threshold=1.0, focal=focal, seed=seed)  # warm
-                tracemalloc.start()
-                robust.ransac(rays, "five_plus_one", threshold=1.0, focal=focal, seed=seed)
-                peak = tracemalloc.get_traced_memory()[1]
-                tracemalloc.stop()
-            # timed without tracemalloc's bookkeeping
-            t0 = time.perf_counter()
-            m = robust.ransac(rays, "five_plus_one", threshold=1.0, focal=focal, seed=seed + k)
-            times.append(time.perf_counter() - t0)
-            c_times.append(float(m.info.get("c_seconds", float("nan"))))
-            rot.append(float(np.degrees(metrics.rotation_error(m.R, R))))
-            inl.append(float(m.info["inlier_ratio"]))
-        dt = float(np.median(times))
-        rows.append(ScaleRow(int(n), dt, 1e6 * dt / n, peak / 1e6, inp, float(np.median(rot)),
-                             float(np.median(inl)), float(np.median(c_times)), len(times),
-                             1e6 * min(times) / n, 1e6 * max(times) / n))
     return rows
