@@ -135,7 +135,7 @@ size_t robust_sample_work_size(void)
     return e > MINIMAL_SOLUTIONS_SIZE ? e : MINIMAL_SOLUTIONS_SIZE;
 }
 
-static double now_seconds(void)
+double robust_now_seconds(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -472,7 +472,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                           double *work, size_t lwork)
 {
     ctx c;
-    double t_start, deadline;
+    double t_start, t_mark, deadline;
     int st, k, iters = 0, k_needed;
     double cen[3];
     const double *wlo, *wp;
@@ -483,7 +483,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     memset(&c, 0, sizeof c);
     /* the clock covers the input checks too (O(N): part of the call's cost,
      * and of the time budget) */
-    t_start = now_seconds();
+    t_start = robust_now_seconds();
     if (opt)
         c.opt = *opt;
     else
@@ -598,7 +598,7 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                 k_needed = adaptive_count(&c);
             /* (a 6-point sample takes ~0.03 s: the clock after each one) */
             if ((iters % CLOCK_EVERY == 0 || c.opt.sampler == MCG_SAMPLER_6PT) &&
-                now_seconds() > deadline) {
+                robust_now_seconds() > deadline) {
                 res->stop = MCG_ROBUST_STOP_TIME;
                 break;
             }
@@ -631,10 +631,12 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
     res->iterations = iters;
     res->hypotheses = c.n_hyp;
     res->local_optimizations = c.n_lo;
+    t_mark = robust_now_seconds();
+    res->seconds_search = t_mark - t_start;
     if (!c.have || c.n_inl < MIN_REFIT) {
         res->n_inliers = c.have ? c.n_inl : 0;
         robust_fill_covariance(res);
-        res->seconds = now_seconds() - t_start;
+        res->seconds = res->seconds_search;
         return MCG_EDEGENERATE;
     }
     memcpy(res->t_hypothesis, c.t, sizeof c.t);
@@ -693,6 +695,8 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                                             c.found);
     }
     robust_fill_covariance(res);
+    res->seconds_final = robust_now_seconds() - t_mark;
+    t_mark += res->seconds_final;
     if (c.opt.verdict_still_factor > 0.0) {
         /* the evidence in the same call (issue 19: the verdict's own
          * cffi call and its Python wrapper were ~1/8 of a cold call's
@@ -718,7 +722,8 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
                                               mcg_verdict_stats_work_size(n_cameras)) == MCG_OK;
         /* the verdict itself (robust_verdict.c) */
         robust_scale_verdict(&c, res, mask, wp);
+        res->seconds_verdict = robust_now_seconds() - t_mark;
     }
-    res->seconds = now_seconds() - t_start;
+    res->seconds = res->seconds_search + res->seconds_final + res->seconds_verdict;
     return MCG_OK;
 }

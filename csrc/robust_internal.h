@@ -214,6 +214,8 @@ static inline double median(const double *x, double *y, int n)
 /* robust.c: the workspace */
 size_t robust_sample_work_size(void);
 int robust_scale_cap(int n);
+/* CLOCK_MONOTONIC, seconds (the result's timings and max_seconds) */
+double robust_now_seconds(void);
 
 /* robust_score.c: MSAC scoring, the best, the records, preemptive scoring */
 double robust_msac2(ctx *c, const double R[9], const double t[3], double bound, int *n_inl,

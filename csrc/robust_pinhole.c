@@ -9,18 +9,13 @@
  */
 #include "mcgeom.h"
 #include "internal.h"
+#include "robust_internal.h"
 
 #include <stddef.h>
 #include <string.h>
 
 #define MAX_CAMERAS 4096 /* mcg_robust_rig_motion's */
 #define NEED_DISTINCT 6  /* pairs of the smallest sample (5+1, 6-point) */
-
-/* doubles for n ints (rounded up) */
-static size_t ints_as_doubles(size_t n)
-{
-    return (n * sizeof(int) + sizeof(double) - 1) / sizeof(double);
-}
 
 size_t mcg_robust_pinhole_work_size(int n, int n_cameras)
 {
@@ -75,7 +70,8 @@ int mcg_robust_rig_motion_pinhole(int n, int n_cameras, const double *intr, cons
                                   size_t lwork)
 {
     const size_t nn = (size_t)n;
-    double *o1, *d1, *o2, *d2, *ppr, *axes, *rest;
+    const double t_start = robust_now_seconds();
+    double *o1, *d1, *o2, *d2, *ppr, *axes, *rest, t_rays;
     int *id1, *id2, bad, st, k, i;
     size_t need;
     if (!intr || !rot || !centres || !focal || !ids1 || !ids2 || !px1 || !px2 || !res ||
@@ -111,6 +107,11 @@ int mcg_robust_rig_motion_pinhole(int n, int n_cameras, const double *intr, cons
     for (k = 0; k < n_cameras; k++)
         for (i = 0; i < 3; i++)
             axes[3 * k + i] = rot[9 * k + 6 + i];
-    return mcg_robust_rig_motion(n, o1, d1, o2, d2, id1, id2, n_cameras, ppr, axes, focal, opt,
-                                 res, mask, weights, rest, lwork - (size_t)(rest - work));
+    t_rays = robust_now_seconds() - t_start;
+    st = mcg_robust_rig_motion(n, o1, d1, o2, d2, id1, id2, n_cameras, ppr, axes, focal, opt, res,
+                               mask, weights, rest, lwork - (size_t)(rest - work));
+    /* (the search cleared *res: the rays' time is added after it) */
+    res->seconds_rays = t_rays;
+    res->seconds += t_rays;
+    return st;
 }

@@ -1446,7 +1446,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     (R, t); the pairs of the final refinement), ``weights`` (N,) of the final
     refinement (0 where unused), ``loss_scale`` (radians), ``score``,
     ``iterations``, ``hypotheses``, ``local_optimizations``, ``stop`` (a name
-    of ``ROBUST_STOP_NAMES``), ``seconds`` and ``refinement`` (the dict of
+    of ``ROBUST_STOP_NAMES``), ``seconds`` (its stages in ``stage_seconds``,
+    :func:`robust_stage_seconds`) and ``refinement`` (the dict of
     :func:`refine_motion` of the final refinement, or None if it did not run),
     ``scale_profile`` (NaN if not computed), ``zero_profile`` (the same at the
     factor 0.01, NaN if not computed; only its side of 9, the bound of
@@ -1573,7 +1574,7 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
 
 
 __all__ += ["robust_pinhole_raw", "robust_struct", "scale_reason", "SCALE_REASONS",
-            "RESULT_OFFSETS"]
+            "RESULT_OFFSETS", "robust_stage_seconds"]
 
 #: float64 offsets of the arrays of an mcg_robust_result (one copy of the
 #: struct gives them all as views)
@@ -1588,6 +1589,17 @@ RESULT_OFFSETS = {k: ffi.offsetof("mcg_robust_result", *f) // 8 for k, f in (
 SCALE_REASONS = {getattr(lib, "MCG_SCALE_" + k): k.lower() for k in (
     "OBSERVABLE", "NO_REDUNDANCY", "ONE_CAMERA", "CRITICAL", "UNCERTAIN", "CHEIRALITY",
     "UNCONFIRMED", "STATIC", "UNDECIDED")}
+
+
+def robust_stage_seconds(res: Any) -> dict:
+    """Where the C robust estimate's time went (``res``: an ``mcg_robust_result
+    *``), wall seconds: ``rays`` (the pixel entry point's rays; 0 on rays),
+    ``search`` (input checks, sampling, scoring, local optimisation, the
+    final scale search), ``final`` (final refinement, scale profiles,
+    covariance), ``verdict`` (the verdict's evidence and the verdict). They
+    sum to ``res.seconds``."""
+    return {"rays": res.seconds_rays, "search": res.seconds_search,
+            "final": res.seconds_final, "verdict": res.seconds_verdict}
 
 
 def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
@@ -1612,7 +1624,7 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
         "n_inliers": res.n_inliers, "iterations": res.iterations,
         "hypotheses": res.hypotheses, "local_optimizations": res.local_optimizations,
         "stop": ROBUST_STOP_NAMES.get(res.stop, "unknown"), "seconds": res.seconds,
-        "scale_profile": res.scale_profile, "zero_profile": res.zero_profile,
+        "stage_seconds": robust_stage_seconds(res), "scale_profile": res.scale_profile, "zero_profile": res.zero_profile,
         "inlier_rms": res.inlier_rms, "refinement": refinement,
         "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
         "sampler": SAMPLER_OF[res.sampler], "sample_size": res.sample_size,

@@ -296,6 +296,12 @@ def _bench_robust(args: argparse.Namespace) -> int:
     print(f"cold: the methods alternate on every problem (errors and 'outside C' from this "
           f"pass); warm: the same problems in blocks of {WARM_BLOCK}, each method on a block "
           f"in turn")
+    print("mcgeom's C call by stage (cold medians, ms; info['c_stage_seconds']): the "
+          "pixels' rays, the search (sampling, scoring, local optimisation), the final "
+          "refinement and scale profiles, the verdict; and the time outside C")
+    for r in rows:
+        if r.method == "mcgeom" and r.stages_ms:
+            print(f"  {r.case:<22} " + ", ".join(f"{k} {v:.3f}" for k, v in r.stages_ms.items()))
     print(f"mcgeom / {TUNED_PEER}, medians' ratio with its 95 % bootstrap interval "
           f"(problems resampled):")
     for r in rows:

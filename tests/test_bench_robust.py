@@ -1,7 +1,8 @@
 """``mcgeom bench robust`` on a few problems: both timings (cold: the methods
 alternating per problem; warm: blocks of problems per method) for every case
-and method, mcgeom's share outside C, the paired comparison, and the printed
-table with its ratio columns."""
+and method, mcgeom's share outside C and its C call's stages, the paired
+comparison, the printed table with its ratio columns, and the scaling part
+(PoseLib on the same pixels, the search alone, the fit)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,11 @@ def test_speed_rows_have_cold_and_warm_times():
         if r.method == "mcgeom":
             assert 0.0 < r.outside_c < 1.0 and np.isnan(r.mcgeom_rot_better)
             assert np.isnan(r.time_ratio_ci).all()
+            # the C call's stages and the time outside it: medians of parts
+            # of the cold time, so their sum is about it
+            assert set(r.stages_ms) == {"rays", "search", "final", "verdict", "outside C"}
+            assert all(v > 0 for v in r.stages_ms.values())
+            assert 0.5 * r.ms < sum(r.stages_ms.values()) < 1.5 * r.ms
         else:
             assert 0.0 <= r.mcgeom_rot_better <= 1.0 and np.isnan(r.outside_c)
             for lo, hi in (r.time_ratio_ci, r.rot_ratio_ci, r.scale_ratio_ci):
@@ -42,6 +48,9 @@ def test_bench_robust_command_prints_both_ratios(capsys):
     assert len(intervals) == 3 and all("scale error" in line and "[" in line
                                        for line in intervals)
     assert "min-max us/corr" in out and "largest / smallest median" not in out  # one size
+    stages = [line for line in out.splitlines() if "search" in line and "verdict" in line
+              and line.startswith("  ")]
+    assert len(stages) == 3 and all("outside C" in line for line in stages)
 
 
 

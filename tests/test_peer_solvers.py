@@ -42,7 +42,12 @@ def test_ransac_part_small():
     assert ring4["mcgeom eigensolver"][2] == ["eigensolver"]
     assert ring4["mcgeom eigensolver"][0][0, 0] < 0.1 and ring4["mcgeom eigensolver"][3][0] > 0
     assert "vs 17-pt" in table and "C vs 5+1" in table and "upright 3+1" in table
-    assert "samples" in table
+    assert "samples" in table and "C final" in table
+    # the C call's final stage (refinement, profiles, verdict): part of its
+    # time for every mcgeom row, none for PoseLib
+    for meth in ("mcgeom façade (auto)", "mcgeom 5+1", "mcgeom upright (0.2 deg)"):
+        assert 0 < ring4[meth][5][0] < ring4[meth][3][0]
+    assert np.isnan(ring4["poselib defaults"][5][0])
 
 
 def test_poselib_refuses_data_it_cannot_sample():

@@ -10,7 +10,8 @@ cases, and every search outside C. Checked here:
   unconfirmed (a sample cap), static (the Python fallback), with and without a
   calibration error -- through the pixel entry point and the general path;
 * the pixel entry point (``mcg_robust_rig_motion_pinhole``) against the two
-  calls it replaces (``pinhole_ray_pairs`` and the search on the rays);
+  calls it replaces (``pinhole_ray_pairs`` and the search on the rays), and
+  the split of both calls' C time into stages (``info["c_stage_seconds"]``);
 * ``observability._verdict`` (whose rule is now ``mcg_scale_reason``) against
   the rule written out here, on random evidence;
 * the constants the C verdict copies from Python;
@@ -50,8 +51,8 @@ def _motions(a, b, ctx: str) -> None:
     assert (sa.observable, sa.reason, sa.critical_angle) == \
         (sb.observable, sb.reason, sb.critical_angle), ctx
     assert sa.rel_std == sb.rel_std, ctx
-    keys = set(a.info) - {"time_s", "c_seconds"}
-    assert keys == set(b.info) - {"time_s", "c_seconds"}, ctx
+    keys = set(a.info) - {"time_s", "c_seconds", "c_stage_seconds"}
+    assert keys == set(b.info) - {"time_s", "c_seconds", "c_stage_seconds"}, ctx
     for k in keys:
         x, y = a.info[k], b.info[k]
         if isinstance(x, np.ndarray):
@@ -150,6 +151,14 @@ def test_pixel_entry_is_the_rays_search(vertical):
         assert a is not None and b is not None
         assert a.info["sampler"] == b.info["sampler"]
         _motions(a, b, f"problem {i}")
+        # where the C time went: the stages sum to c_seconds; the rays' only
+        # on the pixel entry point; the verdict's in both (the façade asks)
+        for m, rays_in_c in ((a, True), (b, False)):
+            stages = m.info["c_stage_seconds"]
+            assert set(stages) == {"rays", "search", "final", "verdict"}
+            assert (stages["rays"] > 0) == rays_in_c
+            assert stages["search"] > 0 and stages["final"] > 0 and stages["verdict"] > 0
+            assert sum(stages.values()) == pytest.approx(m.info["c_seconds"], rel=1e-12)
 
 
 def _reference_verdict(n_in, n_cross, n_centres, crit, rel, max_rel, profile, front):

@@ -1239,7 +1239,8 @@ typedef struct {
     int stop;               /* MCG_ROBUST_STOP_* */
     int refined;            /* 1 if the final refinement ran */
     double loss_scale;      /* loss scale of the final refinement, radians */
-    double seconds;         /* wall time of the call */
+    double seconds;         /* wall time of the call (its stages: the
+                               seconds_* fields at the end) */
     double scale_profile;   /* min over the two factors of (cost with the
                                centroid's travel held at that factor -
                                final cost) / sigma2 (~chi^2, 1 dof; NaN if
@@ -1293,6 +1294,16 @@ typedef struct {
                                opt->verdict_still_factor > 0) */
     mcg_robust_scale scale; /* the verdict: whether t is metric, the t to
                                report, and why (MCG_SCALE_*) */
+    /* Where the call's time went, wall seconds (ABI: appended fields; they
+     * sum to seconds): */
+    double seconds_rays;    /* mcg_robust_rig_motion_pinhole: the pixels'
+                               rays and pixels per radian (0 on rays) */
+    double seconds_search;  /* the input checks, the sampling, scoring and
+                               local optimisation, the final scale search */
+    double seconds_final;   /* the final refinement, the scale profiles, the
+                               covariance */
+    double seconds_verdict; /* the verdict's evidence and the verdict (0
+                               without opt->verdict_still_factor) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */

@@ -20,7 +20,7 @@
  *    negative or NaN calibration std;
  *  - mcg_robust_rig_motion_pinhole: the same result as mcg_pinhole_ray_pairs
  *    followed by mcg_robust_rig_motion (bit for bit), the rays in its
- *    workspace, EDEGENERATE for fewer than 6 distinct correspondences,
+ *    workspace, the stages' times (seconds_*) summing to seconds, EDEGENERATE for fewer than 6 distinct correspondences,
  *    EINVAL for an id out of range, ENOMEM for a short workspace.
  * Exit status 0 iff every check passes.
  */
@@ -249,8 +249,8 @@ static void observable_case(double *work, size_t lwork)
     /* no verdict without its evidence */
     opt.verdict_still_factor = 0.0;
     st = run(N, &opt, &res, work, lwork);
-    check(st == MCG_OK && !res.have_scale, "verdict_still_factor 0: no verdict",
-          res.have_scale, 0);
+    check(st == MCG_OK && !res.have_scale && res.seconds_verdict == 0.0,
+          "verdict_still_factor 0: no verdict (and no time for it)", res.have_scale, 0);
     /* calibration stds: >= 0 and finite */
     opt.verdict_still_factor = 1.5;
     ext[3] = -1e-3;
@@ -356,6 +356,14 @@ static void pinhole_case(double *work, size_t lwork)
               memcmp(wts, wts_b, sizeof wts) == 0 && a.scale.reason == b.scale.reason &&
               memcmp(a.scale.t, b.scale.t, sizeof a.scale.t) == 0,
           "pinhole entry == mcg_pinhole_ray_pairs + mcg_robust_rig_motion", st, 0);
+    /* the stages' times: each >= 0, summing to the call's; the rays' only
+     * on the pixel entry point, the verdict's only when asked for */
+    check(a.seconds_rays > 0.0 && b.seconds_rays == 0.0 && a.seconds_search > 0.0 &&
+              a.seconds_final > 0.0 && a.seconds_verdict > 0.0 &&
+              fabs(a.seconds_rays + a.seconds_search + a.seconds_final + a.seconds_verdict -
+                   a.seconds) <= 1e-12 &&
+              fabs(b.seconds_search + b.seconds_final + b.seconds_verdict - b.seconds) <= 1e-12,
+          "  the stages' times sum to seconds (the rays' on the pixel entry point only)", 0, 0);
     check(memcmp(work, o1, sizeof o1) == 0 && memcmp(work + 3 * N, d1, sizeof d1) == 0 &&
               memcmp(work + 9 * N, d2, sizeof d2) == 0 && memcmp(work + 12 * N, ppr, sizeof ppr) == 0,
           "  its rays and pixels per radian in the workspace", 0, 0);

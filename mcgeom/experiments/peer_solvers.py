@@ -369,6 +369,14 @@ def _sampler_label(info: dict) -> str:
     return name
 
 
+def _final_seconds(info: dict) -> float:
+    """Seconds of the C call after its search (``info["c_stage_seconds"]``'s
+    final refinement and verdict; NaN without them): the stage that every
+    sampler's estimate goes through, whatever it sampled."""
+    st = info.get("c_stage_seconds")
+    return st["final"] + st["verdict"] if st else np.nan
+
+
 #: the façade's default sample cap (``maxIters`` of :func:`mcgeom.cv.estimate`)
 DEFAULT_CAP17 = 1000
 
@@ -380,14 +388,16 @@ def row17(cap: int) -> str:
 
 def _methods(rig: Rig, setup: tuple, p, g1: np.ndarray, g2: np.ndarray, deg: float,
              caps17: Sequence[int] = (DEFAULT_CAP17,)) -> dict:
-    """{row: call returning (R, t, sampler, seconds in C, samples drawn)} of one problem."""
+    """{row: call returning (R, t, sampler, seconds in C, samples drawn, seconds
+    of the C call's final stage)} of one problem."""
     def facade(**kw):
         m = estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0, **kw)
         return (m.R, m.info["t_metric"], _sampler_label(m.info),
-                m.info.get("c_seconds", np.nan), m.info.get("iterations", np.nan))
+                m.info.get("c_seconds", np.nan), m.info.get("iterations", np.nan),
+                _final_seconds(m.info))
 
     def peer(opt):
-        return lambda: poselib_estimate(setup, p, opt) + ("5+1", np.nan, np.nan)
+        return lambda: poselib_estimate(setup, p, opt) + ("5+1", np.nan, np.nan, np.nan)
 
     runs = {"mcgeom façade (auto)": facade,
             "mcgeom 5+1": lambda: facade(method="ransac:five_plus_one"),
@@ -404,12 +414,15 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                gravity_error_deg: float = 0.2, progress: Progress = no_progress,
                caps17: Sequence[int] = (DEFAULT_CAP17,)) -> dict:
     """{case: {method: (errors problems x 2, seconds per problem, samplers, seconds
-    in C, samples drawn)}}: the rotation (deg) and scale errors, NaN where the
-    method cannot sample the data (a ValueError, e.g. 5+1 without a 5-point
-    camera) or finds no motion; the samplers the façade chose; the time of
-    mcgeom's C search (``info["c_seconds"]``: sampling, scoring, LO, final
-    refinement; NaN for the Python drivers and PoseLib) and its samples
-    (``info["iterations"]``: the adaptive stop's count, NaN for PoseLib). Each gravity vector is turned by
+    in C, samples drawn, seconds of the C final stage)}}: the rotation (deg) and
+    scale errors, NaN where the method cannot sample the data (a ValueError,
+    e.g. 5+1 without a 5-point camera) or finds no motion; the samplers the
+    façade chose; the time of mcgeom's C call (``info["c_seconds"]``: rays,
+    sampling, scoring, LO, final refinement, verdict; NaN for the Python
+    drivers and PoseLib), its samples (``info["iterations"]``: the adaptive
+    stop's count, NaN for PoseLib) and the part of its time after the search
+    (:func:`_final_seconds`: the final refinement, scale profiles and
+    verdict, which every sampler's estimate goes through). Each gravity vector is turned by
     ``gravity_error_deg`` about a random axis (the IMU's error). 17-point
     RANSAC runs once per sample cap of ``caps17`` (rows :func:`row17`): its
     17-pair samples are all inliers with probability w^17, so where outliers
@@ -446,28 +459,32 @@ def run_ransac(problems: int = 50, seed: int = 0, cases: Optional[dict] = None,
                 forced = _FORCED.get(meth)
                 if forced is not None and forced == chosen:
                     # the façade ran this very search (same C call, same seed)
-                    e, s, used, cs, its = res["mcgeom façade (auto)"]
-                    err, secs, sampler, c_secs, iters = e[-1], s[-1], used[-1], cs[-1], its[-1]
+                    e, s, used, cs, its, fs = res["mcgeom façade (auto)"]
+                    err, secs, sampler, c_secs, iters, f_secs = \
+                        e[-1], s[-1], used[-1], cs[-1], its[-1], fs[-1]
                 elif meth == "mcgeom 6-pt":
                     continue    # only where the façade chose it (see the module)
                 else:
                     t0 = time.perf_counter()
                     try:
-                        Re, te, sampler, c_secs, iters = fn()
+                        Re, te, sampler, c_secs, iters, f_secs = fn()
                         err = rot_scale_errors(Re, te, R, t)
                     except (ValueError, ArithmeticError):   # cannot sample / nothing found
-                        err, sampler, c_secs, iters = (np.nan, np.nan), "-", np.nan, np.nan
+                        err, sampler, c_secs, iters, f_secs = \
+                            (np.nan, np.nan), "-", np.nan, np.nan, np.nan
                     secs = time.perf_counter() - t0
                 if meth == "mcgeom façade (auto)":
                     chosen = sampler
-                e, s, used, cs, its = res.setdefault(meth, ([], [], [], [], []))
+                e, s, used, cs, its, fs = res.setdefault(meth, ([], [], [], [], [], []))
                 e.append(err)
                 s.append(secs)
                 used.append(sampler)
                 cs.append(c_secs)
                 its.append(iters)
-        out[name] = {k: (np.array(e), np.array(s), u, np.array(cs), np.array(its, dtype=float))
-                     for k, (e, s, u, cs, its) in res.items()}
+                fs.append(f_secs)
+        out[name] = {k: (np.array(e), np.array(s), u, np.array(cs), np.array(its, dtype=float),
+                         np.array(fs, dtype=float))
+                     for k, (e, s, u, cs, its, fs) in res.items()}
     return out
 
 
@@ -483,20 +500,23 @@ def ransac_table(res: dict) -> str:
     search with its speed-up over 5+1's (the search alone, without the
     façade's Python conversions and verdict), and the mean number of samples
     the C search drew (its adaptive stop: w^3 for the upright 3+1, w^4 for
-    the upright 4-point, w^5 for the two-stage 5+1, w^6 for the 6-point)."""
+    the upright 4-point, w^5 for the two-stage 5+1, w^6 for the 6-point),
+    and the median ms of the C call's final stage (``C final``: refinement,
+    scale profiles, verdict; the same work whichever sampler found the
+    motion, so a faster sampler cannot make the estimate faster than it)."""
     # column widths of the longest names (--outliers' cases, the upright row)
     wc = max([30] + [len(case) for case in res])
     wm = max([23] + [len(meth) for methods in res.values() for meth in methods])
     lines = [f"{'case':<{wc}} {'method':<{wm}} {'sampler':<18} {'rot med deg':>11} "
              f"{'scale med':>9} {'failed':>6} {'ms med':>8} {'vs 5+1':>7} {'vs 17-pt':>8} "
-             f"{'C ms med':>8} {'C vs 5+1':>8} {'samples':>7}"]
+             f"{'C ms med':>8} {'C vs 5+1':>8} {'samples':>7} {'C final':>7}"]
     for case, methods in res.items():
         ok5 = np.isfinite(methods["mcgeom 5+1"][0][:, 0])   # (rows not run are absent)
         base5 = np.median(methods["mcgeom 5+1"][1]) if ok5.any() else np.nan
         base17 = np.median(methods[_rows17(methods)[0]][1])
         c5 = methods["mcgeom 5+1"][3]
         c5 = np.median(c5[np.isfinite(c5)]) if np.isfinite(c5).any() else np.nan
-        for meth, (e, secs, used, c_secs, iters) in methods.items():
+        for meth, (e, secs, used, c_secs, iters, f_secs) in methods.items():
             ok = np.isfinite(e[:, 0])
             med = np.median(e[ok], axis=0) if ok.any() else (np.nan, np.nan)
             names, counts = np.unique(used, return_counts=True)
@@ -506,10 +526,12 @@ def ransac_table(res: dict) -> str:
             cms = np.median(c_secs[np.isfinite(c_secs)]) if np.isfinite(c_secs).any() \
                 else np.nan
             its = np.mean(iters[np.isfinite(iters)]) if np.isfinite(iters).any() else np.nan
+            fms = np.median(f_secs[np.isfinite(f_secs)]) if np.isfinite(f_secs).any() \
+                else np.nan
             lines.append(f"{case:<{wc}} {meth:<{wm}} {sampler[:18]:<18} {med[0]:11.4f} "
                          f"{med[1]:9.4f} {np.mean(~ok):6.2f} {1e3 * ms:8.2f} "
                          f"{base5 / ms:6.2f}x {base17 / ms:7.2f}x {1e3 * cms:8.2f} "
-                         f"{c5 / cms:7.2f}x {its:7.1f}")
+                         f"{c5 / cms:7.2f}x {its:7.1f} {1e3 * fms:7.3f}")
         lines.append(equal_success(methods))
     return "\n".join(lines)
 

@@ -176,6 +176,7 @@ def _search_info(res: Any, method: str) -> dict:
     info = {"iterations": res.iterations, "hypotheses": res.hypotheses,
             "local_optimizations": res.local_optimizations, "score": res.score,
             "stop": _core.ROBUST_STOP_NAMES.get(res.stop, "unknown"), "c_seconds": res.seconds,
+            "c_stage_seconds": _core.robust_stage_seconds(res),
             "sampler": method, "sample_size": res.sample_size, "confidence": res.confidence}
     if sampler.startswith("six_point"):
         info["six_point_solver"] = "homotopy" if sampler == "six_point_homotopy" else "local"

@@ -54,7 +54,7 @@ Scaling: :mod:`.robust_scaling`.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -118,6 +118,10 @@ class SpeedRow:
     time_ratio_ci: tuple[float, float] = (float("nan"), float("nan"))
     rot_ratio_ci: tuple[float, float] = (float("nan"), float("nan"))
     scale_ratio_ci: tuple[float, float] = (float("nan"), float("nan"))
+    # mcgeom only: median cold ms of each stage of the C call
+    # (info["c_stage_seconds"]: rays, search, final, verdict) and of the time
+    # outside it ("outside C"); {} for PoseLib
+    stages_ms: dict = field(default_factory=dict)
 
 
 #: problems per block of the warm timing (see the module docstring)
@@ -164,6 +168,7 @@ def bench_speed(problems: int = 300, seed: int = 0,
         secs = {k: [] for k in methods}
         warm = {k: [] for k in methods}
         outside = []
+        stages: dict = {}
         done = []
         for _ in range(problems):
             R, t = motion(rng)
@@ -182,6 +187,9 @@ def bench_speed(problems: int = 300, seed: int = 0,
                 err[meth].append(rot_scale_errors(Re, te, R, t))
                 if m is not None:
                     outside.append(1.0 - m.info.get("c_seconds", 0.0) / dt)
+                    for stage, sec in m.info.get("c_stage_seconds", {}).items():
+                        stages.setdefault(stage, []).append(sec)
+                    stages.setdefault("outside C", []).append(dt - m.info.get("c_seconds", 0.0))
         for b0 in range(0, len(done), WARM_BLOCK):
             for meth, opt in methods.items():
                 for p, seed_k, _, _ in done[b0:b0 + WARM_BLOCK]:
@@ -203,5 +211,7 @@ def bench_speed(problems: int = 300, seed: int = 0,
             rows.append(SpeedRow(name, meth, float(np.median(e[:, 0])),
                                  float(np.median(e[:, 1])), 1e3 * float(np.median(secs[meth])),
                                  float(np.median(outside)) if mine else float("nan"), *better,
-                                 ms_warm=1e3 * float(np.median(warm[meth])), **cis))
+                                 ms_warm=1e3 * float(np.median(warm[meth])),
+                                 stages_ms={k: 1e3 * float(np.median(v)) for k, v in
+                                            stages.items()} if mine else {}, **cis))
     return rows
