@@ -177,12 +177,13 @@ int main(int argc, char **argv)
         printf("FAIL mcg_robust_rig_motion: %s\n", mcg_status_message(st));
         return 1;
     }
-    printf("%d samples, %d hypotheses, %d local optimisations, %d inliers, %.2f ms; "
-           "t = (%.4f, %.4f, %.4f) m, relative std of |t| %.3g (noise %.3g, calibration "
-           "%.3g): %s\n", res.iterations, res.hypotheses, res.local_optimizations, res.n_inliers,
-           1e3 * res.seconds, res.scale.t[0], res.scale.t[1], res.scale.t[2], res.scale.rel_std,
-           res.scale.rel_std_noise, res.scale.rel_std_calibration,
-           mcg_scale_reason_string(res.scale.reason));
+    printf("%d samples, %d hypotheses, %d local optimisations, %d inliers, %.2f ms (search "
+           "%.2f, final refinement %.2f, verdict %.2f); t = (%.4f, %.4f, %.4f) m, relative std "
+           "of |t| %.3g (noise %.3g, calibration %.3g): %s\n", res.iterations, res.hypotheses,
+           res.local_optimizations, res.n_inliers, 1e3 * res.seconds, 1e3 * res.seconds_search,
+           1e3 * res.seconds_final, 1e3 * res.seconds_verdict, res.scale.t[0], res.scale.t[1],
+           res.scale.t[2], res.scale.rel_std, res.scale.rel_std_noise,
+           res.scale.rel_std_calibration, mcg_scale_reason_string(res.scale.reason));
 
     for (i = 0; i < 3; ++i) {
         dt += (res.t[i] - t_true[i]) * (res.t[i] - t_true[i]);
