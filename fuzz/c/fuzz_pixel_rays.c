@@ -13,7 +13,8 @@
  * pixels, at most 10 samples): where the ray pass fails it fails with the
  * same status (EINVAL below 6 pairs); otherwise its workspace holds the
  * ray pass's rays and pixels per radian bit for bit, and on MCG_OK R is a
- * rotation and the scale verdict is there.
+ * rotation, the scale verdict is there and the stage times (the rays'
+ * included) sum to seconds.
  */
 #include "fuzz_input.h"
 #include "mcgeom.h"
@@ -68,6 +69,13 @@ static void robust_from_pixels(int n, int m, const double *intr, const double *r
                                                                  MCG_SCALE_UNDECIDED),
                      "robust_rig_motion_pinhole: verdict %d, evidence %d", res.have_scale,
                      res.have_verdict);
+            FZ_CHECK(res.seconds_rays >= 0.0 && res.seconds_search >= 0.0 &&
+                         res.seconds_final >= 0.0 && res.seconds_verdict >= 0.0 &&
+                         fabs(res.seconds_rays + res.seconds_search + res.seconds_final +
+                              res.seconds_verdict - res.seconds) <= 1e-9,
+                     "robust_rig_motion_pinhole: stage times %g + %g + %g + %g against %g",
+                     res.seconds_rays, res.seconds_search, res.seconds_final,
+                     res.seconds_verdict, res.seconds);
         }
     }
     free(work);

@@ -23,7 +23,9 @@
  * is a rotation (orthonormal to 1e-9, det +1), t is finite, the iterations stay
  * within max_iterations, mask bit 0 agrees with the residuals of
  * mcg_gec_residuals at (R, t) (|r| focal < threshold; pairs within rounding
- * of the threshold excepted), the confidence lies in [0, 1], n_inliers counts it, n_used counts bit 1 and
+ * of the threshold excepted), the confidence lies in [0, 1], the stage
+ * times (seconds_*) are >= 0 and sum to seconds (no rays' time on rays, no
+ * verdict's without one), n_inliers counts it, n_used counts bit 1 and
  * the scale profile is NaN (not asked) or >= 0, the sampler used is the
  * one asked for (AUTO: 5+1 or the local 6-point), its found_rate in (0, 1]
  * (1 but for the local 6-point), the verdict's evidence is there
@@ -309,6 +311,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              "iterations %d outside [1, %d]", res.iterations, opt.max_iterations);
     FZ_CHECK(res.confidence >= 0.0 && res.confidence <= 1.0,
              "confidence %g outside [0, 1]", res.confidence);
+    FZ_CHECK(res.seconds_rays == 0.0 && res.seconds_search >= 0.0 && res.seconds_final >= 0.0 &&
+                 res.seconds_verdict >= 0.0 && (opt.verdict_still_factor > 0.0 ||
+                                                res.seconds_verdict == 0.0) &&
+                 fabs(res.seconds_search + res.seconds_final + res.seconds_verdict -
+                      res.seconds) <= 1e-9,
+             "stage times %g + %g + %g (rays %g) against seconds %g", res.seconds_search,
+             res.seconds_final, res.seconds_verdict, res.seconds_rays, res.seconds);
     st = mcg_gec_residuals(n, o1, d1, o2, d2, res.R, res.t, res_chk);
     FZ_CHECK(st == MCG_OK, "residuals at the result: status %d", st);
     cnt0 = cnt1 = 0;
