@@ -95,6 +95,17 @@ def test_ring_problem_pixels_are_its_rays():
     assert 0.15 < off < 0.22 and np.median(res) < 1.0
 
 
+def test_ring_problem_names_a_motion_that_leaves_nothing_in_view(monkeypatch):
+    """A motion that turns every point out of view is a clear error, not an
+    endless redraw."""
+    from mcgeom import synth
+    from mcgeom.experiments.bench import robust_scaling
+    monkeypatch.setattr(robust_scaling, "generic_motion", lambda rng: (
+        synth.rotation_about([0.0, 0.0, 1.0], np.pi), np.zeros(3)))
+    with pytest.raises(RuntimeError, match="camera 0 keeps too few points in view"):
+        robust_scaling.ring_problem(100, np.random.default_rng(0))
+
+
 def test_fixed_and_marginal_cost_fit():
     """The model seconds = fixed + marginal N is recovered from exact rows
     (across three decades, where an unweighted fit would ignore the

@@ -96,8 +96,12 @@ def ring_problem(n: int, rng: np.random.Generator, outliers: float = 0.2) -> Rin
     px1, px2 = np.empty((n, 2)), np.empty((n, 2))
     for k, c in enumerate(rig.cameras):
         rows = np.flatnonzero(cam == k)
-        got = 0
+        got = rounds = 0
         while got < len(rows):
+            rounds += 1
+            if rounds > 100:   # (a motion that takes every point out of view)
+                raise RuntimeError(f"ring_problem: camera {k} keeps too few points in view "
+                                   f"({got} of {len(rows)} after 100 draws)")
             want = len(rows) - got
             p1 = _uniform_pixels(rng, 2 * want, c)
             X = c.centre + c.pixels_to_bearings(p1) * rng.uniform(2.0, 20.0, size=(2 * want, 1))
