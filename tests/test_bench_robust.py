@@ -65,7 +65,8 @@ def test_bench_robust_prints_the_cost_fit_over_sizes(capsys):
 
 def test_scaling_rows_are_medians_over_several_problems():
     from mcgeom.experiments.bench.robust_scaling import bench_scaling, scaling_problems
-    assert scaling_problems(1000) == 15 and scaling_problems(10 ** 6) == 3
+    assert scaling_problems(1000) == 15 and scaling_problems(10 ** 5) == 10 \
+        and scaling_problems(10 ** 6) == 3
     rows = bench_scaling(sizes=(300, 2000))
     for r, n in zip(rows, (300, 2000)):
         assert r.n == n and r.problems == scaling_problems(n) >= 3
