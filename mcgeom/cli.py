@@ -312,10 +312,10 @@ def _bench_robust(args: argparse.Namespace) -> int:
                     ("time cold", m.ms / r.ms, r.time_ratio_ci),
                     ("rotation error", m.rot_deg / r.rot_deg, r.rot_ratio_ci),
                     ("scale error", m.scale_err / r.scale_err, r.scale_ratio_ci))))
-    print(f"\nscaling: 4-camera ring, 20 % outliers; mcgeom rays in (mcgeom.robust.ransac), "
-          f"PoseLib (min_iterations=100) the same pixels; medians over the problems of each size, each drawn "
-          f"and solved with its own seed; 'search alone': mcgeom without local optimisation "
-          f"and final refinement")
+    print("\nscaling: 4-camera ring, 20 % outliers; mcgeom rays in (mcgeom.robust.ransac), "
+          "PoseLib (min_iterations=100) the same pixels; medians over the problems of each "
+          "size, each drawn and solved with its own seed; 'search alone': mcgeom without "
+          "local optimisation and final refinement")
     print(f"{'N':>8} {'problems':>8} {'seconds':>8} {'us/corr':>8} {'min-max us/corr':>15} "
           f"{'peak MB':>8} {'input MB':>8} {'peak/input':>10} {'rot deg':>8} {'inliers':>7} "
           f"{'C ms':>9} {'outside C':>9} {'search ms':>9} {'PoseLib s':>9} {'us/corr':>8} "

@@ -20,8 +20,9 @@
  *    negative or NaN calibration std;
  *  - mcg_robust_rig_motion_pinhole: the same result as mcg_pinhole_ray_pairs
  *    followed by mcg_robust_rig_motion (bit for bit), the rays in its
- *    workspace, the stages' times (seconds_*) summing to seconds, EDEGENERATE for fewer than 6 distinct correspondences,
- *    EINVAL for an id out of range, ENOMEM for a short workspace.
+ *    workspace, the stages' times (seconds_*) summing to seconds,
+ *    EDEGENERATE for fewer than 6 distinct correspondences, EINVAL for an
+ *    id out of range, ENOMEM for a short workspace.
  * Exit status 0 iff every check passes.
  */
 #include "mcgeom.h"

@@ -372,7 +372,8 @@ def _sampler_label(info: dict) -> str:
 def _final_seconds(info: dict) -> float:
     """Seconds of the C call after its search (``info["c_stage_seconds"]``'s
     final refinement and verdict; NaN without them): the stage that every
-    sampler's estimate goes through, whatever it sampled."""
+    sampler's estimate goes through (its cost depends on how near the optimum
+    the search left the motion, not on what it sampled)."""
     st = info.get("c_stage_seconds")
     return st["final"] + st["verdict"] if st else np.nan
 
@@ -502,8 +503,8 @@ def ransac_table(res: dict) -> str:
     the C search drew (its adaptive stop: w^3 for the upright 3+1, w^4 for
     the upright 4-point, w^5 for the two-stage 5+1, w^6 for the 6-point),
     and the median ms of the C call's final stage (``C final``: refinement,
-    scale profiles, verdict; the same work whichever sampler found the
-    motion, so a faster sampler cannot make the estimate faster than it)."""
+    scale profiles, verdict: work that every sampler's estimate goes
+    through, so a faster sampler cannot make the estimate cheaper than it)."""
     # column widths of the longest names (--outliers' cases, the upright row)
     wc = max([30] + [len(case) for case in res])
     wm = max([23] + [len(meth) for methods in res.values() for meth in methods])
