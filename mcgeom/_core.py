@@ -1446,8 +1446,8 @@ def robust_rig_motion(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, cam1
     (R, t); the pairs of the final refinement), ``weights`` (N,) of the final
     refinement (0 where unused), ``loss_scale`` (radians), ``score``,
     ``iterations``, ``hypotheses``, ``local_optimizations``, ``stop`` (a name
-    of ``ROBUST_STOP_NAMES``), ``seconds`` (its stages in ``stage_seconds``,
-    :func:`robust_stage_seconds`) and ``refinement`` (the dict of
+    of ``ROBUST_STOP_NAMES``), ``seconds`` (its stages:
+    :func:`robust_stage_seconds` of ``_res``) and ``refinement`` (the dict of
     :func:`refine_motion` of the final refinement, or None if it did not run),
     ``scale_profile`` (NaN if not computed), ``zero_profile`` (the same at the
     factor 0.01, NaN if not computed; only its side of 9, the bound of
@@ -1624,8 +1624,7 @@ def _robust_result(res: Any, mask: np.ndarray, weights: np.ndarray) -> dict:
         "n_inliers": res.n_inliers, "iterations": res.iterations,
         "hypotheses": res.hypotheses, "local_optimizations": res.local_optimizations,
         "stop": ROBUST_STOP_NAMES.get(res.stop, "unknown"), "seconds": res.seconds,
-        "stage_seconds": robust_stage_seconds(res), "scale_profile": res.scale_profile,
-        "zero_profile": res.zero_profile,
+        "scale_profile": res.scale_profile, "zero_profile": res.zero_profile,
         "inlier_rms": res.inlier_rms, "refinement": refinement,
         "covariance": f[i:i + 36].reshape(6, 6), "verdict": verdict,
         "sampler": SAMPLER_OF[res.sampler], "sample_size": res.sample_size,

@@ -45,7 +45,7 @@ from ..robust_vs_poselib import ring4
 from .robust import generic_motion
 
 __all__ = ["ScaleRow", "RingProblem", "ring_problem", "bench_scaling", "scaling_problems",
-           "fixed_and_marginal", "fit_worst_error"]
+           "fixed_and_marginal", "fit_worst_error", "spread_ratios", "allowed_at_smallest"]
 
 
 @dataclass
@@ -140,6 +140,22 @@ def fit_worst_error(rows: Sequence[ScaleRow], fixed: float, marginal: float) -> 
     """The largest relative error of ``fixed + marginal * N`` (seconds,
     seconds per correspondence) against the rows' median seconds."""
     return max(abs(fixed + marginal * r.n - r.seconds) / r.seconds for r in rows)
+
+
+def spread_ratios(rows: Sequence[ScaleRow]) -> tuple[float, float]:
+    """Largest / smallest median cost per correspondence over the rows:
+    ``(mcgeom's, PoseLib's)`` (issue 19's target: mcgeom's within 2; NaN for
+    PoseLib when it did not run)."""
+    per = [r.us_per_corr for r in rows]
+    peer = [r.peer_seconds / r.n for r in rows]
+    return max(per) / min(per), max(peer) / min(peer)
+
+
+def allowed_at_smallest(rows: Sequence[ScaleRow]) -> float:
+    """Seconds the estimate at the smallest N may take for its cost per
+    correspondence to lie within 2x of that at the largest N."""
+    small, big = min(rows, key=lambda r: r.n), max(rows, key=lambda r: r.n)
+    return 2.0 * big.seconds / big.n * small.n
 
 
 def scaling_problems(n: int) -> int:
