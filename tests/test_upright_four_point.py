@@ -9,7 +9,8 @@ import pytest
 
 import mcgeom
 from mcgeom import robust, synth
-from mcgeom.estimators.upright_four_point import minimal_solutions, upright_rotation
+from mcgeom.estimators.upright_four_point import (minimal_solutions, upright_rotation,
+                                                  vertical_contradiction, vertical_misfit)
 from problems import make, rot_err
 
 G1 = np.array([0.1, -1.0, 0.3])
@@ -141,3 +142,44 @@ def test_facade_takes_the_vertical():
     with pytest.raises(ValueError, match="does not use a vertical prior"):
         cv.estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, method=cv.RIG_LINEAR17,
                     gravity1=g1, gravity2=g1)
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.01, np.nan, np.inf, "0.01", True, None])
+def test_bad_gravity_std(bad):
+    p = make("most-general", 0, n=20)
+    with pytest.raises(ValueError, match="gravity_std must be a positive number"):
+        mcgeom.estimate(p.rays, "upright_four_point", gravity1=G1, gravity2=p.R @ G1,
+                        gravity_std=bad)
+
+
+def test_vertical_contradiction_threshold():
+    """The vertical check's bound: a^2 / (2 gravity_std^2) at chi-square(2)'s
+    99th percentile (9.21), a the angle between R g1 and g2."""
+    s = np.radians(0.5)
+    limit = s * np.sqrt(2 * 9.21)
+    axis = np.cross(G1, [1.0, 0.0, 0.0])   # (perpendicular to G1: turns it by a)
+    for a, contradicts in [(0.0, False), (0.999 * limit, False), (1.001 * limit, True),
+                           (np.radians(5.0), True)]:
+        g2 = synth.rotation_about(axis, a) @ G1
+        why = vertical_contradiction(np.eye(3), G1, g2, s)
+        assert (why is not None) == contradicts, a
+        assert np.isclose(vertical_misfit(np.eye(3), G1, g2), a, atol=1e-12)
+    assert "gravity_std 0.5 deg" in vertical_contradiction(np.eye(3), G1, -G1, s)
+
+
+def test_wrong_vertical_is_not_metric_unless_its_error_is_given():
+    """Clean data, the vertical at time 2 given 4 deg off: the refinement frees
+    all six degrees of freedom and finds the motion, which turns gravity1 ~4 deg
+    from the given gravity2: at the default gravity_std (0.5 deg) that
+    contradicts the vertical and the scale is not called metric; told that the
+    verticals are only good to 2 deg, the same estimate is metric."""
+    rng = np.random.default_rng(3)
+    p = make("most-general", 3, n=100, angular_noise=1e-4)
+    g2 = synth.tilted(p.R @ G1, 4.0, rng)
+    m = mcgeom.estimate(p.rays, "upright_four_point", gravity1=G1, gravity2=g2)
+    assert np.degrees(rot_err(m.R, p.R)) < 0.1
+    assert not m.scale.observable and "contradicts the given vertical" in m.scale.reason
+    m2 = mcgeom.estimate(p.rays, "upright_four_point", gravity1=G1, gravity2=g2,
+                         gravity_std=np.radians(2.0))
+    assert m2.scale.observable
+    assert np.linalg.norm(m2.t - p.t) < 0.05 * np.linalg.norm(p.t)

@@ -10,6 +10,9 @@ Frames and units (docs/architecture.md §3): rays in the rig frame (metres),
 
 from __future__ import annotations
 
+from dataclasses import replace
+from typing import Callable, Optional
+
 import numpy as np
 
 from .. import _core
@@ -35,7 +38,9 @@ def _refine(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool,
 
 
 def refine_and_report(rays: RayPairs, starts: list, method: str,
-                      max_scale_rel_std: float, info: dict, iterate: bool = True) -> RigMotion:
+                      max_scale_rel_std: float, info: dict, iterate: bool = True,
+                      prior_check: Optional[Callable[[np.ndarray], Optional[str]]] = None
+                      ) -> RigMotion:
     """Refine each start ``(R, t)`` (rig2_from_rig1, metres) on all ``rays`` and
     report the one of least final cost.
 
@@ -52,7 +57,10 @@ def refine_and_report(rays: RayPairs, starts: list, method: str,
     refinement's iterations and ``t_metric`` (the metric estimate whatever the
     verdict). With ``iterate=False`` no start is moved: the least Sampson cost
     among them is kept and the verdict rests on the covariance and profile
-    there.
+    there. ``prior_check(R)``: why the refined rotation contradicts a prior
+    the caller gave (``upright_four_point``'s vertical), None when it does
+    not; a metric verdict it contradicts is made "not observable" with that
+    reason.
     """
     best = None
     for R, t in starts:
@@ -82,6 +90,10 @@ def refine_and_report(rays: RayPairs, starts: list, method: str,
     # outliers is no metric estimate (mcgeom.estimators._outliers)
     verdict, info["outlier_move_stds"] = guard_verdict(rays, R, t, verdict, method,
                                                        max_scale_rel_std)
+    if verdict.observable and prior_check is not None:
+        why = prior_check(R)
+        if why is not None:
+            verdict = replace(verdict, observable=False, reason=why)
     info["t_metric"] = np.array(t)
     if not verdict.observable:
         nt = np.linalg.norm(t)

@@ -31,7 +31,10 @@ of 0.2 % -- on the KITTI raw and DDAD pairs of ``mcgeom experiment honesty``
 metric before, 1 after). The exception: a fit that lands in a wrong basin
 rather than being pulled (``upright_four_point``, 1 % outliers, one of 20:
 |t| 96 % off, the rotation 5.7 deg off); there the Cauchy refit, too, stays
-(its robust scale 1.8e-2 rad, the noise 1e-3).
+(its robust scale 1.8e-2 rad, the noise 1e-3). That estimator has a prior the
+fit can be checked against, the vertical, and its rotation turned the given
+vertical 5 deg away: :func:`mcgeom.estimators.upright_four_point.vertical_contradiction`
+withholds the metric scale there.
 
 Frames and units (docs/architecture.md §3): rays in the rig frame (metres),
 ``X2 = R X1 + t``; residuals in radians.
