@@ -31,7 +31,8 @@ __all__ = [
     "Linear17Options", "linear17", "linear17_raw", "linear17_static_raw", "linear17_dict",
     "L17_OFFSETS",
     "GC_CASE_NAMES",
-    "gec_residuals", "scale_ransac", "sampson_pixel_scale", "refine_motion", "refine_translation",
+    "gec_residuals", "sampson_leverage", "leverage_stats", "scale_ransac",
+    "sampson_pixel_scale", "refine_motion", "refine_translation",
     "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
     "skyline_eig",
@@ -346,6 +347,11 @@ class Linear17Options:
             raise ValueError(f"max_scale_rel_std must be positive, got {c.max_scale_rel_std}")
         self._c = c
 
+    @property
+    def max_scale_rel_std(self) -> float:
+        """The relative std of |t| above which the scale is not metric."""
+        return float(self._c.max_scale_rel_std)
+
 
 _DEFAULT_L17 = Linear17Options()
 _L17_DOUBLES = {name: ffi.offsetof("mcg_linear17_result", name) // 8
@@ -386,7 +392,7 @@ def linear17_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
 def linear17_static_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
                         dirs2: np.ndarray, group: np.ndarray,
                         options: Optional[Linear17Options], static_options: Any
-                        ) -> tuple[int, np.ndarray, Any, int, Any]:
+                        ) -> tuple[int, np.ndarray, Any, Any, Any, Optional[dict]]:
     """``mcg_linear17`` and then, on its success, the static-rig test
     ``mcg_static_check`` of its estimate, the two calls sharing the pointers
     to the rays (issue 22: the public linear17 call marshalled the rays
@@ -395,10 +401,13 @@ def linear17_static_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.nd
     :func:`static_check_rays`, ``static_options`` from
     :func:`static_options`; the test gets the estimate's rotation (``R_est``,
     no given rotation, its noise level estimated). Returns ``(status,
-    buffer, result, static_status, static_result)`` without raising:
+    buffer, result, static_status, static_result, leverage)`` without
+    raising:
     status, buffer and result as :func:`linear17_raw`; ``static_status``
     None when the test did not run (linear17 failed), else its status and
-    ``static_result`` the ``mcg_static_result *``.
+    ``static_result`` the ``mcg_static_result *``; ``leverage`` the dict of
+    :func:`leverage_stats` of a metric estimate of a moving rig that does
+    not fit exactly (RMS above 1e-12 rad), else None.
     """
     f64 = np.empty(_L17_NDOUBLES, dtype=np.float64)
     fp = ffi.cast("double *", ffi.from_buffer(f64))
@@ -409,13 +418,22 @@ def linear17_static_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.nd
             ffi.from_buffer("double[]", origins2), ffi.from_buffer("double[]", dirs2))
     st = lib.mcg_linear17(n, *rays, opt, res)
     if st != lib.MCG_OK:
-        return st, f64, res, None, None
+        return st, f64, res, None, None, None
     out = ffi.new("mcg_static_result *")
     work = np.empty(max(lib.mcg_static_check_work_size(n), 1), dtype=np.float64)
     sst = lib.mcg_static_check(n, *rays, ffi.from_buffer("int[]", group),
                                fp + _L17_DOUBLES["R"], ffi.NULL, 0.0, static_options, out,
                                ffi.from_buffer("double[]", work), work.size)
-    return st, f64, res, sst, out
+    lev = None
+    if sst == lib.MCG_OK and not out.is_static and res.scale_observable and \
+            res.cost_final > 1e-12:
+        # what one pair does to the estimate (mcgeom.estimators._outliers),
+        # on the same pointers; an exact fit is the data's motion
+        lr = ffi.new("mcg_leverage_result *")
+        if lib.mcg_sampson_leverage(n, *rays, fp + _L17_DOUBLES["R"], fp + _L17_DOUBLES["t"],
+                                    0, ffi.NULL, lr) == lib.MCG_OK:
+            lev = _leverage_dict(lr)
+    return st, f64, res, sst, out, lev
 
 
 def linear17(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
@@ -552,6 +570,55 @@ def gec_residuals(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any,
     if st != lib.MCG_OK:
         _ray_error(st, "gec_residuals", rays, (("R", R), ("t", t)))
     return out
+
+
+def sampson_leverage(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any, t: Any,
+                     hold_rotation: bool = False) -> Optional[np.ndarray]:
+    """Each pair's leverage ``J_k (J^T J)^-1 J_k^T`` in [0, 1] in the
+    least-squares fit ``(R, t)`` (rig2_from_rig1, metres) on these rays
+    (``mcg_sampson_leverage``; J the Sampson angular residuals' Jacobian in
+    ``[dw, dt]``, or ``dt`` alone with ``hold_rotation``); 1 - leverage is
+    the pair's redundancy number. None where ``J^T J`` is singular (a
+    direction of the motion that no pair determines). Rays as
+    :func:`gec_residuals`."""
+    rays = _ray_arrays(origins1, dirs1, origins2, dirs2, 0)
+    R = _f64("R", R, (3, 3))
+    t = _f64("t", t, (3,))
+    lev = np.empty(rays[0].shape[0])
+    st = lib.mcg_sampson_leverage(lev.shape[0], _p(rays[0]), _p(rays[1]), _p(rays[2]),
+                                  _p(rays[3]), _p(R), _p(t), int(bool(hold_rotation)), _p(lev),
+                                  ffi.NULL)
+    if st == lib.MCG_EDEGENERATE:
+        return None
+    if st != lib.MCG_OK:
+        _ray_error(st, "sampson_leverage", rays, (("R", R), ("t", t)))
+    return lev
+
+
+def leverage_stats(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
+                   dirs2: np.ndarray, R: np.ndarray, t: np.ndarray,
+                   hold_rotation: bool = False) -> Optional[dict]:
+    """What one pair does to the least-squares fit ``(R, t)`` (rig2_from_rig1,
+    metres) on arrays already checked (float64, C-contiguous (N, 3) rays; an
+    estimator's own): ``mcg_leverage_result`` as a dict -- ``max_leverage``
+    and ``leverage_pair``; ``max_influence`` (the largest change of the
+    centroid's travel when one pair is deleted, relative to the travel),
+    ``max_influence_stds`` (the same in stds of the travel) and
+    ``influence_pair``; ``travel`` (metres) and ``travel_std``. None where
+    ``J^T J`` is singular or the kernel refuses the input."""
+    out = ffi.new("mcg_leverage_result *")
+    st = lib.mcg_sampson_leverage(origins1.shape[0], _p(origins1), _p(dirs1), _p(origins2),
+                                  _p(dirs2), _p(np.ascontiguousarray(R, dtype=np.float64)),
+                                  _p(np.ascontiguousarray(t, dtype=np.float64)),
+                                  int(bool(hold_rotation)), ffi.NULL, out)
+    return _leverage_dict(out) if st == lib.MCG_OK else None
+
+
+def _leverage_dict(r: Any) -> dict:
+    """The dict of :func:`leverage_stats` from an ``mcg_leverage_result *``."""
+    return {"max_leverage": r.max_leverage, "leverage_pair": r.leverage_pair,
+            "max_influence": r.max_influence, "max_influence_stds": r.max_influence_stds,
+            "influence_pair": r.influence_pair, "travel": r.travel, "travel_std": r.travel_std}
 
 
 def scale_ransac(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any, t0: Any,

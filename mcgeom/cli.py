@@ -356,7 +356,8 @@ def _bench_linear17(args: argparse.Namespace) -> int:
 
     rows = bench_linear17(_sizes(args), budget_s=args.budget, progress=progress_bar)
     print("linear17: the public call mcgeom.estimate (RayPairs in, RigMotion with its verdict "
-          "out), the plugin without the shared static-rig test (static = public - plugin; "
+          "out), the plugin without the shared static-rig test (static = public - plugin: "
+          "that test and the one-pair check of a metric estimate; "
           "staticC: its bare kernel mcg_static_check), the cffi wrapper, the bare C kernel, and "
           "a numpy implementation of the same algorithm; python = public - C")
     print(f"{'N':>7} {'public[us]':>10} {'static[us]':>10} {'staticC[us]':>11} {'plugin[us]':>10} "

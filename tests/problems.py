@@ -5,54 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from mcgeom import metrics, synth
+from mcgeom import metrics, synth, synth_kinds
 from mcgeom.types import RayPairs
 
-#: how to produce data of each kind: (rig factory, cross-camera fraction)
-KIND_SETUPS = {
-    "locally-central": (lambda rng: synth.generic_rig(4, rng), 0.0),
-    "most-general": (lambda rng: synth.generic_rig(4, rng), 0.5),
-    "axial": (lambda rng: synth.axial_rig(3), 0.5),
-    "locally-central-and-axial": (lambda rng: synth.stereo_head(0.5), 0.0),
-}
-
-
-def _near_rig_axis(R: np.ndarray, rig, min_angle_deg: float = 5.0) -> bool:
-    """True if the rig's camera centres lie on a line and the rotation axis of
-    R is within min_angle_deg of it (the critical motion of an axial rig)."""
-    c = np.array([cam.centre for cam in rig.cameras])
-    if len(c) < 2:
-        return False
-    _, s, vt = np.linalg.svd(c - c.mean(axis=0))
-    if s[0] == 0.0 or (len(s) > 1 and s[1] > 1e-9 * s[0]):
-        return False
-    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    if not np.linalg.norm(w) > 0.0:
-        return False
-    cosang = abs(w @ vt[0]) / np.linalg.norm(w)
-    return cosang > np.cos(np.radians(min_angle_deg))
-
-
-def make(kind: str, seed: int, n: int = 60, angle: tuple = (0.05, 0.5), t_norm: float = 0.5,
-         angular_noise: float = 0.0, R=None, t=None):
-    """A problem of the given kind with a random motion (or the given R, t)."""
-    rng = np.random.default_rng(seed)
-    rig_factory, cross = KIND_SETUPS[kind]
-    rig = rig_factory(rng)
-    if R is None:
-        R = synth.random_rotation(rng, angle[1])
-        # keep the rotation away from zero, and (intra-camera rays of an
-        # axial rig) its axis away from the rig axis, so that the scale is
-        # observable: a rotation about the rig axis is critical (conditioning
-        # 2e-9 at 0.13 deg from it, found by the property suite)
-        while (np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1)) < angle[0]
-               or (cross == 0.0 and _near_rig_axis(R, rig))):
-            R = synth.random_rotation(rng, angle[1])
-    if t is None:
-        t = rng.normal(size=3)
-        t *= t_norm / np.linalg.norm(t)
-    return synth.make_problem(rig, R, t, n, rng, cross_fraction=cross,
-                              angular_noise=angular_noise, require_visible=False)
+#: how to produce data of each kind, and the problems (mcgeom.synth_kinds)
+KIND_SETUPS = synth_kinds.KIND_SETUPS
+make = synth_kinds.kind_problem
 
 
 def rigid(rng: np.random.Generator):

@@ -19,7 +19,7 @@ from pathlib import Path
 import mcgeom
 
 SRC = Path(mcgeom.__file__).resolve().parent
-SYNTH = {"mcgeom.synth", "mcgeom.synth_views"}
+SYNTH = {"mcgeom.synth", "mcgeom.synth_views", "mcgeom.synth_kinds"}
 
 
 def _modules(src: Path = SRC) -> dict[str, Path]:

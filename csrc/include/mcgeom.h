@@ -371,6 +371,44 @@ int mcg_gec_residuals(int n, const double *o1, const double *d1,
                       const double *o2, const double *d2, const double R[9],
                       const double t[3], double *res);
 
+/* (leverage.c) What one pair does to the least-squares fit of the motion
+ * (R, t) (rig2_from_rig1) on these rays (as mcg_gec_residuals), linearised
+ * there: J the Jacobian of the Sampson angular residuals r in [dw, dt] (the
+ * rotation perturbed on the left, exp([dw]x) R; dt alone when
+ * hold_rotation is 1: a known rotation), J_k pair k's row (0 on the pi/2
+ * cap), H = J^T J. */
+typedef struct {
+    double max_leverage;   /* the largest h_k = J_k H^-1 J_k^T, in [0, 1] */
+    int leverage_pair;     /* its pair (the first; -1 for n = 0) */
+    double max_influence;  /* the largest change of the centroid's travel
+                              |t + R c - c| (c the mean of all origins) when
+                              one pair is deleted, g^T H^-1 J_k^T r_k /
+                              (1 - h_k) (Cook's case deletion, exact for a
+                              linear model), relative to the travel (0 when
+                              it is 0) */
+    double max_influence_stds; /* the same change in stds of the travel
+                              (travel_std; 0 when that is 0 or infinite) */
+    int influence_pair;    /* its pair (-1 for n = 0) */
+    double travel;         /* |t + R c - c|, metres */
+    double travel_std;     /* sigma sqrt(g^T H^-1 g), sigma^2 = sum r^2 /
+                              (n - parameters); HUGE_VAL without redundancy */
+} mcg_leverage_result;
+
+/* lev[k] = h_k (n values, may be NULL) and the result (may be NULL). The
+ * leverages sum to the number of parameters; 1 - h_k is the pair's
+ * redundancy number (Baarda): near 0, the pair fixes a direction of the
+ * motion alone and an error in it does not show in any residual. Independent
+ * of the parameters' scaling. MCG_EINVAL: as mcg_gec_residuals, or
+ * hold_rotation not 0 or 1; MCG_EDEGENERATE: H not positive definite up to
+ * rounding (a direction of the motion no pair determines, e.g. |t| at a
+ * critical motion; fewer pairs than parameters; a reciprocal condition
+ * number below ~1e-10, where the leverages miss their sum by more than
+ * 1e-6), the outputs then unspecified. Two passes over the pairs, no
+ * allocation. */
+int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double *o2,
+                         const double *d2, const double R[9], const double t[3],
+                         int hold_rotation, double *lev, mcg_leverage_result *out);
+
 /* Robust losses rho(z) of the squared residual z = r^2 with scale s
  * (radians); the IRLS weight of a residual is rho'(z). */
 enum {

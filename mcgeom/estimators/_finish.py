@@ -89,7 +89,7 @@ def refine_and_report(rays: RayPairs, starts: list, method: str,
     # every correspondence was taken as an inlier: a fit pulled by gross
     # outliers is no metric estimate (mcgeom.estimators._outliers)
     verdict, info["outlier_move_stds"] = guard_verdict(rays, R, t, verdict, method,
-                                                       max_scale_rel_std)
+                                                       max_scale_rel_std, info=info)
     if verdict.observable and prior_check is not None:
         why = prior_check(R)
         if why is not None:

@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Optional
 
 import numpy as np
 
@@ -52,11 +53,22 @@ from ..errors import DegenerateError
 from ..geometry import centroid_travel, refine_centred
 from ..types import RayPairs, ScaleVerdict
 
-__all__ = ["OUTLIER_MOVE_STDS", "travel_moved", "guard_verdict"]
+__all__ = ["OUTLIER_MOVE_STDS", "MAX_LEVERAGE", "DELETION_STDS", "travel_moved",
+           "one_pair_reason", "one_pair_rule", "guard_verdict"]
 
 #: stds of the estimate's travel that a robust refit may move it by before the
 #: least-squares estimate is called unsupported by the bulk of the data
 OUTLIER_MOVE_STDS = 3.0
+
+#: largest leverage of one correspondence in a metric least-squares estimate
+#: (its redundancy number 1 - h at least 0.1: below, geodetic reliability
+#: analysis counts an observation as uncontrolled, Foerstner 1987); see
+#: :func:`leverage_reason`
+MAX_LEVERAGE = 0.9
+
+#: stds of the travel that deleting one correspondence may move it by (and
+#: by more than the verdict's ``max_rel_std``); see :func:`one_pair_reason`
+DELETION_STDS = 4.0
 
 #: the median absolute deviation of a Gaussian over its std's
 _MAD_TO_STD = 1.4826
@@ -95,17 +107,87 @@ def travel_moved(rays: RayPairs, R: np.ndarray, t: np.ndarray, rel_std: float,
     return abs(after / before - 1.0) / rel_std
 
 
+def one_pair_reason(rays: RayPairs, R: np.ndarray, t: np.ndarray, method: str,
+                    max_rel_std: float = 0.1, hold_rotation: bool = False,
+                    info: Optional[dict] = None) -> Optional[str]:
+    """Why the least-squares estimate ``(R, t)`` of ``method`` on all ``rays``
+    rests on one correspondence, None when it does not (``_core.leverage_stats``,
+    ``csrc/leverage.c``; ``hold_rotation``: R held, t alone fitted):
+
+    * its leverage is above :data:`MAX_LEVERAGE`: it fixes a direction of the
+      motion by itself, and an error in it shows in no residual;
+    * deleting it alone moves the cameras' travel by more than
+      :data:`DELETION_STDS` of the travel's std and by more than
+      ``max_rel_std`` (Cook's case deletion, linearised at the fit).
+
+    ``info`` gets ``max_leverage`` and ``max_influence_stds`` (NaN where the
+    Jacobian is singular; absent when the majority fits exactly).
+
+    A gross outlier pulls a least-squares fit toward itself, and most where
+    it has the leverage to: the fit absorbs the error, its residual and
+    every other one stay small, and neither the residuals' robust scale nor
+    the robust refit of :func:`travel_moved` (which starts in the pulled
+    fit's basin) need see it. Measured on the property suite's four rig
+    kinds with 20-200 correspondences, 1e-3 or 1e-4 rad noise and 2 %
+    random time-2 bearings (20 problems per cell, `five_plus_one`,
+    `six_point`, `upright_four_point`, `eigensolver`, `linear17`,
+    `known_rotation_translation`): 76 cells had metric estimates with |t|
+    15-106 % off, 4 cells after the leverage test (a leverage 0.91-1.00 at
+    the outlier; its residual 0.003 rad at the fit, 0.24 rad at the truth;
+    clean metric estimates: at most 0.89 with 34 correspondences, 0.76 with
+    60, 0.38 with 200), 2 after the deletion test (the outliers moved the
+    travel by 5.0-14.8 of its stds and 18-69 %; clean estimates at most 2.8
+    stds)."""
+    st = _core.leverage_stats(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
+                              hold_rotation)
+    return one_pair_rule(st, method, max_rel_std, info)
+
+
+def one_pair_rule(st: Optional[dict], method: str, max_rel_std: float = 0.1,
+                  info: Optional[dict] = None) -> Optional[str]:
+    """:func:`one_pair_reason`'s decision from the statistics ``st`` of
+    ``_core.leverage_stats`` (None: singular, nothing decided); ``info`` gets
+    ``max_leverage`` and ``max_influence_stds``."""
+    if info is not None:
+        info["max_leverage"] = st["max_leverage"] if st else float("nan")
+        info["max_influence_stds"] = st["max_influence_stds"] if st else float("nan")
+    if st is None:
+        return None
+    if st["max_leverage"] > MAX_LEVERAGE:
+        return (f"scale not confirmed: correspondence {st['leverage_pair']} fixes a direction "
+                f"of the motion almost alone (leverage {st['max_leverage']:.3g}, above "
+                f"{MAX_LEVERAGE:g}), so an error in it (a gross outlier) would not show in any "
+                f"residual; {method} takes every correspondence as an inlier: use "
+                f"mcgeom.robust.ransac, or more correspondences")
+    if st["max_influence_stds"] > DELETION_STDS and st["max_influence"] > max_rel_std:
+        return (f"scale not supported by the bulk of the correspondences: deleting "
+                f"correspondence {st['influence_pair']} alone moves the travelled distance by "
+                f"{100 * st['max_influence']:.3g} % ({st['max_influence_stds']:.3g} of its "
+                f"stds) -- the least-squares fit rests on a gross outlier, and {method} takes "
+                f"every correspondence as an inlier: use mcgeom.robust.ransac")
+    return None
+
+
 def guard_verdict(rays: RayPairs, R: np.ndarray, t: np.ndarray, verdict: ScaleVerdict,
                   method: str, max_rel_std: float = 0.1,
-                  hold_rotation: bool = False) -> tuple[ScaleVerdict, float]:
+                  hold_rotation: bool = False,
+                  info: Optional[dict] = None) -> tuple[ScaleVerdict, float]:
     """``(verdict, moved)``: the verdict of a least-squares estimate ``(R, t)``
-    of ``method`` on all ``rays``, made "not observable" when a robust refit
-    moves its travel by more than :data:`OUTLIER_MOVE_STDS` of its relative
-    std and by more than ``max_rel_std`` (:func:`travel_moved`, whose value
-    in stds is ``moved``; NaN when not checked: a verdict already not
-    observable)."""
+    of ``method`` on all ``rays``, made "not observable" when one
+    correspondence carries the fit (:func:`one_pair_reason`, which writes
+    ``info["max_leverage"]`` and ``info["max_influence_stds"]``) or when a robust refit moves its travel by
+    more than :data:`OUTLIER_MOVE_STDS` of its relative std and by more than
+    ``max_rel_std`` (:func:`travel_moved`, whose value in stds is ``moved``;
+    NaN when not checked: a verdict already not observable, or one
+    correspondence carries the fit)."""
     if not verdict.observable:
         return verdict, float("nan")
+    o = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
+    if not _MAD_TO_STD * float(np.median(np.abs(_core.gec_residuals(*o, R, t)))) > _EXACT:
+        return verdict, 0.0   # the majority fitted exactly: that motion is theirs
+    why = one_pair_reason(rays, R, t, method, max_rel_std, hold_rotation, info)
+    if why is not None:
+        return replace(verdict, observable=False, reason=why), float("nan")
     moved = travel_moved(rays, R, t, verdict.rel_std, hold_rotation)
     relative = moved * verdict.rel_std
     if not (moved > OUTLIER_MOVE_STDS and relative > max_rel_std):

@@ -339,7 +339,7 @@ def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
     # outliers is no metric estimate (mcgeom.estimators._outliers)
     observable = verdict.observable
     verdict, info["outlier_move_stds"] = guard_verdict(rays, R, t, verdict, "five_plus_one",
-                                                       max_scale_rel_std)
+                                                       max_scale_rel_std, info=info)
     pulled = observable and not verdict.observable
     info["t_metric"] = np.array(t)   # metric estimate, whatever the verdict
     # t is the maximum-likelihood metric estimate wherever the data define a

@@ -189,13 +189,14 @@ def _known(rays: RayPairs, R: np.ndarray, max_rel_std: Optional[float],
                            critical_angle(rays, R, t))
     # every correspondence was taken as an inlier: a fit pulled by gross
     # outliers is no metric estimate (mcgeom.estimators._outliers; R held)
+    guard: dict = {}
     verdict, moved = guard_verdict(rays, R, t, verdict, "known_rotation_translation", limit,
-                                   hold_rotation=True)
+                                   hold_rotation=True, info=guard)
     observable = verdict.observable
     if not observable and np.linalg.norm(t) > 0:
         t = t / np.linalg.norm(t)  # the direction only
     info = {"eigenvalues": res.eigenvalues, "converged": res.converged, "timing": res.timing,
-            "metric": observable, "t_linear": t_lin, "outlier_move_stds": moved,
+            "metric": observable, "t_linear": t_lin, "outlier_move_stds": moved, **guard,
             "refinement": None if ref is None else
             {k: ref[k] for k in ("iterations", "reason", "rms", "sigma2", "scale_rel_std")}}
     info["t_metric"] = t_metric   # metric estimate, whatever the verdict

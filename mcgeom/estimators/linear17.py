@@ -18,6 +18,7 @@ unlike the algebraic one, is not biased towards a short t (issue 22,
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Optional
 
 import numpy as np
@@ -26,6 +27,7 @@ from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict, make_rig_motion, make_scale_verdict
+from ._outliers import one_pair_reason, one_pair_rule
 from ._static import KERNEL_OPTIONS, intra_groups, with_static_check
 
 __all__ = ["linear17", "linear17_no_static_check"]
@@ -36,6 +38,9 @@ _NEEDED = {"most-general": 17, "locally-central": 16, "axial": 16,
 
 _OBSERVABLE = "scale fixed by the data (rotation or cross-camera rays)"
 _CENTRAL = "central camera: all rays share one centre, the scale is not observable"
+#: the kernel's default max_scale_rel_std
+_DEFAULT_LIMIT = _core.Linear17Options().max_scale_rel_std
+
 _CRITICAL = ("critical motion: the data leave |t| free (no rotation and only "
              "intra-camera correspondences, thesis ch. 7.3.2)")
 
@@ -101,13 +106,35 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     # the rays (_core.linear17_static_raw; issue 22). Everything but a moving
     # rig's answer (a kernel failure, a static rig) goes the shared way, whose
     # results and errors these are: with_static_check re-runs it
-    st, f, r, sst, sres = _core.linear17_static_raw(
+    st, f, r, sst, sres, lev = _core.linear17_static_raw(
         rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, intra_groups(rays), options,
         KERNEL_OPTIONS)
+    limit = _DEFAULT_LIMIT if options is None else options.max_scale_rel_std
     if st == _core.STATUS_OK and sst == _core.STATUS_OK and not sres.is_static:
-        return _motion(f, r)
-    return with_static_check(rays, "linear17", lambda: linear17_no_static_check(
-        rays, options=options))
+        return _guarded(rays, _motion(f, r), limit, lev)
+    return _guarded(rays, with_static_check(rays, "linear17", lambda: linear17_no_static_check(
+        rays, options=options)), limit)
+
+
+def _guarded(rays: RayPairs, m: RigMotion, max_rel_std: float,
+             stats: Optional[dict] = None) -> RigMotion:
+    """``m`` (a least-squares fit on all ``rays``), with its scale not metric
+    and ``t`` the unit direction where one correspondence carries the fit
+    (:func:`mcgeom.estimators._outliers.one_pair_reason`: a gross outlier
+    that the fit absorbed; ``info["max_leverage"]``,
+    ``info["max_influence_stds"]``; ``stats``: its statistics when
+    ``_core.linear17_static_raw`` gathered them). An exact fit (RMS below
+    1e-12 rad) is the data's motion and is not checked."""
+    if not m.scale.observable or not m.residual_rms > 1e-12:
+        return m
+    why = (one_pair_reason(rays, m.R, m.t, "linear17", max_rel_std, info=m.info)
+           if stats is None else one_pair_rule(stats, "linear17", max_rel_std, m.info))
+    if why is None:
+        return m
+    t = np.asarray(m.info.get("t_metric", m.t), float)
+    return make_rig_motion(m.R, t / np.linalg.norm(t), replace(m.scale, observable=False,
+                                                                 reason=why),
+                           m.method, m.residual_rms, m.inliers, m.info)
 
 
 def _options(rays: RayPairs, refine: bool, max_iterations: Optional[int],

@@ -11,7 +11,9 @@ intra-camera correspondences, 0.05 deg angular noise), the best mean time of:
   (``mcgeom.estimators.linear17.linear17_no_static_check``: input checks, the kernel, the
   info dict and the verdict); ``static`` = public - plugin is what the test
   of :mod:`mcgeom.estimators._static` costs (issue 18's, shared by every
-  estimator);
+  estimator) together with the check that no single correspondence carries
+  a metric estimate (``mcg_sampson_leverage``,
+  :func:`mcgeom.estimators._outliers.one_pair_rule`: ~4 us at 100 rays);
 - ``static C``: that test's kernel ``mcg_static_check`` alone through cffi
   (its pointers, workspace and options made beforehand, the plugin's
   rotation as the estimate's): ``static - static C`` is its Python;

@@ -1,0 +1,99 @@
+/*
+ * fuzz_leverage.c -- libFuzzer harness of mcg_sampson_leverage, each pair's
+ * leverage J_k (J^T J)^-1 J_k^T in the least-squares fit of a rig motion
+ * (Sampson angular residuals, thesis eq. 8.15), 6 parameters or t alone.
+ *
+ * Inputs: mode 0 a synthetic rig scene at a motion near the true one, mode 1
+ * arbitrary arrays and motion. Invariants: a bad size or hold_rotation
+ * gives MCG_EINVAL; NaN/inf inputs never MCG_OK; on MCG_OK every leverage
+ * is in [0, 1], they sum to the number of parameters (the trace of the hat
+ * matrix), max_leverage is the largest and leverage_pair a pair that has
+ * it; the influence is finite and >= 0 with a pair in range, the travel
+ * finite and >= 0, its std > 0; the same call without the per-pair array
+ * gives the same result.
+ */
+#include "fuzz_input.h"
+#include "mcgeom.h"
+
+/* routines selected by the first input byte (fuzz/make_corpus.py writes
+ * seeds for each) */
+#define FUZZ_MODES 2
+
+#define MAXN 64
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_in in = fz_make(data, size);
+    int mode = fz_u8(&in) % FUZZ_MODES, valid, st, st2, i, hold;
+    int n = fz_size(&in, 0, MAXN, &valid);
+    static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], lev[MAXN];
+    double R[9], t[3], sum = 0.0;
+    mcg_leverage_result lr, lr2;
+    hold = fz_int(&in, -1, 2);
+    if (n == (1 << 21))
+        n = (1 << 26) + 1; /* the limit is 2^26 pairs */
+    if (!valid) {
+        st = mcg_sampson_leverage(n, o1, d1, o2, d2, R, t, 0, lev, &lr);
+        FZ_CHECK(st == MCG_EINVAL, "leverage(n = %d) returned %d", n, st);
+        return 0;
+    }
+    if (mode == 0) {
+        double Rt[9], tt[3], dw[3], Rd[9];
+        fz_rotation(&in, Rt);
+        for (i = 0; i < 3; ++i)
+            tt[i] = fz_range(&in, -2.0, 2.0);
+        {   /* decoded in this order (not as arguments of one call) */
+            const int ncams = fz_int(&in, 1, 8), cross = fz_u8(&in) & 1;
+            fz_scene(&in, n, ncams, cross, Rt, tt, o1, d1, o2, d2, NULL);
+        }
+        for (i = 0; i < 3; ++i)
+            dw[i] = fz_range(&in, -0.05, 0.05);
+        if (mcg_rot_from_angle_axis(dw, Rd) != MCG_OK)
+            return 0;
+        fz_matmul3(Rd, Rt, R);
+        for (i = 0; i < 3; ++i)
+            t[i] = tt[i] + fz_range(&in, -0.1, 0.1);
+    } else {
+        fz_rays(&in, (size_t)n, o1, d1, o2, d2);
+        fz_rotation_or_any(&in, R);
+        fz_doubles(&in, t, 3);
+    }
+    st = mcg_sampson_leverage(n, o1, d1, o2, d2, R, t, hold, lev, &lr);
+    FZ_CHECK(fz_status_known(st), "leverage status %d", st);
+    if (hold != 0 && hold != 1) {
+        FZ_CHECK(st == MCG_EINVAL, "leverage with hold_rotation %d: %d", hold, st);
+        return 0;
+    }
+    if (!fz_all_finite(o1, 3 * (size_t)n) || !fz_all_finite(d1, 3 * (size_t)n) ||
+        !fz_all_finite(o2, 3 * (size_t)n) || !fz_all_finite(d2, 3 * (size_t)n) ||
+        !fz_all_finite(R, 9) || !fz_all_finite(t, 3)) {
+        FZ_CHECK(st == MCG_EINVAL, "leverage of non-finite input: %d", st);
+        return 0;
+    }
+    if (st != MCG_OK)
+        return 0;
+    FZ_CHECK(n >= (hold ? 3 : 6), "leverage OK with %d pairs", n);
+    for (i = 0; i < n; ++i) {
+        FZ_CHECK(lev[i] >= 0.0 && lev[i] <= 1.0, "leverage %d = %g", i, lev[i]);
+        sum += lev[i];
+    }
+    FZ_CHECK(fabs(sum - (hold ? 3.0 : 6.0)) <= 1e-5, "leverages sum to %.17g", sum);
+    FZ_CHECK(lr.leverage_pair >= 0 && lr.leverage_pair < n &&
+                 lev[lr.leverage_pair] == lr.max_leverage,
+             "leverage_pair %d, max_leverage %g", lr.leverage_pair, lr.max_leverage);
+    for (i = 0; i < n; ++i)
+        FZ_CHECK(lev[i] <= lr.max_leverage, "leverage %d = %g above max_leverage %g", i, lev[i],
+                 lr.max_leverage);
+    FZ_CHECK(isfinite(lr.max_influence) && lr.max_influence >= 0.0 &&
+                 isfinite(lr.max_influence_stds) && lr.max_influence_stds >= 0.0 &&
+                 lr.influence_pair >= 0 && lr.influence_pair < n,
+             "influence %g (%g stds) at %d", lr.max_influence, lr.max_influence_stds,
+             lr.influence_pair);
+    FZ_CHECK(isfinite(lr.travel) && lr.travel >= 0.0 && lr.travel_std > 0.0 &&
+                 !isnan(lr.travel_std),
+             "travel %g, std %g", lr.travel, lr.travel_std);
+    st2 = mcg_sampson_leverage(n, o1, d1, o2, d2, R, t, hold, NULL, &lr2);
+    FZ_CHECK(st2 == MCG_OK && memcmp(&lr, &lr2, sizeof lr) == 0,
+             "without lev: status %d, another result", st2);
+    return 0;
+}
