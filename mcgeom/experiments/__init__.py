@@ -47,6 +47,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
                                "EuRoC), against their ground truth"),
     "bnb_real": ("bnb_real", "bnb_lp (ch. 10) on the 5+1 inliers of KITTI raw and DDAD: "
                              "rotation, |t|, verdict, time, blocks, certified gap"),
+    "direct_outliers": ("direct_outliers", "the direct estimators given 2 % gross outliers on "
+                                           "the property suite's rig kinds: is a wrong "
+                                           "estimate ever called metric?"),
     "honesty": ("honesty", "every estimator on the inliers of the real recordings: rotation "
                            "error, |t| against the truth, verdict, rel_std, time"),
     "ch6_kitti": ("ch6_kitti", "thesis ch. 6 on real data: the KITTI-00 stereo trajectory "
