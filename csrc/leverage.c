@@ -24,6 +24,7 @@
 #include "refine_internal.h" /* refine_evaluate: J^T J in one vectorised pass */
 #include "sampson.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -39,6 +40,9 @@
  * input, 58 copies of two pairs, pivots 1, 3.8e-4, 4.9e-12, sum 2), and the
  * leverages then mean nothing: MCG_EDEGENERATE. */
 #define TRACE_TOL 1e-6
+/* largest weight accepted (a frequency or pixel scaling is far below; the
+ * products of the pass stay far from overflow) */
+#define MAX_WEIGHT 1e100
 /* pairs per block of the second pass (structure of arrays on the stack, so
  * that the per-pair loops vectorise, as refine_eval.c's) */
 #define BLK 32
@@ -50,9 +54,9 @@
  * the block. */
 MCG_AVX2_CLONE
 static void block_pass(int nb, const double *o1, const double *d1, const double *o2,
-                       const double *d2, const double R[9], const double t[3], int p0,
-                       const double *l, const double *il, const double *sc, const double *w,
-                       double *hb, double *mb)
+                       const double *d2, const double *wts, const double R[9],
+                       const double t[3], int p0, const double *l, const double *il,
+                       const double *sc, const double *w, double *hb, double *mb)
 {
     double rb[BLK], jb[6][BLK], ub[6][BLK];
     const int np = 6 - p0;
@@ -74,23 +78,29 @@ static void block_pass(int nb, const double *o1, const double *d1, const double 
             ub[a][k] = v * il[a];
         }
     for (k = 0; k < nb; k++) {
-        double h = 0.0, g = 0.0;
+        double h = 0.0, g = 0.0, wk = wts ? wts[k] : 1.0;
         for (a = 0; a < np; a++) {
             h += ub[a][k] * ub[a][k];
             g += w[a] * ub[a][k];
         }
+        h *= wk;
+        g *= wk;
         /* (rounding can leave [0, 1] by ~eps cond(J^T J)) */
         h = h < 0.0 ? 0.0 : h > 1.0 ? 1.0 : h;
         hb[k] = h;
         /* (a leverage of 1 to rounding: a bounded stand-in for the unbounded
          * move; the leverage says it) */
         mb[k] = fabs(g * rb[k]) / fmax(1.0 - h, 1e-12);
+        /* (extreme weights: an overflowed or undefined move counts as
+         * unbounded) */
+        mb[k] = mb[k] <= DBL_MAX ? mb[k] : DBL_MAX;
     }
 }
 
 int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double *o2,
-                         const double *d2, const double R[9], const double t[3],
-                         int hold_rotation, double *lev, mcg_leverage_result *out)
+                         const double *d2, const double *weights, const double R[9],
+                         const double t[3], int hold_rotation, double *lev,
+                         mcg_leverage_result *out)
 {
     double l[36], il[6], sc[6], g[6], w[6], cen[3] = {0.0, 0.0, 0.0}, rc[3], v[3];
     double trace = 0.0, travel, ww, sd, best = -1.0, top = -1.0;
@@ -105,18 +115,21 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
         return MCG_EINVAL;
     if (!all_finite(R, 9) || !all_finite(t, 3))
         return MCG_EINVAL;
+    for (k = 0; weights && k < n; k++)
+        if (!(weights[k] >= 0.0 && weights[k] <= MAX_WEIGHT))
+            return MCG_EINVAL;
     memset(&res, 0, sizeof res);
     res.leverage_pair = res.influence_pair = -1;
-    /* J^T J and the sum of squared residuals (least squares: no loss, unit
-     * weights), as the refinement's evaluation computes them */
+    /* J^T W J and the weighted sum of squared residuals (least squares: no
+     * loss), as the refinement's evaluation computes them */
     lf.loss = MCG_LOSS_NONE;
     lf.s = lf.s2 = lf.inv_s2 = 1.0;
-    refine_evaluate(n, o1, d1, o2, d2, NULL, &lf, R, t, &acc);
+    refine_evaluate(n, o1, d1, o2, d2, weights, &lf, R, t, &acc);
     if (acc.bad || !all_finite(acc.h, 36))
         return MCG_EINVAL;
     for (k = 0; k < n; k++)
         for (a = 0; a < 3; a++)
-            cen[a] += o1[3 * k + a] + o2[3 * k + a];
+            cen[a] += (weights && !(weights[k] > 0.0)) ? 0.0 : o1[3 * k + a] + o2[3 * k + a];
     if (!all_finite(cen, 3))
         return MCG_EINVAL;
     /* Cholesky L L^T of the Jacobi-scaled J^T J (the rotation's radians and
@@ -152,13 +165,25 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
      * (exact for a linear model; Cook 1977, Belsley, Kuh & Welsch 1980's
      * DFBETA), so |tau| by -(g^T H^-1 J_k^T) r_k / (1 - h_k), with
      * g^T H^-1 J_k^T = (L^-1 S g) . (L^-1 S J_k); its std is
-     * sigma sqrt(g^T H^-1 g), sigma^2 = sum r^2 / (n - np). */
+     * sigma sqrt(g^T H^-1 g), sigma^2 = sum r^2 / (n - np). With weights
+     * w_k (the pairs a weighted fit used, w_k > 0) H = J^T W J, h_k =
+     * w_k J_k H^-1 J_k^T, the move w_k g^T H^-1 J_k^T r_k / (1 - h_k),
+     * sigma^2 = sum w r^2 / (m - np), m the pairs used; c their centroid. */
+    for (k = 0, c = 0; k < n; k++)
+        c += !(weights && !(weights[k] > 0.0));
     for (a = 0; a < 3; a++)
-        cen[a] /= 2.0 * (n > 0 ? n : 1);
+        cen[a] /= 2.0 * (c > 0 ? c : 1);
     mat_vec(R, cen, rc);
     for (a = 0; a < 3; a++)
         v[a] = t[a] + rc[a] - cen[a];
-    travel = sqrt(dot3(v, v));
+    { /* (scaled: a travel near DBL_MAX does not overflow its square) */
+        double big = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+        travel = big > 0.0 ? big * sqrt((v[0] / big) * (v[0] / big) + (v[1] / big) * (v[1] / big)
+                                        + (v[2] / big) * (v[2] / big))
+                           : 0.0;
+        if (!(travel <= DBL_MAX))
+            return MCG_EINVAL; /* (a travel beyond the doubles: magnitudes far off) */
+    }
     for (a = 0; a < 6; a++)
         g[a] = 0.0;
     if (travel > 0.0) {
@@ -179,12 +204,12 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
         w[a] = x * il[a];
         ww += w[a] * w[a];
     }
-    sd = n > np ? sqrt(acc.swr2 / (n - np) * ww) : HUGE_VAL;
+    sd = acc.n_used > np ? sqrt(acc.swr2 / (acc.n_used - np) * ww) : HUGE_VAL;
     for (k0 = 0; k0 < n; k0 += BLK) {
         int nb = n - k0 < BLK ? n - k0 : BLK;
         double hb[BLK], mb[BLK];
-        block_pass(nb, o1 + 3 * k0, d1 + 3 * k0, o2 + 3 * k0, d2 + 3 * k0, R, t, p0, l, il, sc,
-                   w, hb, mb);
+        block_pass(nb, o1 + 3 * k0, d1 + 3 * k0, o2 + 3 * k0, d2 + 3 * k0,
+                   weights ? weights + k0 : NULL, R, t, p0, l, il, sc, w, hb, mb);
         for (k = 0; k < nb; k++) {
             trace += hb[k];
             if (hb[k] > top) {
@@ -205,8 +230,8 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
     res.travel = travel;
     res.travel_std = sd;
     if (n > 0 && travel > 0.0) {
-        res.max_influence = best / travel;
-        res.max_influence_stds = sd > 0.0 && sd < HUGE_VAL ? best / sd : 0.0;
+        res.max_influence = fmin(best / travel, DBL_MAX);
+        res.max_influence_stds = sd > 0.0 && sd < HUGE_VAL ? fmin(best / sd, DBL_MAX) : 0.0;
     }
     if (out)
         *out = res;

@@ -430,8 +430,8 @@ def linear17_static_raw(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.nd
         # what one pair does to the estimate (mcgeom.estimators._outliers),
         # on the same pointers; an exact fit is the data's motion
         lr = ffi.new("mcg_leverage_result *")
-        if lib.mcg_sampson_leverage(n, *rays, fp + _L17_DOUBLES["R"], fp + _L17_DOUBLES["t"],
-                                    0, ffi.NULL, lr) == lib.MCG_OK:
+        if lib.mcg_sampson_leverage(n, *rays, ffi.NULL, fp + _L17_DOUBLES["R"],
+                                    fp + _L17_DOUBLES["t"], 0, ffi.NULL, lr) == lib.MCG_OK:
             lev = _leverage_dict(lr)
     return st, f64, res, sst, out, lev
 
@@ -586,8 +586,8 @@ def sampson_leverage(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: An
     t = _f64("t", t, (3,))
     lev = np.empty(rays[0].shape[0])
     st = lib.mcg_sampson_leverage(lev.shape[0], _p(rays[0]), _p(rays[1]), _p(rays[2]),
-                                  _p(rays[3]), _p(R), _p(t), int(bool(hold_rotation)), _p(lev),
-                                  ffi.NULL)
+                                  _p(rays[3]), ffi.NULL, _p(R), _p(t), int(bool(hold_rotation)),
+                                  _p(lev), ffi.NULL)
     if st == lib.MCG_EDEGENERATE:
         return None
     if st != lib.MCG_OK:
@@ -597,10 +597,13 @@ def sampson_leverage(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: An
 
 def leverage_stats(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
                    dirs2: np.ndarray, R: np.ndarray, t: np.ndarray,
-                   hold_rotation: bool = False) -> Optional[dict]:
+                   hold_rotation: bool = False,
+                   weights: Optional[np.ndarray] = None) -> Optional[dict]:
     """What one pair does to the least-squares fit ``(R, t)`` (rig2_from_rig1,
     metres) on arrays already checked (float64, C-contiguous (N, 3) rays; an
-    estimator's own): ``mcg_leverage_result`` as a dict -- ``max_leverage``
+    estimator's own; ``weights`` float64 (N,) >= 0, a weighted fit's, e.g.
+    the robust search's final refinement, 0 for the pairs it did not use):
+    ``mcg_leverage_result`` as a dict -- ``max_leverage``
     and ``leverage_pair``; ``max_influence`` (the largest change of the
     centroid's travel when one pair is deleted, relative to the travel),
     ``max_influence_stds`` (the same in stds of the travel) and
@@ -608,7 +611,8 @@ def leverage_stats(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray
     ``J^T J`` is singular or the kernel refuses the input."""
     out = ffi.new("mcg_leverage_result *")
     st = lib.mcg_sampson_leverage(origins1.shape[0], _p(origins1), _p(dirs1), _p(origins2),
-                                  _p(dirs2), _p(np.ascontiguousarray(R, dtype=np.float64)),
+                                  _p(dirs2), ffi.NULL if weights is None else _p(weights),
+                                  _p(np.ascontiguousarray(R, dtype=np.float64)),
                                   _p(np.ascontiguousarray(t, dtype=np.float64)),
                                   int(bool(hold_rotation)), ffi.NULL, out)
     return _leverage_dict(out) if st == lib.MCG_OK else None

@@ -40,3 +40,14 @@ def test_cli_prints_the_summary(capsys):
     assert "outliers 0.02:" in out
     with pytest.raises(SystemExit, match="unknown estimator"):
         ex.run_cli(ap.parse_args(["--estimators", "nope"]))
+
+
+def test_robust_rows():
+    cells = ex.sweep([ex.ROBUST], sizes=[60], noises=[1e-3], fractions=[0.3], problems=3)
+    assert len(cells) == 4 and all(c.estimator == ex.ROBUST for c in cells)
+    for c in cells:
+        assert c.metric + c.not_metric + c.failed == 3
+    ap = argparse.ArgumentParser()
+    ex.add_arguments(ap)
+    with pytest.raises(SystemExit, match="no --estimators"):
+        ex.run_cli(ap.parse_args(["--robust", "--estimators", "linear17"]))

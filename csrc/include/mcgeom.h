@@ -394,20 +394,24 @@ typedef struct {
                               (n - parameters); HUGE_VAL without redundancy */
 } mcg_leverage_result;
 
-/* lev[k] = h_k (n values, may be NULL) and the result (may be NULL). The
+/* lev[k] = h_k (n values, may be NULL) and the result (may be NULL).
+ * weights (n values in [0, 1e100], may be NULL: all 1): a weighted fit's, H =
+ * J^T W J, h_k = w_k J_k H^-1 J_k^T, sigma^2 = sum w r^2 / (pairs with
+ * w > 0 - parameters), c the centroid of the pairs with w > 0. The
  * leverages sum to the number of parameters; 1 - h_k is the pair's
  * redundancy number (Baarda): near 0, the pair fixes a direction of the
  * motion alone and an error in it does not show in any residual. Independent
- * of the parameters' scaling. MCG_EINVAL: as mcg_gec_residuals, or
- * hold_rotation not 0 or 1; MCG_EDEGENERATE: H not positive definite up to
- * rounding (a direction of the motion no pair determines, e.g. |t| at a
+ * of the parameters' scaling. MCG_EINVAL: as mcg_gec_residuals, a weight
+ * outside [0, 1e100] (or NaN), or hold_rotation not 0 or 1;
+ * MCG_EDEGENERATE: H not positive definite up to rounding (a direction of the motion no pair determines, e.g. |t| at a
  * critical motion; fewer pairs than parameters; a reciprocal condition
  * number below ~1e-10, where the leverages miss their sum by more than
  * 1e-6), the outputs then unspecified. Two passes over the pairs, no
  * allocation. */
 int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double *o2,
-                         const double *d2, const double R[9], const double t[3],
-                         int hold_rotation, double *lev, mcg_leverage_result *out);
+                         const double *d2, const double *weights, const double R[9],
+                         const double t[3], int hold_rotation, double *lev,
+                         mcg_leverage_result *out);
 
 /* Robust losses rho(z) of the squared residual z = r^2 with scale s
  * (radians); the IRLS weight of a residual is rho'(z). */

@@ -255,7 +255,7 @@ int main(void)
     ring_scene(R, t);
     for (hold = 0; hold <= 1; ++hold) {
         char what[96];
-        st = mcg_sampson_leverage(N, o1, d1, o2, d2, R, t, hold, lev, &lr);
+        st = mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, R, t, hold, lev, &lr);
         top = lr.max_leverage;
         at = lr.leverage_pair;
         check_status(st, MCG_OK, hold ? "ring, R held: status" : "ring: status");
@@ -301,17 +301,17 @@ int main(void)
         }
         for (k = 0; k < 3; ++k)
             tm[k] = 1000.0 * t[k];
-        (void)mcg_sampson_leverage(N, o1, d1, o2, d2, R, tm, 0, lev_mm, NULL);
+        (void)mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, R, tm, 0, lev_mm, NULL);
         for (k = 0; k < 3 * N; ++k) {
             o1[k] /= 1000.0;
             o2[k] /= 1000.0;
         }
-        (void)mcg_sampson_leverage(N, o1, d1, o2, d2, R, t, 0, lev, NULL);
+        (void)mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, R, t, 0, lev, NULL);
         for (k = 0; k < 3 * N; ++k) {
             o1[k] *= 1000.0;
             o2[k] *= 1000.0;
         }
-        st = mcg_sampson_leverage(N, o1, d1, o2, d2, R, tm, 0, lev_mm, NULL);
+        st = mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, R, tm, 0, lev_mm, NULL);
         err = 0.0;
         for (k = 0; k < N; ++k)
             err = fmax(err, fabs(lev_mm[k] - lev[k]));
@@ -322,6 +322,58 @@ int main(void)
             o2[k] /= 1000.0;
         }
     }
+    /* weights: all 1 as none, all 2 the same leverages, a zero weight as
+     * the pair deleted; negative or NaN weights refused */
+    {
+        static double wt[N], lev_w[N], lev_d[N];
+        static double so1[3 * N], sd1[3 * N], so2[3 * N], sd2[3 * N];
+        mcg_leverage_result l1, l2;
+        int m = 0, q;
+        ring_scene(R, t);
+        (void)mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, R, t, 0, lev, &l1);
+        for (k = 0; k < N; ++k)
+            wt[k] = 1.0;
+        st = mcg_sampson_leverage(N, o1, d1, o2, d2, wt, R, t, 0, lev_w, &l2);
+        check(st == MCG_OK && memcmp(lev, lev_w, sizeof lev) == 0 &&
+                  memcmp(&l1, &l2, sizeof l1) == 0,
+              "weights of 1: the same as none", 0.0, 0.0);
+        for (k = 0; k < N; ++k)
+            wt[k] = 2.0;
+        st = mcg_sampson_leverage(N, o1, d1, o2, d2, wt, R, t, 0, lev_w, &l2);
+        err = 0.0;
+        for (k = 0; k < N; ++k)
+            err = fmax(err, fabs(lev_w[k] - lev[k]));
+        check(st == MCG_OK && err < 1e-12 && fabs(l2.travel_std - l1.travel_std) < 1e-12 * l1.travel_std,
+              "weights of 2: the same leverages and std", err, 1e-12);
+        for (k = 0; k < N; ++k) {
+            wt[k] = k == 9 ? 0.0 : 1.0;
+            if (k != 9) {
+                for (q = 0; q < 3; ++q) {
+                    so1[3 * m + q] = o1[3 * k + q];
+                    sd1[3 * m + q] = d1[3 * k + q];
+                    so2[3 * m + q] = o2[3 * k + q];
+                    sd2[3 * m + q] = d2[3 * k + q];
+                }
+                ++m;
+            }
+        }
+        st = mcg_sampson_leverage(N, o1, d1, o2, d2, wt, R, t, 0, lev_w, &l1);
+        (void)mcg_sampson_leverage(m, so1, sd1, so2, sd2, NULL, R, t, 0, lev_d, &l2);
+        err = fabs(lev_w[9]);
+        for (k = 0, m = 0; k < N; ++k)
+            if (k != 9)
+                err = fmax(err, fabs(lev_w[k] - lev_d[m++]));
+        check(st == MCG_OK && err < 1e-12 && fabs(l1.travel - l2.travel) < 1e-12 &&
+                  fabs(l1.travel_std - l2.travel_std) < 1e-12 * l2.travel_std &&
+                  fabs(l1.max_influence - l2.max_influence) < 1e-12,
+              "a zero weight: the pair deleted", err, 1e-12);
+        wt[3] = -1.0;
+        check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, wt, R, t, 0, lev, NULL), MCG_EINVAL,
+                     "a negative weight");
+        wt[3] = NAN;
+        check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, wt, R, t, 0, lev, NULL), MCG_EINVAL,
+                     "a NaN weight");
+    }
     /* a gross outlier among the pairs that fix the scale: the last
      * cross-camera pair's time-2 bearing turned away, the motion refined on
      * every pair (least squares): the fit absorbs it, and the outlier has
@@ -329,6 +381,7 @@ int main(void)
     {
         double Rf[9], tf[3];
         mcg_refine_result rr;
+        rng_state = TEST_SEED; /* the scene of the first checks */
         ring_scene(R, t);
         d2[3 * (N - 1)] += 1.0;
         d2[3 * (N - 1) + 2] -= 1.0;
@@ -336,7 +389,7 @@ int main(void)
         memcpy(tf, t, sizeof tf);
         st = mcg_refine_motion(N, o1, d1, o2, d2, NULL, NULL, Rf, tf, &rr);
         check_status(st, MCG_OK, "least-squares fit with the outlier");
-        st = mcg_sampson_leverage(N, o1, d1, o2, d2, Rf, tf, 0, NULL, &lr);
+        st = mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, Rf, tf, 0, NULL, &lr);
         check(st == MCG_OK && lr.influence_pair == N - 1 && lr.max_influence_stds > 4.0,
               "the outlier has the largest influence, > 4 stds", lr.max_influence_stds, 4.0);
     }
@@ -348,33 +401,33 @@ int main(void)
         for (k = 0; k < 30; ++k)
             make_pair(k, c0, c0, ax, R, t);
         make_pair(30, ca, cb, ax2, R, t);
-        st = mcg_sampson_leverage(31, o1, d1, o2, d2, R, t, 0, lev, &lr);
+        st = mcg_sampson_leverage(31, o1, d1, o2, d2, NULL, R, t, 0, lev, &lr);
         top = lr.max_leverage;
         at = lr.leverage_pair;
         check(st == MCG_OK && at == 30 && top > 1.0 - 1e-6,
               "the only pair off the centre: leverage 1", 1.0 - top, 1e-6);
-        st = mcg_sampson_leverage(30, o1, d1, o2, d2, R, t, 0, lev, &lr);
+        st = mcg_sampson_leverage(30, o1, d1, o2, d2, NULL, R, t, 0, lev, &lr);
         check_status(st, MCG_EDEGENERATE, "one centre alone: |t| undetermined");
     }
     ring_scene(R, t);
-    check_status(mcg_sampson_leverage(5, o1, d1, o2, d2, R, t, 0, lev, NULL),
+    check_status(mcg_sampson_leverage(5, o1, d1, o2, d2, NULL, R, t, 0, lev, NULL),
                  MCG_EDEGENERATE, "5 pairs, 6 parameters");
-    check_status(mcg_sampson_leverage(0, o1, d1, o2, d2, R, t, 0, lev, &lr),
+    check_status(mcg_sampson_leverage(0, o1, d1, o2, d2, NULL, R, t, 0, lev, &lr),
                  MCG_EDEGENERATE, "no pairs");
-    check_status(mcg_sampson_leverage(N, NULL, d1, o2, d2, R, t, 0, lev, NULL),
+    check_status(mcg_sampson_leverage(N, NULL, d1, o2, d2, NULL, R, t, 0, lev, NULL),
                  MCG_EINVAL, "NULL origins");
-    check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, R, t, 2, lev, NULL), MCG_EINVAL,
+    check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, R, t, 2, lev, NULL), MCG_EINVAL,
                  "hold_rotation 2");
-    check_status(mcg_sampson_leverage(-1, o1, d1, o2, d2, R, t, 0, lev, NULL),
+    check_status(mcg_sampson_leverage(-1, o1, d1, o2, d2, NULL, R, t, 0, lev, NULL),
                  MCG_EINVAL, "n = -1");
     {
         double Rn[9];
         memcpy(Rn, R, sizeof Rn);
         Rn[4] = NAN;
-        check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, Rn, t, 0, lev, NULL),
+        check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, Rn, t, 0, lev, NULL),
                      MCG_EINVAL, "NaN in R");
         d2[3 * 7] = d2[3 * 7 + 1] = d2[3 * 7 + 2] = 0.0;
-        check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, R, t, 0, lev, NULL),
+        check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, R, t, 0, lev, NULL),
                      MCG_EINVAL, "a zero direction");
     }
     printf("%d checks, %d failed\n", n_checks, n_failed);

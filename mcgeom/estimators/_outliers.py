@@ -144,27 +144,33 @@ def one_pair_reason(rays: RayPairs, R: np.ndarray, t: np.ndarray, method: str,
 
 
 def one_pair_rule(st: Optional[dict], method: str, max_rel_std: float = 0.1,
-                  info: Optional[dict] = None) -> Optional[str]:
+                  info: Optional[dict] = None, consensus: bool = False) -> Optional[str]:
     """:func:`one_pair_reason`'s decision from the statistics ``st`` of
     ``_core.leverage_stats`` (None: singular, nothing decided); ``info`` gets
-    ``max_leverage`` and ``max_influence_stds``."""
+    ``max_leverage`` and ``max_influence_stds``. ``consensus``: the fit is a
+    robust search's final refinement on its inliers (the reasons then say
+    so) rather than a direct estimator's on every correspondence."""
     if info is not None:
         info["max_leverage"] = st["max_leverage"] if st else float("nan")
         info["max_influence_stds"] = st["max_influence_stds"] if st else float("nan")
     if st is None:
         return None
+    if consensus:
+        why = (f"the consensus of {method} rests on it, and a wrong match there would not "
+               f"show in any residual: more correspondences or cameras would confirm the scale")
+    else:
+        why = (f"{method} takes every correspondence as an inlier: use mcgeom.robust.ransac, "
+               f"or more correspondences")
     if st["max_leverage"] > MAX_LEVERAGE:
         return (f"scale not confirmed: correspondence {st['leverage_pair']} fixes a direction "
                 f"of the motion almost alone (leverage {st['max_leverage']:.3g}, above "
                 f"{MAX_LEVERAGE:g}), so an error in it (a gross outlier) would not show in any "
-                f"residual; {method} takes every correspondence as an inlier: use "
-                f"mcgeom.robust.ransac, or more correspondences")
+                f"residual; {why}")
     if st["max_influence_stds"] > DELETION_STDS and st["max_influence"] > max_rel_std:
         return (f"scale not supported by the bulk of the correspondences: deleting "
                 f"correspondence {st['influence_pair']} alone moves the travelled distance by "
                 f"{100 * st['max_influence']:.3g} % ({st['max_influence_stds']:.3g} of its "
-                f"stds) -- the least-squares fit rests on a gross outlier, and {method} takes "
-                f"every correspondence as an inlier: use mcgeom.robust.ransac")
+                f"stds) -- the fit rests on one correspondence, maybe a gross outlier; {why}")
     return None
 
 

@@ -19,7 +19,7 @@ from ._no_motion import (MAX_THRESHOLD_RAD, FITS_RAD, check_threshold_angle, not
                          per_camera_counts)
 from ._options import RansacOptions
 from ._scoring import Scorer
-from ._verdict import C_WORDED, conclude, conclude_c, unconfirmed_reason
+from ._verdict import C_WORDED, conclude, conclude_c, one_pair_checked, unconfirmed_reason
 
 
 def _camera_count(rays: RayPairs) -> tuple[np.ndarray, np.ndarray, int]:
@@ -165,8 +165,9 @@ def ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions
             scorer.best = (probe["R"], probe["t"])
             scorer.n_hyp = int(probe["hypotheses"])
         return nothing_found(rays, scorer, options, method, t_start, 6, "", ended)
-    return _c_conclude(rays, out, focal, options, method, t_start, calibration_std, cam1, cam2,
-                       n_cameras)
+    return one_pair_checked(_c_conclude(rays, out, focal, options, method, t_start,
+                                        calibration_std, cam1, cam2, n_cameras),
+                            rays, out["weights"], options, method)
 
 
 def _search_info(res: Any, method: str) -> dict:
@@ -243,18 +244,21 @@ def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np
     unconfirmed = unconfirmed_reason(info["stop"], res.iterations, res.sample_size,
                                      res.confidence)
     inl = (mask & 1).view(bool)
-    if res.have_scale and res.scale.reason in C_WORDED:
-        return conclude_c(res, _core.robust_struct(res), inl, options, method, info, t_start,
-                          unconfirmed)
-    # a verdict the numpy layer decides (static, undecided): the rays and
-    # the dict of the general conclusion, from the same call
+    # the pixels' rays (views of the kernel's workspace)
     rays = RayPairs.prechecked(*(w[3 * n * b:3 * n * (b + 1)].reshape(n, 3) for b in range(4)),
                                ids1, ids2)
+    if res.have_scale and res.scale.reason in C_WORDED:
+        return one_pair_checked(conclude_c(res, _core.robust_struct(res), inl, options, method,
+                                           info, t_start, unconfirmed),
+                                rays, buf[:n], options, method)
+    # a verdict the numpy layer decides (static, undecided): the dict of the
+    # general conclusion, from the same call
     ids32 = w[13 * n:].view(np.int32)
     out = _core._robust_result(res, mask, buf[:n])
     out["extrinsic_std_given"] = calibration_std is not None
-    return _c_conclude(rays, out, w[12 * n:13 * n], options, method, t_start, calibration_std,
-                       ids32[:n], ids32[n:2 * n], len(focal))
+    return one_pair_checked(_c_conclude(rays, out, w[12 * n:13 * n], options, method, t_start,
+                                        calibration_std, ids32[:n], ids32[n:2 * n], len(focal)),
+                            rays, buf[:n], options, method)
 
 
 def _c_seed(options: RansacOptions) -> int:
