@@ -26,15 +26,6 @@
 
 static double o1[3 * N], d1[3 * N], o2[3 * N], d2[3 * N];
 
-static void rot_about(const double axis[3], double th, double r[9])
-{
-    double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]), w[3];
-    int i;
-    for (i = 0; i < 3; ++i)
-        w[i] = th * axis[i] / n;
-    mcg_rot_from_angle_axis(w, r);
-}
-
 static void mat_vec3(const double r[9], const double x[3], double y[3])
 {
     int i;
@@ -118,39 +109,35 @@ static void left(const double w[3], const double R[9], double out[9])
         }
 }
 
+/* the motion moved by +-eps along parameter a of [dw, dt] (the rotation on
+ * the left): (Rp, tp) and (Rm, tm) */
+static void perturbed(int a, double eps, const double R[9], const double t[3], double Rp[9],
+                      double tp[3], double Rm[9], double tm[3])
+{
+    double w[3] = {0, 0, 0};
+    memcpy(Rp, R, 9 * sizeof(double));
+    memcpy(Rm, R, 9 * sizeof(double));
+    memcpy(tp, t, 3 * sizeof(double));
+    memcpy(tm, t, 3 * sizeof(double));
+    if (a < 3) {
+        w[a] = eps;
+        left(w, R, Rp);
+        w[a] = -eps;
+        left(w, R, Rm);
+    } else {
+        tp[a - 3] += eps;
+        tm[a - 3] -= eps;
+    }
+}
+
 static int reference(int n, const double R[9], const double t[3], int hold, double *lev)
 {
     static double rp[N], rm[N];
     double h[6][12], eps = 1e-6;
     int p0 = hold ? 3 : 0, np = 6 - p0, a, b, k, c;
     for (a = p0; a < 6; ++a) {
-        double Rp[9], Rm[9], tp[3], tm[3], w[3] = {0, 0, 0}, dr[9];
-        memcpy(Rp, R, sizeof Rp);
-        memcpy(Rm, R, sizeof Rm);
-        memcpy(tp, t, sizeof tp);
-        memcpy(tm, t, sizeof tm);
-        if (a < 3) {
-            int i, j, q;
-            w[a] = eps;
-            mcg_rot_from_angle_axis(w, dr);
-            for (i = 0; i < 3; ++i)
-                for (j = 0; j < 3; ++j) {
-                    Rp[3 * i + j] = 0.0;
-                    for (q = 0; q < 3; ++q)
-                        Rp[3 * i + j] += dr[3 * i + q] * R[3 * q + j];
-                }
-            w[a] = -eps;
-            mcg_rot_from_angle_axis(w, dr);
-            for (i = 0; i < 3; ++i)
-                for (j = 0; j < 3; ++j) {
-                    Rm[3 * i + j] = 0.0;
-                    for (q = 0; q < 3; ++q)
-                        Rm[3 * i + j] += dr[3 * i + q] * R[3 * q + j];
-                }
-        } else {
-            tp[a - 3] += eps;
-            tm[a - 3] -= eps;
-        }
+        double Rp[9], Rm[9], tp[3], tm[3];
+        perturbed(a, eps, R, t, Rp, tp, Rm, tm);
         if (mcg_gec_residuals(n, o1, d1, o2, d2, Rp, tp, rp) != MCG_OK ||
             mcg_gec_residuals(n, o1, d1, o2, d2, Rm, tm, rm) != MCG_OK)
             return -1;
@@ -208,20 +195,8 @@ static double reference_influence(int n, const double R[9], const double t[3], i
     double g[6], eps = 1e-6, best = -1.0, ssr = 0.0, gg = 0.0;
     int p0 = hold ? 3 : 0, np = 6 - p0, a, b, k;
     for (a = 0; a < 6; ++a) {
-        double w[3] = {0, 0, 0}, Rp[9], Rm[9], tp[3], tm[3];
-        memcpy(Rp, R, sizeof Rp);
-        memcpy(Rm, R, sizeof Rm);
-        memcpy(tp, t, sizeof tp);
-        memcpy(tm, t, sizeof tm);
-        if (a < 3) {
-            w[a] = eps;
-            left(w, R, Rp);
-            w[a] = -eps;
-            left(w, R, Rm);
-        } else {
-            tp[a - 3] += eps;
-            tm[a - 3] -= eps;
-        }
+        double Rp[9], Rm[9], tp[3], tm[3];
+        perturbed(a, eps, R, t, Rp, tp, Rm, tm);
         g[a] = (travel_of(n, Rp, tp) - travel_of(n, Rm, tm)) / (2.0 * eps);
     }
     mcg_gec_residuals(n, o1, d1, o2, d2, R, t, r);

@@ -30,16 +30,6 @@ static int c1[N], c2[N];
 static unsigned char inl[N];
 static double work[64];
 
-/* R = exp([th axis/|axis|]x) (the library's Rodrigues, tested in test_linalg.c) */
-static void rot_about(const double axis[3], double th, double r[9])
-{
-    double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]), w[3];
-    int i;
-    for (i = 0; i < 3; ++i)
-        w[i] = th * axis[i] / n;
-    mcg_rot_from_angle_axis(w, r);
-}
-
 /* A rig of NC cameras on a ring (radius 0.5 m), points 2..20 m out, moving by
  * (R, t); every fifth pair cross-camera when cross != 0. */
 static void scene(const double R[9], const double t[3], int cross)

@@ -4,6 +4,8 @@
 #ifndef MCGEOM_TESTUTIL_H
 #define MCGEOM_TESTUTIL_H
 
+#include "mcgeom.h" /* mcg_rot_from_angle_axis (rot_about) */
+
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -62,6 +64,17 @@ static inline double urand(void) /* uniform in (0, 1) */
 static inline double nrand(void) /* standard normal (Box-Muller) */
 {
     return sqrt(-2.0 * log(urand())) * cos(6.283185307179586 * urand());
+}
+
+/* R = exp([th axis/|axis|]x) (the library's Rodrigues, tested in
+ * test_linalg.c) */
+static inline void rot_about(const double axis[3], double th, double r[9])
+{
+    double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]), w[3];
+    int i;
+    for (i = 0; i < 3; ++i)
+        w[i] = th * axis[i] / n;
+    mcg_rot_from_angle_axis(w, r);
 }
 
 static inline void randn(double *a, int n) /* n standard normal values */

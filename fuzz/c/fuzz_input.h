@@ -18,6 +18,8 @@
 #ifndef MCGEOM_FUZZ_INPUT_H
 #define MCGEOM_FUZZ_INPUT_H
 
+#include "mcgeom.h" /* mcg_rot_from_angle_axis (fz_scene_near) */
+
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
@@ -395,6 +397,60 @@ static inline int fz_scene(fz_in *in, int n, int ncams, int cross, const double 
         arr[at] = v;
     }
     return noise == 0.0 && nbad == 0;
+}
+
+/* fz_scene at a decoded true motion (Rt: fz_rotation; tt in [-2, 2]^3; 1-8
+ * cameras, cross-camera pairs or not) and a start (R, t) near it: Rt turned
+ * by a decoded angle-axis of up to max_turn rad per component, tt shifted by
+ * up to max_shift metres per axis -- the start of a refinement, the fit of a
+ * leverage. Returns 0 when the turn is not a rotation (skip the input). */
+static inline int fz_scene_near(fz_in *in, int n, double max_turn, double max_shift,
+                                double *o1, double *d1, double *o2, double *d2,
+                                double Rt[9], double tt[3], double R[9], double t[3])
+{
+    double dw[3], Rd[9];
+    int i;
+    fz_rotation(in, Rt);
+    for (i = 0; i < 3; ++i)
+        tt[i] = fz_range(in, -2.0, 2.0);
+    {   /* decoded in this order (not as arguments of one call) */
+        const int ncams = fz_int(in, 1, 8), cross = fz_u8(in) & 1;
+        fz_scene(in, n, ncams, cross, Rt, tt, o1, d1, o2, d2, NULL);
+    }
+    for (i = 0; i < 3; ++i)
+        dw[i] = fz_range(in, -max_turn, max_turn);
+    if (mcg_rot_from_angle_axis(dw, Rd) != MCG_OK)
+        return 0;
+    fz_matmul3(Rd, Rt, R);
+    for (i = 0; i < 3; ++i)
+        t[i] = tt[i] + fz_range(in, -max_shift, max_shift);
+    return 1;
+}
+
+/* The rays and the motion of a fit: mode 0 fz_scene_near's scene and start
+ * (the true motion in Rt, tt when not NULL), mode 1 arbitrary rays, a
+ * rotation or any 9 doubles, and any t. Returns 0 to skip the input. */
+static inline int fz_fit_input(fz_in *in, int mode, int n, double max_turn, double max_shift,
+                               double *o1, double *d1, double *o2, double *d2, double R[9],
+                               double t[3])
+{
+    double Rt[9], tt[3];
+    if (mode == 0)
+        return fz_scene_near(in, n, max_turn, max_shift, o1, d1, o2, d2, Rt, tt, R, t);
+    fz_rays(in, (size_t)n, o1, d1, o2, d2);
+    fz_rotation_or_any(in, R);
+    fz_doubles(in, t, 3);
+    return 1;
+}
+
+/* Per-pair weights: none (returns 0, w all 1), in [0, 3] (1) or any doubles
+ * (2), as a weighted fit's. */
+static inline int fz_weights(fz_in *in, int n, double *w)
+{
+    int use_w = fz_u8(in) % 3, i;
+    for (i = 0; i < n; ++i)
+        w[i] = use_w == 1 ? fz_range(in, 0.0, 3.0) : use_w == 2 ? fz_double(in) : 1.0;
+    return use_w;
 }
 
 #endif /* MCGEOM_FUZZ_INPUT_H */

@@ -39,30 +39,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(st == MCG_EINVAL, "leverage(n = %d) returned %d", n, st);
         return 0;
     }
-    if (mode == 0) {
-        double Rt[9], tt[3], dw[3], Rd[9];
-        fz_rotation(&in, Rt);
-        for (i = 0; i < 3; ++i)
-            tt[i] = fz_range(&in, -2.0, 2.0);
-        {   /* decoded in this order (not as arguments of one call) */
-            const int ncams = fz_int(&in, 1, 8), cross = fz_u8(&in) & 1;
-            fz_scene(&in, n, ncams, cross, Rt, tt, o1, d1, o2, d2, NULL);
-        }
-        for (i = 0; i < 3; ++i)
-            dw[i] = fz_range(&in, -0.05, 0.05);
-        if (mcg_rot_from_angle_axis(dw, Rd) != MCG_OK)
-            return 0;
-        fz_matmul3(Rd, Rt, R);
-        for (i = 0; i < 3; ++i)
-            t[i] = tt[i] + fz_range(&in, -0.1, 0.1);
-    } else {
-        fz_rays(&in, (size_t)n, o1, d1, o2, d2);
-        fz_rotation_or_any(&in, R);
-        fz_doubles(&in, t, 3);
-    }
-    use_w = fz_u8(&in) % 3;
-    for (i = 0; i < n; ++i)
-        w[i] = use_w == 1 ? fz_range(&in, 0.0, 3.0) : use_w == 2 ? fz_double(&in) : 1.0;
+    if (!fz_fit_input(&in, mode, n, 0.05, 0.1, o1, d1, o2, d2, R, t))
+        return 0;
+    use_w = fz_weights(&in, n, w);
     st = mcg_sampson_leverage(n, o1, d1, o2, d2, use_w ? w : NULL, R, t, hold, lev, &lr);
     FZ_CHECK(fz_status_known(st), "leverage status %d", st);
     if (hold != 0 && hold != 1) {

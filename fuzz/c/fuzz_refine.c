@@ -32,10 +32,10 @@ static double norm3(const double *v)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_in in = fz_make(data, size);
-    int mode = fz_u8(&in) % FUZZ_MODES, valid, st, i, use_w, use_opt, held;
+    int mode = fz_u8(&in) % FUZZ_MODES, valid, st, use_w, use_opt, held;
     int n = fz_size(&in, 6, MAXN, &valid);
     static double o1[3 * MAXN], d1[3 * MAXN], o2[3 * MAXN], d2[3 * MAXN], w[MAXN];
-    double Rt[9], tt[3], R[9], t[3], R0[9], t0[3];
+    double R[9], t[3], R0[9], t0[3];
     mcg_refine_options opt;
     mcg_refine_result res;
     held = mode >= 2; /* mcg_refine_translation */
@@ -67,31 +67,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(st == MCG_EINVAL, "refine(n = %d) returned %d", n, st);
         return 0;
     }
-    if (mode == 0) {
-        double dw[3], Rd[9];
-        fz_rotation(&in, Rt);
-        for (i = 0; i < 3; ++i)
-            tt[i] = fz_range(&in, -2.0, 2.0);
-        {   /* decoded in this order (not as arguments of one call) */
-            const int ncams = fz_int(&in, 1, 8), cross = fz_u8(&in) & 1;
-            fz_scene(&in, n, ncams, cross, Rt, tt, o1, d1, o2, d2, NULL);
-        }
-        /* the start: the truth moved by a decoded small rotation and shift */
-        for (i = 0; i < 3; ++i)
-            dw[i] = fz_range(&in, -0.2, 0.2);
-        if (mcg_rot_from_angle_axis(dw, Rd) != MCG_OK)
-            return 0;
-        fz_matmul3(Rd, Rt, R);
-        for (i = 0; i < 3; ++i)
-            t[i] = tt[i] + fz_range(&in, -0.3, 0.3);
-    } else {
-        fz_rays(&in, (size_t)n, o1, d1, o2, d2);
-        fz_rotation_or_any(&in, R);
-        fz_doubles(&in, t, 3);
-    }
-    use_w = fz_u8(&in) % 3;
-    for (i = 0; i < n; ++i)
-        w[i] = use_w == 1 ? fz_range(&in, 0.0, 3.0) : use_w == 2 ? fz_double(&in) : 1.0;
+    /* mode 0: the start is the truth moved by a decoded small rotation and shift */
+    if (!fz_fit_input(&in, mode, n, 0.2, 0.3, o1, d1, o2, d2, R, t))
+        return 0;
+    use_w = fz_weights(&in, n, w);
     memcpy(R0, R, sizeof R);
     memcpy(t0, t, sizeof t);
     if (held)
