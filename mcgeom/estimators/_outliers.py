@@ -53,8 +53,9 @@ from ..errors import DegenerateError
 from ..geometry import centroid_travel, refine_centred
 from ..types import RayPairs, ScaleVerdict
 
-__all__ = ["OUTLIER_MOVE_STDS", "MAX_LEVERAGE", "DELETION_STDS", "travel_moved",
-           "one_pair_reason", "one_pair_rule", "guard_verdict"]
+__all__ = ["OUTLIER_MOVE_STDS", "MAX_LEVERAGE", "DELETION_STDS", "SCREEN_LEVERAGE",
+           "SCREEN_STDS", "travel_moved", "one_pair_reason", "one_pair_rule", "guard_verdict",
+           "moved_verdict"]
 
 #: stds of the estimate's travel that a robust refit may move it by before the
 #: least-squares estimate is called unsupported by the bulk of the data
@@ -69,6 +70,17 @@ MAX_LEVERAGE = 0.9
 #: stds of the travel that deleting one correspondence may move it by (and
 #: by more than the verdict's ``max_rel_std``); see :func:`one_pair_reason`
 DELETION_STDS = 4.0
+
+#: ``linear17`` runs the robust refit of :func:`moved_verdict` (~100 us, its
+#: whole call is ~50 us) only where a pair's leverage (and 3 p / n, the
+#: average's triple) or deletion move reaches these: several outliers
+#: masking each other can leave each below the
+#: one-pair rules yet together pull the fit (one problem of 20, 200 rays of a
+#: 2-camera head, 3 outliers: leverages 0.58-0.67, moves 1.0-1.8 stds, |t| 50
+#: % short; the refit moves it back to the truth); clean estimates with 200
+#: rays stay below 0.4 and 1.1
+SCREEN_LEVERAGE = 0.5
+SCREEN_STDS = 1.5
 
 #: the median absolute deviation of a Gaussian over its std's
 _MAD_TO_STD = 1.4826
@@ -138,7 +150,8 @@ def one_pair_reason(rays: RayPairs, R: np.ndarray, t: np.ndarray, method: str,
     clean metric estimates: at most 0.89 with 34 correspondences, 0.76 with
     60, 0.38 with 200), 2 after the deletion test (the outliers moved the
     travel by 5.0-14.8 of its stds and 18-69 %; clean estimates at most 2.8
-    stds)."""
+    stds), none once ``linear17`` also runs the robust refit where these
+    statistics are high (:data:`SCREEN_LEVERAGE`)."""
     st = _core.leverage_stats(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t,
                               hold_rotation)
     return one_pair_rule(st, method, max_rel_std, info)
@@ -182,11 +195,11 @@ def guard_verdict(rays: RayPairs, R: np.ndarray, t: np.ndarray, verdict: ScaleVe
     """``(verdict, moved)``: the verdict of a least-squares estimate ``(R, t)``
     of ``method`` on all ``rays``, made "not observable" when one
     correspondence carries the fit (:func:`one_pair_reason`, which writes
-    ``info["max_leverage"]`` and ``info["max_influence_stds"]``) or when a robust refit moves its travel by
-    more than :data:`OUTLIER_MOVE_STDS` of its relative std and by more than
-    ``max_rel_std`` (:func:`travel_moved`, whose value in stds is ``moved``;
-    NaN when not checked: a verdict already not observable, or one
-    correspondence carries the fit)."""
+    ``info["max_leverage"]`` and ``info["max_influence_stds"]``) or when a
+    robust refit moves its travel by more than :data:`OUTLIER_MOVE_STDS` of
+    its relative std and by more than ``max_rel_std`` (:func:`moved_verdict`;
+    ``moved`` in stds, NaN when not checked: a verdict already not
+    observable, or one correspondence carries the fit)."""
     if not verdict.observable:
         return verdict, float("nan")
     o = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
@@ -195,6 +208,16 @@ def guard_verdict(rays: RayPairs, R: np.ndarray, t: np.ndarray, verdict: ScaleVe
     why = one_pair_reason(rays, R, t, method, max_rel_std, hold_rotation, info)
     if why is not None:
         return replace(verdict, observable=False, reason=why), float("nan")
+    return moved_verdict(rays, R, t, verdict, method, max_rel_std, hold_rotation)
+
+
+def moved_verdict(rays: RayPairs, R: np.ndarray, t: np.ndarray, verdict: ScaleVerdict,
+                  method: str, max_rel_std: float = 0.1,
+                  hold_rotation: bool = False) -> tuple[ScaleVerdict, float]:
+    """``(verdict, moved)``: ``verdict`` (observable) made "not observable"
+    when the robust refit of :func:`travel_moved` moves the travel by more
+    than :data:`OUTLIER_MOVE_STDS` of its relative std and by more than
+    ``max_rel_std``; ``moved`` in stds."""
     moved = travel_moved(rays, R, t, verdict.rel_std, hold_rotation)
     relative = moved * verdict.rel_std
     if not (moved > OUTLIER_MOVE_STDS and relative > max_rel_std):

@@ -27,7 +27,8 @@ from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict, make_rig_motion, make_scale_verdict
-from ._outliers import one_pair_reason, one_pair_rule
+from ._outliers import (SCREEN_LEVERAGE, SCREEN_STDS, moved_verdict, one_pair_reason,
+                        one_pair_rule)
 from ._static import KERNEL_OPTIONS, intra_groups, with_static_check
 
 __all__ = ["linear17", "linear17_no_static_check"]
@@ -129,12 +130,19 @@ def _guarded(rays: RayPairs, m: RigMotion, max_rel_std: float,
         return m
     why = (one_pair_reason(rays, m.R, m.t, "linear17", max_rel_std, info=m.info)
            if stats is None else one_pair_rule(stats, "linear17", max_rel_std, m.info))
-    if why is None:
+    scale = replace(m.scale, observable=False, reason=why) if why is not None else m.scale
+    if why is None and (m.info.get("max_leverage", 0.0) > max(SCREEN_LEVERAGE, 18.0 / len(rays))
+                        or m.info.get("max_influence_stds", 0.0) > SCREEN_STDS):
+        # several outliers may share the pull (the robust refit of the other
+        # direct estimators, screened for its cost; a leverage above 3 p / n,
+        # p = 6 parameters, is Hoaglin & Welsch's (1978) "high")
+        scale, m.info["outlier_move_stds"] = moved_verdict(rays, m.R, m.t, m.scale, "linear17",
+                                                           max_rel_std)
+    if scale.observable:
         return m
     t = np.asarray(m.info.get("t_metric", m.t), float)
-    return make_rig_motion(m.R, t / np.linalg.norm(t), replace(m.scale, observable=False,
-                                                                 reason=why),
-                           m.method, m.residual_rms, m.inliers, m.info)
+    return make_rig_motion(m.R, t / np.linalg.norm(t), scale, m.method, m.residual_rms,
+                           m.inliers, m.info)
 
 
 def _options(rays: RayPairs, refine: bool, max_iterations: Optional[int],
