@@ -25,7 +25,8 @@ estimates (|t| 15-106 % off at stds of 2-8 %); after it, 2 (one problem of
 ``linear17`` at two noise levels: three outliers that mask each other), and
 none since ``linear17`` runs the robust refit where its leverage
 statistics are high. Without outliers no cell has one; the check refuses
-1-3 of 20 correct estimates with 20 correspondences, none from 60 on.
+1-3 of 20 correct estimates with 20 correspondences (1 of 20 of
+``eigensolver``'s with 34), none from 60 on.
 
 ``--robust`` runs the robust estimate instead (:func:`mcgeom.robust.ransac`,
 its default sampler, threshold 3e-3 rad; by default 60 and 200
