@@ -20,6 +20,14 @@
  * scale metric that rests on such a pair. h_k does not depend on how the
  * parameters are scaled or combined, so neither on the rotation's
  * parametrisation nor on the units.
+ *
+ * The result also gives the largest move of the cameras' travel
+ * |t + R c - c| when one pair is deleted (Cook 1977's case deletion,
+ * linearised at the fit) in metres' share of the travel and in stds of it:
+ * a pair of moderate leverage with a large residual moves the fit as much.
+ * With weights (a weighted fit's: the robust search's final refinement,
+ * 0 for the pairs it did not use; mcgeom/robust/_verdict.py) every sum is
+ * weighted.
  */
 #include "refine_internal.h" /* refine_evaluate: J^T J in one vectorised pass */
 #include "sampson.h"
