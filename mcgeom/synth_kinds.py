@@ -17,7 +17,8 @@ import numpy as np
 from . import synth
 from .types import RayPairs
 
-__all__ = ["KIND_SETUPS", "near_rig_axis", "kind_problem", "with_random_bearings"]
+__all__ = ["KIND_SETUPS", "near_rig_axis", "kind_problem", "with_random_bearings",
+           "outlier_problem"]
 
 #: how to produce data of each kind: (rig factory, cross-camera fraction)
 KIND_SETUPS = {
@@ -81,3 +82,17 @@ def with_random_bearings(rays: RayPairs, fraction: float,
     d2[bad] = rng.normal(size=(int(bad.sum()), 3))
     d2[bad] /= np.linalg.norm(d2[bad], axis=1, keepdims=True)
     return RayPairs(rays.origins1, rays.dirs1, rays.origins2, d2, rays.cam1, rays.cam2), bad
+
+
+def outlier_problem(kind: str, seed: int, n: int, angular_noise: float = 1e-3,
+                    fraction: float = 0.02) -> tuple[synth.SyntheticProblem, RayPairs, np.ndarray]:
+    """Problem ``seed`` of the outlier sweeps: :func:`kind_problem` with seed
+    1000 + ``seed`` and ``n`` correspondences, then ``fraction`` of its time-2
+    bearings random (:func:`with_random_bearings`, seed 5000 + ``seed``).
+    Returns the problem (its truth), the rays and the mask of the replaced
+    bearings."""
+    p = kind_problem(kind, 1000 + seed, n=n, angular_noise=angular_noise)
+    if not fraction > 0:
+        return p, p.rays, np.zeros(n, bool)
+    rays, bad = with_random_bearings(p.rays, fraction, np.random.default_rng(5000 + seed))
+    return p, rays, bad

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 import mcgeom
-from mcgeom.synth_kinds import with_random_bearings
+from mcgeom.experiments.direct_outliers import DIRECT, given_options
+from mcgeom.synth_kinds import outlier_problem
 from problems import make, ring_intra_problem
 
 
@@ -79,26 +80,14 @@ def test_upright_wrong_basin_reported_as_a_direction():
 
 
 #: the direct estimators (every correspondence an inlier) with a metric verdict
-_DIRECT = ["five_plus_one", "six_point", "upright_four_point", "eigensolver", "linear17",
-           "known_rotation_translation"]
-_G = np.array([0.3, -0.9, 0.2]) / np.linalg.norm([0.3, -0.9, 0.2])
+_DIRECT = list(DIRECT)
 
 
 def _with_outliers(kind: str, seed: int, n: int, fraction: float = 0.02):
     """A problem of the property suite's ``kind`` (1e-3 rad noise) with
-    ``fraction`` of its time-2 bearings replaced by random directions (as
-    ``mcgeom experiment direct_outliers`` draws them)."""
-    p = make(kind, 1000 + seed, n=n, angular_noise=1e-3)
-    rays, bad = with_random_bearings(p.rays, fraction, np.random.default_rng(5000 + seed))
-    return p, rays, bad
-
-
-def _options(name: str, R: np.ndarray) -> dict:
-    if name == "known_rotation_translation":
-        return {"rotation": R, "rotation_std": 0.0}
-    if name == "upright_four_point":
-        return {"gravity1": _G, "gravity2": R @ _G}
-    return {}
+    ``fraction`` of its time-2 bearings random, as ``mcgeom experiment
+    direct_outliers`` draws it."""
+    return outlier_problem(kind, seed, n, 1e-3, fraction)
 
 
 @pytest.mark.parametrize("name", _DIRECT)
@@ -113,7 +102,7 @@ def test_no_metric_estimate_resting_on_one_outlier(name, kind):
     for s in range(20):
         p, rays, _ = _with_outliers(kind, s, 60)
         try:
-            m = mcgeom.estimate(rays, name, **_options(name, p.R))
+            m = mcgeom.estimate(rays, name, **given_options(name, p.R))
         except (ValueError, mcgeom.DegenerateError):
             continue
         if m.scale.observable:
@@ -132,7 +121,7 @@ def test_one_pair_check_names_the_outlier():
     assert not m.scale.observable and m.info["max_leverage"] > 0.9
     assert f"correspondence {k} fixes a direction" in m.scale.reason
     p, rays, bad = _with_outliers("locally-central", 3, 200)
-    m = mcgeom.estimate(rays, "known_rotation_translation", **_options(
+    m = mcgeom.estimate(rays, "known_rotation_translation", **given_options(
         "known_rotation_translation", p.R))
     assert not m.scale.observable and m.info["max_influence_stds"] > 4
     assert "deleting correspondence" in m.scale.reason
@@ -148,7 +137,7 @@ def test_clean_data_keep_their_metric_verdicts(name):
     0.76, the largest deletion move 2.8 stds)."""
     for s in range(10):
         p = make("axial", 1000 + s, n=60, angular_noise=1e-3)
-        m = mcgeom.estimate(p.rays, name, **_options(name, p.R))
+        m = mcgeom.estimate(p.rays, name, **given_options(name, p.R))
         assert "gross outlier" not in m.scale.reason, (s, m.scale.reason)
 
 

@@ -12,12 +12,11 @@ import pytest
 
 from mcgeom import cv, robust, synth
 from mcgeom.experiments.direct_outliers import wrong_metric
-from mcgeom.synth_kinds import KIND_SETUPS, kind_problem, with_random_bearings
+from mcgeom.synth_kinds import KIND_SETUPS, outlier_problem
 
 
 def _case(kind: str, n: int, fraction: float, s: int):
-    p = kind_problem(kind, 1000 + s, n=n, angular_noise=1e-3)
-    rays, bad = with_random_bearings(p.rays, fraction, np.random.default_rng(5000 + s))
+    p, rays, bad = outlier_problem(kind, s, n, 1e-3, fraction)
     return p, rays, bad, robust.ransac(rays, threshold=3e-3, seed=s)
 
 

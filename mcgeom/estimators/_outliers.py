@@ -54,7 +54,7 @@ from ..geometry import centroid_travel, refine_centred
 from ..types import RayPairs, ScaleVerdict
 
 __all__ = ["OUTLIER_MOVE_STDS", "MAX_LEVERAGE", "DELETION_STDS", "SCREEN_LEVERAGE",
-           "SCREEN_STDS", "travel_moved", "one_pair_reason", "one_pair_rule", "guard_verdict",
+           "SCREEN_STDS", "residual_scale", "travel_moved", "one_pair_reason", "one_pair_rule", "guard_verdict",
            "moved_verdict"]
 
 #: stds of the estimate's travel that a robust refit may move it by before the
@@ -90,18 +90,25 @@ _MAD_TO_STD = 1.4826
 _EXACT = 1e-12
 
 
+def residual_scale(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
+    """The robust scale 1.4826 median |r| (radians) of the Sampson residuals of
+    ``(R, t)`` on ``rays``."""
+    r = _core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t)
+    return _MAD_TO_STD * float(np.median(np.abs(r)))
+
+
 def travel_moved(rays: RayPairs, R: np.ndarray, t: np.ndarray, rel_std: float,
-                 hold_rotation: bool = False) -> float:
+                 hold_rotation: bool = False, scale: Optional[float] = None) -> float:
     """How many of its relative std ``rel_std`` the cameras' travel of the
     estimate ``(R, t)`` (rig2_from_rig1, metres) moves when the estimate is
     refitted on ``rays`` with a Cauchy loss at the residuals' robust scale
     (``hold_rotation``: R held, as a known rotation is). 0 where the estimate
     fits the majority exactly or ``rel_std`` is not a positive number; NaN
-    where the refit fails."""
+    where the refit fails. ``scale``: that robust scale when the caller has
+    it (:func:`residual_scale`)."""
     if not (math.isfinite(rel_std) and rel_std > 0):
         return 0.0
-    r = _core.gec_residuals(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, R, t)
-    s = _MAD_TO_STD * float(np.median(np.abs(r)))
+    s = residual_scale(rays, R, t) if scale is None else scale
     if not s > _EXACT:
         return 0.0
     try:
@@ -202,23 +209,24 @@ def guard_verdict(rays: RayPairs, R: np.ndarray, t: np.ndarray, verdict: ScaleVe
     observable, or one correspondence carries the fit)."""
     if not verdict.observable:
         return verdict, float("nan")
-    o = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
-    if not _MAD_TO_STD * float(np.median(np.abs(_core.gec_residuals(*o, R, t)))) > _EXACT:
+    scale = residual_scale(rays, R, t)
+    if not scale > _EXACT:
         return verdict, 0.0   # the majority fitted exactly: that motion is theirs
     why = one_pair_reason(rays, R, t, method, max_rel_std, hold_rotation, info)
     if why is not None:
         return replace(verdict, observable=False, reason=why), float("nan")
-    return moved_verdict(rays, R, t, verdict, method, max_rel_std, hold_rotation)
+    return moved_verdict(rays, R, t, verdict, method, max_rel_std, hold_rotation, scale)
 
 
 def moved_verdict(rays: RayPairs, R: np.ndarray, t: np.ndarray, verdict: ScaleVerdict,
-                  method: str, max_rel_std: float = 0.1,
-                  hold_rotation: bool = False) -> tuple[ScaleVerdict, float]:
+                  method: str, max_rel_std: float = 0.1, hold_rotation: bool = False,
+                  scale: Optional[float] = None) -> tuple[ScaleVerdict, float]:
     """``(verdict, moved)``: ``verdict`` (observable) made "not observable"
     when the robust refit of :func:`travel_moved` moves the travel by more
     than :data:`OUTLIER_MOVE_STDS` of its relative std and by more than
-    ``max_rel_std``; ``moved`` in stds."""
-    moved = travel_moved(rays, R, t, verdict.rel_std, hold_rotation)
+    ``max_rel_std``; ``moved`` in stds (``scale``: the residuals' robust
+    scale, when the caller has it)."""
+    moved = travel_moved(rays, R, t, verdict.rel_std, hold_rotation, scale)
     relative = moved * verdict.rel_std
     if not (moved > OUTLIER_MOVE_STDS and relative > max_rel_std):
         return verdict, moved

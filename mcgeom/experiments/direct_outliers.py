@@ -53,10 +53,11 @@ import numpy as np
 
 from .. import registry
 from ..errors import McgeomError
-from ..synth_kinds import KIND_SETUPS, kind_problem, with_random_bearings
+from ..synth_kinds import KIND_SETUPS, outlier_problem
 from .common import Progress, no_progress
 
-__all__ = ["DIRECT", "ROBUST", "Cell", "wrong_metric", "sweep", "add_arguments", "run_cli"]
+__all__ = ["DIRECT", "ROBUST", "VERTICAL", "Cell", "wrong_metric", "given_options", "sweep",
+           "add_arguments", "run_cli"]
 
 #: the direct (least-squares, every correspondence an inlier) estimators
 DIRECT = ("five_plus_one", "six_point", "upright_four_point", "eigensolver", "linear17",
@@ -66,7 +67,7 @@ DIRECT = ("five_plus_one", "six_point", "upright_four_point", "eigensolver", "li
 ROBUST = "robust.ransac"
 
 #: the vertical of the problems in rig frame 1, for upright_four_point
-_VERTICAL = np.array([0.3, -0.9, 0.2]) / np.linalg.norm([0.3, -0.9, 0.2])
+VERTICAL = np.array([0.3, -0.9, 0.2]) / np.linalg.norm([0.3, -0.9, 0.2])
 
 
 @dataclass
@@ -93,15 +94,16 @@ def wrong_metric(t_metric: np.ndarray, t_true: np.ndarray, rel_std: float) -> Op
     return err if not err < max(0.1, 4.0 * rel_std) else None
 
 
-def _options(name: str, R: np.ndarray) -> dict:
-    """The true rotation (exact) or the true vertical, for the estimators
-    that take them."""
+def given_options(name: str, R: np.ndarray) -> dict:
+    """The options of estimator ``name`` that give it the truth it needs: the
+    exact rotation ``R`` (rig2_from_rig1), or the vertical in both rig frames
+    (:data:`VERTICAL` and ``R`` times it)."""
     info = registry.get(name)
     out: dict = {"rotation": R} if info.needs_rotation else {}
     if "rotation_std" in info.options:
         out["rotation_std"] = 0.0
     if "gravity1" in info.options:
-        out.update(gravity1=_VERTICAL, gravity2=R @ _VERTICAL)
+        out.update(gravity1=VERTICAL, gravity2=R @ VERTICAL)
     return out
 
 
@@ -128,15 +130,12 @@ def sweep(estimators: Sequence[str] = DIRECT, sizes: Sequence[int] = (20, 60, 20
     for name, kind, n, noise, frac in progress(jobs, total=len(jobs), desc="cells"):
         cell = Cell(name, kind, n, noise, frac)
         for s in range(problems):
-            p = kind_problem(kind, 1000 + s, n=n, angular_noise=noise)
-            rays = p.rays
-            if frac > 0:
-                rays, _ = with_random_bearings(rays, frac, np.random.default_rng(5000 + s))
+            p, rays, _ = outlier_problem(kind, s, n, noise, frac)
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     m = (robust.ransac(rays, threshold=3e-3, seed=s) if name == ROBUST else
-                         mcgeom.estimate(rays, name, **_options(name, p.R)))
+                         mcgeom.estimate(rays, name, **given_options(name, p.R)))
             except (McgeomError, ValueError):
                 cell.failed += 1
                 continue
@@ -180,7 +179,7 @@ def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     sizes = args.sizes or ([60, 200] if args.robust else [20, 60, 200])
     noise = args.noise or ([1e-3] if args.robust else [1e-4, 1e-3])
     fractions = args.fractions or ([0.1, 0.3, 0.5] if args.robust else [0.0, 0.02])
-    for name in names if not args.robust else []:
+    for name in args.estimators or ():
         if name not in registry.names():
             raise SystemExit(f"unknown estimator {name!r}; registered: "
                              f"{', '.join(registry.names())}")
