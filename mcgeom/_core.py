@@ -598,7 +598,8 @@ def sampson_leverage(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: An
 def leverage_stats(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
                    dirs2: np.ndarray, R: np.ndarray, t: np.ndarray,
                    hold_rotation: bool = False,
-                   weights: Optional[np.ndarray] = None) -> Optional[dict]:
+                   weights: Optional[np.ndarray] = None,
+                   leverages: Optional[np.ndarray] = None) -> Optional[dict]:
     """What one pair does to the least-squares fit ``(R, t)`` (rig2_from_rig1,
     metres) on arrays already checked (float64, C-contiguous (N, 3) rays; an
     estimator's own; ``weights`` float64 (N,) >= 0, a weighted fit's, e.g.
@@ -608,13 +609,15 @@ def leverage_stats(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray
     centroid's travel when one pair is deleted, relative to the travel),
     ``max_influence_stds`` (the same in stds of the travel) and
     ``influence_pair``; ``travel`` (metres) and ``travel_std``. None where
-    ``J^T J`` is singular or the kernel refuses the input."""
+    ``J^T J`` is singular or the kernel refuses the input. ``leverages``: a
+    float64 (N,) C-contiguous array that receives every pair's leverage."""
     out = ffi.new("mcg_leverage_result *")
     st = lib.mcg_sampson_leverage(origins1.shape[0], _p(origins1), _p(dirs1), _p(origins2),
                                   _p(dirs2), ffi.NULL if weights is None else _p(weights),
                                   _p(np.ascontiguousarray(R, dtype=np.float64)),
                                   _p(np.ascontiguousarray(t, dtype=np.float64)),
-                                  int(bool(hold_rotation)), ffi.NULL, out)
+                                  int(bool(hold_rotation)),
+                                  ffi.NULL if leverages is None else _p(leverages), out)
     return _leverage_dict(out) if st == lib.MCG_OK else None
 
 

@@ -26,7 +26,7 @@ def test_an_outlier_of_leverage_one_is_not_metric():
     4.9 % before."""
     p, rays, bad, m = _case("locally-central-and-axial", 60, 0.3, 5)
     assert not m.scale.observable
-    assert "leverage above 0.9" in m.scale.reason
+    assert "leverage above" in m.scale.reason
     assert m.info["max_leverage"] > 0.9
     assert abs(np.linalg.norm(m.t) - 1.0) < 1e-12
     assert np.linalg.norm(m.info["t_metric"]) > 0
@@ -43,13 +43,43 @@ def test_the_refit_without_it_moves_the_travel():
     assert m.info["lever_pairs_move"] > 0.15
 
 
+def test_masking_wrong_matches_are_refitted_without_together():
+    """Stereo head, 200 correspondences, 50 % outliers, problem 12: two
+    wrong matches of leverage 0.82 and 0.79 in a consensus of 107 (below
+    the one-pair rules) left |t| 24 % off at a reported std of 3.0 % before
+    session 36; the refit without both moves the travel by 16 %."""
+    p, rays, bad, m = _case("locally-central-and-axial", 200, 0.5, 12)
+    assert not m.scale.observable
+    assert "leverage above 0.5" in m.scale.reason
+    assert m.info["lever_pairs_move"] > 0.1
+
+
+@pytest.mark.parametrize("kind, n, fraction, s", [("axial", 60, 0.3, 18),
+                                                  ("locally-central", 60, 0.5, 19)])
+def test_a_move_within_the_tolerance_widens_the_std(kind, n, fraction, s):
+    """One wrong match of leverage 0.98 / 0.997 in the consensus: |t| 10.2 /
+    10.4 % off at a reported std of 0.36 / 1.0 % before session 36. The
+    refit without it moves the travel by 8.4 / 9.9 %, more than 3 stds but
+    within max_scale_rel_std: the scale stays metric with the move in its
+    std, which then covers the error."""
+    p, rays, bad, m = _case(kind, n, fraction, s)
+    assert m.scale.observable
+    move = m.info["lever_pairs_move"]
+    assert m.info["scale_rel_std_consensus"] == move
+    assert m.scale.rel_std >= move > 0.05
+    assert "without the correspondences of leverage above 0.5" in m.scale.reason
+    assert wrong_metric(m.t, p.t, m.scale.rel_std) is None
+
+
 @pytest.mark.parametrize("kind", list(KIND_SETUPS))
 def test_clean_consensus_keeps_its_verdicts(kind):
-    """Without outliers no metric estimate is refused by the check."""
+    """Without outliers no metric estimate is refused by the check (the
+    refit without pairs of leverage above 0.5 may widen a std: most-general
+    kind, problem 0, 0.46 -> 1.5 %, still metric)."""
     for s in range(10):
         p, rays, bad, m = _case(kind, 60, 0.0, s)
-        assert "leverage above" not in m.scale.reason, (s, m.scale.reason)
-        assert "deleting correspondence" not in m.scale.reason, (s, m.scale.reason)
+        assert "scale not confirmed" not in m.scale.reason, (s, m.scale.reason)
+        assert "not supported by the bulk" not in m.scale.reason, (s, m.scale.reason)
         if m.scale.observable:
             assert wrong_metric(m.t, p.t, m.scale.rel_std) is None
 

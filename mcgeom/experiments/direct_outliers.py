@@ -35,8 +35,12 @@ take in a wrong match with the leverage to pull the final refinement onto
 itself (:func:`mcgeom.robust._verdict.one_pair_checked`). Measured (session
 35): 13 wrong metric estimates of 427 before that check (|t| 10-73 % off at
 stds of 0.4-5 %, each with a used pair of leverage above 0.8), 4 of 411
-after it (two of them 10.2-10.4 % off; two with three wrong matches in the
-consensus).
+after it (two of them 10.2-10.4 % off at stds of 0.36-1.0 %; two with
+three wrong matches in the consensus). Session 36 (the refit without every
+pair of leverage above 0.5, the std widened by a move within the
+tolerance): 1 of 407 (|t| 16.6 % off at a std of 2.8 %); with
+``--problems 60 --fractions 0 0.1 0.3 0.5``, 12 of 1,687 -> 5 of 1,677,
+and the same 445 metric estimates without outliers.
 
 ``mcgeom experiment direct_outliers [--problems 20] [--estimators NAME ...]
 [--sizes 20 60 200] [--noise 1e-4 1e-3] [--fractions 0 0.02] [--robust]``
