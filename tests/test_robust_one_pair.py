@@ -65,10 +65,20 @@ def test_a_move_within_the_tolerance_widens_the_std(kind, n, fraction, s):
     p, rays, bad, m = _case(kind, n, fraction, s)
     assert m.scale.observable
     move = m.info["lever_pairs_move"]
-    assert m.info["scale_rel_std_consensus"] == move
-    assert m.scale.rel_std >= move > 0.05
+    assert m.info["scale_rel_std_consensus"] == m.scale.rel_std >= move > 0.05
     assert "without the correspondences of leverage above 0.5" in m.scale.reason
     assert wrong_metric(m.t, p.t, m.scale.rel_std) is None
+
+
+def test_the_std_is_that_of_the_consensus_without_its_uncontrolled_pairs():
+    """Stereo head, 200 correspondences, 30 % outliers, problem 48: two wrong
+    matches of leverage 0.93 and 0.90 in a consensus of 141, |t| 13 % off at
+    a reported std of 2.0 % before session 36. Without them the travel
+    hardly moves, but the rest of the consensus fixes |t| to 6.1 % only."""
+    p, rays, bad, m = _case("locally-central-and-axial", 200, 0.3, 48)
+    assert m.scale.rel_std > 0.05
+    if m.scale.observable:
+        assert wrong_metric(m.t, p.t, m.scale.rel_std) is None
 
 
 @pytest.mark.parametrize("kind", list(KIND_SETUPS))
