@@ -49,5 +49,15 @@ def test_robust_rows():
         assert c.metric + c.not_metric + c.failed == 3
     ap = argparse.ArgumentParser()
     ex.add_arguments(ap)
-    with pytest.raises(SystemExit, match="no --estimators"):
-        ex.run_cli(ap.parse_args(["--robust", "--estimators", "linear17"]))
+    with pytest.raises(SystemExit, match="not a sampler of the robust estimate"):
+        ex.run_cli(ap.parse_args(["--robust", "--estimators", "known_rotation_translation"]))
+
+
+def test_robust_rows_of_other_samplers():
+    """--robust --estimators names the robust estimate's samplers; the
+    upright one is given the true vertical."""
+    name = ex.ROBUST + ":upright_four_point"
+    cells = ex.sweep([name], sizes=[60], noises=[1e-3], fractions=[0.3], problems=2)
+    assert len(cells) == 4 and all(c.estimator == name for c in cells)
+    assert sum(c.failed for c in cells) == 0
+    assert sum(c.metric for c in cells) > 0 and sum(c.wrong for c in cells) == 0

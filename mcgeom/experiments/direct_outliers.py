@@ -29,7 +29,8 @@ statistics are high. Without outliers no cell has one; the check refuses
 ``eigensolver``'s with 34), none from 60 on.
 
 ``--robust`` runs the robust estimate instead (:func:`mcgeom.robust.ransac`,
-its default sampler, threshold 3e-3 rad; by default 60 and 200
+its default sampler or those named by ``--estimators``, the upright one
+given the true vertical, threshold 3e-3 rad; by default 60 and 200
 correspondences, 1e-3 rad, 10 / 30 / 50 % outliers), whose consensus can
 take in a wrong match with the leverage to pull the final refinement onto
 itself (:func:`mcgeom.robust._verdict.one_pair_checked`). Measured (session
@@ -117,16 +118,32 @@ def sweep(estimators: Sequence[str] = DIRECT, sizes: Sequence[int] = (20, 60, 20
           problems: int = 20, progress: Progress = no_progress) -> list[Cell]:
     """The cells of the module docstring (each size raised to twice the
     estimator's minimal sample; :data:`ROBUST` among ``estimators``: the
-    robust estimate, on every kind)."""
+    robust estimate, on every kind; ``ROBUST + ":" + method``: the robust
+    estimate with that sampler, e.g. ``"robust.ransac:six_point"``, the
+    upright one given the true vertical)."""
     import mcgeom
     from mcgeom import robust
 
+    def robust_method(name: str) -> Optional[str]:
+        # "robust.ransac" (its default sampler) or "robust.ransac:METHOD"
+        if name == ROBUST:
+            return "five_plus_one"
+        return name[len(ROBUST) + 1:] if name.startswith(ROBUST + ":") else None
+
     def kinds(name: str) -> list:
-        own = list(KIND_SETUPS) if name == ROBUST else registry.get(name).camera_kinds
+        own = list(KIND_SETUPS) if robust_method(name) else registry.get(name).camera_kinds
         return [k for k in own if k in KIND_SETUPS]
 
     def smallest(name: str) -> int:
-        return 12 if name == ROBUST else 2 * registry.get(name).min_sample
+        return 12 if robust_method(name) else 2 * registry.get(name).min_sample
+
+    def run(name: str, rays, p, s: int):
+        method = robust_method(name)
+        if method is None:
+            return mcgeom.estimate(rays, name, **given_options(name, p.R))
+        vertical = given_options(method, p.R) if method == "upright_four_point" else {}
+        return robust.ransac(rays, method, threshold=3e-3, seed=s,
+                             solver_options=vertical or None)
 
     jobs = [(name, kind, max(int(n), smallest(name)), noise, frac)
             for name in estimators for kind in kinds(name)
@@ -139,8 +156,7 @@ def sweep(estimators: Sequence[str] = DIRECT, sizes: Sequence[int] = (20, 60, 20
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    m = (robust.ransac(rays, threshold=3e-3, seed=s) if name == ROBUST else
-                         mcgeom.estimate(rays, name, **given_options(name, p.R)))
+                    m = run(name, rays, p, s)
             except (McgeomError, ValueError):
                 cell.failed += 1
                 continue
@@ -160,7 +176,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--problems", type=int, default=20,
                     help="problems per cell (default: 20)")
     ap.add_argument("--estimators", nargs="+", default=None, metavar="NAME",
-                    help="registered estimators (default: the direct ones)")
+                    help="registered estimators (default: the direct ones); with --robust "
+                         "the samplers of the robust estimate (default: five_plus_one)")
     ap.add_argument("--sizes", nargs="+", type=int, default=None, metavar="N",
                     help="correspondences per problem, each at least 2x the minimal sample "
                          "(default: 20 60 200; with --robust 60 200)")
@@ -178,13 +195,20 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     if args.problems < 1:
         raise SystemExit("--problems must be at least 1")
-    if args.robust and args.estimators:
-        raise SystemExit("--robust runs mcgeom.robust.ransac: no --estimators with it")
-    names = [ROBUST] if args.robust else (args.estimators or list(DIRECT))
+    if args.robust:
+        from mcgeom.robust import C_SAMPLERS
+        for name in args.estimators or ():
+            if name not in C_SAMPLERS:
+                raise SystemExit(f"--robust: {name!r} is not a sampler of the robust "
+                                 f"estimate; samplers: {', '.join(sorted(C_SAMPLERS))}")
+        names = [ROBUST if e == "five_plus_one" else f"{ROBUST}:{e}"
+                 for e in (args.estimators or ["five_plus_one"])]
+    else:
+        names = args.estimators or list(DIRECT)
     sizes = args.sizes or ([60, 200] if args.robust else [20, 60, 200])
     noise = args.noise or ([1e-3] if args.robust else [1e-4, 1e-3])
     fractions = args.fractions or ([0.1, 0.3, 0.5] if args.robust else [0.0, 0.02])
-    for name in args.estimators or ():
+    for name in () if args.robust else args.estimators or ():
         if name not in registry.names():
             raise SystemExit(f"unknown estimator {name!r}; registered: "
                              f"{', '.join(registry.names())}")
