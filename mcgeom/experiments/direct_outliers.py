@@ -40,7 +40,7 @@ after it (two of them 10.2-10.4 % off at stds of 0.36-1.0 %; two with
 three wrong matches in the consensus). Session 36 (the refit without every
 pair of leverage above 0.5; the reported std at least the refit's, plus
 its move where that exceeds 3 stds): none of 404; with ``--problems 60
---fractions 0 0.1 0.3 0.5``, 12 of 1,687 -> none of 1,670, and the same
+--fractions 0 0.1 0.3 0.5``, 12 of 1,687 -> none of 1,671, and the same
 445 metric estimates without outliers (with 60 correspondences 9-21 of
 60 of them report a std 1.35-1.5x wider, with 200 none).
 
