@@ -361,13 +361,16 @@ def one_pair_checked(m: RigMotion, rays: RayPairs, weights: Optional[np.ndarray]
     if not m.scale.observable or weights is None:
         return m
     a = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
-    lev = np.empty(len(rays))
-    st = _core.leverage_stats(*a, m.R, m.t, weights=weights, leverages=lev)
+    st = _core.leverage_stats(*a, m.R, m.t, weights=weights)
     why = one_pair_rule(st, f"ransac[{method}]", options.max_scale_rel_std, m.info,
                         consensus=True)
     rel_std = m.scale.rel_std
     if st is not None and st["max_leverage"] > SCREEN_LEVERAGE and \
             (why is None or st["max_leverage"] > MAX_LEVERAGE):
+        # every pair's leverage, only where some is high (the pass again:
+        # no N-sized array on the estimate's common path, issue 19's memory)
+        lev = np.empty(len(rays))
+        st = _core.leverage_stats(*a, m.R, m.t, weights=weights, leverages=lev)
         why, rel_std = _without_lever_pairs(rays, weights, m, st, lev, options, method)
     if why is None:
         if rel_std == m.scale.rel_std:
