@@ -270,8 +270,8 @@ def _without_lever_pairs(rays: RayPairs, weights: np.ndarray, m: RigMotion, st: 
     29: linear 2.3 stds, the refit 20 % = 10 stds)."""
     # (the refits run on the pairs the refinement used, shifted once to their
     # centroid c, the frame of geometry.refine_centred: the travel judged is
-    # that of c, as the refinement's rel_std is; ~0.15 ms of a 1 ms estimate
-    # on 1e3 pairs instead of ~0.45)
+    # that of c, as the refinement's rel_std is: one refit and its leverage
+    # pass ~0.27 ms on 1e3 pairs instead of ~0.44)
     used = np.flatnonzero(weights > 0)
     o1, d1, o2, d2 = (a[used] for a in (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2))
     c = 0.5 * (np.add.reduce(o1) + np.add.reduce(o2)) / len(used)
@@ -330,9 +330,10 @@ def _without_lever_pairs(rays: RayPairs, weights: np.ndarray, m: RigMotion, st: 
     rel_std = max(rel_std, rel)
     if not rel_std <= options.max_scale_rel_std:
         return (f"scale too uncertain: without correspondence(s) {pairs} (leverage above "
-                f"{SCREEN_LEVERAGE:g}) the travelled distance moves by {100 * move:.3g} % and "
-                f"its relative std is {rel:.3g}: with them, {rel_std:.3g} > "
-                f"{options.max_scale_rel_std:g}; {tail}"), rel_std
+                f"{SCREEN_LEVERAGE:g}: errors in them would show little in any residual) the "
+                f"rest of the consensus fixes |t| to a relative std of {rel:.3g} and the "
+                f"travelled distance moves by {100 * move:.3g} %: a relative std of "
+                f"{rel_std:.3g} > {options.max_scale_rel_std:g}; {tail}"), rel_std
     return None, rel_std
 
 
