@@ -42,7 +42,10 @@ pair of leverage above 0.5; the reported std at least the refit's, plus
 its move where that exceeds 3 stds): none of 404; with ``--problems 60
 --fractions 0 0.1 0.3 0.5``, 12 of 1,687 -> none of 1,671, and the same
 445 metric estimates without outliers (with 60 correspondences 9-21 of
-60 of them report a std 1.35-1.5x wider, with 200 none).
+60 of them report a std 1.35-1.5x wider, with 200 none; the errors of the
+214 clean metric estimates with 60 correspondences fall within 1 / 2 / 3
+reported stds in 69.6 / 94.4 / 99.1 % of them, 64.0 / 93.5 / 98.6 %
+before: nearer the Gaussian 68.3 / 95.4 / 99.7).
 
 ``mcgeom experiment direct_outliers [--problems 20] [--estimators NAME ...]
 [--sizes 20 60 200] [--noise 1e-4 1e-3] [--fractions 0 0.02] [--robust]``
