@@ -47,6 +47,7 @@ def test_robust_rows():
     assert len(cells) == 4 and all(c.estimator == ex.ROBUST for c in cells)
     for c in cells:
         assert c.metric + c.not_metric + c.failed == 3
+        assert len(c.z) == c.metric and all(np.isfinite(c.z))
     ap = argparse.ArgumentParser()
     ex.add_arguments(ap)
     with pytest.raises(SystemExit, match="not a sampler of the robust estimate"):
