@@ -47,7 +47,8 @@ def near_rig_axis(R: np.ndarray, rig, min_angle_deg: float = 5.0) -> bool:
 
 def kind_problem(kind: str, seed: int, n: int = 60, angle: tuple = (0.05, 0.5),
                  t_norm: float = 0.5, angular_noise: float = 0.0,
-                 R: Optional[np.ndarray] = None, t: Optional[np.ndarray] = None) -> synth.SyntheticProblem:
+                 R: Optional[np.ndarray] = None, t: Optional[np.ndarray] = None
+                 ) -> synth.SyntheticProblem:
     """A problem of ``kind`` (a key of :data:`KIND_SETUPS`) with ``n``
     correspondences: its rig drawn with ``seed``, a random rotation of
     ``angle`` radians (min, max) away from the critical ones and a t of

@@ -54,8 +54,8 @@ from ..geometry import centroid_travel, refine_centred
 from ..types import RayPairs, ScaleVerdict
 
 __all__ = ["OUTLIER_MOVE_STDS", "MAX_LEVERAGE", "DELETION_STDS", "SCREEN_LEVERAGE",
-           "SCREEN_STDS", "residual_scale", "travel_moved", "one_pair_reason", "one_pair_rule", "guard_verdict",
-           "moved_verdict"]
+           "SCREEN_STDS", "residual_scale", "travel_moved", "one_pair_reason", "one_pair_rule",
+           "guard_verdict", "moved_verdict"]
 
 #: stds of the estimate's travel that a robust refit may move it by before the
 #: least-squares estimate is called unsupported by the bulk of the data
