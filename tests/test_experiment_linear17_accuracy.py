@@ -22,3 +22,21 @@ def test_variants_are_paired_and_the_kernel_beats_the_previous_version():
     text = exp.paired(res, "previous")
     assert case in text and "previous is more accurate" in text
     assert case in exp.table(res)
+
+
+def test_bound_of_every_case_and_the_kernel_near_it():
+    """Every case declares its noise; on the ring the kernel's medians are
+    those of an efficient estimator (the Cramer-Rao bound) within the spread
+    of 12 problems, and the table names each case."""
+    assert set(exp.NOISE) == set(exp.CASES)
+    case = "4 cams x 50, 0.5 px (200)"
+    cases = {case: exp.CASES[case]}
+    res = exp.run(trials=12, seed=0, cases=cases, variants=["kernel"])
+    bnd = exp.bounds(trials=12, seed=0, cases=cases)
+    b_scale, b_rot = bnd[case]
+    assert 0.01 < b_scale < 0.06 and 0.005 < b_rot < 0.05
+    k = res[case]["kernel"]
+    assert 0.6 < np.median(k[:, 1]) / b_scale < 1.6
+    assert 0.6 < np.median(k[:, 0]) / b_rot < 1.6
+    text = exp.bound_table(res, bnd)
+    assert case in text and "Cramer-Rao" in text

@@ -44,7 +44,12 @@ also the fraction of trials it reports scale-observable and the median scale
 error on those), and the paired
 per-trial comparison of the kernel with ``previous`` and with ``opengv``:
 the fraction of trials where the other is more accurate and the median of the
-per-trial differences with a bootstrap 95 % interval.
+per-trial differences with a bootstrap 95 % interval. Last, the Cramer-Rao
+bound of each case on the same problems (:mod:`.motion_bound`: the two-view
+bundle adjustment's information with the points eliminated) as the median
+rotation and scale errors an efficient estimator would have, and the
+kernel's medians over them: no unbiased estimator can be much below 1 there,
+so a target under the bound cannot be met on these problems by any method.
 ``mcgeom experiment linear17_accuracy [--trials 100] [--seed 0]``
 """
 
@@ -61,8 +66,10 @@ from mcgeom.rig import Rig
 
 from .bench.linear17_numpy import exp_so3, skew
 from .common import Progress, add_count_and_seed, no_progress
+from .motion_bound import median_abs_error, motion_bound
 
-__all__ = ["CASES", "VARIANTS", "run", "table", "paired", "add_arguments", "run_cli"]
+__all__ = ["CASES", "NOISE", "VARIANTS", "run", "table", "paired", "bounds", "bound_table",
+           "add_arguments", "run_cli"]
 
 _EPS = np.finfo(float).eps
 _W = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
@@ -77,11 +84,17 @@ def _ch8_motion(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     return R, t
 
 
+#: the cases' noise: angular (radians, the raw-ray cases and the car rig) and
+#: pixel (px, the 4-camera ring)
+ANGULAR_NOISE = float(np.deg2rad(0.05))
+PIXEL_NOISE = 0.5
+
+
 def _raw_case(make_rig: Callable[[np.random.Generator], Rig], n: int):
     def make(rng: np.random.Generator):
         rig = make_rig(rng)
         R, t = _ch8_motion(rng)
-        return synth.make_problem(rig, R, t, n, rng, angular_noise=np.deg2rad(0.05),
+        return synth.make_problem(rig, R, t, n, rng, angular_noise=ANGULAR_NOISE,
                                   require_visible=False)
     return make
 
@@ -92,7 +105,7 @@ def _ring4_case(rng: np.random.Generator):
     while metrics.rotation_error(R, np.eye(3)) < 0.05:
         R = synth.random_rotation(rng, 0.3)
     t = rng.normal(size=3)
-    return synth.make_problem(rig, R, t / np.linalg.norm(t), 200, rng, pixel_noise=0.5)
+    return synth.make_problem(rig, R, t / np.linalg.norm(t), 200, rng, pixel_noise=PIXEL_NOISE)
 
 
 def _car_case(rng: np.random.Generator):
@@ -100,8 +113,7 @@ def _car_case(rng: np.random.Generator):
     dist = rng.uniform(0.5, 2.0)
     Rw = synth.rotation_about([0, 0, 1], yaw)            # rig2 pose in the rig1 frame
     R, t = Rw.T, -Rw.T @ np.array([dist, 0.0, 0.0])
-    return synth.make_problem(synth.vehicle8(), R, t, 320, rng,
-                              angular_noise=np.deg2rad(0.05))
+    return synth.make_problem(synth.vehicle8(), R, t, 320, rng, angular_noise=ANGULAR_NOISE)
 
 
 #: name -> problem factory (rng -> SyntheticProblem)
@@ -111,6 +123,16 @@ CASES: dict[str, Callable] = {
     "2-cam non-overlap (100)": _raw_case(lambda rng: synth.stereo_head(0.5), 100),
     "4 cams x 50, 0.5 px (200)": _ring4_case,
     "8-cam car, forward (320)": _car_case,
+}
+
+#: name -> the noise its factory adds, (pixel px, angular rad): the model of
+#: the Cramer-Rao bound (:func:`bounds`)
+NOISE: dict[str, tuple[float, float]] = {
+    "general 6-cam rig (100)": (0.0, ANGULAR_NOISE),
+    "axial 4-cam rig (100)": (0.0, ANGULAR_NOISE),
+    "2-cam non-overlap (100)": (0.0, ANGULAR_NOISE),
+    "4 cams x 50, 0.5 px (200)": (PIXEL_NOISE, 0.0),
+    "8-cam car, forward (320)": (0.0, ANGULAR_NOISE),
 }
 
 
@@ -316,6 +338,44 @@ def paired(res: dict, against: str, boot: int = 2000, seed: int = 1,
     return "\n".join(lines)
 
 
+def bounds(trials: int = 100, seed: int = 0, cases=None, draws: int = 200,
+           progress: Progress = no_progress) -> dict:
+    """{case: (scale, rotation)}: the Cramer-Rao bound of each case
+    (:func:`mcgeom.experiments.motion_bound.motion_bound` with the case's
+    :data:`NOISE`) on the same problems as :func:`run` with the same
+    ``trials`` and ``seed``, as the median errors an efficient estimator
+    would have over them: the median |scale error|
+    (:func:`~mcgeom.experiments.motion_bound.median_abs_error` of the
+    per-problem stds of |t| / |t_true|) and the median rotation error (deg;
+    ``draws`` errors per problem drawn from its bound, pooled)."""
+    out = {}
+    for name, make in (cases or CASES).items():
+        rng, draw = np.random.default_rng(seed), np.random.default_rng(seed + 1)
+        stds, rot = [], []
+        for _ in progress(range(trials), total=trials, desc=f"bound: {name}"):
+            b = motion_bound(make(rng), *NOISE[name])
+            stds.append(b.scale_rel_std)
+            rot.append(b.rotation_errors_deg(draws, draw))
+        out[name] = (median_abs_error(np.array(stds)), float(np.median(np.concatenate(rot))))
+    return out
+
+
+def bound_table(res: dict, bnd: dict, ref: str = "kernel") -> str:
+    """Variant ``ref``'s median errors next to the bound's (:func:`bounds`):
+    their ratio is 1 for an efficient estimator and cannot be much below 1
+    (by the problems' spread: ~0.1 at 100 trials) for any unbiased one."""
+    lines = [f"Cramer-Rao bound: the median errors of an efficient estimator on the same "
+             f"problems, and {ref}'s over them",
+             f"{'case':<27} {'rot bound [deg]':>15} {ref + ' / bound':>16} "
+             f"{'scale bound':>12} {ref + ' / bound':>16}"]
+    for case, (b_scale, b_rot) in bnd.items():
+        e = res[case][ref]
+        rot, sc = np.median(e[:, 0]), np.median(e[:, 1])
+        lines.append(f"{case:<27} {b_rot:15.4f} {rot / b_rot:16.2f} {b_scale:12.4f} "
+                     f"{sc / b_scale:16.2f}")
+    return "\n".join(lines)
+
+
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """The options of ``mcgeom experiment linear17_accuracy``."""
     add_count_and_seed(ap, "--trials", 100, "problems per case")
@@ -328,4 +388,6 @@ def run_cli(args: argparse.Namespace, progress: Progress = no_progress) -> int:
     for against in ("previous", "opengv"):
         print()
         print(paired(res, against))
+    print()
+    print(bound_table(res, bounds(args.trials, args.seed, progress=progress)))
     return 0
