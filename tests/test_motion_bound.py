@@ -99,3 +99,19 @@ def test_refusals_name_what_is_wrong():
     with pytest.raises(ValueError, match="do not fix the motion"):
         motion_bound(one, pixel_noise=0.5)
     assert math.isfinite(motion_bound(p, pixel_noise=0.5).scale_rel_std)
+
+
+def test_a_subset_of_the_pairs_bounds_less_tightly():
+    rng = np.random.default_rng(4)
+    R, t = synth.random_motion(rng, max_angle=0.3, t_norm=1.0)
+    p = synth.make_problem(synth.ring_rig(4, 0.25, 500.0), R, t, 120, rng, outlier_fraction=0.25)
+    every = motion_bound(p, pixel_noise=0.5)
+    np.testing.assert_array_equal(motion_bound(p, pixel_noise=0.5,
+                                               use=np.ones(len(p), bool)).covariance,
+                                  every.covariance)
+    inl = motion_bound(p, pixel_noise=0.5, use=p.inlier)
+    # fewer pairs, less information: the inliers' bound is the wider one
+    assert inl.scale_rel_std > every.scale_rel_std
+    assert np.all(np.linalg.eigvalsh(inl.covariance - every.covariance) > -1e-12)
+    with pytest.raises(ValueError, match="boolean mask of the 120"):
+        motion_bound(p, pixel_noise=0.5, use=p.inlier[:10])

@@ -34,7 +34,8 @@ measurement functions (the projections are smooth at the truth).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Optional
 
 import numpy as np
 
@@ -126,14 +127,24 @@ class _Measurements:
 
 
 def motion_bound(p: SyntheticProblem, pixel_noise: float = 0.0,
-                 angular_noise: float = 0.0) -> MotionBound:
-    """The Cramer-Rao bound of the motion of ``p`` (all its correspondences
-    taken as inliers) under ``pixel_noise`` (px) or ``angular_noise`` (rad,
-    the model of :func:`mcgeom.synth.make_problem`; exactly one positive).
+                 angular_noise: float = 0.0, use: Optional[np.ndarray] = None) -> MotionBound:
+    """The Cramer-Rao bound of the motion of ``p`` under ``pixel_noise`` (px)
+    or ``angular_noise`` (rad, the model of :func:`mcgeom.synth.make_problem`;
+    exactly one positive), from the correspondences ``use`` selects (a
+    boolean mask; None: all), e.g. ``p.inlier``: the bound of an estimator
+    told which pairs are the outliers, which no robust one can beat.
 
     Raises ValueError when the noise is not given as above, or when the
     points do not fix the motion (a singular reduced information: e.g. a
     single camera, whose |t| no data fix)."""
+    if use is not None:
+        use = np.asarray(use, bool)
+        if use.shape != (len(p),):
+            raise ValueError(f"use must be a boolean mask of the {len(p)} correspondences, "
+                             f"got shape {use.shape}")
+        p = replace(p, points=p.points[use], cam1=p.cam1[use], cam2=p.cam2[use],
+                    pixels1=p.pixels1[use], pixels2=p.pixels2[use], rays=p.rays.take(use),
+                    inlier=p.inlier[use])
     f = _Measurements(p, float(pixel_noise), float(angular_noise))
     X0, w0, t0 = np.asarray(p.points, float), np.zeros(3), np.asarray(p.t, float)
     n = len(X0)
