@@ -313,6 +313,16 @@ def _bench_robust(args: argparse.Namespace) -> int:
                     ("time cold", m.ms / r.ms, r.time_ratio_ci),
                     ("rotation error", m.rot_deg / r.rot_deg, r.rot_ratio_ci),
                     ("scale error", m.scale_err / r.scale_err, r.scale_ratio_ci))))
+    print("Cramer-Rao bound on the same problems (pixel noise, the inliers known): the "
+          "median errors of an efficient estimator, and each method's medians over them "
+          "(below 1: the draw of the problems, a bias, or heavy tails)")
+    for r in rows:
+        b = own[r.case]
+        if r.method == "mcgeom":
+            print(f"  {r.case:<22} bound: rotation {b.bound_rot_deg:.4f} deg, scale "
+                  f"{b.bound_scale_err:.4f}")
+        print(f"  {'':<22} {r.method:<19} rotation {r.rot_deg / b.bound_rot_deg:5.2f}x, "
+              f"scale {r.scale_err / b.bound_scale_err:5.2f}x")
     print("\nscaling: 4-camera ring, 20 % outliers; mcgeom rays in (mcgeom.robust.ransac), "
           "PoseLib (min_iterations=100) the same pixels; medians over the problems of each "
           "size, each drawn and solved with its own seed; 'search alone': mcgeom without "

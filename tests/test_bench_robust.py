@@ -28,8 +28,12 @@ def test_speed_rows_have_cold_and_warm_times():
             assert set(r.stages_ms) == {"rays", "search", "final", "verdict", "outside C"}
             assert all(v > 0 for v in r.stages_ms.values())
             assert 0.5 * r.ms < sum(r.stages_ms.values()) < 1.5 * r.ms
+            # the bound of 12 problems: mcgeom's medians within their spread of it
+            assert 0.5 < r.rot_deg / r.bound_rot_deg < 2.0
+            assert 0.0 < r.bound_scale_err < 1.0
         else:
             assert 0.0 <= r.mcgeom_rot_better <= 1.0 and np.isnan(r.outside_c)
+            assert np.isnan(r.bound_rot_deg) and np.isnan(r.bound_scale_err)
             for lo, hi in (r.time_ratio_ci, r.rot_ratio_ci, r.scale_ratio_ci):
                 assert 0.0 < lo <= hi < np.inf
 
@@ -41,7 +45,7 @@ def test_bench_robust_command_prints_both_ratios(capsys):
     header = next(line for line in out.splitlines() if line.startswith("case"))
     assert "ms cold" in header and "ms warm" in header and header.count("mcgeom/this") == 2
     rows = [line for line in out.splitlines() if "poselib min_it=100" in line
-            and not line.startswith("mcgeom / ")]      # (the intervals' heading)
+            and not line.startswith(("mcgeom / ", " "))]  # (the intervals, the bound)
     assert len(rows) == 3 and all(line.count("x ") >= 2 for line in rows)
     assert "warm: the same problems in blocks" in out
     intervals = [line for line in out.splitlines() if "time cold" in line]
@@ -51,6 +55,9 @@ def test_bench_robust_command_prints_both_ratios(capsys):
     stages = [line for line in out.splitlines() if "search" in line and "verdict" in line
               and line.startswith("  ")]
     assert len(stages) == 3 and all("outside C" in line for line in stages)
+    # the Cramer-Rao bound of each case, and every method's medians over it
+    assert sum(1 for line in out.splitlines() if " bound: rotation " in line) == 3
+    assert sum(1 for line in out.splitlines() if line.startswith(" ") and "x, scale" in line) == 9
 
 
 
