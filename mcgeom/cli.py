@@ -330,7 +330,8 @@ def _bench_robust(args: argparse.Namespace) -> int:
     print(f"{'N':>8} {'problems':>8} {'seconds':>8} {'us/corr':>8} {'min-max us/corr':>15} "
           f"{'peak MB':>8} {'input MB':>8} {'peak/input':>10} {'rot deg':>8} {'inliers':>7} "
           f"{'C ms':>9} {'outside C':>9} {'search ms':>9} {'PoseLib s':>9} {'us/corr':>8} "
-          f"{'rot deg':>8} {'mcgeom/PoseLib':>14}")
+          f"{'rot deg':>8} {'mcgeom/PoseLib':>14} {'facade us/corr':>14} "
+          f"{'facade peak/px in':>17}")
     scaling = bench_scaling(_sizes(args), progress=progress_bar)
     for r in scaling:
         spread = f"{r.us_per_corr_min:.3f}-{r.us_per_corr_max:.3f}"
@@ -339,11 +340,15 @@ def _bench_robust(args: argparse.Namespace) -> int:
               f"{r.rot_deg:8.4f} {r.inlier_ratio:7.3f} {1e3 * r.c_seconds:9.3f} "
               f"{100 * (1 - r.c_seconds / r.seconds):8.0f}% {1e3 * r.search_seconds:9.3f} "
               f"{r.peer_seconds:9.3f} {1e6 * r.peer_seconds / r.n:8.3f} {r.peer_rot_deg:8.4f} "
-              f"{r.seconds / r.peer_seconds:13.3f}x")
+              f"{r.seconds / r.peer_seconds:13.3f}x {1e6 * r.facade_seconds / r.n:14.3f} "
+              f"{r.facade_peak_mb / r.facade_input_mb:17.2f}")
     if len(scaling) > 1:
-        ours, theirs = spread_ratios(scaling)
+        ours, theirs, facade = spread_ratios(scaling)
         print(f"cost per correspondence, largest / smallest median: mcgeom "
-              f"{ours:.2f}x (issue 19's target: within 2x), PoseLib {theirs:.2f}x")
+              f"{ours:.2f}x (issue 19's target: within 2x), PoseLib {theirs:.2f}x; the "
+              f"facade (mcgeom.cv.estimate, pixels and ids in) {facade:.2f}x, its peak "
+              f"memory over ITS input (pixels and ids, half the rays' bytes) in the last "
+              f"column")
         fixed, marginal = fixed_and_marginal(scaling)
         small, big = min(scaling, key=lambda r: r.n), max(scaling, key=lambda r: r.n)
         off = fit_worst_error(scaling, fixed, marginal)

@@ -65,7 +65,7 @@ def test_bench_robust_prints_the_cost_fit_over_sizes(capsys):
     pytest.importorskip("poselib")
     assert cli.main(["bench", "robust", "--problems", "2", "--sizes", "1000,3000"]) == 0
     out = capsys.readouterr().out
-    assert "largest / smallest median" in out
+    assert "largest / smallest median" in out and "the facade (mcgeom.cv.estimate" in out
     fit = next(line for line in out.splitlines() if line.startswith("fit of the medians"))
     assert "us x N, within" in fit and "of the time at N = 1000" in fit
 
@@ -92,6 +92,10 @@ def test_scaling_rows_are_medians_over_several_problems():
             assert r.peer_seconds > 0 and r.peer_rot_deg < 0.5
         else:
             assert np.isnan(r.peer_seconds) and np.isnan(r.peer_rot_deg)
+        # the façade on the same pixels: its time, its peak over its input
+        # (pixels and ids: 48 bytes a correspondence)
+        assert r.facade_seconds > 0 and r.facade_peak_mb > r.facade_input_mb > 0
+        assert r.facade_input_mb == pytest.approx(48 * n / 1e6)
 
 
 def test_ring_problem_pixels_are_its_rays():

@@ -83,8 +83,12 @@ def test_median_abs_error_of_a_gaussian_mixture():
     e = np.random.default_rng(0).normal(size=(200000, 3)) * stds
     assert median_abs_error(stds) == pytest.approx(np.median(np.abs(e)), rel=0.01)
     for bad in ([], [0.0, 1.0], [np.nan], [-1.0]):
-        with pytest.raises(ValueError, match="positive finite"):
+        with pytest.raises(ValueError, match="positive numbers"):
             median_abs_error(np.array(bad))
+    # a problem that fixes nothing: an error above any bound
+    assert median_abs_error(np.array([0.01, np.inf, 0.01])) > median_abs_error(
+        np.full(3, 0.01))
+    assert median_abs_error(np.array([0.01, np.inf])) == np.inf
 
 
 def test_refusals_name_what_is_wrong():

@@ -165,13 +165,19 @@ def case_bound(problems: list, noise: float, seed: int = 0, draws: int = 200
     (:func:`mcgeom.experiments.motion_bound.motion_bound` on its inliers),
     ``draws`` rotation errors drawn from each and pooled, and
     :func:`~mcgeom.experiments.motion_bound.median_abs_error` of the stds of
-    |t| / |t_true|. A method's median below it comes from the draw of the
+    |t| / |t_true| (a problem whose inliers do not fix the motion counts as
+    an infinite error). A method's median below it comes from the draw of the
     problems, a bias, or errors with heavier tails than a Gaussian at the
     bound (the bound is on the variance)."""
     rng = np.random.default_rng(seed)
     stds, rot = [], []
     for p in problems:
-        b = motion_bound(p, pixel_noise=noise, use=p.inlier)
+        try:
+            b = motion_bound(p, pixel_noise=noise, use=p.inlier)
+        except ValueError:      # inliers that do not fix the motion: no bound
+            stds.append(float("inf"))
+            rot.append(np.full(draws, np.inf))
+            continue
         stds.append(b.scale_rel_std)
         rot.append(b.rotation_errors_deg(draws, rng))
     return float(np.median(np.concatenate(rot))), median_abs_error(np.array(stds))

@@ -20,7 +20,12 @@ microseconds per correspondence, the peak memory allocated during the call
 with numpy) against the size of the input arrays, the share of the time
 inside the C entry point (``info["c_seconds"]``), the same search without
 local optimisation and final refinement (what the samples alone cost: the
-floor of the fixed part), and PoseLib's time and rotation error. Then the fit
+floor of the fixed part), PoseLib's time and rotation error, and the façade
+on the same pixels (:func:`mcgeom.cv.estimate`: pixels and camera ids in, the
+rays made in C): its time and its peak memory against ITS input, the pixels
+and ids (48 bytes a correspondence, half the rays' 96: the rays alone are 2x
+that input, so a peak within 2x of it is out of reach of any design that
+holds the rays). Then the fit
 of mcgeom's medians to a fixed cost per estimate plus a cost per
 correspondence (:func:`fixed_and_marginal`).
 """
@@ -35,6 +40,7 @@ from typing import Sequence
 import numpy as np
 
 from mcgeom import metrics, robust
+from mcgeom.cv import estimate
 from mcgeom.pixel_noise import pixels_per_radian
 from mcgeom.rig import Rig
 from mcgeom.types import RayPairs
@@ -67,6 +73,12 @@ class ScaleRow:
     # PoseLib (TUNED_PEER) on the same pixels: median seconds, rotation error
     peer_seconds: float = float("nan")
     peer_rot_deg: float = float("nan")
+    # the façade on the same pixels (mcgeom.cv.estimate: pixels and camera
+    # ids in, their rays made in C): median seconds, and problem 0's peak
+    # memory against its input (the pixels and ids, MB)
+    facade_seconds: float = float("nan")
+    facade_peak_mb: float = float("nan")
+    facade_input_mb: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -142,13 +154,14 @@ def fit_worst_error(rows: Sequence[ScaleRow], fixed: float, marginal: float) -> 
     return max(abs(fixed + marginal * r.n - r.seconds) / r.seconds for r in rows)
 
 
-def spread_ratios(rows: Sequence[ScaleRow]) -> tuple[float, float]:
+def spread_ratios(rows: Sequence[ScaleRow]) -> tuple[float, float, float]:
     """Largest / smallest median cost per correspondence over the rows:
-    ``(mcgeom's, PoseLib's)`` (issue 19's target: mcgeom's within 2; NaN for
-    PoseLib when it did not run)."""
+    ``(mcgeom's, PoseLib's, the façade's)`` (issue 19's target: mcgeom's
+    within 2; NaN for PoseLib when it did not run)."""
     per = [r.us_per_corr for r in rows]
     peer = [r.peer_seconds / r.n for r in rows]
-    return max(per) / min(per), max(peer) / min(peer)
+    fac = [r.facade_seconds / r.n for r in rows]
+    return max(per) / min(per), max(peer) / min(peer), max(fac) / min(fac)
 
 
 def allowed_at_smallest(rows: Sequence[ScaleRow]) -> float:
@@ -183,7 +196,8 @@ def bench_scaling(sizes=(1000, 10000, 100000, 1000000), seed: int = 0, peer: boo
     setup = poselib_setup(ring4(), "mcgeom bench robust") if peer else None
     for n in progress(list(sizes), total=len(sizes), desc="scaling"):
         times, c_times, search, peer_times, rot, peer_rot, inl = [], [], [], [], [], [], []
-        peak = inp = 0.0
+        facade = []
+        peak = inp = f_peak = f_inp = 0.0
         for k in range(scaling_problems(int(n))):
             p = ring_problem(int(n), np.random.default_rng(seed + k))
             focal = pixels_per_radian(p.rig, p.rays)
@@ -191,7 +205,16 @@ def bench_scaling(sizes=(1000, 10000, 100000, 1000000), seed: int = 0, peer: boo
             def run(s: int, **kw) -> object:
                 return robust.ransac(p.rays, "five_plus_one", threshold=1.0, focal=focal,
                                      seed=s, **kw)
+
+            def run_facade(s: int) -> object:
+                return estimate(p.pixels1, p.pixels2, p.cam, p.cam, p.rig, threshold=1.0, seed=s)
             if k == 0:
+                f_inp = (p.pixels1.nbytes + p.pixels2.nbytes + 2 * p.cam.nbytes) / 1e6
+                run_facade(seed)  # warm
+                tracemalloc.start()
+                run_facade(seed)
+                f_peak = tracemalloc.get_traced_memory()[1]
+                tracemalloc.stop()
                 r = p.rays
                 inp = (r.origins1.nbytes + r.dirs1.nbytes + r.origins2.nbytes + r.dirs2.nbytes
                        + focal.nbytes + r.cam1.nbytes + r.cam2.nbytes) / 1e6
@@ -208,6 +231,7 @@ def bench_scaling(sizes=(1000, 10000, 100000, 1000000), seed: int = 0, peer: boo
             inl.append(float(m.info["inlier_ratio"]))
             search.append(_timed(lambda: run(seed + k, refine=False,
                                              local_optimization=False))[0])
+            facade.append(_timed(lambda: run_facade(seed + k))[0])
             if setup is not None:
                 dt, (Rp, _) = _timed(lambda: poselib_estimate_pixels(
                     setup, p.pixels1, p.pixels2, p.cam, p.cam, POSELIB_SETTINGS[TUNED_PEER]))
@@ -219,5 +243,6 @@ def bench_scaling(sizes=(1000, 10000, 100000, 1000000), seed: int = 0, peer: boo
                              1e6 * min(times) / n, 1e6 * max(times) / n,
                              float(np.median(search)),
                              float(np.median(peer_times)) if peer_times else float("nan"),
-                             float(np.median(peer_rot)) if peer_rot else float("nan")))
+                             float(np.median(peer_rot)) if peer_rot else float("nan"),
+                             float(np.median(facade)), f_peak / 1e6, f_inp))
     return rows
