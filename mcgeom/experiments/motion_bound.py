@@ -8,8 +8,9 @@ figure is reachable on ours at all).
 
 The model is the full two-view bundle adjustment of the problem's own
 geometry: the unknowns are the motion rig2_from_rig1 -- a rotation
-increment w (radians, R = exp([w]x) R_true, rig-1 axes on the right) and t
-(metres, rig-2 frame) -- and every scene point X_k (metres, rig-1 frame); the
+increment w (radians, rig-2 axes: R = exp([w]x) R_true, so |w| is the
+rotation error of :func:`mcgeom.metrics.rotation_error`) and t (metres,
+rig-2 frame) -- and every scene point X_k (metres, rig-1 frame); the
 measurements are both observations of each point:
 
 - pixel noise (``pixel_noise`` px, i.i.d. Gaussian on each pixel
