@@ -140,7 +140,9 @@ def eigensolver(rays: RayPairs, *, rotation_start: Any = None, refine: bool = Fa
     (``info["trivial_avoided"]``). Of the runs' results the one of least
     Sampson angular cost is kept; ``refine`` then refines all six degrees of
     freedom on that error. The verdict rests on the covariance of the
-    Sampson cost at the result. ``info``: ``lambda_min`` (the algebraic cost
+    Sampson cost at the result; without ``refine`` the relative std of |t|
+    also counts the result's distance from the Sampson optimum
+    (``info["move_to_optimum"]``), whose covariance that is. ``info``: ``lambda_min`` (the algebraic cost
     left) and ``iterations`` of the run of least algebraic cost, ``starts``.
     Raises ValueError for bad input, DegenerateError when no start is found.
     """
