@@ -352,6 +352,11 @@ class Linear17Options:
         """The relative std of |t| above which the scale is not metric."""
         return float(self._c.max_scale_rel_std)
 
+    @property
+    def refine(self) -> bool:
+        """Whether the linear solution is refined to the Sampson optimum."""
+        return bool(self._c.refine)
+
 
 _DEFAULT_L17 = Linear17Options()
 _L17_DOUBLES = {name: ffi.offsetof("mcg_linear17_result", name) // 8

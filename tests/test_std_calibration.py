@@ -3,8 +3,12 @@ over the property suite's four rig kinds (clean rays, 1e-3 rad of angular
 noise, 100 correspondences), the metric estimates' errors |t| / |t_true| - 1
 divided by their reported std have an rms near 1 and none is extreme. A std
 that is too small lets a scale through as metric that the data do not
-support; the eigensolver's without ``refine`` was one (rms 1.36: the std of
-the Sampson optimum, reported for its own algebraic estimate)."""
+support. Three were, each reporting for an unrefined estimate a std that
+belongs to another estimate (session 37): the eigensolver by default (rms
+1.36: the Sampson optimum's std for its algebraic optimum), linear17 with
+``refine=False`` (1.50: the algebraic cost's std) and five_plus_one with
+``refine=False`` (2.98, errors up to 11.9 stds: the spread of its scale
+samples)."""
 
 from __future__ import annotations
 
@@ -22,7 +26,7 @@ from mcgeom.synth_kinds import KIND_SETUPS, outlier_problem
 _PROBLEMS = {"bnb_lp": 15}
 
 
-def _z_scores(name: str) -> np.ndarray:
+def _z_scores(name: str, options: dict) -> np.ndarray:
     z = []
     for kind in KIND_SETUPS:
         if kind not in registry.get(name).camera_kinds:
@@ -31,16 +35,24 @@ def _z_scores(name: str) -> np.ndarray:
             p, rays, _ = outlier_problem(kind, s, 100, 1e-3, 0.0)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                m = mcgeom.estimate(rays, name, **given_options(name, p.R))
+                m = mcgeom.estimate(rays, name, **given_options(name, p.R), **options)
             if m.scale.observable:
                 t_m = m.info.get("t_metric", m.t)
                 z.append((np.linalg.norm(t_m) / np.linalg.norm(p.t) - 1.0) / m.scale.rel_std)
     return np.array(z)
 
 
-@pytest.mark.parametrize("name", registry.names())
-def test_reported_std_matches_the_errors(name):
-    z = _z_scores(name)
+#: every estimator at its defaults, and the options that change which
+#: estimate the std is reported for
+_CASES = [(name, {}) for name in registry.names()] + [
+    ("linear17", {"refine": False}), ("five_plus_one", {"refine": False}),
+    ("eigensolver", {"refine": True})]
+
+
+@pytest.mark.parametrize("name, options", _CASES,
+                         ids=[n + "".join(f"-{k}={v}" for k, v in o.items()) for n, o in _CASES])
+def test_reported_std_matches_the_errors(name, options):
+    z = _z_scores(name, options)
     assert len(z) >= 40, f"{name}: only {len(z)} metric estimates"
     rms = float(np.sqrt(np.mean(z ** 2)))
     # (the rms of n unit-variance draws moves by ~1/sqrt(2n): ~7 % at 100;

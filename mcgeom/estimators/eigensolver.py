@@ -32,7 +32,7 @@ from ..types import RayPairs, RigMotion
 from ..validation import check_rotation
 from ._finish import refine_and_report
 from ._start import best_start
-from .linear17 import linear17
+from .linear17 import linear17_start
 
 __all__ = ["eigensolver", "minimal_solutions"]
 
@@ -41,7 +41,7 @@ def _start(rays: RayPairs, rotation_start: Any) -> np.ndarray:
     """The start rotation: the given one, else linear17's."""
     if rotation_start is not None:
         return check_rotation("rotation_start", rotation_start)
-    return linear17(rays, refine=False).R
+    return linear17_start(rays).R
 
 
 def _default_starts(rays: RayPairs) -> list[np.ndarray]:
@@ -61,7 +61,7 @@ def _default_starts(rays: RayPairs) -> list[np.ndarray]:
     """
     R_lin, failure = None, None
     try:
-        R_lin = linear17(rays, refine=False).R
+        R_lin = linear17_start(rays).R
     except (DegenerateError, ValueError) as e:
         failure = e
     try:

@@ -38,6 +38,7 @@ from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict
 from ..validation import integral_camera_ids
 from ._common import camera_ids, in_mirrored_minimum, intra_counts, travel_direction
+from ._finish import unrefined_scale_std
 from ._outliers import guard_verdict
 from ._static import with_static_check
 from .essential import USAC_EXPLICIT, bearings_planar, essential_motions
@@ -328,6 +329,13 @@ def _five_plus_one(rays: RayPairs, five_camera: Optional[int], refine: bool,
                 k = 1.0 + 3.0 * max_scale_rel_std
                 info["scale_profile"] = scale_profile(rays, R, t, out["final_cost"],
                                                       out["sigma2"], (1.0 / k, k))
+    if out is None and len(rays) > 6 and not fixed:
+        # unrefined: the spread of the scale samples misses the 5-point
+        # motion's own error (rms of error / that std 2.98 over the property
+        # suite's kinds); the Sampson cost's std and the distance to its
+        # optimum, whichever is larger (_finish.unrefined_scale_std)
+        geo, info["move_to_optimum"] = unrefined_scale_std(rays, R, t)
+        rel = max(rel, geo)
     sol["critical_angles"] = critical_angles(R, t, camera_ids(rays)[2], sol["five_camera"])
     info["critical_angles"] = sol["critical_angles"]
     # a profile that does not exclude |t| x/ (1 + 3 max_scale_rel_std) makes

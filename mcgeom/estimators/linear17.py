@@ -27,11 +27,12 @@ from .. import _core
 from ..errors import DegenerateError
 from ..registry import register
 from ..types import RayPairs, RigMotion, ScaleVerdict, make_rig_motion, make_scale_verdict
+from ._finish import unrefined_scale_std
 from ._outliers import (SCREEN_LEVERAGE, SCREEN_STDS, moved_verdict, one_pair_reason,
                         one_pair_rule)
 from ._static import KERNEL_OPTIONS, intra_groups, with_static_check
 
-__all__ = ["linear17", "linear17_no_static_check"]
+__all__ = ["linear17", "linear17_start", "linear17_no_static_check"]
 
 _NEEDED = {"most-general": 17, "locally-central": 16, "axial": 16,
            "locally-central-and-axial": 14, "central": 8}
@@ -100,9 +101,25 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     degenerate configurations, or fewer than 17 distinct correspondences
     among 17 or more).
     """
+    options = _options(rays, refine, max_iterations, tolerance, max_scale_rel_std, options)
+    m = _linear17(rays, options)
+    limit = _DEFAULT_LIMIT if options is None else options.max_scale_rel_std
+    return m if options is None or options.refine else _unrefined(rays, m, limit)
+
+
+def linear17_start(rays: RayPairs) -> RigMotion:
+    """``linear17(rays, refine=False)``'s motion for an estimator that starts
+    from it (six_point, eigensolver): the linear solution with the kernel's
+    verdict, without the unrefined estimate's own std (:func:`_unrefined`),
+    which a start does not use. Same checks and errors as :func:`linear17`."""
+    return _linear17(rays, _options(rays, False, None, None, None, None))
+
+
+def _linear17(rays: RayPairs, options: Optional[_core.Linear17Options]) -> RigMotion:
+    """:func:`linear17` with its kernel options made and checked, up to the
+    unrefined estimate's std."""
     # E = 0 has no null space of the right dimension: a static rig raises
     # DegenerateError in the kernel (thesis ch. 8.3's kinds all assume t != 0)
-    options = _options(rays, refine, max_iterations, tolerance, max_scale_rel_std, options)
     # the estimate and the shared static-rig test of it in one marshalling of
     # the rays (_core.linear17_static_raw; issue 22). Everything but a moving
     # rig's answer (a kernel failure, a static rig) goes the shared way, whose
@@ -115,6 +132,32 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
         return _guarded(rays, _motion(f, r), limit, lev)
     return _guarded(rays, with_static_check(rays, "linear17", lambda: linear17_no_static_check(
         rays, options=options)), limit)
+
+
+def _unrefined(rays: RayPairs, m: RigMotion, max_rel_std: float) -> RigMotion:
+    """The verdict of an estimate that ``refine=False`` left at the linear
+    solution (thesis Algorithm 2 without ch. 8.4.3): the kernel's std is the
+    algebraic cost's, while the solution is not that of an efficient
+    estimator (rms of error / that std 1.50 over the property suite's four
+    rig kinds, errors up to 4.2 stds). The std is at least the Sampson cost's
+    at the estimate with the estimate's distance from its optimum in
+    quadrature (:func:`._finish.unrefined_scale_std`: rms 1.02); above
+    ``max_rel_std`` the scale is not reported."""
+    if not m.scale.observable:
+        return m
+    t = np.asarray(m.info.get("t_metric", m.t), float)
+    geo, move = unrefined_scale_std(rays, m.R, t)
+    m.info["move_to_optimum"] = move
+    rel = max(float(m.scale.rel_std), geo)
+    if rel <= max_rel_std:
+        return make_rig_motion(m.R, m.t, replace(m.scale, rel_std=rel), m.method,
+                               m.residual_rms, m.inliers, m.info)
+    why = (f"scale too uncertain: relative std {rel:.3g} > {max_rel_std:.3g} for the "
+           f"unrefined linear estimate, which lies {move:.2g} (relative) from the Sampson "
+           f"optimum (refine=True reaches it)")
+    return make_rig_motion(m.R, t / np.linalg.norm(t), replace(m.scale, observable=False,
+                                                                reason=why, rel_std=rel),
+                           m.method, m.residual_rms, m.inliers, m.info)
 
 
 def _guarded(rays: RayPairs, m: RigMotion, max_rel_std: float,

@@ -34,7 +34,7 @@ from ..types import RayPairs, RigMotion
 from ._finish import refine_and_report
 from ._static import check_static
 from .five_plus_one import five_plus_one
-from .linear17 import linear17
+from .linear17 import linear17_start
 
 __all__ = ["six_point", "minimal_solutions"]
 
@@ -102,7 +102,7 @@ def _cauchy_cost(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
 def _other_estimate(rays: RayPairs):
     """``(name, (R, t))`` of linear17 (>= 17 correspondences), else of
     five_plus_one (a camera with 5), unrefined; None when neither applies."""
-    for name, fn, need in (("linear17", lambda: linear17(rays, refine=False), 17),
+    for name, fn, need in (("linear17", lambda: linear17_start(rays), 17),
                            ("five_plus_one", lambda: five_plus_one(rays), 6)):
         if len(rays) < need:
             continue
