@@ -102,7 +102,8 @@ def refine_and_report(rays: RayPairs, starts: list, method: str,
     verdict). With ``iterate=False`` no start is moved: the least Sampson cost
     among them is kept and the verdict rests on the covariance and profile
     there, the relative std widened by the start's distance from the Sampson
-    optimum (``info["move_to_optimum"]``, one step's first-order estimate). ``prior_check(R)``: why the refined rotation contradicts a prior
+    optimum (``info["move_to_optimum"]``, one step's first-order estimate).
+    ``prior_check(R)``: why the refined rotation contradicts a prior
     the caller gave (``upright_four_point``'s vertical), None when it does
     not; a metric verdict it contradicts is made "not observable" with that
     reason.

@@ -142,8 +142,9 @@ def eigensolver(rays: RayPairs, *, rotation_start: Any = None, refine: bool = Fa
     freedom on that error. The verdict rests on the covariance of the
     Sampson cost at the result; without ``refine`` the relative std of |t|
     also counts the result's distance from the Sampson optimum
-    (``info["move_to_optimum"]``), whose covariance that is. ``info``: ``lambda_min`` (the algebraic cost
-    left) and ``iterations`` of the run of least algebraic cost, ``starts``.
+    (``info["move_to_optimum"]``), whose covariance that is. ``info``:
+    ``lambda_min`` (the algebraic cost left) and ``iterations`` of the run of
+    least algebraic cost, ``starts``.
     Raises ValueError for bad input, DegenerateError when no start is found.
     """
     if not isinstance(rays, RayPairs):
