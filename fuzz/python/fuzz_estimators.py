@@ -109,6 +109,10 @@ def options_for(fdp, name: str) -> dict:
                 "max_iterations": fdp.ConsumeIntInRange(-1, 60)}
     elif name == "linear17" and fdp.ConsumeBool():
         opts = {"refine": fdp.ConsumeBool(), "max_iterations": fdp.ConsumeIntInRange(-1, 200)}
+    elif name in ("five_plus_one", "eigensolver") and fdp.ConsumeBool():
+        # (unrefined, their std comes from the Sampson cost at the estimate
+        # and one step towards its optimum: _finish.unrefined_scale_std)
+        opts = {"refine": fdp.ConsumeBool()}
     return opts
 
 

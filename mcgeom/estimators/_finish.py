@@ -16,7 +16,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from .. import _core
-from ..errors import DegenerateError
+from ..errors import DegenerateError, McgeomError
 from ..geometry import centroid_travel, refine_centred
 from ..observability import scale_profile, scale_verdict
 from ._static import check_static
@@ -41,7 +41,8 @@ def _move_to_optimum(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
     """How far the cameras' travel (the centroid's translation, whose length
     the verdict judges) lies from the Sampson optimum, relative, to first
     order: one Levenberg-Marquardt step from (R, t). inf where that step
-    cannot be taken (a singular normal matrix: |t| not determined).
+    cannot be taken (a singular normal matrix: |t| not determined; a
+    numerical failure): no metric scale is then claimed.
 
     Why: the covariance at an estimate that is not the optimum is that of
     the optimum, an efficient estimator; an algebraic estimate (the
@@ -52,7 +53,7 @@ def _move_to_optimum(rays: RayPairs, R: np.ndarray, t: np.ndarray) -> float:
     refinement's move)."""
     try:
         out = refine_centred(rays, R, t, loss="none", fix_scale=False, max_iterations=1)
-    except DegenerateError:
+    except (McgeomError, ValueError):   # (no step: nothing says how far the optimum is)
         return float("inf")
     before = centroid_travel(rays, R, t)
     return abs(centroid_travel(rays, out["R"], out["t"]) / before - 1.0) if before > 0.0 \
@@ -75,7 +76,7 @@ def unrefined_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
         try:
             at_estimate = float(refine_centred(rays, R, t, loss="none", fix_scale=False,
                                                max_iterations=0)["scale_rel_std"])
-        except DegenerateError:
+        except (McgeomError, ValueError):
             return float("inf"), float("inf")
     move = _move_to_optimum(rays, R, t)
     return float(np.hypot(at_estimate, move)), move
