@@ -70,8 +70,8 @@ from .bench.linear17_numpy import exp_so3, skew
 from .common import Progress, add_count_and_seed, no_progress
 from .motion_bound import median_abs_error, motion_bound
 
-__all__ = ["CASES", "NOISE", "ISSUE_OPENGV", "VARIANTS", "run", "table", "paired", "bounds", "bound_table",
-           "add_arguments", "run_cli"]
+__all__ = ["CASES", "NOISE", "ISSUE_OPENGV", "VARIANTS", "run", "table", "paired", "bounds",
+           "bound_table", "add_arguments", "run_cli"]
 
 _EPS = np.finfo(float).eps
 _W = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
