@@ -117,7 +117,8 @@ def minimal_solutions(sample: RayPairs) -> list[tuple[np.ndarray, np.ndarray]]:
     options={"rotation_start": "start rotation (default: both linear17's and that of the "
                                 "best available estimate, 5+1 or linear17; the lower Sampson "
                                 "cost wins)",
-             "refine": "joint Sampson refinement after it (default False)",
+             "refine": "joint Sampson refinement after it (default False; without it the "
+                       "std of |t| also counts the distance to the Sampson optimum)",
              "max_iterations": "cap on the Levenberg-Marquardt steps (100)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
                                   "unobservable (0.1)"},

@@ -229,7 +229,8 @@ def _refine_all(rays: RayPairs, R: np.ndarray, t: np.ndarray, fix_scale: bool) -
                 "from the other cameras by eq. 7.4, critical angle (thesis ch. 7)",
     options={"five_camera": "camera whose 5-point essential matrix gives R and the direction "
                             "(default: the one with most intra-camera correspondences)",
-             "refine": "joint nonlinear refinement on all correspondences (default True)",
+             "refine": "joint nonlinear refinement on all correspondences (default True; "
+                       "without it the std of |t| also counts the distance to the optimum)",
              "max_scale_rel_std": "relative std of |t| above which the scale is reported "
                                   "unobservable (0.1)",
              "calibration_std": "extrinsic calibration error of the cameras: (position std "

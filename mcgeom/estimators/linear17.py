@@ -73,7 +73,8 @@ def _verdict(observable: bool, gc_case: str, conditioning: float,
     description="linear 17-point generalized essential matrix with constrained SVD, refined "
                 "to the Sampson-error optimum (thesis ch. 8)",
     options={"refine": "run the refinement of ch. 8.4.3 to the Sampson-error optimum "
-                       "(default True)",
+                       "(default True; without it the std of |t| also counts the distance "
+                       "to that optimum)",
              "max_iterations": "cap on refinement iterations (default 100)",
              "tolerance": "relative cost decrease that stops the alternation (1e-10); the "
                           "refinement also stops after a step below 0.3 standard "
