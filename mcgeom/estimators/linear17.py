@@ -103,8 +103,8 @@ def linear17(rays: RayPairs, *, refine: bool = True, max_iterations: Optional[in
     among 17 or more).
     """
     options = _options(rays, refine, max_iterations, tolerance, max_scale_rel_std, options)
-    m = _linear17(rays, options)
     limit = _DEFAULT_LIMIT if options is None else options.max_scale_rel_std
+    m = _linear17(rays, options, limit)
     return m if options is None or options.refine else _unrefined(rays, m, limit)
 
 
@@ -113,12 +113,14 @@ def linear17_start(rays: RayPairs) -> RigMotion:
     from it (six_point, eigensolver): the linear solution with the kernel's
     verdict, without the unrefined estimate's own std (:func:`_unrefined`),
     which a start does not use. Same checks and errors as :func:`linear17`."""
-    return _linear17(rays, _options(rays, False, None, None, None, None))
+    options = _options(rays, False, None, None, None, None)
+    return _linear17(rays, options, options.max_scale_rel_std)
 
 
-def _linear17(rays: RayPairs, options: Optional[_core.Linear17Options]) -> RigMotion:
-    """:func:`linear17` with its kernel options made and checked, up to the
-    unrefined estimate's std."""
+def _linear17(rays: RayPairs, options: Optional[_core.Linear17Options],
+              limit: float) -> RigMotion:
+    """:func:`linear17` with its kernel options made and checked (``limit``
+    their ``max_scale_rel_std``), up to the unrefined estimate's std."""
     # E = 0 has no null space of the right dimension: a static rig raises
     # DegenerateError in the kernel (thesis ch. 8.3's kinds all assume t != 0)
     # the estimate and the shared static-rig test of it in one marshalling of
@@ -128,7 +130,6 @@ def _linear17(rays: RayPairs, options: Optional[_core.Linear17Options]) -> RigMo
     st, f, r, sst, sres, lev = _core.linear17_static_raw(
         rays.origins1, rays.dirs1, rays.origins2, rays.dirs2, intra_groups(rays), options,
         KERNEL_OPTIONS)
-    limit = _DEFAULT_LIMIT if options is None else options.max_scale_rel_std
     if st == _core.STATUS_OK and sst == _core.STATUS_OK and not sres.is_static:
         return _guarded(rays, _motion(f, r), limit, lev)
     return _guarded(rays, with_static_check(rays, "linear17", lambda: linear17_no_static_check(

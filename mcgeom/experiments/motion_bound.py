@@ -42,6 +42,8 @@ import numpy as np
 
 from mcgeom.synth import SyntheticProblem
 
+from .bench.linear17_numpy import exp_so3
+
 __all__ = ["MotionBound", "motion_bound", "median_abs_error"]
 
 _STEP = 1e-6          # relative central-difference step
@@ -64,18 +66,6 @@ class MotionBound:
         an efficient estimator's median rotation error would be."""
         w = rng.multivariate_normal(np.zeros(3), self.covariance[:3, :3], size=draws)
         return np.degrees(np.linalg.norm(w, axis=1))
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def _exp_so3(w: np.ndarray) -> np.ndarray:
-    th = float(np.linalg.norm(w))
-    K = _skew(w)
-    if th < 1e-12:
-        return np.eye(3) + K
-    return np.eye(3) + math.sin(th) / th * K + (1.0 - math.cos(th)) / th ** 2 * K @ K
 
 
 def _tangent_bases(u: np.ndarray) -> np.ndarray:
@@ -117,7 +107,7 @@ class _Measurements:
         return out
 
     def __call__(self, X: np.ndarray, w: np.ndarray, t: np.ndarray) -> np.ndarray:
-        X2 = X @ (_exp_so3(w) @ self.p.R).T + t
+        X2 = X @ (exp_so3(w) @ self.p.R).T + t
         if self.pixel:
             m = np.hstack([self._pixels(self.p.cam1, X), self._pixels(self.p.cam2, X2)])
         else:
