@@ -25,6 +25,12 @@
  * |t + R c - c| when one pair is deleted (Cook 1977's case deletion,
  * linearised at the fit) in metres' share of the travel and in stds of it:
  * a pair of moderate leverage with a large residual moves the fit as much.
+ * The root sum of squares of those moves is the travel's std that the
+ * pairs' own residuals tell (HC3, MacKinnon & White 1985; Long & Ervin
+ * 2000 for small samples), where travel_std assumes one noise level for
+ * all pairs: a wrong match within a robust fit's threshold, whose residual
+ * is uniform over the threshold band rather than noise, at a pair that
+ * fixes much of |t|, moves the estimate by more than travel_std says.
  * With weights (a weighted fit's: the robust search's final refinement,
  * 0 for the pairs it did not use; mcgeom/robust/_verdict.py) every sum is
  * weighted.
@@ -111,7 +117,7 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
                          mcg_leverage_result *out)
 {
     double l[36], il[6], sc[6], g[6], w[6], cen[3] = {0.0, 0.0, 0.0}, rc[3], v[3];
-    double trace = 0.0, travel, ww, sd, best = -1.0, top = -1.0;
+    double trace = 0.0, travel, ww, sd, best = -1.0, top = -1.0, hc_scale = 0.0, hc_ssq = 1.0;
     const int p0 = hold_rotation ? 3 : 0, np = 6 - p0;
     int k, k0, a, b, c;
     accum acc;
@@ -228,6 +234,14 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
                 best = mb[k];
                 res.influence_pair = k0 + k;
             }
+            /* sum of mb^2, scaled by the largest so far (as BLAS dnrm2):
+             * no overflow of the squares short of the result's own */
+            if (mb[k] > hc_scale) {
+                hc_ssq = 1.0 + hc_ssq * (hc_scale / mb[k]) * (hc_scale / mb[k]);
+                hc_scale = mb[k];
+            } else if (mb[k] > 0.0) {
+                hc_ssq += (mb[k] / hc_scale) * (mb[k] / hc_scale);
+            }
         }
         if (lev)
             memcpy(lev + k0, hb, (size_t)nb * sizeof(double));
@@ -237,6 +251,9 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
     res.max_leverage = top;
     res.travel = travel;
     res.travel_std = sd;
+    res.travel_std_hc = hc_scale * sqrt(hc_ssq);
+    if (!(res.travel_std_hc <= DBL_MAX))
+        res.travel_std_hc = HUGE_VAL;
     if (n > 0 && travel > 0.0) {
         res.max_influence = fmin(best / travel, DBL_MAX);
         res.max_influence_stds = sd > 0.0 && sd < HUGE_VAL ? fmin(best / sd, DBL_MAX) : 0.0;

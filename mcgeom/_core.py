@@ -613,7 +613,9 @@ def leverage_stats(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray
     and ``leverage_pair``; ``max_influence`` (the largest change of the
     centroid's travel when one pair is deleted, relative to the travel),
     ``max_influence_stds`` (the same in stds of the travel) and
-    ``influence_pair``; ``travel`` (metres) and ``travel_std``. None where
+    ``influence_pair``; ``travel`` (metres) and ``travel_std``; ``travel_std_hc``
+    (metres: the std the pairs' own residuals tell, the root sum of squares
+    of the deletion moves, HC3). None where
     ``J^T J`` is singular or the kernel refuses the input. ``leverages``: a
     float64 (N,) C-contiguous array that receives every pair's leverage."""
     out = ffi.new("mcg_leverage_result *")
@@ -630,7 +632,8 @@ def _leverage_dict(r: Any) -> dict:
     """The dict of :func:`leverage_stats` from an ``mcg_leverage_result *``."""
     return {"max_leverage": r.max_leverage, "leverage_pair": r.leverage_pair,
             "max_influence": r.max_influence, "max_influence_stds": r.max_influence_stds,
-            "influence_pair": r.influence_pair, "travel": r.travel, "travel_std": r.travel_std}
+            "influence_pair": r.influence_pair, "travel": r.travel, "travel_std": r.travel_std,
+            "travel_std_hc": r.travel_std_hc}
 
 
 def scale_ransac(origins1: Any, dirs1: Any, origins2: Any, dirs2: Any, R: Any, t0: Any,

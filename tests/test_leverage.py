@@ -52,6 +52,48 @@ def test_against_finite_differences(kind, hold):
     assert st["max_leverage"] == lev.max() and lev[st["leverage_pair"]] == lev.max()
 
 
+@pytest.mark.parametrize("weighted", [False, True])
+def test_hc_std_against_numpy(weighted):
+    """travel_std_hc: the root sum of squares of the deletion moves
+    w_k g^T H^-1 J_k^T r_k / (1 - h_k), H = J^T W J, g the gradient of the
+    centroid's travel |t + R c - c| (numpy, the Jacobian by central
+    differences); and travel_std, sigma sqrt(g^T H^-1 g)."""
+    p = make("most-general", 21, n=50, angular_noise=1e-3)
+    r = p.rays
+    a = (r.origins1, r.dirs1, r.origins2, r.dirs2)
+    rng = np.random.default_rng(3)
+    w = rng.uniform(0.5, 2.0, len(r)) if weighted else np.ones(len(r))
+    w[:3] = 0.0 if weighted else 1.0       # (pairs the fit did not use)
+    eps = 1e-6
+    cols = []
+    for j in range(6):
+        d = np.zeros(3)
+        d[j % 3] = eps
+        if j < 3:
+            cols.append((_core.gec_residuals(*a, _rotvec(d) @ p.R, p.t)
+                         - _core.gec_residuals(*a, _rotvec(-d) @ p.R, p.t)) / (2 * eps))
+        else:
+            cols.append((_core.gec_residuals(*a, p.R, p.t + d)
+                         - _core.gec_residuals(*a, p.R, p.t - d)) / (2 * eps))
+    J = np.stack(cols, axis=1)
+    res = _core.gec_residuals(*a, p.R, p.t)
+    used = w > 0
+    c = 0.5 * (r.origins1[used].mean(0) + r.origins2[used].mean(0))
+    tau = p.t + p.R @ c - c
+    u = tau / np.linalg.norm(tau)
+    g = np.concatenate([np.cross(p.R @ c, u), u])
+    H = J.T @ (w[:, None] * J)
+    Hg = np.linalg.solve(H, g)
+    h = w * np.einsum("ij,ij->i", J, np.linalg.solve(H, J.T).T)
+    moves = w * (J @ Hg) * res / (1.0 - h)
+    sd = np.sqrt(np.sum(w * res ** 2) / (used.sum() - 6) * g @ Hg)
+    st = _core.leverage_stats(*a, p.R, p.t, weights=w)
+    assert st["travel_std_hc"] == pytest.approx(np.sqrt(np.sum(moves ** 2)), rel=1e-6)
+    assert st["travel_std"] == pytest.approx(sd, rel=1e-6)
+    assert st["max_influence"] == pytest.approx(np.abs(moves).max() / np.linalg.norm(tau),
+                                                rel=1e-6)
+
+
 def test_gross_outlier_has_the_leverage():
     """A random time-2 bearing pulls the least-squares fit onto itself: at the
     fit its residual is small, its leverage near 1."""

@@ -392,6 +392,14 @@ typedef struct {
     double travel;         /* |t + R c - c|, metres */
     double travel_std;     /* sigma sqrt(g^T H^-1 g), sigma^2 = sum r^2 /
                               (n - parameters); HUGE_VAL without redundancy */
+    double travel_std_hc;  /* the std of the travel that each pair's own
+                              residual tells: sqrt(sum_k move_k^2), move_k
+                              the deletion move above (the
+                              heteroscedasticity-consistent HC3 estimate,
+                              MacKinnon & White 1985: a pair whose residual
+                              is larger than the noise, e.g. a wrong match
+                              within the threshold, counts with its own
+                              variance; metres, HUGE_VAL where it overflows) */
 } mcg_leverage_result;
 
 /* lev[k] = h_k (n values, may be NULL) and the result (may be NULL).

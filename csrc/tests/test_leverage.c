@@ -187,12 +187,13 @@ static int reference(int n, const double R[9], const double t[3], int hold, doub
 
 /* the reference's largest |change of the travel| on deleting one pair,
  * g^T H^-1 J_k^T r_k / (1 - h_k) with g by central differences of
- * travel_of, and the travel's std; after reference() */
+ * travel_of, the travel's std and the root sum of squares of the changes
+ * (travel_std_hc); after reference() */
 static double reference_influence(int n, const double R[9], const double t[3], int hold,
-                                  const double *lev, int *at, double *sd)
+                                  const double *lev, int *at, double *sd, double *hc)
 {
     static double r[N];
-    double g[6], eps = 1e-6, best = -1.0, ssr = 0.0, gg = 0.0;
+    double g[6], eps = 1e-6, best = -1.0, ssr = 0.0, gg = 0.0, sq = 0.0;
     int p0 = hold ? 3 : 0, np = 6 - p0, a, b, k;
     for (a = 0; a < 6; ++a) {
         double Rp[9], Rm[9], tp[3], tm[3];
@@ -207,6 +208,7 @@ static double reference_influence(int n, const double R[9], const double t[3], i
             for (b = 0; b < np; ++b)
                 q += g[p0 + a] * hinv[a][b] * jac[k][p0 + b];
         q = fabs(q * r[k]) / (1.0 - lev[k]);
+        sq += q * q;
         if (q > best) {
             best = q;
             *at = k;
@@ -216,6 +218,7 @@ static double reference_influence(int n, const double R[9], const double t[3], i
         for (b = 0; b < np; ++b)
             gg += g[p0 + a] * hinv[a][b] * g[p0 + b];
     *sd = sqrt(ssr / (n - np) * gg);
+    *hc = sqrt(sq);
     return best;
 }
 
@@ -255,12 +258,14 @@ int main(void)
               fabs(top - big), 0.0);
         {
             int kr = -1;
-            double sd, inf = reference_influence(N, R, t, hold, ref, &kr, &sd);
+            double sd, hc, inf = reference_influence(N, R, t, hold, ref, &kr, &sd, &hc);
             double trv = travel_of(N, R, t);
-            snprintf(what, sizeof what, "%s: largest deletion influence, its pair, the std",
+            snprintf(what, sizeof what,
+                     "%s: largest deletion influence, its pair, the std, the HC3 std",
                      hold ? "R held" : "6 dof");
-            err = fmax(fabs(lr.max_influence - inf / trv) / (inf / trv),
-                       fabs(lr.travel_std - sd) / sd);
+            err = fmax(fmax(fabs(lr.max_influence - inf / trv) / (inf / trv),
+                            fabs(lr.travel_std - sd) / sd),
+                       fabs(lr.travel_std_hc - hc) / hc);
             check(err < 1e-5 && lr.influence_pair == kr && fabs(lr.travel - trv) < 1e-12 &&
                       fabs(lr.max_influence_stds - inf / sd) < 1e-5 * inf / sd,
                   what, err, 1e-5);
@@ -318,8 +323,10 @@ int main(void)
         err = 0.0;
         for (k = 0; k < N; ++k)
             err = fmax(err, fabs(lev_w[k] - lev[k]));
-        check(st == MCG_OK && err < 1e-12 && fabs(l2.travel_std - l1.travel_std) < 1e-12 * l1.travel_std,
-              "weights of 2: the same leverages and std", err, 1e-12);
+        check(st == MCG_OK && err < 1e-12 &&
+                  fabs(l2.travel_std - l1.travel_std) < 1e-12 * l1.travel_std &&
+                  fabs(l2.travel_std_hc - l1.travel_std_hc) < 1e-12 * l1.travel_std_hc,
+              "weights of 2: the same leverages, std and HC3 std", err, 1e-12);
         for (k = 0; k < N; ++k) {
             wt[k] = k == 9 ? 0.0 : 1.0;
             if (k != 9) {
@@ -340,7 +347,8 @@ int main(void)
                 err = fmax(err, fabs(lev_w[k] - lev_d[m++]));
         check(st == MCG_OK && err < 1e-12 && fabs(l1.travel - l2.travel) < 1e-12 &&
                   fabs(l1.travel_std - l2.travel_std) < 1e-12 * l2.travel_std &&
-                  fabs(l1.max_influence - l2.max_influence) < 1e-12,
+                  fabs(l1.max_influence - l2.max_influence) < 1e-12 &&
+                  fabs(l1.travel_std_hc - l2.travel_std_hc) < 1e-12 * l2.travel_std_hc,
               "a zero weight: the pair deleted", err, 1e-12);
         wt[3] = -1.0;
         check_status(mcg_sampson_leverage(N, o1, d1, o2, d2, wt, R, t, 0, lev, NULL), MCG_EINVAL,
@@ -367,6 +375,11 @@ int main(void)
         st = mcg_sampson_leverage(N, o1, d1, o2, d2, NULL, Rf, tf, 0, NULL, &lr);
         check(st == MCG_OK && lr.influence_pair == N - 1 && lr.max_influence_stds > 4.0,
               "the outlier has the largest influence, > 4 stds", lr.max_influence_stds, 4.0);
+        /* its own residual, far beyond the others', tells a larger std
+         * than the common noise level does */
+        check(lr.travel_std_hc > 2.0 * lr.travel_std,
+              "the outlier: the HC3 std > 2 x the std of one noise level",
+              lr.travel_std_hc / lr.travel_std, 2.0);
     }
     /* one camera at the origin (its pairs fix R and the direction of t) and
      * one pair from another centre: that pair alone fixes |t| */

@@ -10,7 +10,8 @@
  * is in [0, 1], they sum to the number of parameters (the trace of the hat
  * matrix), max_leverage is the largest and leverage_pair a pair that has
  * it; the influence is finite and >= 0 with a pair in range, the travel
- * finite and >= 0, its std >= 0; the same call without the per-pair array
+ * finite and >= 0, its std >= 0, the HC3 std >= 0 and at least the largest
+ * deletion move (a root sum of squares of the moves); the same call without the per-pair array
  * gives the same result.
  */
 #include "fuzz_input.h"
@@ -81,6 +82,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(isfinite(lr.travel) && lr.travel >= 0.0 && lr.travel_std >= 0.0 &&
                  !isnan(lr.travel_std),
              "travel %g, std %g", lr.travel, lr.travel_std);
+    FZ_CHECK(lr.travel_std_hc >= 0.0 &&
+                 (lr.travel == 0.0 || lr.travel_std_hc >= lr.max_influence * lr.travel *
+                                                             (1.0 - 1e-9)),
+             "HC3 std %g, largest move %g", lr.travel_std_hc, lr.max_influence * lr.travel);
     st2 = mcg_sampson_leverage(n, o1, d1, o2, d2, use_w ? w : NULL, R, t, hold, NULL, &lr2);
     FZ_CHECK(st2 == MCG_OK && memcmp(&lr, &lr2, sizeof lr) == 0,
              "without lev: status %d, another result", st2);
