@@ -13,7 +13,7 @@ from ..types import RayPairs, RigMotion
 from ._options import RansacOptions
 from ._scoring import (WIDE, MIN_REFIT, Scorer, true_fraction, refine_fit, adaptive_iterations,
                        sample_across_cameras)
-from ._verdict import conclude, unconfirmed_reason, search_confidence
+from ._verdict import conclude, one_pair_checked, unconfirmed_reason, search_confidence
 
 
 def check_solver_options(solver: Callable, method: str, solver_options: dict) -> None:
@@ -139,6 +139,13 @@ def finish(rays: RayPairs, scorer: Scorer, options: RansacOptions, method: str,
         unconfirmed = unconfirmed_reason(sampled["stop"], sampled["iterations"],
                                          sampled["sample_size"], info["confidence"])
     fit = (out, used, scale_used, w_used) if options.refine else None
-    return conclude(rays, R, t, r, inl, fit, scorer.loss_scale, np.linalg.norm(scorer.best[1]),
-                    options, method, info, t_start, calibration_std=calibration_std,
-                    unconfirmed=unconfirmed)
+    m = conclude(rays, R, t, r, inl, fit, scorer.loss_scale, np.linalg.norm(scorer.best[1]),
+                 options, method, info, t_start, calibration_std=calibration_std,
+                 unconfirmed=unconfirmed)
+    if fit is None:
+        return m
+    # the final refinement's weights over all pairs (0: not used), for the
+    # checks of a consensus that the C search's estimates get too
+    weights = np.zeros(len(rays))
+    weights[used] = 1.0 if w_used is None else w_used
+    return one_pair_checked(m, rays, weights, options, method)
