@@ -31,7 +31,7 @@ __all__ = [
     "Linear17Options", "linear17", "linear17_raw", "linear17_static_raw", "linear17_dict",
     "L17_OFFSETS",
     "GC_CASE_NAMES",
-    "gec_residuals", "sampson_leverage", "leverage_stats", "scale_ransac",
+    "gec_residuals", "sampson_leverage", "leverage_stats", "consensus_check", "scale_ransac",
     "sampson_pixel_scale", "refine_motion", "refine_translation",
     "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
@@ -626,6 +626,51 @@ def leverage_stats(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray
                                   int(bool(hold_rotation)),
                                   ffi.NULL if leverages is None else _p(leverages), out)
     return _leverage_dict(out) if st == lib.MCG_OK else None
+
+
+#: mcg_consensus_result.reason -> its name (mcgeom.robust._verdict words them)
+CONSENSUS_REASONS = {lib.MCG_CONSENSUS_METRIC: "metric", lib.MCG_CONSENSUS_ONE_PAIR: "one_pair",
+                     lib.MCG_CONSENSUS_UNDETERMINED: "undetermined",
+                     lib.MCG_CONSENSUS_LEVER_STD: "lever_std",
+                     lib.MCG_CONSENSUS_LEVER_MOVE: "lever_move",
+                     lib.MCG_CONSENSUS_WIDENED_STD: "widened_std",
+                     lib.MCG_CONSENSUS_RESIDUALS_STD: "residuals_std"}
+
+
+def consensus_check(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarray,
+                    dirs2: np.ndarray, weights: np.ndarray, R: np.ndarray, t: np.ndarray,
+                    rel_std: float, cal_rel_std: float, max_rel_std: float) -> dict:
+    """The checks of a robust estimate's consensus (``mcg_consensus_check``,
+    csrc/consensus.c) on arrays already checked (float64, C-contiguous (N, 3)
+    rays; ``weights`` float64 (N,) >= 0, the final refinement's, 0 for the
+    pairs it did not use): its fit ``(R, t)`` (rig2_from_rig1, metres), its
+    relative std of |t| ``rel_std`` with the calibration's part
+    ``cal_rel_std``, ``max_rel_std`` the precision of a metric scale.
+    Returns a dict: ``reason`` (a name of :data:`CONSENSUS_REASONS`),
+    ``rel_std`` (widened), ``stats`` (:func:`leverage_stats`' dict of the
+    fit, None when singular), ``residuals_rel_std``, ``dropped`` (list of
+    pair indices), ``lever_strong``, ``lever_move`` (None unless measured),
+    ``lever_rel_std``, ``rel_std_lever``, ``widened_by_lever``,
+    ``widened_by_residuals``. ValueError where the kernel refuses the input."""
+    n = origins1.shape[0]
+    work = np.empty(max(lib.mcg_consensus_check_work_size(n), 1))
+    out = ffi.new("mcg_consensus_result *")
+    st = lib.mcg_consensus_check(n, _p(origins1), _p(dirs1), _p(origins2), _p(dirs2),
+                                 _p(weights), _p(np.ascontiguousarray(R, dtype=np.float64)),
+                                 _p(np.ascontiguousarray(t, dtype=np.float64)), float(rel_std),
+                                 float(cal_rel_std), float(max_rel_std), out,
+                                 ffi.from_buffer("double[]", work), work.size)
+    if st != lib.MCG_OK:
+        raise ValueError(f"mcg_consensus_check: {_message(st)}")
+    return {"reason": CONSENSUS_REASONS[out.reason], "rel_std": out.rel_std,
+            "stats": _leverage_dict(out.stats) if out.have_stats else None,
+            "residuals_rel_std": out.residuals_rel_std,
+            "dropped": [out.dropped[k] for k in range(out.n_dropped)],
+            "lever_strong": bool(out.lever_strong),
+            "lever_move": out.lever_move if out.have_move else None,
+            "lever_rel_std": out.lever_rel_std, "rel_std_lever": out.rel_std_lever,
+            "widened_by_lever": bool(out.widened_by_lever),
+            "widened_by_residuals": bool(out.widened_by_residuals)}
 
 
 def _leverage_dict(r: Any) -> dict:

@@ -68,7 +68,7 @@ def test_reported_std_matches_the_errors(name, options):
 def test_robust_std_matches_the_errors_with_outliers(method, strategy):
     """The robust estimate's std with 30 % random time-2 bearings: a wrong
     match within the threshold counts with its own residual
-    (mcgeom.robust._verdict.residuals_rel_std). With one noise level for all
+    (csrc/consensus.c, mcg_consensus_check). With one noise level for all
     the pairs used the rms was 1.17 (five_plus_one) and 1.32
     (upright_four_point), errors up to 3.4 stds; the Python search
     (``strategy="minimal"``) had none of the checks of a consensus: 2.75,

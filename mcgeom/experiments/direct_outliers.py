@@ -48,8 +48,8 @@ reported stds in 69.6 / 94.4 / 99.1 % of them, 64.0 / 93.5 / 98.6 %
 before: nearer the Gaussian 68.3 / 95.4 / 99.7; ``--robust --sizes 60
 --fractions 0 --problems 60`` prints them). Session 38 (the std the
 inliers' own residuals tell, HC3, where it exceeds the reported one by
-1.25x: :func:`mcgeom.robust._verdict.residuals_rel_std`): those 213 clean
-estimates 70.4 / 95.8 / 99.5 %; with ``--problems 60 --estimators
+1.25x; csrc/consensus.c): those 213 clean estimates 70.4 / 95.8 / 99.5 %;
+with ``--problems 60 --estimators
 five_plus_one upright_four_point linear17 eigensolver`` at 10 / 30 / 50 %
 outliers 68.5 / 96.0 / 100.0, 70.8 / 95.4 / 99.7 and 73.1 / 96.0 / 99.7 %
 (64.6 / 93.4 / 99.6, 63.9 / 90.0 / 98.4 and 64.7 / 90.9 / 97.8 % before),

@@ -15,9 +15,7 @@ import numpy as np
 # the same (see mcgeom.estimators._common: no estimator imports this package)
 from .. import _core
 from ..estimators._common import in_mirrored_minimum, travel_direction
-from ..errors import DegenerateError
-from ..estimators._outliers import (MAX_LEVERAGE, OUTLIER_MOVE_STDS, SCREEN_LEVERAGE,
-                                     one_pair_rule)
+from ..estimators._outliers import MAX_LEVERAGE, SCREEN_LEVERAGE, one_pair_rule
 from ..observability import (ZERO_FACTOR, combine_rel_std, scale_determined, scale_profile,
                              scale_verdict, scale_verdict_stats, total_scale_std, verdict_text)
 from ..types import RayPairs, RigMotion, ScaleVerdict
@@ -226,175 +224,68 @@ def conclude_c(res: Any, f: np.ndarray, inl: np.ndarray, options: RansacOptions,
                      f"ransac[{method}]", res.inlier_rms, inl, info)
 
 
-#: pairs of high leverage that :func:`one_pair_checked` refits without, at most
-LEVER_ROUNDS = 3
-
-
-def _without_lever_pairs(rays: RayPairs, weights: np.ndarray, m: RigMotion, st: dict,
-                         lev: np.ndarray, options: RansacOptions, method: str
-                         ) -> tuple[Optional[str], float]:
-    """Why the robust estimate ``m`` is not metric once its refinement's pairs
-    of high leverage are left out (None: it is), and the relative std of its
-    travel that counts that test (``m.scale.rel_std`` unless the test moved
-    it). ``st``, ``lev``: :func:`mcgeom._core.leverage_stats` of ``m`` and
-    every pair's leverage.
-
-    The least-squares refit without the pair of highest leverage, while it is
-    above :data:`SCREEN_LEVERAGE` (up to :data:`LEVER_ROUNDS` pairs, each
-    round on the refit; several wrong matches in a consensus can mask each
-    other, each below :data:`MAX_LEVERAGE` or hidden by the others: two of
-    leverage 0.80 and 0.79 in a consensus of 107 left |t| 24 % off at a
-    reported std of 3 %). The scale is not metric where
-
-    * a dropped pair had a leverage above :data:`MAX_LEVERAGE` and without
-      them |t| is more uncertain than ``max_scale_rel_std``, the motion is
-      undetermined, or such a pair remains (the scale rests on them, and an
-      error in them would show in no residual);
-    * the refit moves the travel by more than :data:`OUTLIER_MOVE_STDS` of
-      ``m``'s stds and more than ``max_scale_rel_std``.
-
-    Otherwise the std returned is at least the refit's: an error in the
-    dropped pairs would show little in their residuals (their redundancy
-    numbers 1 - h are below 0.5), so the scale is no more precise than the
-    rest of the consensus fixes it (two wrong matches of leverage 0.93 and
-    0.90 in a consensus of 141: |t| 13 % off at a reported std of 2.0 %, the
-    refit's 6.1 %). A move of more than :data:`OUTLIER_MOVE_STDS` stds
-    within ``max_scale_rel_std`` says that the few pairs and the bulk
-    disagree by more than the noise: the move is added in quadrature (a
-    consensus of 38 with a wrong match of leverage 0.98: |t| 10.2 % off,
-    reported std 0.36 %, the refit 8.4 % away). The scale is not metric
-    where that std exceeds ``max_scale_rel_std``.
-
-    Deletion, not its linearisation: for a leverage near 1 the linear move
-    r / (1 - h) is far off (an outlier of leverage 0.999 in a consensus of
-    29: linear 2.3 stds, the refit 20 % = 10 stds)."""
-    # (the refits run on the pairs the refinement used, shifted once to their
-    # centroid c, the frame of geometry.refine_centred: the travel judged is
-    # that of c, as the refinement's rel_std is: one refit and its leverage
-    # pass ~0.27 ms on 1e3 pairs instead of ~0.44)
-    used = np.flatnonzero(weights > 0)
-    o1, d1, o2, d2 = (a[used] for a in (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2))
-    c = 0.5 * (np.add.reduce(o1) + np.add.reduce(o2)) / len(used)
-    o1 -= c
-    o2 -= c
-    w, lev = weights[used], lev[used]
-    R, tc = m.R, m.t + m.R @ c - c          # tc: the travel of c
-    before = float(np.linalg.norm(tc))
-    dropped, rel, strong = [], float("nan"), False
-    for _ in range(LEVER_ROUNDS):
-        if st is None:
-            break
-        k = int(np.argmax(lev))
-        if not lev[k] > SCREEN_LEVERAGE:
-            break
-        strong = strong or lev[k] > MAX_LEVERAGE
-        dropped.append(int(used[k]))
-        w[k] = 0.0
-        try:
-            # (|t| to ~1e-3 of its std: REFINE_TOL of csrc/robust_lo.c)
-            fit = _core.refine_motion(o1, d1, o2, d2, R, tc, weights=w,
-                                      cost_tolerance=1e-3 / len(used))
-        except (ValueError, DegenerateError):
-            st = None
-            break
-        R, tc, rel = fit["R"], fit["t"], float(fit["scale_rel_std"])
-        st = _core.leverage_stats(o1, d1, o2, d2, R, tc, weights=w, leverages=lev)
-    rel_std = m.scale.rel_std
-    if not dropped:
-        return None, rel_std
-    pairs = ", ".join(str(k) for k in dropped)
+def _consensus_reason(c: dict, m: RigMotion, options: RansacOptions, method: str
+                      ) -> Optional[str]:
+    """The words of :func:`mcgeom._core.consensus_check`'s result ``c`` for the
+    robust estimate ``m``: why its scale is not metric (None: it is)."""
+    pairs = ", ".join(str(k) for k in c["dropped"])
     tail = (f"the consensus of ransac[{method}] rests on them; more correspondences or "
             f"cameras would confirm the scale")
-    if strong and (st is None or st["max_leverage"] > MAX_LEVERAGE):
+    rel, move, max_rel = c["lever_rel_std"], c["lever_move"], options.max_scale_rel_std
+    reason = c["reason"]
+    if reason == "one_pair":
+        return one_pair_rule(c["stats"], f"ransac[{method}]", max_rel, consensus=True)
+    if reason == "undetermined":
         return (f"scale not confirmed: correspondence(s) {pairs} fix a direction of the "
                 f"motion almost alone (leverage above {MAX_LEVERAGE:g}) and without them the "
-                f"motion is not determined; {tail}"), rel_std
-    if st is None:
-        return None, rel_std
-    move = abs(float(np.linalg.norm(tc)) / before - 1.0) if before > 0 else float("inf")
-    m.info["lever_pairs_move"] = move
-    if strong and not rel <= options.max_scale_rel_std:
+                f"motion is not determined; {tail}")
+    if reason == "lever_std":
         return (f"scale not confirmed: without correspondence(s) {pairs} (leverage above "
                 f"{MAX_LEVERAGE:g}: an error in them would not show in any residual) the "
-                f"relative std of |t| is {rel:.3g}; {tail}"), rel_std
-    if move > OUTLIER_MOVE_STDS * rel_std:
-        if move > options.max_scale_rel_std:
-            return (f"scale not supported by the bulk of the inliers: without "
-                    f"correspondence(s) {pairs} (leverage above {SCREEN_LEVERAGE:g}) the "
-                    f"travelled distance moves by {100 * move:.3g} %, "
-                    f"{move / rel_std:.3g} of its stds -- wrong matches the refinement "
-                    f"absorbed; {tail}"), rel_std
-        rel_std = math.hypot(rel_std, move)
-    # (an error in the dropped pairs would show little in their residuals:
-    # the scale is no more precise than the rest of the consensus fixes it)
-    rel_std = max(rel_std, rel)
-    if not rel_std <= options.max_scale_rel_std:
+                f"relative std of |t| is {rel:.3g}; {tail}")
+    if reason == "lever_move":
+        return (f"scale not supported by the bulk of the inliers: without "
+                f"correspondence(s) {pairs} (leverage above {SCREEN_LEVERAGE:g}) the "
+                f"travelled distance moves by {100 * move:.3g} %, "
+                f"{move / m.scale.rel_std:.3g} of its stds -- wrong matches the refinement "
+                f"absorbed; {tail}")
+    if reason == "widened_std":
         return (f"scale too uncertain: without correspondence(s) {pairs} (leverage above "
                 f"{SCREEN_LEVERAGE:g}: errors in them would show little in any residual) the "
                 f"rest of the consensus fixes |t| to a relative std of {rel:.3g} and the "
                 f"travelled distance moves by {100 * move:.3g} %: a relative std of "
-                f"{rel_std:.3g} > {options.max_scale_rel_std:g}; {tail}"), rel_std
-    return None, rel_std
+                f"{c['rel_std']:.3g} > {max_rel:g}; {tail}")
+    if reason == "residuals_std":
+        return (f"scale too uncertain: {_residuals_said(c)}; {c['rel_std']:.3g} > {max_rel:g}; "
+                f"the consensus of ransac[{method}] does not fix |t| well enough")
+    return None
 
 
-#: the std from the pairs' own residuals replaces the estimate's where it is
-#: more than this many times larger (and the reason says so): the two
-#: estimate one std, each with its own noise, and on clean rays the former
-#: is the larger for half of the estimates, by ~3 % in the median
-RESIDUALS_WIDEN = 1.25
-
-
-def residuals_rel_std(st: Optional[dict]) -> Optional[float]:
-    """The relative std of the travel that the pairs' own residuals tell
-    (``travel_std_hc / travel`` of :func:`mcgeom._core.leverage_stats`
-    ``st``: the root sum of squares of every pair's deletion move, the
-    heteroscedasticity-consistent HC3 estimate of MacKinnon & White 1985),
-    None without ``st`` or a travel.
-
-    Why: the final refinement's std assumes one noise level for every pair it
-    used. A wrong match that falls within the threshold (a random bearing
-    lies near its epipolar curve by chance) has a residual spread over the
-    whole threshold band, and where it helps fix |t| it moves the estimate
-    by more than that std says. Measured with ``robust.ransac`` (five_plus_one,
-    3e-3 rad) on the property suite's four rig kinds, 200 pairs, 1e-3 rad,
-    50 problems per kind, at 0 / 10 / 30 / 50 % random time-2 bearings: the
-    rms of error / std of the metric estimates 1.03 / 1.18 / 1.20 / 1.31
-    (1.28-1.41 where such a match was among the inliers) -> 0.99 / 1.02 /
-    1.03 / 1.09 with this std where it exceeds the estimate's by
-    :data:`RESIDUALS_WIDEN`; errors beyond 3 stds 1 / 2 / 4 / 5 -> 1 / 0 /
-    1 / 2; metric estimates lost 0 / 0 / 1 / 3 of 194 / 192 / 182 / 177."""
-    if st is None or not st["travel"] > 0.0:
-        return None
-    return float(st["travel_std_hc"] / st["travel"])
-
-
-def _residuals_widened(hc: float, rel_std: float, options: RansacOptions, method: str
-                       ) -> tuple[Optional[str], Optional[str]]:
-    """The robust estimate's relative std ``rel_std`` widened to ``hc``
-    (:func:`residuals_rel_std`, > rel_std): (why its scale is not metric,
-    None if it still is; the note on the reason where it still is)."""
-    said = (f"the inliers' own residuals put the relative std of |t| at {hc:.3g} "
-            f"(heteroscedasticity-consistent, HC3), {hc / rel_std:.3g} times what one noise "
+def _residuals_said(c: dict) -> str:
+    """What the std of the inliers' own residuals says (``c`` a result of
+    :func:`mcgeom._core.consensus_check` that it widened)."""
+    hc, before = c["rel_std"], c["rel_std_lever"]
+    return (f"the inliers' own residuals put the relative std of |t| at {hc:.3g} "
+            f"(heteroscedasticity-consistent, HC3), {hc / before:.3g} times what one noise "
             f"level for all of them gives: some fit worse than the noise -- wrong matches "
             f"within the threshold, or noise beyond the model")
-    if not hc <= options.max_scale_rel_std:
-        return (f"scale too uncertain: {said}; {hc:.3g} > {options.max_scale_rel_std:g}; "
-                f"the consensus of ransac[{method}] does not fix |t| well enough"), None
-    return None, said
 
 
 def one_pair_checked(m: RigMotion, rays: RayPairs, weights: Optional[np.ndarray],
                      options: RansacOptions, method: str) -> RigMotion:
-    """``m``, a robust estimate on ``rays``, with its scale not metric and
-    ``t`` the unit direction of travel where one correspondence, or a few of
-    high leverage, carry its final refinement (``weights``: that
-    refinement's, float64 (N,), 0 for the pairs it did not use): deleting
-    one pair moves the travel by more than 4 stds and more than
-    ``max_scale_rel_std`` (:func:`mcgeom.estimators._outliers.one_pair_rule`),
-    or the refit without the pairs of leverage above 0.5 says so
-    (:func:`_without_lever_pairs`, which may also widen the reported std).
+    """``m``, a robust estimate on ``rays``, after the checks of its consensus
+    (:func:`mcgeom._core.consensus_check`, csrc/consensus.c) on its final
+    refinement (``weights``: that refinement's, float64 (N,), 0 for the
+    pairs it did not use): its scale not metric and ``t`` the unit direction
+    of travel where one correspondence, or a few of high leverage, carry
+    the fit -- deleting one pair moves the travel by more than 4 stds and
+    more than ``max_scale_rel_std``, or the refit without the pairs of
+    leverage above 0.5 says so -- or where the std it reports, widened by
+    that refit or by the std of the inliers' own residuals (HC3), exceeds
+    ``max_scale_rel_std``; else its std so widened, the reason saying why.
     ``info["max_leverage"]``, ``info["max_influence_stds"]``,
-    ``info["lever_pairs_move"]``.
+    ``info["lever_pairs_move"]``, ``info["scale_rel_std_consensus"]``,
+    ``info["scale_rel_std_residuals"]``.
 
     A wrong match that the consensus took in, with the leverage to pull the
     refinement onto itself, leaves every residual small: on the property
@@ -404,44 +295,42 @@ def one_pair_checked(m: RigMotion, rays: RayPairs, weights: Optional[np.ndarray]
     reported stds of 0.4-5 %, each with a used pair of leverage 0.80-0.997;
     4 of 411 with the one-pair rule and the refit without pairs of leverage
     above 0.9 (session 35), none of 404 with the refit without those above
-    0.5 and the widened std (``mcgeom experiment direct_outliers --robust``)."""
+    0.5 and the widened std (``mcgeom experiment direct_outliers --robust``).
+    A wrong match that falls within the threshold has a residual spread over
+    the threshold band, not the noise, and where it helps fix |t| moves the
+    estimate by more than the std of one noise level says: with 10 / 30 /
+    50 % random time-2 bearings (five_plus_one, 50 problems per rig kind,
+    200 pairs) the rms of error / std was 1.18 / 1.20 / 1.31 (1.03 without
+    outliers), 1.02 / 1.03 / 1.09 (0.99) with the HC3 std where it exceeds
+    the reported one by 1.25x (session 38)."""
     if not m.scale.observable or weights is None:
         return m
     a = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
-    st = _core.leverage_stats(*a, m.R, m.t, weights=weights)
-    why = one_pair_rule(st, f"ransac[{method}]", options.max_scale_rel_std, m.info,
-                        consensus=True)
-    hc = residuals_rel_std(st)
-    if hc is not None:
-        m.info["scale_rel_std_residuals"] = hc
-        # (the noise part it replaces; the calibration's, if any, stays)
-        hc = combine_rel_std(hc, m.info.get("scale_rel_std_calibration", 0.0))
-    rel_std = m.scale.rel_std
-    if st is not None and st["max_leverage"] > SCREEN_LEVERAGE and \
-            (why is None or st["max_leverage"] > MAX_LEVERAGE):
-        # every pair's leverage, only where some is high (the pass again:
-        # no N-sized array on the estimate's common path, issue 19's memory)
-        lev = np.empty(len(rays))
-        st = _core.leverage_stats(*a, m.R, m.t, weights=weights, leverages=lev)
-        why, rel_std = _without_lever_pairs(rays, weights, m, st, lev, options, method)
-    notes = []
-    if why is None and rel_std != m.scale.rel_std:
-        m.info["scale_rel_std_consensus"] = rel_std
-        notes.append(f"the relative std of |t| is {rel_std:.3g} without the correspondences "
-                     f"of leverage above {SCREEN_LEVERAGE:g}, whose errors would show little in "
-                     f"their residuals (the travel moves by "
-                     f"{100 * m.info['lever_pairs_move']:.3g} % without them)")
-    if why is None and hc is not None and hc > RESIDUALS_WIDEN * rel_std:
-        why, note = _residuals_widened(hc, rel_std, options, method)
-        rel_std = hc
-        if note:
-            notes.append(note)
+    c = _core.consensus_check(*a, weights, m.R, m.t, m.scale.rel_std,
+                              m.info.get("scale_rel_std_calibration", 0.0),
+                              options.max_scale_rel_std)
+    info, st = m.info, c["stats"]
+    info["max_leverage"] = st["max_leverage"] if st else float("nan")
+    info["max_influence_stds"] = st["max_influence_stds"] if st else float("nan")
+    if not math.isnan(c["residuals_rel_std"]):
+        info["scale_rel_std_residuals"] = c["residuals_rel_std"]
+    if c["lever_move"] is not None:
+        info["lever_pairs_move"] = c["lever_move"]
+    if c["widened_by_lever"]:
+        info["scale_rel_std_consensus"] = c["rel_std_lever"]
+    why = _consensus_reason(c, m, options, method)
     if why is None:
-        if rel_std == m.scale.rel_std:
+        if c["rel_std"] == m.scale.rel_std:
             return m
-        reason = "; ".join([m.scale.reason] + notes)
-        return replace(m, scale=replace(m.scale, rel_std=rel_std, reason=reason))
-    info = m.info
+        notes = [m.scale.reason]
+        if c["widened_by_lever"]:
+            notes.append(f"the relative std of |t| is {c['rel_std_lever']:.3g} without the "
+                         f"correspondences of leverage above {SCREEN_LEVERAGE:g}, whose errors "
+                         f"would show little in their residuals (the travel moves by "
+                         f"{100 * c['lever_move']:.3g} % without them)")
+        if c["widened_by_residuals"]:
+            notes.append(_residuals_said(c))
+        return replace(m, scale=replace(m.scale, rel_std=c["rel_std"], reason="; ".join(notes)))
     t_dir = travel_direction(rays, m.inliers, m.R, m.t)
     info.update(t_direction=t_dir, t_slid=False, scale_determined=False)
     return RigMotion(m.R, t_dir, replace(m.scale, observable=False, reason=why), m.method,
