@@ -720,8 +720,10 @@ int mcg_robust_rig_motion(int n, const double *o1, const double *d1, const doubl
         res->have_verdict = mcg_verdict_stats(n, o1, d1, o2, d2, cam1, cam2, n_cameras, mask,
                                               res->R, tv, still, &res->verdict, c.vwork,
                                               mcg_verdict_stats_work_size(n_cameras)) == MCG_OK;
-        /* the verdict itself (robust_verdict.c) */
+        /* the verdict itself and the checks of its consensus
+         * (robust_verdict.c) */
         robust_scale_verdict(&c, res, mask, wp);
+        robust_consensus(&c, res, mask, weights, wp, work);
         res->seconds_verdict = robust_now_seconds() - t_mark;
     }
     res->seconds = res->seconds_search + res->seconds_final + res->seconds_verdict;

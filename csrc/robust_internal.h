@@ -278,5 +278,9 @@ void robust_fill_covariance(mcg_robust_result *res);
 /* robust_verdict.c: the scale verdict of the result (res->scale) */
 void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *mask,
                           const double *w);
+/* robust_verdict.c: the checks of the consensus of an observable scale
+ * (res->consensus; work: the call's workspace, free after the verdict) */
+void robust_consensus(ctx *c, mcg_robust_result *res, const unsigned char *mask,
+                      const double *weights, const double *wp, double *work);
 
 #endif /* MCGEOM_ROBUST_INTERNAL_H */

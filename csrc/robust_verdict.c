@@ -50,6 +50,8 @@ const char *mcg_scale_reason_string(int reason)
         return "no translation detected";
     case MCG_SCALE_UNDECIDED:
         return "undecided: the verdict's evidence is incomplete";
+    case MCG_SCALE_CONSENSUS:
+        return "not confirmed by the checks of the consensus";
     default:
         return "unknown";
     }
@@ -278,4 +280,45 @@ void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *m
             s->determined = 0;
         }
     }
+}
+
+/* The checks of the consensus of an observable scale (mcg_consensus_check;
+ * mcgeom.robust._verdict.one_pair_checked words them): on the final
+ * refinement's weights (weights, the caller's, else made from mask bit 1
+ * and wp, the final refinement's pixel weights or NULL for all equal),
+ * at (R, t). Workspace: work, the call's, whose residual buffers, gathered
+ * subset and index array are free once the verdict is taken: its first n
+ * doubles hold the weights made here, the next 15 n + 1 the check's. A
+ * refusal makes the scale MCG_SCALE_CONSENSUS and t the unit direction of
+ * travel (t_metric kept); a widened std is the scale's rel_std. */
+void robust_consensus(ctx *c, mcg_robust_result *res, const unsigned char *mask,
+                      const double *weights, const double *wp, double *work)
+{
+    mcg_robust_scale *s = &res->scale;
+    const size_t n = (size_t)c->n;
+    const double *w = weights;
+    int i;
+    size_t k;
+    if (!res->have_scale || !s->observable)
+        return;
+    if (!w) {
+        for (k = 0; k < n; k++)
+            work[k] = (mask[k] & 2) ? (wp ? wp[k] : 1.0) : 0.0;
+        w = work;
+    }
+    res->have_consensus =
+        mcg_consensus_check(c->n, c->o1, c->d1, c->o2, c->d2, w, res->R, res->t, s->rel_std,
+                            s->rel_std_calibration, c->opt.max_scale_rel_std, &res->consensus,
+                            work + n, mcg_consensus_check_work_size(c->n)) == MCG_OK;
+    if (!res->have_consensus)
+        return;
+    s->rel_std = s->verdict_rel_std = res->consensus.rel_std;
+    if (res->consensus.reason == MCG_CONSENSUS_METRIC)
+        return;
+    s->reason = MCG_SCALE_CONSENSUS;
+    s->observable = 0;
+    s->determined = 0;
+    s->slid = 0;
+    for (i = 0; i < 3; i++)
+        s->t[i] = res->verdict.t_direction[i];
 }

@@ -31,7 +31,8 @@ __all__ = [
     "Linear17Options", "linear17", "linear17_raw", "linear17_static_raw", "linear17_dict",
     "L17_OFFSETS",
     "GC_CASE_NAMES",
-    "gec_residuals", "sampson_leverage", "leverage_stats", "consensus_check", "scale_ransac",
+    "gec_residuals", "sampson_leverage", "leverage_stats", "consensus_check", "consensus_dict",
+    "scale_ransac",
     "sampson_pixel_scale", "refine_motion", "refine_translation",
     "LOSS_NAMES", "REFINE_STOP_NAMES",
     "bilinear_rows", "trilinear_rows", "relation_grams", "skyline_cholesky", "skyline_solve",
@@ -662,6 +663,12 @@ def consensus_check(origins1: np.ndarray, dirs1: np.ndarray, origins2: np.ndarra
                                  ffi.from_buffer("double[]", work), work.size)
     if st != lib.MCG_OK:
         raise ValueError(f"mcg_consensus_check: {_message(st)}")
+    return consensus_dict(out)
+
+
+def consensus_dict(out: Any) -> dict:
+    """The dict of :func:`consensus_check` from an ``mcg_consensus_result``
+    (also ``mcg_robust_result.consensus``, the robust call's own checks)."""
     return {"reason": CONSENSUS_REASONS[out.reason], "rel_std": out.rel_std,
             "stats": _leverage_dict(out.stats) if out.have_stats else None,
             "residuals_rel_std": out.residuals_rel_std,
@@ -1715,7 +1722,7 @@ RESULT_OFFSETS = {k: ffi.offsetof("mcg_robust_result", *f) // 8 for k, f in (
 #: the reasons of the C scale verdict (``mcg_robust_scale.reason``), by value
 SCALE_REASONS = {getattr(lib, "MCG_SCALE_" + k): k.lower() for k in (
     "OBSERVABLE", "NO_REDUNDANCY", "ONE_CAMERA", "CRITICAL", "UNCERTAIN", "CHEIRALITY",
-    "UNCONFIRMED", "STATIC", "UNDECIDED")}
+    "UNCONFIRMED", "STATIC", "UNDECIDED", "CONSENSUS")}
 
 
 def robust_stage_seconds(res: Any) -> dict:

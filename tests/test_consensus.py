@@ -2,8 +2,9 @@
 the same rules written here in numpy on the public kernels (leverage_stats,
 refine_motion), as mcgeom.robust._verdict ran them in Python before session
 38, on the final refinements of robust estimates with 0-50 % random time-2
-bearings (their weights captured from the robust search), and on fits built
-to take each branch; its refusals of bad input."""
+bearings (their weights captured from the robust search, with the checks
+the robust call ran itself), and on fits built to take each branch; its
+refusals of bad input."""
 
 from __future__ import annotations
 
@@ -85,16 +86,20 @@ def _reference(rays, weights, R, t, rel_std, cal, max_rel):
 
 
 def _captured_fits(monkeypatch, fractions=(0.0, 0.1, 0.3, 0.5), problems=6):
-    """(rays, weights, R, t, rel_std) of the final refinements of robust
-    estimates called metric by the search's verdict."""
+    """(rays, weights, R, t, rel_std, the call's own checks) of the final
+    refinements of robust estimates whose scale the C verdict called
+    observable (the robust call then ran the checks itself)."""
     seen = []
+    orig = c_search._checked
 
-    def capture(m, rays, weights, options, method):
-        if m.scale.observable and weights is not None:
-            seen.append((rays, weights.copy(), m.R.copy(), np.array(m.t), m.scale.rel_std))
-        return m
+    def capture(m, res, rays, weights, options, method):
+        if res.have_consensus:
+            rel = math.hypot(res.scale.rel_std_noise, res.scale.rel_std_calibration)
+            seen.append((rays, weights.copy(), np.array(list(res.R)).reshape(3, 3),
+                         np.array(list(res.t)), rel, _core.consensus_dict(res.consensus)))
+        return orig(m, res, rays, weights, options, method)
 
-    monkeypatch.setattr(c_search, "one_pair_checked", capture)
+    monkeypatch.setattr(c_search, "_checked", capture)
     for kind in KIND_SETUPS:
         for frac in fractions:
             for n in (60, 200):
@@ -107,10 +112,15 @@ def _captured_fits(monkeypatch, fractions=(0.0, 0.1, 0.3, 0.5), problems=6):
 
 
 def test_against_the_numpy_reference(monkeypatch):
+    """The robust call's own checks, and mcg_consensus_check called alone at
+    two limits, against the reference."""
     fits = _captured_fits(monkeypatch)
     assert len(fits) > 150
     reasons = set()
-    for rays, w, R, t, rel in fits:
+    for rays, w, R, t, rel, in_call in fits:
+        want = _reference(rays, w, R, t, rel, 0.0, 0.1)
+        assert (in_call["reason"], in_call["dropped"]) == (want[0], want[2])
+        assert in_call["rel_std"] == pytest.approx(want[1], rel=1e-6)
         for max_rel in (0.1, 0.01):
             got = _core.consensus_check(rays.origins1, rays.dirs1, rays.origins2, rays.dirs2,
                                         w, R, t, rel, 0.0, max_rel)

@@ -1095,6 +1095,76 @@ int mcg_verdict_stats(int n, const double *o1, const double *d1, const double *o
                       const unsigned char *inlier, const double R[9], const double t[3],
                       double still_angle, mcg_verdict_stats_result *out, double *work,
                       size_t lwork);
+/* ----------------------------------------------------------- consensus.c */
+
+/* Why mcg_consensus_check does not call a robust estimate's scale metric
+ * (mcg_consensus_result.reason). */
+enum {
+    MCG_CONSENSUS_METRIC = 0,      /* metric (its std possibly widened) */
+    MCG_CONSENSUS_ONE_PAIR = 1,    /* deleting one pair moves the travel by
+                                      more than 4 stds and max_rel_std */
+    MCG_CONSENSUS_UNDETERMINED = 2, /* without the pairs of leverage above
+                                      0.5 (one above 0.9) the motion is not
+                                      determined, or such a pair remains */
+    MCG_CONSENSUS_LEVER_STD = 3,   /* without them (one above 0.9) |t| is
+                                      more uncertain than max_rel_std */
+    MCG_CONSENSUS_LEVER_MOVE = 4,  /* without them the travel moves by more
+                                      than 3 stds and max_rel_std */
+    MCG_CONSENSUS_WIDENED_STD = 5, /* the std widened by that refit exceeds
+                                      max_rel_std */
+    MCG_CONSENSUS_RESIDUALS_STD = 6 /* the std of the pairs' own residuals
+                                      (HC3) exceeds max_rel_std */
+};
+
+/* Result of mcg_consensus_check. */
+typedef struct {
+    int reason;              /* MCG_CONSENSUS_* */
+    double rel_std;          /* the relative std of |t| to report: rel_std
+                                in, widened by the checks */
+    int have_stats;          /* 1: stats holds the fit's leverage statistics
+                                (0: its J^T W J was singular) */
+    mcg_leverage_result stats; /* mcg_sampson_leverage of the fit as given */
+    double residuals_rel_std; /* stats.travel_std_hc / stats.travel (NaN
+                                without) */
+    int n_dropped;           /* pairs of high leverage refitted without */
+    int dropped[3];          /* their indices, in the order dropped */
+    int lever_strong;        /* 1: one of them had a leverage above 0.9 */
+    int have_move;           /* 1: lever_move was measured */
+    double lever_move;       /* relative change of the travel without them */
+    double lever_rel_std;    /* the last refit's relative std (NaN: none) */
+    int widened_by_lever;    /* 1: rel_std widened by that refit */
+    double rel_std_lever;    /* rel_std after the refits (rel_std in where
+                                they did not run or widen it) */
+    int widened_by_residuals; /* 1: rel_std replaced by the residuals' */
+} mcg_consensus_result;
+
+size_t mcg_consensus_check_work_size(int n);
+
+/* The checks of a robust estimate's consensus before its scale is called
+ * metric (mcgeom/robust/_verdict.py one_pair_checked; csrc/consensus.c):
+ * the fit (R, t) (rig2_from_rig1, metres) of the final refinement, on the
+ * pairs with weights > 0 (weights: n values in [0, 1e100], its own), whose
+ * relative std of |t| is rel_std, of which cal_rel_std (>= 0) is the
+ * calibration's part; max_rel_std (> 0) the precision a metric scale
+ * promises. In order: the one-pair rule (deleting one pair moves the
+ * travel by more than 4 of its stds and max_rel_std: not metric); the
+ * refit without the pair of highest leverage while that is above 0.5, up
+ * to 3 pairs (each refit least squares, from the previous; the leverages
+ * recomputed), and its decisions (see the reasons; a move of more than 3
+ * stds within max_rel_std is added to the std in quadrature, and the std
+ * is at least the refit's); then the std of the pairs' own residuals
+ * (HC3, mcg_leverage_result.travel_std_hc, the calibration part added in
+ * quadrature) replaces rel_std where it is more than 1.25 times larger.
+ * Workspace lwork >= mcg_consensus_check_work_size(n) doubles. MCG_EINVAL:
+ * NULL pointers, n outside [0, 2^26], NaN/inf in R or t, bad weights, a
+ * negative or NaN rel_std or cal_rel_std, max_rel_std not > 0, or what
+ * mcg_sampson_leverage refuses; MCG_ENOMEM: lwork too small. A singular
+ * fit is no error: nothing is decided (reason METRIC, have_stats 0). */
+int mcg_consensus_check(int n, const double *o1, const double *d1, const double *o2,
+                        const double *d2, const double *weights, const double R[9],
+                        const double t[3], double rel_std, double cal_rel_std,
+                        double max_rel_std, mcg_consensus_result *out, double *work,
+                        size_t lwork);
 /* --------------------------------------------------------------- robust.c */
 
 /* Options of mcg_robust_rig_motion (mcg_robust_default_options in brackets). */
@@ -1166,12 +1236,17 @@ enum {
                                     explains 90 % of the intra-camera inliers
                                     within 1.5 noise levels (static rig, pure
                                     rotation, scene at infinity); t = 0 */
-    MCG_SCALE_UNDECIDED = 8      /* the evidence is incomplete (no verdict
+    MCG_SCALE_UNDECIDED = 8,     /* the evidence is incomplete (no verdict
                                     evidence gathered, intra-camera bearings of
                                     rank < 2 for the rotation-only test, or a
                                     failed calibration propagation): not
                                     metric; mcgeom's Python layer decides these
                                     with numpy */
+    MCG_SCALE_CONSENSUS = 9      /* the checks of the consensus refuse it
+                                    (res->consensus.reason, mcg_consensus_check:
+                                    a wrong match may carry the fit, or the
+                                    inliers' own residuals leave |t| too
+                                    uncertain); t the unit direction of travel */
 };
 
 /* The scale verdict of mcg_robust_rig_motion (res->scale, when
@@ -1354,6 +1429,14 @@ typedef struct {
                                covariance */
     double seconds_verdict; /* the verdict's evidence and the verdict (0
                                without opt->verdict_still_factor) */
+    /* The checks of the consensus (ABI: appended fields): */
+    int have_consensus;     /* 1 when consensus holds them: run on a scale the
+                               verdict called observable (and the checks could
+                               run); their refusal makes scale.reason
+                               MCG_SCALE_CONSENSUS, their widened std is
+                               scale.rel_std */
+    mcg_consensus_result consensus; /* mcg_consensus_check on the final
+                               refinement's weights at (R, t) */
 } mcg_robust_result;
 
 /* Fill *opt with the defaults in brackets above (no-op for NULL). */
@@ -1422,7 +1505,11 @@ size_t mcg_robust_work_size(int n, int n_cameras);
  * res->verdict, and the cap's confidence decide whether t is metric, and
  * res->scale.t is the translation to report (metric, the unit direction of
  * travel, or 0 for a static rig); a profile the verdict needs and the call
- * had not computed is computed then. Returns MCG_OK, MCG_EDEGENERATE when no motion
+ * had not computed is computed then. A scale the verdict calls observable
+ * then goes through the checks of its consensus (res->consensus,
+ * mcg_consensus_check on the final refinement's weights, in the
+ * workspace): MCG_SCALE_CONSENSUS where they refuse it, its std widened
+ * where they widen it. Returns MCG_OK, MCG_EDEGENERATE when no motion
  * explains 6 correspondences (res has the counts; e.g. no camera with 5
  * intra-camera correspondences, fewer than 17 pairs with MCG_SAMPLER_EIGEN
  * or MCG_SAMPLER_LINEAR17,
@@ -1660,76 +1747,6 @@ int mcg_static_check(int n, const double *o1, const double *d1, const double *o2
                      const double *d2, const int *group, const double *R_est,
                      const double *R_given, double noise_level, const mcg_static_options *opt,
                      mcg_static_result *out, double *work, size_t lwork);
-/* ----------------------------------------------------------- consensus.c */
-
-/* Why mcg_consensus_check does not call a robust estimate's scale metric
- * (mcg_consensus_result.reason). */
-enum {
-    MCG_CONSENSUS_METRIC = 0,      /* metric (its std possibly widened) */
-    MCG_CONSENSUS_ONE_PAIR = 1,    /* deleting one pair moves the travel by
-                                      more than 4 stds and max_rel_std */
-    MCG_CONSENSUS_UNDETERMINED = 2, /* without the pairs of leverage above
-                                      0.5 (one above 0.9) the motion is not
-                                      determined, or such a pair remains */
-    MCG_CONSENSUS_LEVER_STD = 3,   /* without them (one above 0.9) |t| is
-                                      more uncertain than max_rel_std */
-    MCG_CONSENSUS_LEVER_MOVE = 4,  /* without them the travel moves by more
-                                      than 3 stds and max_rel_std */
-    MCG_CONSENSUS_WIDENED_STD = 5, /* the std widened by that refit exceeds
-                                      max_rel_std */
-    MCG_CONSENSUS_RESIDUALS_STD = 6 /* the std of the pairs' own residuals
-                                      (HC3) exceeds max_rel_std */
-};
-
-/* Result of mcg_consensus_check. */
-typedef struct {
-    int reason;              /* MCG_CONSENSUS_* */
-    double rel_std;          /* the relative std of |t| to report: rel_std
-                                in, widened by the checks */
-    int have_stats;          /* 1: stats holds the fit's leverage statistics
-                                (0: its J^T W J was singular) */
-    mcg_leverage_result stats; /* mcg_sampson_leverage of the fit as given */
-    double residuals_rel_std; /* stats.travel_std_hc / stats.travel (NaN
-                                without) */
-    int n_dropped;           /* pairs of high leverage refitted without */
-    int dropped[3];          /* their indices, in the order dropped */
-    int lever_strong;        /* 1: one of them had a leverage above 0.9 */
-    int have_move;           /* 1: lever_move was measured */
-    double lever_move;       /* relative change of the travel without them */
-    double lever_rel_std;    /* the last refit's relative std (NaN: none) */
-    int widened_by_lever;    /* 1: rel_std widened by that refit */
-    double rel_std_lever;    /* rel_std after the refits (rel_std in where
-                                they did not run or widen it) */
-    int widened_by_residuals; /* 1: rel_std replaced by the residuals' */
-} mcg_consensus_result;
-
-size_t mcg_consensus_check_work_size(int n);
-
-/* The checks of a robust estimate's consensus before its scale is called
- * metric (mcgeom/robust/_verdict.py one_pair_checked; csrc/consensus.c):
- * the fit (R, t) (rig2_from_rig1, metres) of the final refinement, on the
- * pairs with weights > 0 (weights: n values in [0, 1e100], its own), whose
- * relative std of |t| is rel_std, of which cal_rel_std (>= 0) is the
- * calibration's part; max_rel_std (> 0) the precision a metric scale
- * promises. In order: the one-pair rule (deleting one pair moves the
- * travel by more than 4 of its stds and max_rel_std: not metric); the
- * refit without the pair of highest leverage while that is above 0.5, up
- * to 3 pairs (each refit least squares, from the previous; the leverages
- * recomputed), and its decisions (see the reasons; a move of more than 3
- * stds within max_rel_std is added to the std in quadrature, and the std
- * is at least the refit's); then the std of the pairs' own residuals
- * (HC3, mcg_leverage_result.travel_std_hc, the calibration part added in
- * quadrature) replaces rel_std where it is more than 1.25 times larger.
- * Workspace lwork >= mcg_consensus_check_work_size(n) doubles. MCG_EINVAL:
- * NULL pointers, n outside [0, 2^26], NaN/inf in R or t, bad weights, a
- * negative or NaN rel_std or cal_rel_std, max_rel_std not > 0, or what
- * mcg_sampson_leverage refuses; MCG_ENOMEM: lwork too small. A singular
- * fit is no error: nothing is decided (reason METRIC, have_stats 0). */
-int mcg_consensus_check(int n, const double *o1, const double *d1, const double *o2,
-                        const double *d2, const double *weights, const double R[9],
-                        const double t[3], double rel_std, double cal_rel_std,
-                        double max_rel_std, mcg_consensus_result *out, double *work,
-                        size_t lwork);
 /* --------------------------------------------------------------- sixpt.c */
 
 /* Upper bound on the solutions of mcg_sixpt (Stewenius, Nister, Oskarsson,

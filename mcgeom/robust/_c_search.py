@@ -165,9 +165,8 @@ def ransac_c(rays: RayPairs, focal: Optional[np.ndarray], options: RansacOptions
             scorer.best = (probe["R"], probe["t"])
             scorer.n_hyp = int(probe["hypotheses"])
         return nothing_found(rays, scorer, options, method, t_start, 6, "", ended)
-    return one_pair_checked(_c_conclude(rays, out, focal, options, method, t_start,
-                                        calibration_std, cam1, cam2, n_cameras),
-                            rays, out["weights"], options, method)
+    return _c_conclude(rays, out, focal, options, method, t_start, calibration_std, cam1, cam2,
+                       n_cameras)
 
 
 def _search_info(res: Any, method: str) -> dict:
@@ -248,17 +247,15 @@ def estimate_pinhole_c(tables: tuple, px1: np.ndarray, px2: np.ndarray, ids1: np
     rays = RayPairs.prechecked(*(w[3 * n * b:3 * n * (b + 1)].reshape(n, 3) for b in range(4)),
                                ids1, ids2)
     if res.have_scale and res.scale.reason in C_WORDED:
-        return one_pair_checked(conclude_c(res, _core.robust_struct(res), inl, options, method,
-                                           info, t_start, unconfirmed),
-                                rays, buf[:n], options, method)
+        return _checked(conclude_c(res, _core.robust_struct(res), inl, options, method, info,
+                                   t_start, unconfirmed), res, rays, buf[:n], options, method)
     # a verdict the numpy layer decides (static, undecided): the dict of the
     # general conclusion, from the same call
     ids32 = w[13 * n:].view(np.int32)
     out = _core._robust_result(res, mask, buf[:n])
     out["extrinsic_std_given"] = calibration_std is not None
-    return one_pair_checked(_c_conclude(rays, out, w[12 * n:13 * n], options, method, t_start,
-                                        calibration_std, ids32[:n], ids32[n:2 * n], len(focal)),
-                            rays, buf[:n], options, method)
+    return _c_conclude(rays, out, w[12 * n:13 * n], options, method, t_start, calibration_std,
+                       ids32[:n], ids32[n:2 * n], len(focal))
 
 
 def _c_seed(options: RansacOptions) -> int:
@@ -314,12 +311,24 @@ def _extrinsic_table(calibration_std: Any, n_cameras: int) -> Optional[np.ndarra
     return sig if np.isfinite(sig).all() and (sig >= 0).all() else None
 
 
+def _checked(m: RigMotion, res: Any, rays: RayPairs, weights: np.ndarray,
+             options: RansacOptions, method: str) -> RigMotion:
+    """``m``, the RigMotion :func:`conclude_c` made of the C call's result
+    ``res``, after the checks of its consensus: those of the call itself
+    where it ran them (``res.have_consensus``), else
+    :func:`one_pair_checked`'s."""
+    if res.have_consensus:
+        return m
+    return one_pair_checked(m, rays, weights, options, method)
+
+
 def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options: RansacOptions,
                 method: str, t_start: float, calibration_std: Any, cam1: np.ndarray,
                 cam2: np.ndarray, n_cameras: int) -> RigMotion:
     """The RigMotion of a C search's result ``out`` (``_core.robust_rig_motion``
     with ``verdict_still_factor`` :data:`NO_PARALLAX_FACTOR`, not None) on
-    ``rays`` (camera ids ``cam1``/``cam2`` as passed to it): the verdict here."""
+    ``rays`` (camera ids ``cam1``/``cam2`` as passed to it): the verdict here,
+    and the checks of its consensus (:func:`_checked`)."""
     R, t, inl = out["R"], out["t"], out["inliers"]
     res = out["_res"]
     info = _search_info(res, method)
@@ -328,7 +337,8 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
     if res.have_scale and res.scale.reason in C_WORDED and \
             (calibration_std is None or out.get("extrinsic_std_given", False)):
         # the search decided the verdict itself (csrc/robust_verdict.c)
-        return conclude_c(res, out["_f"], inl, options, method, info, t_start, unconfirmed)
+        return _checked(conclude_c(res, out["_f"], inl, options, method, info, t_start,
+                                   unconfirmed), res, rays, out["weights"], options, method)
     fit = None
     if out["refinement"] is not None:
         out["refinement"]["covariance"] = out["covariance"]   # (total_scale_std's)
@@ -341,9 +351,9 @@ def _c_conclude(rays: RayPairs, out: dict, focal: Optional[np.ndarray], options:
                np.maximum.reduce(w) == np.minimum.reduce(w) else w)
     # the RMS residual of the inliers and the verdict's evidence come from C
     # (no Python pass over the rays: issue 19)
-    return conclude(rays, R, t, None, inl, fit, out["loss_scale"],
-                    math.hypot(*out["t_hypothesis"].tolist()), options, method,
-                    info, t_start,
-                    out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
-                    c_ids=(cam1, cam2, n_cameras, out["mask"], out["verdict"]),
-                    zero_profile=float(out["zero_profile"]), unconfirmed=unconfirmed)
+    m = conclude(rays, R, t, None, inl, fit, out["loss_scale"],
+                 math.hypot(*out["t_hypothesis"].tolist()), options, method, info, t_start,
+                 out["scale_profile"], calibration_std, rms=float(out["inlier_rms"]),
+                 c_ids=(cam1, cam2, n_cameras, out["mask"], out["verdict"]),
+                 zero_profile=float(out["zero_profile"]), unconfirmed=unconfirmed)
+    return one_pair_checked(m, rays, out["weights"], options, method)

@@ -199,14 +199,23 @@ def conclude_c(res: Any, f: np.ndarray, inl: np.ndarray, options: RansacOptions,
         profile = info["scale_profile"] = sc.profile
     reason = _core.SCALE_REASONS[sc.reason]
     n_in, crit = v.n_inliers, v.critical_angle
+    # the checks of the consensus of an observable scale, in the same call
+    # (csrc/consensus.c; one_pair_checked's for the other paths)
+    c = _core.consensus_dict(res.consensus) if res.have_consensus else None
+    if c is not None:
+        _consensus_info(info, c)
     if reason == "unconfirmed":
         text = unconfirmed
         # (the verdict it replaces keeps its std: inf for too few inliers)
         quoted = float("inf") if n_in <= 6 else rel_std
+    elif reason == "consensus":
+        text, quoted = _consensus_reason(c, rel_std, options, method), rel_std
     else:
         text = verdict_text(reason, n_in, v.n_cross, v.n_cameras_intra, crit, rel_std,
                             options.max_scale_rel_std, profile, sc.front_fraction)
         quoted = float("inf") if reason == "no_redundancy" else rel_std
+        if c is not None and c["rel_std"] != rel_std:
+            text, quoted = "; ".join([text] + _consensus_notes(c)), c["rel_std"]
     observable = bool(sc.observable)
     info["translation_detected"] = True
     k = _AT["scale_t_metric"]
@@ -224,10 +233,11 @@ def conclude_c(res: Any, f: np.ndarray, inl: np.ndarray, options: RansacOptions,
                      f"ransac[{method}]", res.inlier_rms, inl, info)
 
 
-def _consensus_reason(c: dict, m: RigMotion, options: RansacOptions, method: str
+def _consensus_reason(c: dict, rel_std: float, options: RansacOptions, method: str
                       ) -> Optional[str]:
-    """The words of :func:`mcgeom._core.consensus_check`'s result ``c`` for the
-    robust estimate ``m``: why its scale is not metric (None: it is)."""
+    """The words of :func:`mcgeom._core.consensus_check`'s result ``c`` for a
+    robust estimate whose relative std of |t| was ``rel_std``: why its scale
+    is not metric (None: it is)."""
     pairs = ", ".join(str(k) for k in c["dropped"])
     tail = (f"the consensus of ransac[{method}] rests on them; more correspondences or "
             f"cameras would confirm the scale")
@@ -247,7 +257,7 @@ def _consensus_reason(c: dict, m: RigMotion, options: RansacOptions, method: str
         return (f"scale not supported by the bulk of the inliers: without "
                 f"correspondence(s) {pairs} (leverage above {SCREEN_LEVERAGE:g}) the "
                 f"travelled distance moves by {100 * move:.3g} %, "
-                f"{move / m.scale.rel_std:.3g} of its stds -- wrong matches the refinement "
+                f"{move / rel_std:.3g} of its stds -- wrong matches the refinement "
                 f"absorbed; {tail}")
     if reason == "widened_std":
         return (f"scale too uncertain: without correspondence(s) {pairs} (leverage above "
@@ -259,6 +269,34 @@ def _consensus_reason(c: dict, m: RigMotion, options: RansacOptions, method: str
         return (f"scale too uncertain: {_residuals_said(c)}; {c['rel_std']:.3g} > {max_rel:g}; "
                 f"the consensus of ransac[{method}] does not fix |t| well enough")
     return None
+
+
+def _consensus_info(info: dict, c: dict) -> None:
+    """``info``'s entries of the checks of the consensus ``c``
+    (:func:`mcgeom._core.consensus_check`)."""
+    st = c["stats"]
+    info["max_leverage"] = st["max_leverage"] if st else float("nan")
+    info["max_influence_stds"] = st["max_influence_stds"] if st else float("nan")
+    if not math.isnan(c["residuals_rel_std"]):
+        info["scale_rel_std_residuals"] = c["residuals_rel_std"]
+    if c["lever_move"] is not None:
+        info["lever_pairs_move"] = c["lever_move"]
+    if c["widened_by_lever"]:
+        info["scale_rel_std_consensus"] = c["rel_std_lever"]
+
+
+def _consensus_notes(c: dict) -> list[str]:
+    """What the reason of a metric scale adds where the checks of its
+    consensus ``c`` widened its std."""
+    notes = []
+    if c["widened_by_lever"]:
+        notes.append(f"the relative std of |t| is {c['rel_std_lever']:.3g} without the "
+                     f"correspondences of leverage above {SCREEN_LEVERAGE:g}, whose errors "
+                     f"would show little in their residuals (the travel moves by "
+                     f"{100 * c['lever_move']:.3g} % without them)")
+    if c["widened_by_residuals"]:
+        notes.append(_residuals_said(c))
+    return notes
 
 
 def _residuals_said(c: dict) -> str:
@@ -306,31 +344,20 @@ def one_pair_checked(m: RigMotion, rays: RayPairs, weights: Optional[np.ndarray]
     if not m.scale.observable or weights is None:
         return m
     a = (rays.origins1, rays.dirs1, rays.origins2, rays.dirs2)
-    c = _core.consensus_check(*a, weights, m.R, m.t, m.scale.rel_std,
-                              m.info.get("scale_rel_std_calibration", 0.0),
-                              options.max_scale_rel_std)
-    info, st = m.info, c["stats"]
-    info["max_leverage"] = st["max_leverage"] if st else float("nan")
-    info["max_influence_stds"] = st["max_influence_stds"] if st else float("nan")
-    if not math.isnan(c["residuals_rel_std"]):
-        info["scale_rel_std_residuals"] = c["residuals_rel_std"]
-    if c["lever_move"] is not None:
-        info["lever_pairs_move"] = c["lever_move"]
-    if c["widened_by_lever"]:
-        info["scale_rel_std_consensus"] = c["rel_std_lever"]
-    why = _consensus_reason(c, m, options, method)
+    cal = m.info.get("scale_rel_std_calibration", 0.0)
+    try:
+        c = _core.consensus_check(*a, weights, m.R, m.t, m.scale.rel_std,
+                                  cal if math.isfinite(cal) else 0.0, options.max_scale_rel_std)
+    except ValueError:      # (input the kernel refuses: nothing decided)
+        return m
+    info = m.info
+    _consensus_info(info, c)
+    why = _consensus_reason(c, m.scale.rel_std, options, method)
     if why is None:
         if c["rel_std"] == m.scale.rel_std:
             return m
-        notes = [m.scale.reason]
-        if c["widened_by_lever"]:
-            notes.append(f"the relative std of |t| is {c['rel_std_lever']:.3g} without the "
-                         f"correspondences of leverage above {SCREEN_LEVERAGE:g}, whose errors "
-                         f"would show little in their residuals (the travel moves by "
-                         f"{100 * c['lever_move']:.3g} % without them)")
-        if c["widened_by_residuals"]:
-            notes.append(_residuals_said(c))
-        return replace(m, scale=replace(m.scale, rel_std=c["rel_std"], reason="; ".join(notes)))
+        reason = "; ".join([m.scale.reason] + _consensus_notes(c))
+        return replace(m, scale=replace(m.scale, rel_std=c["rel_std"], reason=reason))
     t_dir = travel_direction(rays, m.inliers, m.R, m.t)
     info.update(t_direction=t_dir, t_slid=False, scale_determined=False)
     return RigMotion(m.R, t_dir, replace(m.scale, observable=False, reason=why), m.method,
