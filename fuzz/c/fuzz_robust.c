@@ -37,7 +37,10 @@
  * static, not undecided) a unit vector (0 for res.t = 0), a static one 0,
  * an undecided one unit (or 0); rel_std never
  * negative or NaN; unconfirmed exactly when a cap ended the search below a
- * confidence of 0.5 (reasons other than static and undecided). A negative
+ * confidence of 0.5 (reasons other than static and undecided); the checks
+ * of the consensus (res.consensus) ran only on an observable scale, which
+ * they left observable or made MCG_SCALE_CONSENSUS, their std the
+ * verdict's. A negative
  * or non-finite calibration std is MCG_EINVAL.
  * Bounded time: max_iterations <= 200 (<= 3 with the 6-point sampler,
  * whose solver takes about a second per sample under the sanitizers, <= 20
@@ -364,8 +367,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (res.have_scale) {
         const mcg_robust_scale *v = &res.scale;
         const double nt = sqrt(v->t[0] * v->t[0] + v->t[1] * v->t[1] + v->t[2] * v->t[2]);
-        FZ_CHECK(v->reason >= MCG_SCALE_OBSERVABLE && v->reason <= MCG_SCALE_UNDECIDED,
+        FZ_CHECK(v->reason >= MCG_SCALE_OBSERVABLE && v->reason <= MCG_SCALE_CONSENSUS,
                  "scale reason %d", v->reason);
+        /* the checks of the consensus: run on an observable scale, their
+         * refusal the verdict's reason, their std the verdict's */
+        FZ_CHECK(res.have_consensus
+                     ? (res.consensus.reason == MCG_CONSENSUS_METRIC
+                            ? v->reason == MCG_SCALE_OBSERVABLE
+                            : v->reason == MCG_SCALE_CONSENSUS) &&
+                           v->rel_std == res.consensus.rel_std
+                     : v->reason != MCG_SCALE_CONSENSUS,
+                 "consensus %d (reason %d, std %g) with scale reason %d, std %g",
+                 res.have_consensus, res.consensus.reason, res.consensus.rel_std, v->reason,
+                 v->rel_std);
         FZ_CHECK(v->observable == (v->reason == MCG_SCALE_OBSERVABLE),
                  "observable %d with reason %d", v->observable, v->reason);
         FZ_CHECK(!v->observable || (v->determined && v->rel_std <= opt.max_scale_rel_std),
