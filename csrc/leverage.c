@@ -219,6 +219,11 @@ int mcg_sampson_leverage(int n, const double *o1, const double *d1, const double
         ww += w[a] * w[a];
     }
     sd = acc.n_used > np ? sqrt(acc.swr2 / (acc.n_used - np) * ww) : HUGE_VAL;
+    /* (an exact fit, sum w r^2 = 0, with a gradient beyond the doubles,
+     * ww = inf: 0 x inf, a std nothing determines; fuzz_leverage, a travel
+     * of 1e77 m) */
+    if (isnan(sd))
+        sd = HUGE_VAL;
     for (k0 = 0; k0 < n; k0 += BLK) {
         int nb = n - k0 < BLK ? n - k0 : BLK;
         double hb[BLK], mb[BLK];

@@ -887,6 +887,45 @@ static void test_robust_verdict_of_a_far_translation(void)
           (double)res.verdict.n_inliers, (double)res.n_inliers);
 }
 
+/* fuzz_leverage (session 38): t alone fitted (R held, here 9 arbitrary
+ * doubles as fuzz input gives them), 7 pairs whose time-2 origins are 0,
+ * one time-1 origin at -2.4e77 m: an exact fit (sum w r^2 = 0) with a
+ * travel gradient beyond the doubles, and the travel's std came out NaN
+ * (0 x inf) with MCG_OK. Now HUGE_VAL: a std nothing determines. */
+static void test_leverage_nan_std(void)
+{
+    static const double o1[21] = {-2.7109375, 3.053466796875, -0.526611328125,
+                                  0.133056640625, 0.54345703125, 3.38818359375,
+                                  3.38818359375, 3.199951171875, 3.199951171875,
+                                  -0.686279296875, -0.00048828125, 5.949462890625,
+                                  6.76708984375, -2.1875, 0.375,
+                                  2.9375, 6.5625, -2.375,
+                                  2.3125, 7.62158203125, -2.4413519756306118e+77};
+    static const double d1[21] = {0.746826171875, 2.29931640625, 3.529296875,
+                                  -1.462646484375, 0, 0.05029296875,
+                                  2.240478515625, 6.89794921875, 10.587890625,
+                                  -5.8505859375, 0, 0.201171875,
+                                  3.734130859375, 11.49658203125, 17.646484375,
+                                  -8.77587890625, 0, 0.3017578125,
+                                  5.227783203125, 16.09521484375, 24.705078125};
+    static const double o2[21] = {-1.1875e-160, -0.0, 4.8828124999999999e-164,
+                                  9.5214843749999998e-123, 0, 0};
+    static const double d2[21] = {0.99999999999999989, -0.021728515625, 0,
+                                  2.25, 0.004638671875, 0.054443359375,
+                                  -6.5625, -6.525634765625, -6.525634765625,
+                                  -6.525634765625, -6.525634765625, -6.525634765625,
+                                  -6.525634765625, -6.525634765625, -6.525634765625,
+                                  -6.525634765625, -6.525634765625, -6.525634765625,
+                                  -6.525634765625, -6.525634765625, -6.525634765625};
+    const double R[9] = {-6.525634765625, -6.525634765625, -6.525634765625, 0, 0, 0, 0, 0, 0};
+    const double t[3] = {0, 0, 0};
+    mcg_leverage_result lr;
+    int st = mcg_sampson_leverage(7, o1, d1, o2, d2, NULL, R, t, 1, NULL, &lr);
+    check(st != MCG_OK || (lr.travel_std >= 0.0 && lr.travel_std_hc >= 0.0),
+          "sampson_leverage: an exact fit with an overflowing gradient, std not NaN",
+          lr.travel_std, 0.0);
+}
+
 int main(void)
 {
     test_robust_verdict_of_a_far_translation();
@@ -912,6 +951,7 @@ int main(void)
     test_angle_axis_overflow();
     test_qr_graded_columns();
     test_qr_subnormal_column();
+    test_leverage_nan_std();
     printf("%d checks, %d failed\n", n_checks, n_failed);
     return n_failed != 0;
 }
