@@ -57,15 +57,6 @@ size_t mcg_consensus_check_work_size(int n)
     return ok ? w : 0;
 }
 
-/* sqrt(a^2 + b^2), HUGE_VAL if either is not finite (combine_rel_std of
- * mcgeom.observability) */
-static double combine(double a, double b)
-{
-    if (!(isfinite(a) && isfinite(b)))
-        return HUGE_VAL;
-    return hypot(a, b);
-}
-
 static double norm3(const double v[3]) { return sqrt(dot3(v, v)); }
 
 /* The refits without the pairs of highest leverage (see the file comment):
@@ -228,7 +219,7 @@ int mcg_consensus_check(int n, const double *o1, const double *d1, const double 
         res.widened_by_lever = res.reason == MCG_CONSENSUS_METRIC && rel != rel_std;
     }
     res.rel_std_lever = rel;
-    hc = combine(res.residuals_rel_std, cal_rel_std);
+    hc = combine_rel_std(res.residuals_rel_std, cal_rel_std);
     if (res.reason == MCG_CONSENSUS_METRIC && !isnan(res.residuals_rel_std) &&
         hc > RESIDUALS_WIDEN * rel) {
         rel = hc;

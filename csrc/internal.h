@@ -102,6 +102,17 @@ static inline double norm_scaled(const double *y, size_t n)
     return mx * sqrt(acc);
 }
 
+/* Two independent parts of a relative std of |t| (the noise's and the
+ * calibration's) in quadrature, HUGE_VAL if either is not finite
+ * (mcgeom.observability.combine_rel_std); shared by the robust verdict and
+ * the checks of its consensus. */
+static inline double combine_rel_std(double a, double b)
+{
+    if (!(isfinite(a) && isfinite(b)))
+        return HUGE_VAL;
+    return hypot(a, b);
+}
+
 /* Centroid c of the 2n ray origins o1, o2 (n x 3 each, n >= 1) and the RMS
  * distance of the origins from it: the position and size of a rig, both
  * independent of the rig frame's origin and orientation. */

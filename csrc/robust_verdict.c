@@ -67,14 +67,6 @@ static int scale_determined(double rel_std, double zero_profile)
     return isfinite(rel_std) && rel_std <= UNDETERMINED_REL_STD;
 }
 
-/* observability.combine_rel_std: independent parts in quadrature */
-static double combine(double noise, double calibration)
-{
-    if (!(isfinite(noise) && isfinite(calibration)))
-        return HUGE_VAL;
-    return hypot(noise, calibration);
-}
-
 /* The calibration error's part of the relative std of |t|
  * (observability.calibration_scale_std on the refinement's pairs, as
  * robust._verdict.conclude hands them over: gathered in input order, the
@@ -203,7 +195,7 @@ void robust_scale_verdict(ctx *c, mcg_robust_result *res, const unsigned char *m
             return;
         s->rel_std_noise = res->refinement.scale_rel_std;
         s->rel_std_calibration = cal;
-        rel = combine(s->rel_std_noise, cal);
+        rel = combine_rel_std(s->rel_std_noise, cal);
         /* the profile at 1 +- 3 max_scale_rel_std where the std allows a
          * metric verdict (computed by the call already: rel <= max_rel
          * implies the noise part is) */
