@@ -83,11 +83,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                  !isnan(lr.travel_std),
              "travel %g, std %g", lr.travel, lr.travel_std);
     {
-        /* (the largest move, back from its share of the travel: beyond the
-         * doubles when that share was capped at DBL_MAX, then not compared) */
+        /* (the largest move, back from its share of the travel: not
+         * compared when that share is subnormal -- a move of 1e-12 m on a
+         * travel of 1e307 m keeps a few digits -- or the move comes back
+         * beyond the doubles, the share capped at DBL_MAX) */
         const double move = lr.max_influence * lr.travel;
         FZ_CHECK(lr.travel_std_hc >= 0.0 &&
-                     (lr.travel == 0.0 || !(move <= DBL_MAX) ||
+                     (lr.travel == 0.0 || !(move <= DBL_MAX) || lr.max_influence < DBL_MIN ||
                       lr.travel_std_hc >= move * (1.0 - 1e-9)),
                  "HC3 std %g, largest move %g", lr.travel_std_hc, move);
     }
