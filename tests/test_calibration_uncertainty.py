@@ -13,7 +13,7 @@ from mcgeom import _core, synth
 from mcgeom.cv import estimate as cv_estimate
 from mcgeom.experiments import calibration_coverage
 from mcgeom.io.mcgeom_json import rig_from_dict, rig_to_dict
-from mcgeom.observability import calibration_scale_std
+from mcgeom.observability import calibration_scale_std, sampled_calibration_scale_std
 from mcgeom.rig import DEFAULT_EXTRINSIC_STD, Rig
 
 
@@ -260,3 +260,35 @@ def test_c_derivatives_match_central_differences():
     ref = _differenced_covariance(rays, R, t, std, weights, 2e-3)
     assert rel > 0
     np.testing.assert_allclose(cov, ref, rtol=0, atol=1e-6 * np.abs(ref).max())
+
+
+def test_sampled_calibration_std_matches_the_first_order_one_where_linear():
+    """sampled_calibration_scale_std (the check of the first-order figure by
+    rigs drawn with the stated error) against calibration_scale_std on a
+    turning car rig, where the estimate is linear in the extrinsics over
+    their error; and at a tenth of the error it scales with it."""
+    rng = np.random.default_rng(4)
+    rig = synth.vehicle8()
+    std = np.array([2e-3, np.radians(0.1)])
+    Rw = synth.rotation_about([0, 0, 1], np.radians(10))
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    p = synth.make_problem(rig, R, t, 300, rng, pixel_noise=0.5, cross_fraction=0.1)
+    first = calibration_scale_std(p.rays, R, t, std)[0]
+    sampled = sampled_calibration_scale_std(p.rays, R, t, std, draws=128, seed=1)
+    assert 0.8 < sampled / first < 1.25
+    small = sampled_calibration_scale_std(p.rays, R, t, std / 10, draws=128, seed=1)
+    assert small / sampled == pytest.approx(0.1, rel=0.1)
+    assert sampled_calibration_scale_std(p.rays, R, t, (0.0, 0.0)) == 0.0
+
+
+@pytest.mark.parametrize("draws", [0, 3, 2.0, "64"])
+def test_sampled_calibration_std_bad_draws_name_it(draws):
+    rng = np.random.default_rng(5)
+    rig = synth.vehicle8()
+    Rw = synth.rotation_about([0, 0, 1], np.radians(10))
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    p = synth.make_problem(rig, R, t, 50, rng, cross_fraction=0.1)
+    with pytest.raises(ValueError, match="draws"):
+        sampled_calibration_scale_std(p.rays, R, t, (1e-3, 1e-3), draws=draws)
+    with pytest.raises(ValueError, match="calibration_std"):
+        sampled_calibration_scale_std(p.rays, R, t, np.ones((2, 2)))

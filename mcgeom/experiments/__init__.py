@@ -41,6 +41,9 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
     "calibration_coverage": ("calibration_coverage", "synthetic rigs with perturbed "
                                                      "extrinsics: does the 3-sigma interval "
                                                      "of |t| contain the truth?"),
+    "calibration_real": ("calibration_real", "a real near-critical DDAD step: the first-order "
+                                             "calibration part of the std of |t| next to the "
+                                             "sampled one"),
     "robust_vs_poselib": ("robust_vs_poselib", "robust rig motion from pixels: mcgeom "
                                                "against PoseLib (needs poselib)"),
     "real_data": ("real_data", "the robust pipeline on the real recordings (KITTI, DDAD, "
