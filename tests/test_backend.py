@@ -228,3 +228,23 @@ def test_bad_input_is_a_value_error():
         estimate_trajectory(RING, tracks, metric_from="guess")
     with pytest.raises(ValueError, match="threshold"):
         estimate_trajectory(RING, tracks, threshold=-1.0)
+
+
+def test_metric_steps_of_a_rig_with_a_calibration_error_are_checked_by_sampling():
+    """A rig that states its extrinsic error: every metric step's calibration
+    part is checked against rigs drawn with it (calibration_check="sampled",
+    the default); where the estimate is linear in the extrinsics (a turning
+    ring) the sampled figure is the first-order one and the steps stay
+    metric. "first_order" skips the check."""
+    rig = Rig(RING.cameras, calibration_std=(2e-3, np.radians(0.1)))
+    poses, tracks = _sequence([10.0, -12.0], seed=3, n_points=1500)
+    tr = estimate_trajectory(rig, tracks)
+    assert [s.status for s in tr.steps] == ["metric", "metric"]
+    for s in tr.steps:
+        info = s.motion.info
+        ratio = info["scale_rel_std_calibration_sampled"] / info["scale_rel_std_calibration"]
+        assert 0.7 < ratio < 1.4
+    plain = estimate_trajectory(rig, tracks, calibration_check="first_order")
+    assert all("scale_rel_std_calibration_sampled" not in s.motion.info for s in plain.steps)
+    with pytest.raises(ValueError, match="calibration_check"):
+        estimate_trajectory(rig, tracks, calibration_check="none")

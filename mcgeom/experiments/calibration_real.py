@@ -37,14 +37,22 @@ from .odometry_real import load
 SET = "ddad_02"
 
 
-def run(root: Path, seeds: int = 10, draws: int = 256, step: int = 0,
-        progress: Progress = no_progress) -> list[dict]:
-    """One row per seed 0 .. ``seeds`` - 1 of the estimate of frames ``step``
-    -> ``step`` + 1 (see the module)."""
+def ddad_tracks(root: Path, progress: Progress = no_progress) -> tuple:
+    """``(rig, tracks, gt)`` of the set: its rig, the feature tracks of its
+    images (:func:`mcgeom.sequence.build_tracks`) and world_from_rig ground
+    truth (F, 4, 4), the first frame the identity."""
     rig, images, gt = load(SET, root)
-    if not 0 <= step < len(gt) - 1:
-        raise ValueError(f"step must be in [0, {len(gt) - 2}] for {SET}, got {step}")
-    tracks = build_tracks(rig, find_image_sequence(images, rig), progress=progress)
+    return rig, build_tracks(rig, find_image_sequence(images, rig), progress=progress), gt
+
+
+def run(root: Path, seeds: int = 10, draws: int = 256, step: int = 0,
+        progress: Progress = no_progress, data: Optional[tuple] = None) -> list[dict]:
+    """One row per seed 0 .. ``seeds`` - 1 of the estimate of frames ``step``
+    -> ``step`` + 1 (see the module); ``data`` the :func:`ddad_tracks` of
+    ``root`` when already built."""
+    if not 0 <= step < 2:
+        raise ValueError(f"step must be 0 or 1 for {SET} (3 frames), got {step}")
+    rig, tracks, gt = data if data is not None else ddad_tracks(root, progress)
     p1, p2, c1, c2, _ = tracks.correspondences(step, step + 1)
     rays = rig.ray_pairs(p1, p2, c1, c2)
     true_t = np.linalg.solve(gt[step + 1], gt[step])[:3, 3]

@@ -75,7 +75,8 @@ def run_odometry(rig: Any, images: Any, out: Any, *, start: int = 0, end: Option
                  step: int = 1, features: str = "sift", n_features: int = 4000,
                  cross_camera: bool = True, threshold: float = 1.0, gt: Any = None,
                  title: str = "", extra_outputs: Optional[dict] = None,
-                 progress: Optional[Progress] = None, rig_frame: Any = None) -> OdometryRun:
+                 progress: Optional[Progress] = None, rig_frame: Any = None,
+                 calibration_check: str = "sampled") -> OdometryRun:
     """Run the sequence pipeline and write its outputs.
 
     ``rig``: a :class:`mcgeom.rig.Rig` or a rig file (any format of
@@ -89,7 +90,10 @@ def run_odometry(rig: Any, images: Any, out: Any, *, start: int = 0, end: Option
     loops over frames and steps; ``rig_frame``: the rig frame of the estimated
     motions (``frame=`` of :func:`mcgeom.load_rig`: None for the file's default,
     ``"body"``, ``"camera:<name or index>"`` or a 4x4 transform); the ground truth
-    must be world_from_rig of that frame.
+    must be world_from_rig of that frame; ``calibration_check``: how a metric
+    step's calibration part of the std of |t| is checked
+    (:data:`mcgeom.sequence.backend.CALIBRATION_CHECKS`, see
+    :func:`mcgeom.sequence.estimate_trajectory`).
     """
     bar = progress or _no_progress
     times = {}
@@ -101,7 +105,8 @@ def run_odometry(rig: Any, images: Any, out: Any, *, start: int = 0, end: Option
                           cross_camera=cross_camera, progress=bar)
     times["front end"] = time.perf_counter() - t0
     t1 = time.perf_counter()
-    trajectory = estimate_trajectory(rig, tracks, threshold=threshold, progress=bar)
+    trajectory = estimate_trajectory(rig, tracks, threshold=threshold, progress=bar,
+                                     calibration_check=calibration_check)
     times["back end"] = time.perf_counter() - t1
     errors = None if gt_poses is None else evaluate(trajectory, gt_poses)
     t2 = time.perf_counter()
