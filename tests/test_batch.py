@@ -189,6 +189,8 @@ def _manifest(tmp_path, text: str):
     ("name,rig,images,gt\n../a,r.json,i,\n", ["line 2", "'name'", "folder"]),
     ("name,rig,images,gt\n", ["no sequence"]),
     ("name,rig,images,gt,rig_frame\na,r.json,i,,imu\n", ["line 2", "'rig_frame'", "camera:NAME"]),
+    ("name,rig,images,gt,calibration_check\na,r.json,i,,none\n",
+     ["line 2", "'calibration_check'", "first_order"]),
 ])
 def test_manifest_errors_name_line_and_column(tmp_path, text, words):
     with pytest.raises(ValueError) as e:
@@ -200,12 +202,13 @@ def test_manifest_errors_name_line_and_column(tmp_path, text, words):
 def test_manifest_paths_are_relative_to_its_folder(tmp_path):
     (tmp_path / "sub").mkdir()
     p = tmp_path / "sub" / "m.csv"
-    p.write_text("name,rig,images,gt,start,threshold,cross_camera,rig_frame\n"
-                 f"a,r.json,imgs,gt.txt,2,1.5,false,camera:front\nb,{tmp_path}/r.json,i,,,,,\n")
+    p.write_text("name,rig,images,gt,start,threshold,cross_camera,rig_frame,calibration_check\n"
+                 f"a,r.json,imgs,gt.txt,2,1.5,false,camera:front,first-order\n"
+                 f"b,{tmp_path}/r.json,i,,,,,,\n")
     a, b = read_manifest(p)
     assert a.rig == tmp_path / "sub" / "r.json" and a.gt == tmp_path / "sub" / "gt.txt"
     assert a.options == {"start": 2, "threshold": 1.5, "cross_camera": False,
-                         "rig_frame": "camera:front"}
+                         "rig_frame": "camera:front", "calibration_check": "first_order"}
     assert b.rig == tmp_path / "r.json" and b.gt is None and b.options == {}
     with pytest.raises(ValueError, match="not a file"):
         read_manifest(tmp_path / "missing.csv")

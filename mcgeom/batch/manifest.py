@@ -5,8 +5,10 @@ row: no ground truth, no errors); further columns carry per-sequence options
 of :func:`mcgeom.sequence.run.run_odometry`, each optional and empty for its
 default: ``start``, ``end``, ``step``, ``features`` (``sift`` / ``orb``),
 ``n_features``, ``threshold`` (pixels), ``cross_camera`` (``true`` /
-``false``) and ``rig_frame`` (``body``, ``camera:NAME`` or ``camera:INDEX``: the
-rig frame of the motions, as ``mcgeom odometry --rig-frame``). Paths are relative to the manifest's folder (absolute ones are
+``false``), ``rig_frame`` (``body``, ``camera:NAME`` or ``camera:INDEX``: the
+rig frame of the motions, as ``mcgeom odometry --rig-frame``) and
+``calibration_check`` (``sampled`` / ``first_order``, as ``mcgeom odometry
+--calibration-check``). Paths are relative to the manifest's folder (absolute ones are
 kept); they are resolved here and not opened: a missing images folder is the
 failure of that one sequence, not of the batch.
 
@@ -71,11 +73,19 @@ def _rig_frame(text: str) -> str:
     raise ValueError("expected body, camera:NAME or camera:INDEX")
 
 
+def _calibration_check(text: str) -> str:
+    """sampled or first_order (first-order too)"""
+    value = text.replace("-", "_")
+    if value in ("sampled", "first_order"):
+        return value
+    raise ValueError("expected sampled or first_order")
+
+
 #: option column -> parser of its cell (the keyword of run_odometry is the name)
 OPTION_COLUMNS: dict[str, Callable[[str], Any]] = {
     "start": _int(0), "end": _int(1), "step": _int(1), "features": _features,
     "n_features": _int(1), "threshold": _positive_float, "cross_camera": _boolean,
-    "rig_frame": _rig_frame,
+    "rig_frame": _rig_frame, "calibration_check": _calibration_check,
 }
 
 
