@@ -30,6 +30,7 @@ from typing import Optional
 import numpy as np
 
 from . import _core
+from .errors import DegenerateError
 from .geometry import (count_in_front, displacements, origin_centroid, rcross, refine_centred,
                        rotation_fit, same_camera)
 from .types import RayPairs, ScaleVerdict
@@ -590,9 +591,9 @@ def with_calibration(motion, rays: RayPairs, calibration_std,
 #: rigs drawn by :func:`with_sampled_calibration` (antithetic pairs): near
 #: the critical motion the refit tips into another scale's valley for a
 #: fraction of the rigs (DDAD scene_02's first step: 10 % of 512 rigs moved
-#: |t| by 40-74 %, the rest by a std of ~0.06); 128 rigs contain at least two
-#: such draws, which lift the sampled std above 0.1 there, with probability
-#: 1 - 0.9^128 - 128 0.1 0.9^127 > 0.9999
+#: |t| by 40-74 %, the rest by a std of ~0.06); 128 rigs hold at least 4
+#: such draws, enough to lift the sampled std above 0.1 there, with
+#: probability 0.9992 (binomial, 10 % a draw)
 SAMPLED_DRAWS = 128
 
 #: intra-camera pairs refitted at most by :func:`with_sampled_calibration`
@@ -620,7 +621,9 @@ def with_sampled_calibration(motion, rays: RayPairs, calibration_std,
     calibration error can move |t| far more than the first-order figure
     says. ``info`` gains ``scale_rel_std_calibration_sampled`` (and the
     draws). Costs ``draws`` refinements on the inliers (at most
-    :data:`SAMPLED_MAX_INTRA` intra-camera ones, all cross-camera ones).
+    :data:`SAMPLED_MAX_INTRA` intra-camera ones, all cross-camera ones). A
+    refit that fails on a drawn rig (degenerate or numerical trouble) leaves
+    the scale unconfirmed: not metric, the reason says why.
     """
     info = motion.info if isinstance(motion.info, dict) else {}
     t = np.asarray(motion.t, dtype=np.float64)
@@ -632,10 +635,23 @@ def with_sampled_calibration(motion, rays: RayPairs, calibration_std,
     if sel.size < _MOTION_DOF:
         return motion
     first = float(info.get("scale_rel_std_calibration", 0.0))
-    sampled = sampled_calibration_scale_std(
-        rays.take(sel), motion.R, t, calibration_std, draws=draws, seed=seed,
-        weights=None if weights is None else np.asarray(weights, dtype=np.float64)[sel],
-        loss=loss, loss_scale=loss_scale, max_intra=SAMPLED_MAX_INTRA)
+    w = None if weights is None else np.asarray(weights, dtype=np.float64)
+    if w is not None and w.shape != (len(rays),):
+        raise ValueError(f"weights must have shape ({len(rays)},), one per pair, got {w.shape}")
+    failure: object = "no finite travel"
+    try:
+        sampled = sampled_calibration_scale_std(
+            rays.take(sel), motion.R, t, calibration_std, draws=draws, seed=seed,
+            weights=None if w is None else w[sel], loss=loss, loss_scale=loss_scale,
+            max_intra=SAMPLED_MAX_INTRA)
+    except (ArithmeticError, DegenerateError) as exc:   # (NumericalError is one)
+        sampled, failure = float("nan"), exc
+    if not np.isfinite(sampled):
+        reason = (f"scale not confirmed: the refit on rigs drawn with the calibration error "
+                  f"failed ({failure}); {v.reason}")
+        return replace(motion, scale=ScaleVerdict(False, reason, v.conditioning, v.rel_std,
+                                                  v.critical_angle),
+                       info={**info, "scale_rel_std_calibration_sampled": sampled})
     new_info = {**info, "scale_rel_std_calibration_sampled": sampled,
                 "calibration_draws": draws}
     if not sampled > first:

@@ -5,6 +5,8 @@ of |t| contains the truth when the extrinsics are off by the stated error."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -13,7 +15,8 @@ from mcgeom import _core, synth
 from mcgeom.cv import estimate as cv_estimate
 from mcgeom.experiments import calibration_coverage
 from mcgeom.io.mcgeom_json import rig_from_dict, rig_to_dict
-from mcgeom.observability import calibration_scale_std, sampled_calibration_scale_std
+from mcgeom.observability import (calibration_scale_std, sampled_calibration_scale_std,
+                                  with_sampled_calibration)
 from mcgeom.rig import DEFAULT_EXTRINSIC_STD, Rig
 
 
@@ -292,3 +295,40 @@ def test_sampled_calibration_std_bad_draws_name_it(draws):
         sampled_calibration_scale_std(p.rays, R, t, (1e-3, 1e-3), draws=draws)
     with pytest.raises(ValueError, match="calibration_std"):
         sampled_calibration_scale_std(p.rays, R, t, np.ones((2, 2)))
+
+
+def _turning_motion(seed: int, n: int = 200):
+    rng = np.random.default_rng(seed)
+    rig = Rig(synth.vehicle8().cameras, calibration_std=(2e-3, np.radians(0.1)))
+    Rw = synth.rotation_about([0, 0, 1], np.radians(10))
+    R, t = Rw.T, -Rw.T @ np.array([1.0, 0.0, 0.0])
+    p = synth.make_problem(rig, R, t, n, rng, pixel_noise=0.5, cross_fraction=0.1)
+    m = cv_estimate(p.pixels1, p.pixels2, p.cam1, p.cam2, rig, threshold=1.0)
+    return rig, rig.ray_pairs(p.pixels1, p.pixels2, p.cam1, p.cam2), m
+
+
+def test_with_sampled_calibration_keeps_a_linear_metric_estimate():
+    rig, rays, m = _turning_motion(6)
+    assert m.scale.observable
+    out = with_sampled_calibration(m, rays, rig.extrinsic_std)
+    assert out.scale.observable
+    s = out.info["scale_rel_std_calibration_sampled"]
+    assert 0.7 < s / m.info["scale_rel_std_calibration"] < 1.4
+    assert out.scale.rel_std >= m.scale.rel_std
+    # a motion that is not metric is returned as it is
+    not_metric = replace(m, scale=replace(m.scale, observable=False))
+    assert with_sampled_calibration(not_metric, rays, rig.extrinsic_std) is not_metric
+    with pytest.raises(ValueError, match="weights"):
+        with_sampled_calibration(m, rays, rig.extrinsic_std, weights=np.ones(3))
+
+
+def test_with_sampled_calibration_failed_refit_is_not_metric(monkeypatch):
+    rig, rays, m = _turning_motion(7)
+    assert m.scale.observable
+
+    def fail(*args, **kwargs):
+        raise mcgeom.errors.DegenerateError("nothing constrains the motion")
+    monkeypatch.setattr(_core, "refine_motion", fail)
+    out = with_sampled_calibration(m, rays, rig.extrinsic_std)
+    assert not out.scale.observable
+    assert "not confirmed" in out.scale.reason and "nothing constrains" in out.scale.reason
