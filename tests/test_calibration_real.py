@@ -56,3 +56,19 @@ def test_back_end_does_not_chain_a_step_the_calibration_error_unsettles(ddad):
 def test_bad_step_names_it():
     with pytest.raises(ValueError, match="step"):
         calibration_real.run(ev.DATA_ROOT, seeds=1, draws=2, step=5)
+
+
+def test_facade_checks_by_sampling_on_request(ddad):
+    """cv.estimate(..., calibration_check="sampled"): the façade's own opt-in
+    of the back end's check; the default keeps the first-order verdict."""
+    from mcgeom.cv import estimate
+    rig, tracks, _ = ddad
+    p1, p2, c1, c2, _ = tracks.correspondences(0, 1)
+    first = estimate(p1, p2, c1, c2, rig, seed=2)
+    assert first.scale.observable
+    checked = estimate(p1, p2, c1, c2, rig, seed=2, calibration_check="sampled")
+    assert not checked.scale.observable and "rigs drawn" in checked.scale.reason
+    assert checked.info["scale_rel_std_calibration_sampled"] > 0.1
+    assert np.array_equal(checked.R, first.R) and np.array_equal(checked.inliers, first.inliers)
+    with pytest.raises(ValueError, match="calibration_check"):
+        estimate(p1, p2, c1, c2, rig, calibration_check="yes")

@@ -80,8 +80,6 @@ from ..errors import DegenerateError, NumericalError
 from ..geometry import line_normal_equations
 from ..metrics import polyline_length
 from ..multiview import translations_from_tracks
-from ..observability import with_sampled_calibration
-from ..pixel_noise import pixels_per_radian
 from ..rig import Rig
 from ..types import RigMotion
 from .tracks import Tracks
@@ -92,16 +90,13 @@ __all__ = ["estimate_trajectory", "METRIC_FROM", "CALIBRATION_CHECKS", "MIN_STEP
 #: where a segment's metric comes from (see the module docstring)
 METRIC_FROM = ("tracks", "steps")
 
-#: how a metric step's calibration part of the std of |t| is checked:
-#: "sampled" (:func:`mcgeom.observability.with_sampled_calibration`: rigs
-#: drawn with the rig's stated extrinsic error, each step refitted; near the
-#: critical motion the first-order figure can be 3x too small, DDAD
-#: scene_02) or "first_order" (the two-frame verdict's own figure only)
-CALIBRATION_CHECKS = ("sampled", "first_order")
-
-#: the two-frame verdict's limit on the relative std of |t| (the robust
-#: pipeline's default, mcgeom.robust.RansacOptions.max_scale_rel_std)
-_MAX_SCALE_REL_STD = 0.1
+#: how a metric step's calibration part of the std of |t| is checked
+#: (``calibration_check`` of :func:`mcgeom.cv.estimate`): "sampled"
+#: (:func:`mcgeom.observability.with_sampled_calibration`: rigs drawn with
+#: the rig's stated extrinsic error, each step refitted; near the critical
+#: motion the first-order figure can be 3x too small, DDAD scene_02) or
+#: "first_order" (the two-frame verdict's own figure only)
+CALIBRATION_CHECKS = cv.CALIBRATION_CHECKS
 #: a step with fewer two-frame correspondences is not estimated (the 5+1 and
 #: 17-point samples need 6 and 17; below a dozen RANSAC has nothing to vote)
 MIN_STEP_CORRESPONDENCES = 12
@@ -159,24 +154,6 @@ def _observation_index(tracks: Tracks, n_cams: int) -> Callable:
     return index
 
 
-def _sampled_calibration(rig: Rig, corr: tuple, m: RigMotion, threshold: float,
-                         max_rel_std: float) -> RigMotion:
-    """A metric step ``m`` of the correspondences ``corr`` (pixels and camera
-    ids at both frames) with its calibration part checked by drawing rigs
-    with the rig's stated extrinsic error
-    (:func:`mcgeom.observability.with_sampled_calibration`, weighted and
-    with the Cauchy loss at ``threshold`` pixels as the final refinement);
-    unchanged where the rig states none or the step is not metric."""
-    if not m.scale.observable or not np.any(rig.extrinsic_std > 0) or not np.any(m.t != 0):
-        return m
-    rays = rig.ray_pairs(*corr)
-    f = pixels_per_radian(rig, rays)
-    med = float(np.median(f))
-    return with_sampled_calibration(m, rays, rig.extrinsic_std, max_rel_std,
-                                    weights=(f / med) ** 2, loss="cauchy",
-                                    loss_scale=threshold / med)
-
-
 def _static_verdict(m: RigMotion, cross_inliers: np.ndarray) -> RigMotion:
     """A step with "no translation detected" (``t = 0``: a pure rotation
     explains every inlier) is metric -- zero metres -- when cross-camera
@@ -219,7 +196,7 @@ def _step_estimates(rig: Rig, tracks: Tracks, method: str, threshold: float,
             continue
         try:
             m = cv.estimate(p1, p2, c1, c2, rig, method=method, threshold=threshold,
-                            **options)
+                            calibration_check=calibration_check, **options)
         except (DegenerateError, NumericalError) as exc:
             motions.append(None)
             n_inl.append(0)
@@ -227,9 +204,6 @@ def _step_estimates(rig: Rig, tracks: Tracks, method: str, threshold: float,
             continue
         mask = np.asarray(m.inliers, bool)
         m = _static_verdict(m, mask & (c1 != c2))
-        if calibration_check == "sampled":
-            m = _sampled_calibration(rig, (p1, p2, c1, c2), m, threshold,
-                                     float(options.get("max_scale_rel_std", _MAX_SCALE_REL_STD)))
         motions.append(m)
         n_inl.append(int(mask.sum()))
         reasons.append(m.scale.reason)
