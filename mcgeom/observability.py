@@ -404,6 +404,8 @@ def _camera_stds(rays: RayPairs, extrinsic_std) -> tuple[np.ndarray, np.ndarray,
     if sig.ndim != 2 or sig.shape[1] != 2 or sig.shape[0] < m:
         raise ValueError(f"calibration_std must have shape (2,) or (M, 2) with M >= {m} "
                          f"(the cameras of the rays), got {sig.shape}")
+    if not (np.isfinite(sig[:m]).all() and (sig[:m] >= 0).all()):
+        raise ValueError("calibration_std must hold finite values >= 0")
     return cam1, cam2, sig[:m]
 
 
@@ -449,6 +451,10 @@ def sampled_calibration_scale_std(rays: RayPairs, R: np.ndarray, t: np.ndarray,
         raise ValueError(f"max_intra must be None or an integer >= 1, got {max_intra!r}")
     R = np.asarray(R, dtype=np.float64)
     t = np.asarray(t, dtype=np.float64)
+    if R.shape != (3, 3) or t.shape != (3,):
+        raise ValueError(f"R must be (3, 3) and t (3,), got shapes {R.shape} and {t.shape}")
+    if not (np.isfinite(R).all() and np.isfinite(t).all()):
+        raise ValueError("R and t must be finite (NaN or inf given)")
     cam1, cam2, sig = _camera_stds(rays, extrinsic_std)
     c = origin_centroid(rays)
     tau0 = float(np.linalg.norm(t + R @ c - c))

@@ -295,6 +295,15 @@ def test_sampled_calibration_std_bad_draws_name_it(draws):
         sampled_calibration_scale_std(p.rays, R, t, (1e-3, 1e-3), draws=draws)
     with pytest.raises(ValueError, match="calibration_std"):
         sampled_calibration_scale_std(p.rays, R, t, np.ones((2, 2)))
+    for bad in [(np.nan, 1e-3), (-1e-3, 1e-3)]:
+        with pytest.raises(ValueError, match="finite values >= 0"):
+            sampled_calibration_scale_std(p.rays, R, t, bad)
+        with pytest.raises(ValueError, match="finite values >= 0"):
+            calibration_scale_std(p.rays, R, t, bad)
+    with pytest.raises(ValueError, match="finite"):
+        sampled_calibration_scale_std(p.rays, R, np.array([np.nan, 0.0, 0.0]), (1e-3, 1e-3))
+    with pytest.raises(ValueError, match="max_intra"):
+        sampled_calibration_scale_std(p.rays, R, t, (1e-3, 1e-3), max_intra=0)
 
 
 def _turning_motion(seed: int, n: int = 200):
