@@ -231,7 +231,9 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
                      maxIters, mask, seed, robust, calibration_std, gravity1, gravity2,
                      **options)
         return _sampled_check(m, points1, points2, cameraIds1, cameraIds2, rig, threshold,
-                              calibration_std, float(options.get("max_scale_rel_std", 0.1)))
+                              calibration_std,
+                              float(options.get("max_scale_rel_std",
+                                                _robust.RansacOptions.max_scale_rel_std)))
     fast = _ONE_CALL.get(method) if type(method) is str else None
     if (fast is not None and mask is None and robust is None and not options
             and calibration_std is None and (gravity1 is None) == (gravity2 is None)
@@ -260,8 +262,7 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     name, run_robust = _resolve(method, robust)
     if not run_robust:
         _no_ransac_options(name, prob=prob, threshold=threshold, maxIters=maxIters, seed=seed)
-    cal = rig.extrinsic_std if calibration_std is None else \
-        Rig(rig.cameras, calibration_std).extrinsic_std   # (checked: names the option)
+    cal = _extrinsic_std(rig, calibration_std)
     # p1, p2, ids1, ids2 are checked above (finite float64 pixels, int64 ids of
     # the rig's cameras): the rig need not check them again
     # the rays and their pixels per radian (the pixel-noise model of the
@@ -306,6 +307,14 @@ def estimate(points1: Any, points2: Any, cameraIds1: Any, cameraIds2: Any, rig: 
     return RigMotion(m.R, m.t, m.scale, m.method, m.residual_rms, inl, m.info)
 
 
+def _extrinsic_std(rig: Rig, calibration_std: Any) -> np.ndarray:
+    """The (M, 2) extrinsic stds (metres, radians) :func:`estimate` uses: the
+    rig's, or ``calibration_std`` when given (checked by :class:`Rig`, whose
+    error names the option)."""
+    return rig.extrinsic_std if calibration_std is None else \
+        Rig(rig.cameras, calibration_std).extrinsic_std
+
+
 #: how :func:`estimate` checks the calibration part of a metric result's std
 CALIBRATION_CHECKS = ("first_order", "sampled")
 
@@ -320,8 +329,7 @@ def _sampled_check(m: RigMotion, points1: Any, points2: Any, cameraIds1: Any, ca
     pixels per radian squared over their inliers' median, with the Cauchy
     loss at ``threshold`` pixels (1 if None) where a robust search made
     ``m`` (its final refinement's), least squares otherwise."""
-    cal = rig.extrinsic_std if calibration_std is None else \
-        Rig(rig.cameras, calibration_std).extrinsic_std
+    cal = _extrinsic_std(rig, calibration_std)
     if not m.scale.observable or not np.any(cal > 0) or not np.any(m.t != 0):
         return m
     p1, p2 = _points("points1", points1), _points("points2", points2)

@@ -38,6 +38,7 @@ from .types import RayPairs, ScaleVerdict
 __all__ = ["scale_verdict", "critical_angle", "rig_critical_angle", "scale_profile",
            "scale_determined", "UNDETERMINED_REL_STD", "ZERO_FACTOR", "calibration_scale_std",
            "sampled_calibration_scale_std", "with_sampled_calibration", "SAMPLED_DRAWS",
+           "SAMPLED_MAX_INTRA",
            "combine_rel_std", "total_scale_std", "no_parallax", "with_calibration",
            "scale_verdict_stats", "verdict_text"]
 
